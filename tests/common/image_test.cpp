@@ -1,0 +1,107 @@
+#include "tools/common/image.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "tools/common/error.h"
+
+namespace igi {
+namespace {
+
+class ImageTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("igi_image_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  static Image Gradient(int w, int h, int c) {
+    Image im(w, h, c);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int k = 0; k < c; ++k) im.at(x, y, k) = float(x + 2 * y + k) / float(w + 2 * h + c);
+    return im;
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(ImageTest, ExrFloatRoundTripIsExactAndKeepsMetadata) {
+  Image im = Gradient(17, 9, 3);
+  im.at(3, 4, 1) = 1234.5f;  // radiance is not limited to [0, 1]
+  im.metadata["igi:camera"] = std::string("cam0");
+  im.metadata["ExposureTime"] = 0.004;
+  im.metadata["igi:frame"] = int64_t(7);
+  WriteImage(dir_ / "a.exr", im);
+  Image back = ReadImage(dir_ / "a.exr");
+  ASSERT_EQ(back.width, 17);
+  ASSERT_EQ(back.height, 9);
+  ASSERT_EQ(back.channels, 3);
+  EXPECT_EQ(back.pixels, im.pixels);
+  EXPECT_EQ(std::get<std::string>(back.metadata.at("igi:camera")), "cam0");
+  EXPECT_NEAR(std::get<double>(back.metadata.at("ExposureTime")), 0.004, 1e-9);
+  EXPECT_EQ(std::get<int64_t>(back.metadata.at("igi:frame")), 7);
+}
+
+TEST_F(ImageTest, HalfExrRoundTripWithinHalfPrecision) {
+  Image im = Gradient(8, 8, 3);
+  WriteImageOptions half;
+  half.type = PixelType::kHalf;
+  half.compression = "piz";
+  WriteImage(dir_ / "h.exr", im, half);
+  EXPECT_EQ(ReadImageInfo(dir_ / "h.exr").type, PixelType::kHalf);
+  Image back = ReadImage(dir_ / "h.exr");
+  for (size_t i = 0; i < im.pixels.size(); ++i) EXPECT_NEAR(back.pixels[i], im.pixels[i], 1e-3);
+}
+
+TEST_F(ImageTest, IntegerFormatsQuantiseToTheirLevels) {
+  Image im = Gradient(32, 16, 3);
+  for (auto [name, levels] : {std::pair{"a.png", 255.0}, {"a.tif", 65535.0}}) {
+    WriteImage(dir_ / name, im);
+    Image back = ReadImage(dir_ / name);
+    for (size_t i = 0; i < im.pixels.size(); ++i) {
+      EXPECT_NEAR(back.pixels[i], std::round(im.pixels[i] * levels) / levels, 1e-6) << name;
+    }
+  }
+  WriteImageOptions sixteen;
+  sixteen.type = PixelType::kUInt16;
+  WriteImage(dir_ / "b.png", im, sixteen);
+  EXPECT_EQ(ReadImageInfo(dir_ / "b.png").type, PixelType::kUInt16);
+  WriteImage(dir_ / "a.jpg", im);
+  Image jpg = ReadImage(dir_ / "a.jpg");
+  double err = 0;
+  for (size_t i = 0; i < im.pixels.size(); ++i) err += std::abs(jpg.pixels[i] - im.pixels[i]);
+  EXPECT_LT(err / im.pixels.size(), 0.02);  // lossy, but close at quality 95
+}
+
+TEST_F(ImageTest, ChannelSelectionExpandsGrey) {
+  Image grey = Gradient(4, 4, 1);
+  WriteImage(dir_ / "g.exr", grey);
+  Image rgb = ReadImage(dir_ / "g.exr", 3);
+  ASSERT_EQ(rgb.channels, 3);
+  EXPECT_EQ(rgb.at(2, 1, 2), grey.at(2, 1, 0));
+}
+
+TEST_F(ImageTest, UnreadableFileIsInputErrorNamingTheFile) {
+  std::ofstream(dir_ / "bad.exr") << "not an exr";
+  try {
+    ReadImage(dir_ / "bad.exr");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.exr"), std::string::npos);
+  }
+  EXPECT_THROW(ReadImageInfo(dir_ / "missing.exr"), InputError);
+}
+
+TEST_F(ImageTest, FailedWriteLeavesNoFileBehind) {
+  Image empty;
+  EXPECT_THROW(WriteImage(dir_ / "e.exr", empty), Error);
+  EXPECT_THROW(WriteImage(dir_ / "x.unknownext", Gradient(2, 2, 3)), Error);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+}  // namespace
+}  // namespace igi

@@ -1,0 +1,55 @@
+#include "tools/common/cli.h"
+
+#include <cstdio>
+#include <exception>
+
+#include "tools/common/error.h"
+#include "tools/common/logging.h"
+#include "tools/common/parallel.h"
+
+#ifndef IGI_VERSION
+#define IGI_VERSION "0.0.0"
+#endif
+
+namespace igi {
+
+const char* Version() { return IGI_VERSION; }
+
+void AddCommonFlags(CLI::App& app, CommonFlags* flags, bool computes) {
+  app.set_version_flag("--version", std::string(app.get_name()) + " " + Version());
+  app.add_flag("-v,--verbose", flags->verbose, "Log details to stderr");
+  app.add_flag("-q,--quiet", flags->quiet, "Log only errors");
+  if (computes) {
+    app.add_option("--threads", flags->threads, "Worker threads (0 = all cores)")
+        ->check(CLI::NonNegativeNumber);
+  }
+}
+
+int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
+            const std::function<int()>& body) {
+  const std::string program = app.get_name();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "%s: error: %s (see --help)\n", program.c_str(), e.what());
+    return static_cast<int>(ExitCode::kBadInput);
+  }
+  InitLogging(program, flags.quiet     ? LogLevel::kQuiet
+                       : flags.verbose ? LogLevel::kDebug
+                                       : LogLevel::kInfo);
+  SetDefaultThreads(flags.threads);
+  try {
+    return body();
+  } catch (const Error& e) {
+    for (const std::string& line : e.Lines()) {
+      std::fprintf(stderr, "%s: error: %s\n", program.c_str(), line.c_str());
+    }
+    return static_cast<int>(e.code());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: internal: %s\n", program.c_str(), e.what());
+    return static_cast<int>(ExitCode::kFailed);
+  }
+}
+
+}  // namespace igi

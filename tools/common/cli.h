@@ -1,0 +1,30 @@
+#pragma once
+// Scaffolding shared by every igi executable (tools/igi-*.cpp): the common flags
+// (--version, --threads, --verbose, --quiet), and the mapping of errors to one line per problem
+// on stderr and the contract's exit codes (0 ok, 1 failed, 2 bad usage or input, 3 partial).
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+
+namespace igi {
+
+// The toolkit's version string ("0.1.0").
+const char* Version();
+
+struct CommonFlags {
+  int threads = 0;  // 0 = all cores
+  bool verbose = false;
+  bool quiet = false;
+};
+
+// Adds --version, --verbose, --quiet and (when `computes`) --threads to `app`.
+void AddCommonFlags(CLI::App& app, CommonFlags* flags, bool computes = true);
+
+// Parses the command line, sets up logging and the thread default, then runs `body`, mapping
+// what it throws to stderr lines ("igi-xxx: error: ...") and an exit code. Usage errors exit 2;
+// --help and --version exit 0.
+int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
+            const std::function<int()>& body);
+
+}  // namespace igi

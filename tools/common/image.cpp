@@ -1,0 +1,156 @@
+#include "tools/common/image.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+
+namespace igi {
+namespace {
+
+PixelType FromOiio(OIIO::TypeDesc t) {
+  switch (t.basetype) {
+    case OIIO::TypeDesc::UINT8: return PixelType::kUInt8;
+    case OIIO::TypeDesc::UINT16: return PixelType::kUInt16;
+    case OIIO::TypeDesc::HALF: return PixelType::kHalf;
+    default: return PixelType::kFloat;
+  }
+}
+
+OIIO::TypeDesc ToOiio(PixelType t) {
+  switch (t) {
+    case PixelType::kUInt8: return OIIO::TypeDesc::UINT8;
+    case PixelType::kUInt16: return OIIO::TypeDesc::UINT16;
+    case PixelType::kHalf: return OIIO::TypeDesc::HALF;
+    default: return OIIO::TypeDesc::FLOAT;
+  }
+}
+
+ImageMetadata MetadataFromSpec(const OIIO::ImageSpec& spec) {
+  ImageMetadata out;
+  for (const OIIO::ParamValue& p : spec.extra_attribs) {
+    const OIIO::TypeDesc t = p.type();
+    const std::string name = p.name().string();
+    if (t == OIIO::TypeDesc::STRING) {
+      out[name] = std::string(p.get_ustring().string());
+    } else if (t.basetype == OIIO::TypeDesc::FLOAT || t.basetype == OIIO::TypeDesc::DOUBLE ||
+               t.basetype == OIIO::TypeDesc::HALF) {
+      if (t.aggregate == OIIO::TypeDesc::SCALAR && t.arraylen == 0) out[name] = p.get_float();
+    } else if (t.aggregate == OIIO::TypeDesc::SCALAR && t.arraylen == 0 &&
+               t.basetype != OIIO::TypeDesc::PTR) {
+      if (t == OIIO::TypeRational) {
+        out[name] = double(p.get_float());
+      } else {
+        out[name] = int64_t(p.get_int());
+      }
+    }
+  }
+  return out;
+}
+
+void MetadataToSpec(const ImageMetadata& metadata, OIIO::ImageSpec* spec) {
+  for (const auto& [name, value] : metadata) {
+    if (const auto* i = std::get_if<int64_t>(&value)) {
+      spec->attribute(name, int(*i));
+    } else if (const auto* d = std::get_if<double>(&value)) {
+      spec->attribute(name, float(*d));
+    } else {
+      spec->attribute(name, std::get<std::string>(value));
+    }
+  }
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+ImageInfo ReadImageInfo(const std::filesystem::path& path) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) {
+    throw InputError(DescribeProblem(path.string(), "", "",
+                                     "cannot read image: " + OIIO::geterror()));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageInfo info;
+  info.width = spec.width;
+  info.height = spec.height;
+  info.channels = spec.nchannels;
+  info.type = FromOiio(spec.format);
+  info.bits_per_sample = spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size() * 8));
+  info.format = in->format_name();
+  info.metadata = MetadataFromSpec(spec);
+  in->close();
+  return info;
+}
+
+Image ReadImage(const std::filesystem::path& path, int channels) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) {
+    throw InputError(DescribeProblem(path.string(), "", "",
+                                     "cannot read image: " + OIIO::geterror()));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    throw InputError(DescribeProblem(path.string(), "", "", "image has no pixels"));
+  }
+  Image image(spec.width, spec.height, spec.nchannels);
+  image.metadata = MetadataFromSpec(spec);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    throw InputError(DescribeProblem(path.string(), "", "",
+                                     "cannot read image data: " + in->geterror()));
+  }
+  in->close();
+  if (channels <= 0 || channels == image.channels) return image;
+  Image out(image.width, image.height, channels);
+  out.metadata = image.metadata;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < channels; ++c) {
+        const int src = image.channels == 1 ? 0 : std::min(c, image.channels - 1);
+        out.at(x, y, c) = c < image.channels || image.channels == 1 ? image.at(x, y, src) : 0.0f;
+      }
+    }
+  }
+  return out;
+}
+
+void WriteImage(const std::filesystem::path& path, const Image& image,
+                const WriteImageOptions& options) {
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+      image.pixels.size() != size_t(image.width) * image.height * image.channels) {
+    throw Error(DescribeProblem(path.string(), "", "", "refusing to write an empty or malformed image"));
+  }
+  const std::string ext = Lower(path.extension().string());
+  PixelType type = options.type;
+  if (type == PixelType::kAuto) {
+    if (ext == ".exr" || ext == ".hdr") type = PixelType::kFloat;
+    else if (ext == ".tif" || ext == ".tiff") type = PixelType::kUInt16;
+    else type = PixelType::kUInt8;
+  }
+  AtomicOutput atomic(path);
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    throw Error(DescribeProblem(path.string(), "", "", "no image writer for this extension: " + OIIO::geterror()));
+  }
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, ToOiio(type));
+  MetadataToSpec(image.metadata, &spec);
+  if (!options.compression.empty()) spec.attribute("compression", options.compression);
+  if (ext == ".jpg" || ext == ".jpeg") spec.attribute("CompressionQuality", options.jpeg_quality);
+  if (!out->open(atomic.temp_path().string(), spec)) {
+    throw Error(DescribeProblem(path.string(), "", "", "cannot write image: " + out->geterror()));
+  }
+  if (!out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    throw Error(DescribeProblem(path.string(), "", "", "cannot write image data: " + out->geterror()));
+  }
+  if (!out->close()) {
+    throw Error(DescribeProblem(path.string(), "", "", "cannot finish image: " + out->geterror()));
+  }
+  atomic.Commit();
+}
+
+}  // namespace igi
