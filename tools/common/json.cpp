@@ -96,7 +96,7 @@ bool JsonCursor::RequirePresent() const {
   return false;
 }
 
-bool JsonCursor::ExpectObject(std::initializer_list<std::string_view> allowed) const {
+bool JsonCursor::ExpectObject(const std::vector<std::string_view>& allowed) const {
   if (!RequirePresent()) return false;
   if (!value_->is_object()) {
     Problem("must be an object");

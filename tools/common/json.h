@@ -71,7 +71,7 @@ class JsonCursor {
 
   // Requires an object whose keys are all in `allowed`; reports each unknown key. Returns
   // whether the value is an object at all.
-  bool ExpectObject(std::initializer_list<std::string_view> allowed) const;
+  bool ExpectObject(const std::vector<std::string_view>& allowed) const;
   // Requires an object (any keys); returns its keys in file order.
   std::vector<std::string> ObjectKeys() const;
   // Requires an array; returns its size (0 when not an array). `min_size` is checked too.

@@ -1,0 +1,113 @@
+#include "recon/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace igi {
+namespace {
+
+struct BrdfName {
+  BrdfModel model;
+  std::string_view name;
+};
+constexpr BrdfName kBrdfNames[] = {
+    {BrdfModel::kLambert, "lambert"},     {BrdfModel::kWard, "ward"},
+    {BrdfModel::kWardGmd, "ward_gmd"},    {BrdfModel::kWardAniso, "ward_aniso"},
+    {BrdfModel::kWardGmdAniso, "ward_gmd_aniso"}, {BrdfModel::kEmitter, "emitter"},
+    {BrdfModel::kBlack, "black"},
+};
+
+template <typename T>
+int FindByName(const std::vector<T>& items, std::string_view name) {
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (items[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+std::string_view BrdfModelName(BrdfModel model) {
+  for (const BrdfName& b : kBrdfNames) {
+    if (b.model == model) return b.name;
+  }
+  return "unknown";
+}
+
+std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
+  for (const BrdfName& b : kBrdfNames) {
+    if (b.name == name) return b.model;
+  }
+  return std::nullopt;
+}
+
+bool IsAnisotropic(BrdfModel model) {
+  return model == BrdfModel::kWardAniso || model == BrdfModel::kWardGmdAniso;
+}
+
+bool HasSpecularLobe(BrdfModel model) {
+  return model == BrdfModel::kWard || model == BrdfModel::kWardGmd || IsAnisotropic(model);
+}
+
+std::vector<std::string> Material::MissingForRendering() const {
+  std::vector<std::string> missing;
+  if (brdf == BrdfModel::kBlack) return missing;
+  if (brdf == BrdfModel::kEmitter) {
+    if (!radiance) missing.push_back("radiance");
+    return missing;
+  }
+  if (!rho_d && !rho_d_map) missing.push_back("rho_d");
+  if (!HasSpecularLobe(brdf)) return missing;
+  if (!rho_s) missing.push_back("rho_s");
+  if (IsAnisotropic(brdf)) {
+    if (!alpha_x) missing.push_back("alpha_x");
+    if (!alpha_y) missing.push_back("alpha_y");
+    if (!tangent) missing.push_back("tangent");
+  } else if (!alpha) {
+    missing.push_back("alpha");
+  }
+  return missing;
+}
+
+std::string_view LightTypeName(LightType type) {
+  switch (type) {
+    case LightType::kPoint: return "point";
+    case LightType::kSpot: return "spot";
+    case LightType::kDirectional: return "directional";
+    case LightType::kSphere: return "sphere";
+    case LightType::kArea: return "area";
+  }
+  return "unknown";
+}
+
+double SpotProfile::Relative(double theta, double phi) const {
+  switch (kind) {
+    case Kind::kNone: return 1.0;
+    case Kind::kCosPower: {
+      const double c = std::cos(theta);
+      return c > 0 ? std::pow(c, cos_power) : 0.0;
+    }
+    case Kind::kCone: {
+      const double deg = theta * 180.0 / M_PI;
+      if (deg <= inner_deg) return 1.0;
+      if (deg >= outer_deg) return 0.0;
+      const double t = (outer_deg - deg) / (outer_deg - inner_deg);
+      return t * t * (3 - 2 * t);
+    }
+    case Kind::kIes: {
+      const double peak = ies->MaxCandela();
+      if (!(peak > 0)) return 0.0;
+      double phi_deg = phi * 180.0 / M_PI;
+      if (phi_deg < 0) phi_deg += 360.0;
+      return ies->Candela(theta * 180.0 / M_PI, phi_deg) / peak;
+    }
+  }
+  return 0.0;
+}
+
+int Scene::FindMaterial(std::string_view name) const { return FindByName(materials, name); }
+int Scene::FindLight(std::string_view name) const { return FindByName(lights, name); }
+int Scene::FindLighting(std::string_view name) const { return FindByName(lightings, name); }
+int Scene::FindCamera(std::string_view name) const { return FindByName(cameras, name); }
+
+}  // namespace igi

@@ -1,0 +1,127 @@
+#pragma once
+// The calibrated scene of scene.json (CONTRACT.md §3): geometry with regions, materials, lights,
+// lightings, cameras and photos. LoadScene validates everything and reports every problem it
+// finds (as one igi::InputError carrying one line per problem), not just the first.
+//
+// Units: metres, radiance in W·sr⁻¹·m⁻² (or any scale consistent between lights and photos),
+// point/spot intensity in W·sr⁻¹, directional irradiance in W·m⁻². Directions are unit vectors
+// in the world frame. Paths are absolute after loading (resolved against the scene's folder).
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "recon/camera.h"
+#include "recon/ies_profile.h"
+#include "recon/mesh.h"
+#include "tools/common/json.h"
+
+namespace igi {
+
+// The "brdf" values of CONTRACT.md §2.
+enum class BrdfModel { kLambert, kWard, kWardGmd, kWardAniso, kWardGmdAniso, kEmitter, kBlack };
+
+std::string_view BrdfModelName(BrdfModel model);
+std::optional<BrdfModel> BrdfModelFromName(std::string_view name);
+bool IsAnisotropic(BrdfModel model);
+bool HasSpecularLobe(BrdfModel model);
+
+// What is known of one region's reflectance. Absent values are unknowns for the solver; for
+// rendering every value the model needs must be present (Material::MissingForRendering).
+struct Material {
+  std::string name;
+  BrdfModel brdf = BrdfModel::kLambert;
+  std::optional<Eigen::Vector3d> rho_d;              // diffuse albedo (region mean), RGB
+  std::optional<std::filesystem::path> rho_d_map;    // albedo texture (linear), indexed by UVs
+  std::optional<Eigen::Vector3d> rho_s;              // specular albedo, RGB
+  std::optional<double> alpha;                       // isotropic roughness
+  std::optional<double> alpha_x, alpha_y;            // anisotropic roughness along t and b
+  std::optional<Eigen::Vector3d> tangent;            // unit x direction of the lobe (world)
+  std::optional<Eigen::Vector3d> radiance;           // "emitter" only, W·sr⁻¹·m⁻²
+
+  // Names of the values that rendering needs but this material lacks (empty = complete).
+  std::vector<std::string> MissingForRendering() const;
+};
+
+enum class LightType { kPoint, kSpot, kDirectional, kSphere, kArea };
+std::string_view LightTypeName(LightType type);
+
+// A spot light's emission profile. The relative intensity in a direction at angle θ from the
+// spot's axis (and azimuth φ around it) multiplies the light's "intensity":
+//   none:      1 everywhere;   cos_power: cos(θ)^n for θ < 90°, else 0;
+//   cone:      1 inside inner_deg, 0 outside outer_deg, smoothstep between;
+//   ies:       candela(θ, φ) / max candela (so "intensity" is the peak intensity).
+struct SpotProfile {
+  enum class Kind { kNone, kCosPower, kCone, kIes };
+  Kind kind = Kind::kNone;
+  double cos_power = 0;
+  double inner_deg = 0, outer_deg = 0;
+  std::filesystem::path ies_file;
+  std::shared_ptr<const IesProfile> ies;
+
+  // Relative intensity (0..1) at `theta` radians from the axis and azimuth `phi` radians.
+  double Relative(double theta, double phi) const;
+};
+
+struct Light {
+  std::string name;
+  LightType type = LightType::kPoint;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();   // point, spot
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ(); // spot axis; directional: travel dir.
+  Eigen::Vector3d intensity = Eigen::Vector3d::Zero();  // point, spot: W·sr⁻¹
+  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero(); // directional: W·m⁻² ⟂ to direction
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();     // sphere
+  double radius = 0;                                    // sphere, metres
+  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();   // sphere, area: W·sr⁻¹·m⁻²
+  std::filesystem::path file;                           // area: mesh (front = CCW)
+  TriangleMesh mesh;                                    // area: loaded mesh
+  SpotProfile profile;                                  // spot
+};
+
+struct Lighting {
+  std::string name;
+  std::vector<int> lights;  // indices into Scene::lights
+};
+
+struct Photo {
+  std::filesystem::path file;
+  std::optional<std::filesystem::path> mask;
+  int camera = -1;    // index into Scene::cameras
+  int lighting = -1;  // index into Scene::lightings
+};
+
+struct Scene {
+  std::filesystem::path file;  // the scene.json read
+  std::filesystem::path dir;   // its folder (paths in the file are relative to it)
+  Json document;               // the file as read, for writers that fill values in
+  std::vector<std::filesystem::path> geometry_files;
+  TriangleMesh mesh;  // all geometry files; triangle_region indexes `materials`
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  std::vector<Lighting> lightings;
+  std::vector<Camera> cameras;
+  std::optional<std::filesystem::path> colmap_model;  // when cameras came from COLMAP
+  std::vector<Photo> photos;
+
+  int FindMaterial(std::string_view name) const;
+  int FindLight(std::string_view name) const;
+  int FindLighting(std::string_view name) const;
+  int FindCamera(std::string_view name) const;
+};
+
+struct SceneLoadOptions {
+  bool load_geometry = true;  // read meshes (area lights' too)
+  bool check_images = true;   // read the headers of photos, masks and textures
+  // Require every material value rendering needs (igi-render); otherwise absent = unknown.
+  bool require_complete_materials = false;
+};
+
+// Loads and validates `path`. Throws InputError listing every problem ("FILE: KEY: VALUE: RULE").
+Scene LoadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
+
+}  // namespace igi

@@ -1,0 +1,128 @@
+#include "recon/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kMini = fs::path(IGI_SOURCE_DIR) / "tests/data/scenes/mini/scene.json";
+const fs::path kData(IGI_SHARED_DATA_DIR);
+
+TEST(SceneTest, MiniSceneLoadsEveryPart) {
+  const Scene scene = LoadScene(kMini);
+  ASSERT_EQ(scene.materials.size(), 4u);
+  EXPECT_EQ(scene.mesh.num_triangles(), 22u);
+  EXPECT_TRUE(scene.mesh.has_uvs());
+
+  const Material& floor = scene.materials[scene.FindMaterial("floor")];
+  EXPECT_EQ(floor.brdf, BrdfModel::kWard);
+  ASSERT_TRUE(floor.rho_d_map);
+  EXPECT_TRUE(floor.rho_d_map->is_absolute());
+  EXPECT_EQ(*floor.rho_s, Eigen::Vector3d::Constant(0.04));
+  EXPECT_TRUE(floor.MissingForRendering().empty());
+  EXPECT_EQ(*scene.materials[scene.FindMaterial("ceiling")].rho_d, Eigen::Vector3d::Constant(0.8));
+  const Material& box = scene.materials[scene.FindMaterial("box")];
+  EXPECT_EQ(box.brdf, BrdfModel::kWardAniso);
+  EXPECT_EQ(box.MissingForRendering(),
+            (std::vector<std::string>{"rho_d", "rho_s", "alpha_x", "alpha_y"}));
+
+  // Every triangle is bound to a material index; the box's 10 triangles to "box".
+  size_t box_triangles = 0;
+  for (int r : scene.mesh.triangle_region) box_triangles += r == scene.FindMaterial("box");
+  EXPECT_EQ(box_triangles, 10u);
+
+  ASSERT_EQ(scene.lights.size(), 7u);
+  const Light& spot = scene.lights[scene.FindLight("spot")];
+  EXPECT_EQ(spot.type, LightType::kSpot);
+  EXPECT_NEAR(spot.direction.norm(), 1.0, 1e-12);
+  ASSERT_EQ(spot.profile.kind, SpotProfile::Kind::kIes);
+  EXPECT_NEAR(spot.profile.Relative(0, 0), 1.0, 1e-12);  // peak on the axis
+  EXPECT_NEAR(spot.profile.Relative(45 * M_PI / 180, 0), 0.6, 1e-9);
+  const Light& cone = scene.lights[scene.FindLight("spot2")];
+  EXPECT_EQ(cone.intensity, Eigen::Vector3d::Constant(5));
+  EXPECT_DOUBLE_EQ(cone.profile.Relative(10 * M_PI / 180, 0), 1.0);
+  EXPECT_DOUBLE_EQ(cone.profile.Relative(25 * M_PI / 180, 0), 0.5);
+  EXPECT_DOUBLE_EQ(cone.profile.Relative(31 * M_PI / 180, 0), 0.0);
+  const Light& cosp = scene.lights[scene.FindLight("spot3")];
+  EXPECT_NEAR(cosp.profile.Relative(M_PI / 3, 0), std::pow(0.5, 4), 1e-12);
+  const Light& panel = scene.lights[scene.FindLight("panel")];
+  EXPECT_EQ(panel.mesh.num_triangles(), 2u);
+  EXPECT_NEAR(panel.mesh.FaceNormal(0).z(), -1.0f, 1e-6f);  // faces down into the room
+  EXPECT_EQ(scene.lights[scene.FindLight("bulb")].radius, 0.05);
+
+  ASSERT_EQ(scene.lightings.size(), 3u);
+  EXPECT_EQ(scene.lightings[1].lights,
+            (std::vector<int>{scene.FindLight("spot"), scene.FindLight("panel")}));
+
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  EXPECT_EQ(scene.cameras[1].model, CameraModel::kOpenCv);
+  EXPECT_NEAR((scene.cameras[0].CenterInWorld() - Eigen::Vector3d(1, 1, 1)).norm(), 0, 1e-12);
+  ASSERT_EQ(scene.photos.size(), 2u);
+  EXPECT_TRUE(scene.photos[0].mask.has_value());
+  EXPECT_FALSE(scene.photos[1].mask.has_value());
+  EXPECT_EQ(scene.photos[1].lighting, scene.FindLighting("L1"));
+  EXPECT_EQ(scene.document["materials"]["box"]["brdf"], "ward_aniso");
+}
+
+TEST(SceneTest, RenderingRequiresCompleteMaterials) {
+  SceneLoadOptions options;
+  options.require_complete_materials = true;
+  try {
+    LoadScene(kMini, options);
+    FAIL();
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_NE(e.problems()[0].find("materials.box"), std::string::npos);
+    EXPECT_NE(e.problems()[0].find("missing rho_d, rho_s, alpha_x, alpha_y"), std::string::npos);
+  }
+}
+
+TEST(SceneTest, SharedReferenceAndRealScenesLoad) {
+  const Scene room = LoadScene(kData / "reference/radiance_room/scene.json");
+  EXPECT_EQ(room.materials.size(), 8u);
+  EXPECT_EQ(room.mesh.num_triangles(), 36u);
+  EXPECT_EQ(room.photos.size(), 4u);
+  EXPECT_EQ(room.materials[room.FindMaterial("glossy_box")].brdf, BrdfModel::kWardGmd);
+  EXPECT_NEAR(room.lights[room.FindLight("lamp")].radius, 0.1, 1e-12);
+  // cam0 stands at (2, 0.3, 1.5) (README of radiance_room).
+  EXPECT_NEAR((room.cameras[room.FindCamera("cam0")].CenterInWorld() -
+               Eigen::Vector3d(2, 0.3, 1.5)).norm(), 0.0, 1e-6);
+
+  const Scene ball = LoadScene(kData / "real/diligent_ball/scene.json");
+  EXPECT_EQ(ball.photos.size(), 48u);
+  EXPECT_EQ(ball.lights.size(), 48u);
+  EXPECT_EQ(ball.lights[0].type, LightType::kDirectional);
+  EXPECT_FALSE(ball.materials[0].rho_d.has_value());  // unknown: the solver's job
+  EXPECT_NEAR((ball.cameras[0].CenterInWorld() - Eigen::Vector3d(0, 0, 50)).norm(), 0, 1e-9);
+  EXPECT_TRUE(ball.photos[0].mask.has_value());
+}
+
+TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
+  const fs::path dir = fs::temp_directory_path() / "igi_scene_many_problems";
+  fs::create_directories(dir);
+  Json doc = ReadJsonFile(kMini);
+  for (auto& g : doc["geometry"]) g["file"] = (kMini.parent_path() / g["file"].get<std::string>()).string();
+  doc["materials"]["floor"].erase("rho_d_map");
+  doc["materials"]["walls"]["rho_d"] = 2.0;                 // out of range
+  doc["lights"]["bulb"]["radius"] = -1;                     // must be > 0
+  doc["cameras"]["cam0"]["qvec"] = {1, 1, 0, 0};            // not unit
+  doc["lights"].erase("spot");
+  doc["lightings"]["L1"] = {"panel"};
+  doc["photos"] = Json::array();
+  doc["lights"]["panel"]["file"] = "nowhere.obj";           // missing file
+  WriteJsonFile(dir / "scene.json", doc);
+  try {
+    LoadScene(dir / "scene.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().size(), 4u) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace igi
