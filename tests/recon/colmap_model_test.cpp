@@ -1,0 +1,444 @@
+// Tests of the COLMAP model readers and writer: round trips, a cross-check against COLMAP 3.8
+// itself (its model_converter reads igi's TXT and writes BIN and TXT that igi reads back; a real
+// reconstruction of the Sceaux castle photos), and a corpus of broken model folders.
+//
+// Every comparison of numbers here is exact: TXT carries 17 significant digits, which is enough
+// for any double to survive printing and parsing bit for bit, and BIN carries the bits.
+
+#include "recon/colmap_model.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+#include "tools/common/strings.h"
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() /
+            ("igi_colmap_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// COLMAP is a declared test dependency (the README's setup installs it): without it the
+// cross-check tests fail, they are not skipped.
+std::string FindColmap() {
+  const char* path = std::getenv("PATH");
+  for (const std::string& dir : SplitTokens(path == nullptr ? "" : path, ":")) {
+    const fs::path candidate = fs::path(dir) / "colmap";
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
+  }
+  return "";
+}
+
+void RunColmap(const std::string& arguments, const fs::path& log) {
+  const std::string colmap = FindColmap();
+  ASSERT_FALSE(colmap.empty())
+      << "colmap (COLMAP 3.8) is not on PATH; it is required for this test: install it as the "
+         "README's setup does (apt-get install colmap)";
+  const std::string command =
+      "QT_QPA_PLATFORM=offscreen " + colmap + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_EQ(status, 0) << command << "\n" << ReadFileToString(log);
+}
+
+// COLMAP's model_converter: `in` (TXT or BIN) to `out` in `type` (BIN or TXT).
+void ConvertWithColmap(const fs::path& in, const fs::path& out, const std::string& type) {
+  fs::create_directories(out);
+  RunColmap("model_converter --input_path " + in.string() + " --output_path " + out.string() +
+                " --output_type " + type,
+            out / "colmap.log");
+}
+
+// The first difference between two models, with full precision, or "" if they are equal.
+std::string FirstDifference(const ColmapModel& a, const ColmapModel& b) {
+  std::ostringstream out;
+  out.precision(17);
+  if (a.cameras.size() != b.cameras.size() || a.images.size() != b.images.size() ||
+      a.points3d.size() != b.points3d.size()) {
+    out << "sizes differ: " << a.cameras.size() << "/" << a.images.size() << "/"
+        << a.points3d.size() << " vs " << b.cameras.size() << "/" << b.images.size() << "/"
+        << b.points3d.size();
+    return out.str();
+  }
+  for (auto [i, j] = std::pair(a.cameras.begin(), b.cameras.begin()); i != a.cameras.end();
+       ++i, ++j) {
+    if (i->second == j->second) continue;
+    out << "camera " << i->first << " vs " << j->first << ": " << i->second.model << " "
+        << j->second.model;
+    for (size_t k = 0; k < std::min(i->second.params.size(), j->second.params.size()); ++k) {
+      out << " [" << i->second.params[k] << " " << j->second.params[k] << "]";
+    }
+    return out.str();
+  }
+  for (auto [i, j] = std::pair(a.images.begin(), b.images.begin()); i != a.images.end(); ++i, ++j) {
+    const ColmapImage& x = i->second;
+    const ColmapImage& y = j->second;
+    if (x == y) continue;
+    out << "image " << i->first << " vs " << j->first << ": q " << x.qvec.transpose() << " | "
+        << y.qvec.transpose() << ", t " << x.tvec.transpose() << " | " << y.tvec.transpose()
+        << ", camera " << x.camera_id << " | " << y.camera_id << ", name " << x.name << " | "
+        << y.name << ", points " << x.points2d.size() << " | " << y.points2d.size();
+    return out.str();
+  }
+  for (auto [i, j] = std::pair(a.points3d.begin(), b.points3d.begin()); i != a.points3d.end();
+       ++i, ++j) {
+    const ColmapPoint3D& x = i->second;
+    const ColmapPoint3D& y = j->second;
+    if (x == y) continue;
+    out << "point " << i->first << " vs " << j->first << ": xyz " << x.xyz.transpose() << " | "
+        << y.xyz.transpose() << ", error " << x.error << " | " << y.error << ", track "
+        << x.track.size() << " | " << y.track.size();
+    return out.str();
+  }
+  return "";
+}
+
+// A quaternion q with q / |q| == q bit for bit, as COLMAP normalises each one it reads or
+// writes: such a q passes through COLMAP unchanged.
+Eigen::Vector4d RandomUnitQuaternion(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  while (true) {
+    Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector4d next = q / q.norm();
+      if (next == q) return q;
+      q = next;
+    }
+  }
+}
+
+// A double of any sign and magnitude from 1e-12 to 1e6 with all 53 bits random, or one of a few
+// awkward values (0.1, 1/3, -0, 1e300, ...).
+double AwkwardDouble(std::mt19937_64& rng) {
+  static constexpr double kSpecial[] = {0.1, 1.0 / 3.0, -0.0, 0.0, 1e300, -2.5e-308, 123456789.0};
+  std::uniform_int_distribution<int> pick(0, 9);
+  const int k = pick(rng);
+  if (k < 3) return kSpecial[std::uniform_int_distribution<int>(0, 6)(rng)];
+  const double mantissa = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+  return mantissa * std::pow(10.0, std::uniform_int_distribution<int>(-12, 6)(rng));
+}
+
+// A consistent model using every camera model, large and sparse ids, an image without 2D points
+// and a point without a track.
+ColmapModel MakeSyntheticModel(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  ColmapModel model;
+  std::vector<uint32_t> camera_ids;
+  const auto names = ColmapModelNames();
+  for (size_t m = 0; m < names.size(); ++m) {
+    ColmapCamera camera;
+    camera.camera_id = m == 0 ? 4294967294u : static_cast<uint32_t>(3 * m + 1);
+    camera.model = names[m];
+    camera.width = std::uniform_int_distribution<int>(1, 9000)(rng);
+    camera.height = std::uniform_int_distribution<int>(1, 9000)(rng);
+    for (int p = 0; p < ColmapModelNumParams(names[m]); ++p)
+      camera.params.push_back(AwkwardDouble(rng));
+    camera_ids.push_back(camera.camera_id);
+    model.cameras[camera.camera_id] = camera;
+  }
+  const std::vector<std::string> image_names = {
+      "a.jpg", "sub/dir/b.JPG", "c_ü.png", "d-00001.tif", "e.jpeg", "f.png", "g/h/i/j.jpg"};
+  std::vector<uint32_t> image_ids;
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    ColmapImage image;
+    image.image_id = i == 0 ? 4000000000u : static_cast<uint32_t>(10 * i + 7);
+    image.qvec = RandomUnitQuaternion(rng);
+    image.tvec = Eigen::Vector3d(AwkwardDouble(rng), AwkwardDouble(rng), AwkwardDouble(rng));
+    image.camera_id = camera_ids[i % camera_ids.size()];
+    image.name = image_names[i];
+    const int num_points = i == 2 ? 0 : std::uniform_int_distribution<int>(5, 60)(rng);
+    std::uniform_real_distribution<double> pixel(0.0, 5000.0);
+    for (int k = 0; k < num_points; ++k) image.points2d.push_back({{pixel(rng), pixel(rng)}, -1});
+    image_ids.push_back(image.image_id);
+    model.images[image.image_id] = image;
+  }
+  for (int p = 0; p < 40; ++p) {
+    ColmapPoint3D point;
+    point.point3d_id = p == 0 ? 5000000001ull : p == 1 ? (1ull << 62) : 100 + 7 * p;
+    point.xyz = Eigen::Vector3d(AwkwardDouble(rng), AwkwardDouble(rng), AwkwardDouble(rng));
+    for (auto& c : point.rgb) c = static_cast<uint8_t>(rng() & 0xff);
+    point.error = p % 5 == 0 ? -1.0 : std::abs(AwkwardDouble(rng));
+    const int track_length = p == 2 ? 0 : std::uniform_int_distribution<int>(2, 4)(rng);
+    for (int t = 0; t < track_length; ++t) {
+      ColmapImage& image = model.images[image_ids[(p + 2 * t) % image_ids.size()]];
+      for (size_t k = 0; k < image.points2d.size(); ++k) {
+        if (image.points2d[k].point3d_id != -1) continue;
+        image.points2d[k].point3d_id = static_cast<int64_t>(point.point3d_id);
+        point.track.push_back({image.image_id, static_cast<uint32_t>(k)});
+        break;
+      }
+    }
+    model.points3d[point.point3d_id] = point;
+  }
+  return model;
+}
+
+std::vector<std::string> HeadLines(const fs::path& path, size_t n) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; lines.size() < n && std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Camera model table
+
+TEST(ColmapCameraModels, MatchColmap38) {
+  const std::vector<std::pair<std::string, int>> expected = {{"SIMPLE_PINHOLE", 3},
+                                                             {"PINHOLE", 4},
+                                                             {"SIMPLE_RADIAL", 4},
+                                                             {"RADIAL", 5},
+                                                             {"OPENCV", 8},
+                                                             {"OPENCV_FISHEYE", 8},
+                                                             {"FULL_OPENCV", 12},
+                                                             {"FOV", 5},
+                                                             {"SIMPLE_RADIAL_FISHEYE", 4},
+                                                             {"RADIAL_FISHEYE", 5},
+                                                             {"THIN_PRISM_FISHEYE", 12}};
+  ASSERT_EQ(ColmapModelNames().size(), expected.size());
+  for (size_t id = 0; id < expected.size(); ++id) {
+    EXPECT_EQ(ColmapModelNames()[id], expected[id].first);
+    EXPECT_EQ(ColmapModelNumParams(expected[id].first), expected[id].second);
+    EXPECT_EQ(ColmapModelIdFromName(expected[id].first), static_cast<int>(id));
+    EXPECT_EQ(ColmapModelNameFromId(static_cast<int>(id)), expected[id].first);
+  }
+  EXPECT_EQ(ColmapModelNumParams("pinhole"), -1);
+  EXPECT_EQ(ColmapModelIdFromName("BROWN"), std::nullopt);
+  EXPECT_EQ(ColmapModelNameFromId(11), std::nullopt);
+  EXPECT_EQ(ColmapModelNameFromId(-1), std::nullopt);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips within igi
+
+TEST(ColmapModelText, WriteReadIsLosslessAndRewriteIsIdentical) {
+  TempDir tmp;
+  const ColmapModel model = MakeSyntheticModel(1);
+  WriteColmapModelText(model, tmp.path() / "a");
+  const ColmapModel read = ReadColmapModelText(tmp.path() / "a");
+  EXPECT_EQ(FirstDifference(model, read), "");
+  EXPECT_TRUE(read == model);
+  WriteColmapModelText(read, tmp.path() / "b");
+  for (const char* file : {"cameras.txt", "images.txt", "points3D.txt"}) {
+    EXPECT_EQ(ReadFileToString(tmp.path() / "a" / file), ReadFileToString(tmp.path() / "b" / file))
+        << file;
+  }
+  EXPECT_TRUE(ReadColmapModel(tmp.path() / "a") == model);  // detects TXT
+  ASSERT_NE(read.FindImageByName("sub/dir/b.JPG"), nullptr);
+  EXPECT_EQ(read.FindImageByName("sub/dir/b.JPG")->image_id, 17u);
+  EXPECT_EQ(read.FindImageByName("nope.jpg"), nullptr);
+}
+
+TEST(ColmapModelText, WritesColmapHeadersAndLineLayout) {
+  TempDir tmp;
+  ColmapModel model;
+  model.cameras[1] = {1, "PINHOLE", 640, 480, {500, 500.5, 320, 240}};
+  model.images[1] = {1, {1, 0, 0, 0}, {0.1, 0, -2}, 1, "a.jpg", {{{10, 20}, 7}, {{30, 40}, -1}}};
+  model.images[2] = {2, {0, 1, 0, 0}, {0, 0, 0}, 1, "b.jpg", {}};
+  model.points3d[7] = {7, {1, 2, 3}, {255, 128, 0}, 0.25, {{1, 0}}};
+  model.points3d[8] = {8, {0, 0, 0}, {0, 0, 0}, -1, {}};
+  WriteColmapModelText(model, tmp.path());
+  EXPECT_EQ(ReadFileToString(tmp.path() / "cameras.txt"),
+            "# Camera list with one line of data per camera:\n"
+            "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+            "# Number of cameras: 1\n"
+            "1 PINHOLE 640 480 500 500.5 320 240\n");
+  EXPECT_EQ(ReadFileToString(tmp.path() / "images.txt"),
+            "# Image list with two lines of data per image:\n"
+            "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+            "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+            "# Number of images: 2, mean observations per image: 0.5\n"
+            "1 1 0 0 0 0.10000000000000001 0 -2 1 a.jpg\n"
+            "10 20 7 30 40 -1\n"
+            "2 0 1 0 0 0 0 0 1 b.jpg\n"
+            "\n");
+  EXPECT_EQ(ReadFileToString(tmp.path() / "points3D.txt"),
+            "# 3D point list with one line of data per point:\n"
+            "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+            "# Number of points: 2, mean track length: 0.5\n"
+            "7 1 2 3 255 128 0 0.25 1 0\n"
+            "8 0 0 0 0 0 0 -1 \n");
+}
+
+TEST(ColmapModelText, QuaternionsNearUnitAreNormalisedOthersRejected) {
+  TempDir tmp;
+  WriteFileAtomic(tmp.path() / "cameras.txt", "1 SIMPLE_PINHOLE 100 100 50 50 50\n");
+  WriteFileAtomic(tmp.path() / "points3D.txt", "");
+  // Six digits, as many tools print: |q| = 1.0000003, normalised.
+  WriteFileAtomic(tmp.path() / "images.txt", "1 0.707107 0.707107 0 0 0 0 0 1 a.jpg\n\n");
+  const ColmapModel model = ReadColmapModelText(tmp.path());
+  const Eigen::Vector4d q = model.images.at(1).qvec;
+  EXPECT_NEAR(q.norm(), 1.0, 1e-15);  // a few ulp of rounding in q / |q|
+  EXPECT_EQ(q[0], q[1]);
+  // |q| = 1.01: rejected.
+  WriteFileAtomic(tmp.path() / "images.txt", "1 1.01 0 0 0 0 0 0 1 a.jpg\n\n");
+  try {
+    ReadColmapModelText(tmp.path());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("images.txt: line 1: |q| = 1.01: non-unit quaternion"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ColmapModelText, ReadsColmapDocumentationExampleCameras) {
+  // The cameras of COLMAP's format documentation (doc/format.rst), with its comment header.
+  TempDir tmp;
+  WriteFileAtomic(tmp.path() / "cameras.txt",
+                  "# Camera list with one line of data per camera:\n"
+                  "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+                  "# Number of cameras: 3\n"
+                  "1 SIMPLE_PINHOLE 3072 2304 2559.81 1536 1152\n"
+                  "2 PINHOLE 3072 2304 2560.56 2560.56 1536 1152\n"
+                  "3 SIMPLE_RADIAL 3072 2304 2559.69 1536 1152 -0.0218531\n");
+  WriteFileAtomic(tmp.path() / "images.txt",
+                  "1 0.851773 0.0165051 0.503764 -0.142941 -0.737434 1.02973 3.74354 1 "
+                  "P1180141.JPG\n2362.39 248.498 -1 1784.7 268.254 -1\n");
+  WriteFileAtomic(tmp.path() / "points3D.txt", "\n");
+  const ColmapModel model = ReadColmapModel(tmp.path());
+  ASSERT_EQ(model.cameras.size(), 3u);
+  EXPECT_EQ(model.cameras.at(3).model, "SIMPLE_RADIAL");
+  EXPECT_EQ(model.cameras.at(3).params, (std::vector<double>{2559.69, 1536, 1152, -0.0218531}));
+  EXPECT_EQ(model.cameras.at(2).width, 3072);
+  ASSERT_EQ(model.images.at(1).points2d.size(), 2u);
+  EXPECT_EQ(model.images.at(1).points2d[1].xy, Eigen::Vector2d(1784.7, 268.254));
+  EXPECT_EQ(model.images.at(1).name, "P1180141.JPG");
+}
+
+TEST(ColmapModelText, WriterValidatesFirstAndWritesNothingOnError) {
+  TempDir tmp;
+  ColmapModel model = MakeSyntheticModel(2);
+  model.images.begin()->second.camera_id = 999;
+  try {
+    WriteColmapModelText(model, tmp.path() / "out");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("images.txt: IMAGE_ID"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("image references a missing camera"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cross-check with COLMAP 3.8
+
+TEST(ColmapModelCrossCheck, ColmapReadsIgiTextAndIgiReadsColmapBinAndText) {
+  TempDir tmp;
+  const ColmapModel model = MakeSyntheticModel(3);
+  WriteColmapModelText(model, tmp.path() / "igi_txt");
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi_txt", tmp.path() / "bin", "BIN"));
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi_txt", tmp.path() / "txt", "TXT"));
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "bin", tmp.path() / "bin_txt", "TXT"));
+
+  const ColmapModel from_bin = ReadColmapModelBinary(tmp.path() / "bin");
+  EXPECT_EQ(FirstDifference(model, from_bin), "");
+  EXPECT_TRUE(ReadColmapModel(tmp.path() / "bin") == model);  // detects BIN
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelText(tmp.path() / "txt")), "");
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelText(tmp.path() / "bin_txt")), "");
+  // COLMAP's header comments, counts and means are what igi writes.
+  for (auto [file, n] : {std::pair("cameras.txt", 3), {"images.txt", 4}, {"points3D.txt", 3}}) {
+    EXPECT_EQ(HeadLines(tmp.path() / "igi_txt" / file, n), HeadLines(tmp.path() / "txt" / file, n));
+  }
+}
+
+TEST(ColmapModelCrossCheck, SingleRecordFilesAreByteIdenticalToColmaps) {
+  // With one record per file COLMAP's (hash-map) order cannot differ, so the bytes must match.
+  TempDir tmp;
+  std::mt19937_64 rng(4);
+  for (int variant = 0; variant < 2; ++variant) {
+    ColmapModel model;
+    model.cameras[3] = {3, "OPENCV", 1920, 1080, {}};
+    for (int p = 0; p < 8; ++p) model.cameras[3].params.push_back(AwkwardDouble(rng));
+    model.images[5] = {5, RandomUnitQuaternion(rng), {AwkwardDouble(rng), 1e-300, -0.0},
+                       3, "dir/photo_01.jpg",        {}};
+    model.points3d[9] = {9, {AwkwardDouble(rng), 0.1, 3}, {1, 2, 3}, 0.7, {}};
+    if (variant == 0) {
+      model.images[5].points2d = {{{1.5, 2.25}, -1}, {{1e-3, 4000.123456789}, 9}};
+      model.points3d[9].track = {{5, 1}};
+    }
+    const fs::path igi = tmp.path() / ("igi" + std::to_string(variant));
+    const fs::path colmap = tmp.path() / ("colmap" + std::to_string(variant));
+    WriteColmapModelText(model, igi);
+    ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(igi, colmap, "TXT"));
+    for (const char* file : {"cameras.txt", "images.txt", "points3D.txt"}) {
+      EXPECT_EQ(ReadFileToString(igi / file), ReadFileToString(colmap / file))
+          << "variant " << variant << " " << file;
+    }
+  }
+}
+
+TEST(ColmapModelCrossCheck, RealReconstructionOfSceauxCastle) {
+  // COLMAP reconstructs 4 real photos (openMVG's Sceaux castle sample, downscaled to 640 px for
+  // speed); igi must read its BIN model and COLMAP's TXT export of it as the same model, and
+  // COLMAP must read igi's TXT rewrite back to the same model.
+  TempDir tmp;
+  const fs::path photos = fs::path(IGI_SHARED_DATA_DIR) / "real/sceaux_castle";
+  const fs::path images = tmp.path() / "images";
+  fs::create_directories(images);
+  for (const char* name : {"100_7100.JPG", "100_7101.JPG", "100_7102.JPG", "100_7103.JPG"}) {
+    fs::create_symlink(photos / name, images / name);
+  }
+  const std::string db = (tmp.path() / "db.db").string();
+  ASSERT_NO_FATAL_FAILURE(
+      RunColmap("feature_extractor --database_path " + db + " --image_path " + images.string() +
+                    " --ImageReader.single_camera 1 --SiftExtraction.use_gpu 0"
+                    " --SiftExtraction.max_image_size 640 --SiftExtraction.num_threads 2",
+                tmp.path() / "extract.log"));
+  ASSERT_NO_FATAL_FAILURE(RunColmap("exhaustive_matcher --database_path " + db +
+                                        " --SiftMatching.use_gpu 0 --SiftMatching.num_threads 2",
+                                    tmp.path() / "match.log"));
+  fs::create_directories(tmp.path() / "sparse");
+  ASSERT_NO_FATAL_FAILURE(RunColmap(
+      "mapper --database_path " + db + " --image_path " + images.string() + " --output_path " +
+          (tmp.path() / "sparse").string() + " --Mapper.num_threads 2",
+      tmp.path() / "mapper.log"));
+  const fs::path bin = tmp.path() / "sparse/0";
+  const ColmapModel model = ReadColmapModel(bin);
+  EXPECT_EQ(model.cameras.size(), 1u);
+  EXPECT_EQ(model.cameras.begin()->second.model, "SIMPLE_RADIAL");  // COLMAP's default
+  EXPECT_GE(model.images.size(), 3u);
+  EXPECT_GT(model.points3d.size(), 100u);
+  EXPECT_NE(model.FindImageByName("100_7100.JPG"), nullptr);
+
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(bin, tmp.path() / "colmap_txt", "TXT"));
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelText(tmp.path() / "colmap_txt")), "");
+  WriteColmapModelText(model, tmp.path() / "igi_txt");
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi_txt", tmp.path() / "back", "BIN"));
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelBinary(tmp.path() / "back")), "");
+  for (const char* file : {"cameras.bin", "points3D.bin"}) {
+    // Single camera: identical; points: same set (order may differ), so compare sizes.
+    EXPECT_EQ(fs::file_size(bin / file), fs::file_size(tmp.path() / "back" / file)) << file;
+  }
+}
+
+}  // namespace
+}  // namespace igi
