@@ -335,6 +335,22 @@ TEST(ColmapModelText, ReadsColmapDocumentationExampleCameras) {
   EXPECT_EQ(model.images.at(1).name, "P1180141.JPG");
 }
 
+TEST(ColmapModelText, AcceptsCrlfBlankLinesAndAMissingLastPointsLine) {
+  // Windows line ends, blank lines between records, and a file that ends right after the last
+  // image's first line (read as an image without 2D points).
+  TempDir tmp;
+  WriteFileAtomic(tmp.path() / "cameras.txt", "# c\r\n\r\n1 SIMPLE_PINHOLE 10 10 5 5 5\r\n");
+  WriteFileAtomic(tmp.path() / "images.txt",
+                  "# i\r\n1 1 0 0 0 0 0 0 1 a.jpg\r\n1 2 -1 3 4 -1\r\n\r\n2 1 0 0 0 0 0 0 1 b.jpg");
+  WriteFileAtomic(tmp.path() / "points3D.txt", "");
+  const ColmapModel model = ReadColmapModelText(tmp.path());
+  ASSERT_EQ(model.images.size(), 2u);
+  EXPECT_EQ(model.images.at(1).points2d.size(), 2u);
+  EXPECT_EQ(model.images.at(1).name, "a.jpg");
+  EXPECT_TRUE(model.images.at(2).points2d.empty());
+  EXPECT_EQ(model.cameras.at(1).params, (std::vector<double>{5, 5, 5}));
+}
+
 TEST(ColmapModelText, WriterValidatesFirstAndWritesNothingOnError) {
   TempDir tmp;
   ColmapModel model = MakeSyntheticModel(2);
