@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -334,6 +335,22 @@ TEST(ColmapModelText, ReadsColmapDocumentationExampleCameras) {
   EXPECT_EQ(model.images.at(1).name, "P1180141.JPG");
 }
 
+TEST(ColmapModelText, AcceptsCrlfBlankLinesAndAMissingLastPointsLine) {
+  // Windows line ends, blank lines between records, and a file that ends right after the last
+  // image's first line (read as an image without 2D points).
+  TempDir tmp;
+  WriteFileAtomic(tmp.path() / "cameras.txt", "# c\r\n\r\n1 SIMPLE_PINHOLE 10 10 5 5 5\r\n");
+  WriteFileAtomic(tmp.path() / "images.txt",
+                  "# i\r\n1 1 0 0 0 0 0 0 1 a.jpg\r\n1 2 -1 3 4 -1\r\n\r\n2 1 0 0 0 0 0 0 1 b.jpg");
+  WriteFileAtomic(tmp.path() / "points3D.txt", "");
+  const ColmapModel model = ReadColmapModelText(tmp.path());
+  ASSERT_EQ(model.images.size(), 2u);
+  EXPECT_EQ(model.images.at(1).points2d.size(), 2u);
+  EXPECT_EQ(model.images.at(1).name, "a.jpg");
+  EXPECT_TRUE(model.images.at(2).points2d.empty());
+  EXPECT_EQ(model.cameras.at(1).params, (std::vector<double>{5, 5, 5}));
+}
+
 TEST(ColmapModelText, WriterValidatesFirstAndWritesNothingOnError) {
   TempDir tmp;
   ColmapModel model = MakeSyntheticModel(2);
@@ -437,6 +454,293 @@ TEST(ColmapModelCrossCheck, RealReconstructionOfSceauxCastle) {
   for (const char* file : {"cameras.bin", "points3D.bin"}) {
     // Single camera: identical; points: same set (order may differ), so compare sizes.
     EXPECT_EQ(fs::file_size(bin / file), fs::file_size(tmp.path() / "back" / file)) << file;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Broken model folders: each must give an InputError naming the file, the line (TXT) or record
+// and byte (BIN), the value and the rule.
+
+// A valid model: 1 camera, 2 images, 1 point seen by both (line numbers matter below).
+const std::map<std::string, std::string> kGoodText = {
+    {"cameras.txt",
+     "# Camera list with one line of data per camera:\n"
+     "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+     "# Number of cameras: 1\n"
+     "1 PINHOLE 640 480 500 500 320 240\n"},
+    {"images.txt",
+     "# Image list with two lines of data per image:\n"
+     "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+     "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+     "# Number of images: 2, mean observations per image: 1\n"
+     "1 1 0 0 0 0 0 0 1 a.jpg\n"
+     "10 20 7 30 40 -1\n"
+     "2 1 0 0 0 1 0 0 1 b.jpg\n"
+     "11 21 7\n"},
+    {"points3D.txt",
+     "# 3D point list with one line of data per point:\n"
+     "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+     "# Number of points: 1, mean track length: 2\n"
+     "7 0 0 5 255 128 0 0.5 1 0 2 0\n"}};
+
+// The same model in COLMAP's binary layout (little-endian; the test assumes a little-endian
+// host). Byte offsets: cameras.bin record 0 at 8 (model id at 12); images.bin record 0 at 8
+// (qw at 12, name at 72, points2D count at 78), record 1 at 134; points3D.bin record 0 at 8.
+std::map<std::string, std::string> GoodBinary() {
+  std::string cameras, images, points;
+  auto put = [](std::string& out, auto value) {
+    char bytes[sizeof(value)];
+    std::memcpy(bytes, &value, sizeof(value));
+    out.append(bytes, sizeof(value));
+  };
+  put(cameras, uint64_t{1});
+  put(cameras, uint32_t{1});
+  put(cameras, int32_t{1});  // PINHOLE
+  put(cameras, uint64_t{640});
+  put(cameras, uint64_t{480});
+  for (double p : {500.0, 500.0, 320.0, 240.0}) put(cameras, p);
+  put(images, uint64_t{2});
+  const std::array<std::tuple<uint32_t, double, const char*, double, uint64_t>, 2> rows = {
+      {{1, 0.0, "a.jpg", 10.0, 7}, {2, 1.0, "b.jpg", 11.0, 7}}};
+  for (const auto& [id, tx, name, x, point3d] : rows) {
+    put(images, id);
+    for (double v : {1.0, 0.0, 0.0, 0.0, tx, 0.0, 0.0}) put(images, v);
+    put(images, uint32_t{1});
+    images.append(name, std::strlen(name) + 1);
+    put(images, uint64_t{id == 1 ? 2u : 1u});
+    put(images, x);
+    put(images, x + 10);
+    put(images, point3d);
+    if (id == 1) {
+      for (double v : {30.0, 40.0}) put(images, v);
+      put(images, ~uint64_t{0});  // -1
+    }
+  }
+  put(points, uint64_t{1});
+  put(points, uint64_t{7});
+  for (double v : {0.0, 0.0, 5.0}) put(points, v);
+  for (uint8_t c : {255, 128, 0}) put(points, c);
+  put(points, 0.5);
+  put(points, uint64_t{2});
+  for (uint32_t v : {1u, 0u, 2u, 0u}) put(points, v);
+  return {{"cameras.bin", cameras}, {"images.bin", images}, {"points3D.bin", points}};
+}
+
+void WriteFolder(const fs::path& dir, const std::map<std::string, std::string>& files) {
+  for (const auto& [name, text] : files) WriteFileAtomic(dir / name, text);
+}
+
+void ExpectInputError(const fs::path& dir, const std::vector<std::string>& expected) {
+  try {
+    ReadColmapModel(dir);
+    ADD_FAILURE() << dir << ": no error";
+  } catch (const InputError& e) {
+    for (const std::string& part : expected) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+          << dir.filename() << ": expected \"" << part << "\" in:\n"
+          << e.what();
+    }
+  }
+}
+
+TEST(ColmapModelBroken, GoodFoldersReadTheSameInTextAndBinary) {
+  TempDir tmp;
+  WriteFolder(tmp.path() / "txt", kGoodText);
+  WriteFolder(tmp.path() / "bin", GoodBinary());
+  const ColmapModel text = ReadColmapModel(tmp.path() / "txt");
+  EXPECT_EQ(text.images.at(1).points2d.at(1).point3d_id, -1);
+  EXPECT_EQ(text.points3d.at(7).track, (std::vector<ColmapTrackElement>{{1, 0}, {2, 0}}));
+  EXPECT_EQ(FirstDifference(text, ReadColmapModel(tmp.path() / "bin")), "");
+}
+
+TEST(ColmapModelBroken, TextCorpus) {
+  struct Case {
+    const char* name;
+    const char* file;
+    std::string from, to;  // replaced in the good file; an empty `from` deletes the file
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases = {
+      {"unknown_model",
+       "cameras.txt",
+       "1 PINHOLE",
+       "1 PINHOLEX",
+       {"cameras.txt: line 4: PINHOLEX: unknown camera model"}},
+      {"param_count",
+       "cameras.txt",
+       "500 500 320 240",
+       "500 500 320",
+       {"cameras.txt: line 4: 3 params: wrong number of params: PINHOLE needs 4"}},
+      {"negative_width",
+       "cameras.txt",
+       "640 480",
+       "-640 480",
+       {"cameras.txt: line 4: -640: WIDTH must be an integer in [1, 2147483647]"}},
+      {"duplicate_camera",
+       "cameras.txt",
+       "320 240\n",
+       "320 240\n1 PINHOLE 64 48 5 5 3 2\n",
+       {"cameras.txt: line 5: 1: duplicate CAMERA_ID (first on line 4)"}},
+      {"non_numeric",
+       "images.txt",
+       "10 20 7",
+       "10 2O 7",
+       {"images.txt: line 6: 2O: POINTS2D[0] Y is not a finite number"}},
+      {"non_unit_quaternion",
+       "images.txt",
+       "2 1 0 0 0",
+       "2 1 0.5 0 0",
+       {"images.txt: line 7: |q| = 1.118", "non-unit quaternion"}},
+      {"missing_camera",
+       "images.txt",
+       "0 0 1 b.jpg",
+       "0 0 3 b.jpg",
+       {"images.txt: line 7: CAMERA_ID 3: image references a missing camera"}},
+      {"missing_point3d",
+       "images.txt",
+       "11 21 7",
+       "11 21 8",
+       {"images.txt: line 7: POINTS2D[0] POINT3D_ID 8: 2D point references a missing 3D point"}},
+      {"not_triples",
+       "images.txt",
+       "11 21 7",
+       "11 21",
+       {"images.txt: line 8: 2 values: POINTS2D[] must be (X, Y, POINT3D_ID) triples"}},
+      {"duplicate_name",
+       "images.txt",
+       "b.jpg",
+       "a.jpg",
+       {"images.txt: line 7: a.jpg: duplicate NAME (also IMAGE_ID 1)"}},
+      {"track_missing_image",
+       "points3D.txt",
+       "1 0 2 0",
+       "1 0 5 0",
+       {"points3D.txt: line 4: TRACK IMAGE_ID 5: track references a missing image"}},
+      {"track_missing_point2d",
+       "points3D.txt",
+       "1 0 2 0",
+       "1 0 2 4",
+       {"points3D.txt: line 4: TRACK (IMAGE_ID 2, POINT2D_IDX 4): track references a missing 2D "
+        "point (that image has 1)"}},
+      {"colour_range",
+       "points3D.txt",
+       "255 128",
+       "256 128",
+       {"points3D.txt: line 4: 256: R must be an integer in [0, 255]"}},
+      {"odd_track",
+       "points3D.txt",
+       "1 0 2 0",
+       "1 0 2",
+       {"points3D.txt: line 4: 11 values: a 3D point line needs"}},
+      {"missing_file", "points3D.txt", "", "", {"points3D.txt: missing file"}},
+  };
+  TempDir tmp;
+  for (const Case& c : cases) {
+    const fs::path dir = tmp.path() / c.name;
+    std::map<std::string, std::string> files = kGoodText;
+    if (c.from.empty()) {
+      files.erase(c.file);
+    } else {
+      std::string& text = files.at(c.file);
+      const size_t at = text.find(c.from);
+      ASSERT_NE(at, std::string::npos) << c.name;
+      text.replace(at, c.from.size(), c.to);
+    }
+    WriteFolder(dir, files);
+    ExpectInputError(dir, c.expected);
+  }
+}
+
+TEST(ColmapModelBroken, BinaryCorpus) {
+  struct Case {
+    const char* name;
+    const char* file;
+    std::function<void(std::string&)> mutate;
+    std::vector<std::string> expected;
+  };
+  auto put_at = [](size_t offset, auto value) {
+    return [offset, value](std::string& bytes) {
+      std::memcpy(bytes.data() + offset, &value, sizeof(value));
+    };
+  };
+  auto truncate = [](size_t size) { return [size](std::string& bytes) { bytes.resize(size); }; };
+  const std::vector<Case> cases = {
+      {"truncated_params",
+       "cameras.bin",
+       truncate(40),
+       {"cameras.bin: camera record 0 (byte 8): 8 bytes needed at byte 40, file has 40: "
+        "truncated file"}},
+      {"unknown_model_id",
+       "cameras.bin",
+       put_at(12, int32_t{42}),
+       {"cameras.bin: camera record 0 (byte 8): model id 42: unknown camera model"}},
+      {"truncated_name",
+       "images.bin",
+       truncate(203),
+       {"images.bin: image record 1 (byte 134): NAME starting at byte 198 has no terminating "
+        "NUL: truncated file"}},
+      {"count_beyond_file",
+       "images.bin",
+       truncate(75),
+       {"images.bin: header (byte 0): 2 images need at least 146 bytes, 67 left: truncated file "
+        "or corrupt count"}},
+      {"huge_count",
+       "images.bin",
+       put_at(78, uint64_t{1} << 60),
+       {"images.bin: image record 0 (byte 8): 1152921504606846976 points2D need at least",
+        "truncated file or corrupt count"}},
+      {"non_unit_quaternion",
+       "images.bin",
+       put_at(12, 2.0),
+       {"images.bin: image record 0 (byte 8): |q| = 2: non-unit quaternion"}},
+      {"missing_camera",
+       "images.bin",
+       put_at(134 + 60, uint32_t{9}),
+       {"images.bin: image record 1 (byte 134): CAMERA_ID 9: image references a missing camera"}},
+      {"track_missing_image",
+       "points3D.bin",
+       put_at(8 + 8 + 24 + 3 + 8 + 8 + 8, uint32_t{99}),
+       {"points3D.bin: point record 0 (byte 8): TRACK IMAGE_ID 99: track references a missing "
+        "image"}},
+      {"trailing_bytes",
+       "points3D.bin",
+       [](std::string& bytes) { bytes += "abc"; },
+       {"points3D.bin: byte 75: 3 bytes: trailing bytes after the last record"}},
+      {"empty_file",
+       "points3D.bin",
+       truncate(0),
+       {"points3D.bin: header (byte 0): 8 bytes needed at byte 0, file has 0: truncated file"}},
+  };
+  TempDir tmp;
+  for (const Case& c : cases) {
+    std::map<std::string, std::string> files = GoodBinary();
+    c.mutate(files.at(c.file));
+    WriteFolder(tmp.path() / c.name, files);
+    ExpectInputError(tmp.path() / c.name, c.expected);
+  }
+}
+
+TEST(ColmapModelBroken, ListsEveryProblemAndNamesMissingFiles) {
+  TempDir tmp;
+  std::map<std::string, std::string> files = kGoodText;
+  files["cameras.txt"] += "2 FISHEYE 1 1 1\n3 PINHOLE 1 1 x 1 1 1\n";
+  WriteFolder(tmp.path() / "two", files);
+  try {
+    ReadColmapModelText(tmp.path() / "two");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 2u) << e.what();
+    EXPECT_NE(e.problems()[0].find("line 5: FISHEYE: unknown camera model"), std::string::npos);
+    EXPECT_NE(e.problems()[1].find("line 6: x: PARAMS[0] is not a finite number"),
+              std::string::npos);
+  }
+  // An empty folder: every missing .txt file is named.
+  fs::create_directories(tmp.path() / "empty");
+  try {
+    ReadColmapModel(tmp.path() / "empty");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().size(), 3u) << e.what();
   }
 }
 
