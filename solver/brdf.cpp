@@ -118,10 +118,9 @@ BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, doubl
     // 1 - u.x() is in (0, 1], so the log is finite.
     const double radius = std::sqrt(-std::log(1.0 - u.x()));
     const double phi = 2.0 * kPi * u.y();
-    const Eigen::Vector3d h =
-        Eigen::Vector3d(params.AlphaX() * radius * std::cos(phi),
-                        params.AlphaY() * radius * std::sin(phi), 1.0)
-            .normalized();
+    const Eigen::Vector3d h = Eigen::Vector3d(params.AlphaX() * radius * std::cos(phi),
+                                              params.AlphaY() * radius * std::sin(phi), 1.0)
+                                  .normalized();
     const double wo_dot_h = wo.dot(h);
     if (!(wo_dot_h > 0.0)) return sample;  // wo would mirror to the back of h: a failed draw
     sample.wi = (2.0 * wo_dot_h * h - wo).normalized();

@@ -103,8 +103,7 @@ Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matri
   if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) return Eigen::Matrix<T, 3, 1>::Zero();
   Eigen::Matrix<T, 3, 1> f = params.rho_d * T(kInvPi);
   if (HasSpecularLobe(params.model)) {
-    f += params.rho_s *
-         SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
+    f += params.rho_s * SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
   }
   return f;
 }

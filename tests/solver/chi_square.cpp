@@ -161,10 +161,9 @@ std::vector<double> SphereHistogram::Probabilities(
   return probabilities;
 }
 
-ChiSquareResult TestDirections(
-    const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
-    const std::function<double(const Eigen::Vector3d&)>& pdf, const SphereHistogram& histogram,
-    int num_samples, uint64_t seed) {
+ChiSquareResult TestDirections(const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
+                               const std::function<double(const Eigen::Vector3d&)>& pdf,
+                               const SphereHistogram& histogram, int num_samples, uint64_t seed) {
   Pcg32 rng(seed, 7);
   std::vector<double> observed(histogram.NumBins(), 0.0);
   for (int s = 0; s < num_samples; ++s) observed[histogram.Bin(draw(rng))] += 1.0;

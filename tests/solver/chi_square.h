@@ -45,10 +45,9 @@ struct SphereHistogram {
 };
 
 // Draws `num_samples` directions (nullopt = failed draw) and tests them against `pdf`.
-ChiSquareResult TestDirections(
-    const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
-    const std::function<double(const Eigen::Vector3d&)>& pdf, const SphereHistogram& histogram,
-    int num_samples, uint64_t seed);
+ChiSquareResult TestDirections(const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
+                               const std::function<double(const Eigen::Vector3d&)>& pdf,
+                               const SphereHistogram& histogram, int num_samples, uint64_t seed);
 
 // Per-test significance level that keeps the family-wise level at `overall` over `num_tests`
 // independent tests (Šidák correction).

@@ -205,8 +205,7 @@ std::vector<WarpCase> DirectionWarps() {
        [](const Eigen::Vector3d& d) { return CosineHemispherePdf(d.z()); }, kPi / 2},
       {"uniform_hemisphere",
        [](Pcg32& r) { return std::optional(SampleUniformHemisphere(r.Uniform2D())); },
-       [](const Eigen::Vector3d& d) { return d.z() > 0 ? UniformHemispherePdf() : 0.0; },
-       kPi / 2},
+       [](const Eigen::Vector3d& d) { return d.z() > 0 ? UniformHemispherePdf() : 0.0; }, kPi / 2},
       {"uniform_sphere", [](Pcg32& r) { return std::optional(SampleUniformSphere(r.Uniform2D())); },
        [](const Eigen::Vector3d&) { return UniformSpherePdf(); }, kPi},
       {"cone_narrow", [](Pcg32& r) { return std::optional(SampleUniformCone(r.Uniform2D(), 0.8)); },
@@ -217,8 +216,8 @@ std::vector<WarpCase> DirectionWarps() {
        std::acos(-0.5)},
       {"sphere_from_outside",
        [=](Pcg32& r) {
-         return std::optional(axis.ToLocal(
-             SampleSphereFromPoint(point, center, kRadius, r.Uniform2D()).direction));
+         return std::optional(
+             axis.ToLocal(SampleSphereFromPoint(point, center, kRadius, r.Uniform2D()).direction));
        },
        [=](const Eigen::Vector3d& d) {
          return SphereFromPointPdf(point, center, kRadius, axis.ToWorld(d));
@@ -262,10 +261,11 @@ TEST(WarpTest, DirectionPdfsIntegrateToOne) {
               1e-6);
   // A sphere straight up the z axis from the origin: its cone is θ <= asin(r/d).
   const Eigen::Vector3d center(0, 0, 4);
-  EXPECT_NEAR(integrate([&](const Eigen::Vector3d& d) {
-                return SphereFromPointPdf(Eigen::Vector3d::Zero(), center, 1.0, d);
-              },
-                        std::asin(0.25) * (1 - 1e-12)),
+  EXPECT_NEAR(integrate(
+                  [&](const Eigen::Vector3d& d) {
+                    return SphereFromPointPdf(Eigen::Vector3d::Zero(), center, 1.0, d);
+                  },
+                  std::asin(0.25) * (1 - 1e-12)),
               1.0, 1e-6);
   // A tiny, distant sphere keeps its pdf accurate (1 - cosθmax computed without cancellation).
   const double tiny = 1e-5;
