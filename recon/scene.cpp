@@ -41,14 +41,6 @@ std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
   return std::nullopt;
 }
 
-bool IsAnisotropic(BrdfModel model) {
-  return model == BrdfModel::kWardAniso || model == BrdfModel::kWardGmdAniso;
-}
-
-bool HasSpecularLobe(BrdfModel model) {
-  return model == BrdfModel::kWard || model == BrdfModel::kWardGmd || IsAnisotropic(model);
-}
-
 std::vector<std::string> Material::MissingForRendering() const {
   std::vector<std::string> missing;
   if (brdf == BrdfModel::kBlack) return missing;

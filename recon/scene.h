@@ -16,20 +16,13 @@
 #include <string_view>
 #include <vector>
 
+#include "recon/brdf_model.h"
 #include "recon/camera.h"
 #include "recon/ies_profile.h"
 #include "recon/mesh.h"
 #include "tools/common/json.h"
 
 namespace igi {
-
-// The "brdf" values of CONTRACT.md §2.
-enum class BrdfModel { kLambert, kWard, kWardGmd, kWardAniso, kWardGmdAniso, kEmitter, kBlack };
-
-std::string_view BrdfModelName(BrdfModel model);
-std::optional<BrdfModel> BrdfModelFromName(std::string_view name);
-bool IsAnisotropic(BrdfModel model);
-bool HasSpecularLobe(BrdfModel model);
 
 // What is known of one region's reflectance. Absent values are unknowns for the solver; for
 // rendering every value the model needs must be present (Material::MissingForRendering).

@@ -8,13 +8,6 @@
 namespace igi {
 namespace {
 
-constexpr std::array<std::pair<BrdfModel, std::string_view>, 5> kModelNames = {{
-    {BrdfModel::kLambert, "lambert"},
-    {BrdfModel::kWard, "ward"},
-    {BrdfModel::kWardGmd, "ward_gmd"},
-    {BrdfModel::kWardAniso, "ward_aniso"},
-    {BrdfModel::kWardGmdAniso, "ward_gmd_aniso"},
-}};
 
 void CheckRgb(const Eigen::Vector3d& rho, const std::string& key,
               std::vector<BrdfParamProblem>* problems) {
@@ -34,20 +27,6 @@ void CheckAlpha(double alpha, const char* key, std::vector<BrdfParamProblem>* pr
 double Mean(const Eigen::Vector3d& v) { return (v[0] + v[1] + v[2]) / 3.0; }
 
 }  // namespace
-
-std::string_view BrdfModelName(BrdfModel model) {
-  for (const auto& [value, name] : kModelNames) {
-    if (value == model) return name;
-  }
-  return "unknown";
-}
-
-std::optional<BrdfModel> ParseBrdfModel(std::string_view name) {
-  for (const auto& [value, model_name] : kModelNames) {
-    if (model_name == name) return value;
-  }
-  return std::nullopt;
-}
 
 std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
   std::vector<BrdfParamProblem> problems;

@@ -33,23 +33,15 @@
 #include <string_view>
 #include <vector>
 
+#include "recon/brdf_model.h"
 #include "solver/sampling.h"
 
 namespace igi {
 
 // The `"brdf"` names of CONTRACT.md §2 that are reflectance models ("emitter" and "black" are
 // not: the renderer handles them).
-enum class BrdfModel { kLambert, kWard, kWardGmd, kWardAniso, kWardGmdAniso };
-
-std::string_view BrdfModelName(BrdfModel model);                 // e.g. "ward_gmd"
-std::optional<BrdfModel> ParseBrdfModel(std::string_view name);  // nullopt for other names
-inline bool IsAnisotropic(BrdfModel model) {
-  return model == BrdfModel::kWardAniso || model == BrdfModel::kWardGmdAniso;
-}
-inline bool IsGmd(BrdfModel model) {
-  return model == BrdfModel::kWardGmd || model == BrdfModel::kWardGmdAniso;
-}
-inline bool HasSpecularLobe(BrdfModel model) { return model != BrdfModel::kLambert; }
+// BrdfModel, IsAnisotropic, IsGmd, HasSpecularLobe: recon/brdf_model.h. Only the reflective
+// models (IsReflective) are evaluated here.
 
 // One material's parameters, named as its scene.json keys. Isotropic models read `alpha` and
 // ignore alpha_x/alpha_y; anisotropic models read alpha_x (along t) and alpha_y (along b) and
@@ -86,7 +78,7 @@ T SpecularFactor(BrdfModel model, const T& alpha_x, const T& alpha_y,
                  const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
   using std::exp;
   using std::sqrt;
-  if (model == BrdfModel::kLambert || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return T(0.0);
+  if (!HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return T(0.0);
   const Eigen::Matrix<T, 3, 1> h = wo + wi;
   const T hz2 = h.z() * h.z();
   const T slope_x = h.x() / alpha_x;

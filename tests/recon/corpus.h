@@ -3,6 +3,7 @@
 // and the executables' end-to-end test.
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -34,4 +35,9 @@ inline std::vector<CorpusCase> ReadCorpus() {
   return cases;
 }
 
+}  // namespace igi
+
+namespace igi {
+// Prints a case by name in test listings (instead of its bytes).
+inline void PrintTo(const CorpusCase& c, std::ostream* os) { *os << c.name; }
 }  // namespace igi
