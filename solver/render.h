@@ -1,0 +1,67 @@
+#pragma once
+// The forward model: a physically based path tracer on Embree 3 (next-event estimation with
+// multiple importance sampling, every BRDF of CONTRACT.md §2, every light type, albedo
+// textures, PINHOLE/OPENCV cameras, unbiased Russian roulette). Results are deterministic for
+// a given seed, whatever the number of threads.
+//
+// Output: linear radiance in the scene's units (W·sr⁻¹·m⁻² per channel), RGB, each pixel the
+// mean over its square (CONTRACT.md §1). Lights not in the rendered lighting are absent,
+// geometry included (area and sphere emitters), as in the RADIANCE references.
+
+#include <cstdint>
+#include <memory>
+
+#include "recon/scene.h"
+#include "tools/common/image.h"
+
+namespace igi {
+
+struct RenderOptions {
+  int spp = 64;             // samples (paths) per pixel, >= 1
+  uint64_t seed = 0;        // same seed -> same image
+  int max_bounces = 64;     // path length cap (Russian roulette ends paths long before)
+  int rr_start_bounce = 3;  // Russian roulette from this bounce on (unbiased)
+  int num_threads = 0;      // 0 = the process default (--threads), 0 there = all cores
+  int width = 0;            // output size; 0 = the camera's. Another size rescales the
+  int height = 0;           // intrinsics (same field of view).
+  bool show_progress = true;
+
+  // Throws InputError naming the field and the rule.
+  void Validate() const;
+};
+
+struct RenderSummary {
+  double seconds = 0;
+  uint64_t camera_rays = 0;
+  uint64_t rays = 0;  // all rays traced (camera, bounce and shadow rays)
+  double RaysPerSecond() const { return seconds > 0 ? double(rays) / seconds : 0.0; }
+};
+
+// One lighting of a scene, ready to render from any camera: the Embree scene, materials with
+// textures loaded, and the lighting's emitters. Build once, render many cameras.
+class Renderer {
+ public:
+  // `scene` must have complete materials (SceneLoadOptions::require_complete_materials) and
+  // outlive the renderer. Throws InputError when the lighting has no light and the scene no
+  // emitter material, or a texture cannot be read.
+  Renderer(const Scene& scene, int lighting);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders `camera`'s view (linear radiance, RGB).
+  Image Render(const Camera& camera, const RenderOptions& options,
+               RenderSummary* summary = nullptr) const;
+
+  // Radiance arriving along one ray (world frame), estimated with `spp` paths; for tests and
+  // the solver.
+  Eigen::Vector3d Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                           int spp, uint64_t seed) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace igi
