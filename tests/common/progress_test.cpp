@@ -1,0 +1,68 @@
+#include "tools/common/progress.h"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace igi {
+namespace {
+
+// Runs `fn` with stderr sent to a file and returns what it wrote.
+template <typename Fn>
+std::string CaptureStderr(Fn fn) {
+  const auto path = std::filesystem::temp_directory_path() / "igi_progress_stderr.txt";
+  std::fflush(stderr);
+  const int saved = dup(STDERR_FILENO);
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  dup2(fd, STDERR_FILENO);
+  close(fd);
+  fn();
+  std::fflush(stderr);
+  dup2(saved, STDERR_FILENO);
+  close(saved);
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::filesystem::remove(path);
+  return ss.str();
+}
+
+TEST(ProgressTest, QuietInPipesAndCi) {
+  // stderr is a file here, not a terminal.
+  EXPECT_EQ(CaptureStderr([] { EXPECT_FALSE(ProgressAllowed()); }), "");
+  setenv("CI", "true", 1);
+  EXPECT_FALSE(ProgressAllowed());
+  unsetenv("CI");
+  const std::string out = CaptureStderr([] {
+    Progress progress("work", 10);  // enabled only on a terminal: not here
+    for (int i = 0; i < 10; ++i) progress.Add();
+  });
+  EXPECT_EQ(out, "");
+}
+
+TEST(ProgressTest, DrawsWhenEnabledAndAfterTheDelay) {
+  const std::string shown = CaptureStderr([] {
+    Progress progress("render", 4, /*delay_s=*/0.0, /*enabled=*/true);
+    for (int i = 0; i < 4; ++i) progress.Add();
+    progress.Finish();
+    EXPECT_EQ(progress.done(), 4);
+  });
+  EXPECT_NE(shown.find("render ["), std::string::npos) << shown;
+  EXPECT_NE(shown.find("100%"), std::string::npos) << shown;
+  EXPECT_EQ(shown.back(), '\n');
+  // Work shorter than the delay draws nothing.
+  const std::string quick = CaptureStderr([] {
+    Progress progress("quick", 4, /*delay_s=*/60.0, /*enabled=*/true);
+    progress.Add(4);
+  });
+  EXPECT_EQ(quick, "");
+}
+
+}  // namespace
+}  // namespace igi
