@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "recon/colmap_model.h"
+
 namespace igi {
 namespace {
 
@@ -120,6 +122,63 @@ TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.problems().size(), 4u) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace igi
+
+namespace igi {
+namespace {
+
+// Cameras from a COLMAP model: each image becomes a camera named by its image name, and a
+// photo without "camera" uses the image of its own file name.
+TEST(SceneTest, CamerasFromColmapModel) {
+  const fs::path dir = fs::temp_directory_path() / "igi_scene_colmap";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "sparse/0");
+  ColmapModel model;
+  model.cameras[1] = ColmapCamera{1, "SIMPLE_RADIAL", 8, 6, {4.0, 4.0, 3.0, -0.05}};
+  ColmapImage image;
+  image.image_id = 3;
+  image.qvec = Eigen::Vector4d(0, 1, 0, 0);
+  image.tvec = Eigen::Vector3d(-1, 1, 1);
+  image.camera_id = 1;
+  image.name = "cam0_L0.exr";
+  model.images[3] = image;
+  WriteColmapModelText(model, dir / "sparse/0");
+
+  Json doc = ReadJsonFile(kMini);
+  const fs::path mini = kMini.parent_path();
+  for (auto& g : doc["geometry"]) g["file"] = (mini / g["file"].get<std::string>()).string();
+  doc["materials"]["floor"]["rho_d_map"] = (mini / "textures/floor.exr").string();
+  doc["lights"]["spot"]["profile"]["ies"] = (mini / "lights/spot.ies").string();
+  doc["lights"]["panel"]["file"] = (mini / "geometry/panel.obj").string();
+  doc["cameras"] = Json{{"colmap", "sparse/0"}};
+  doc["photos"] = Json::array({Json{{"file", (mini / "photos/cam0_L0.exr").string()},
+                                    {"lighting", "L0"}}});
+  WriteJsonFile(dir / "scene.json", doc);
+  const Scene scene = LoadScene(dir / "scene.json");
+  ASSERT_EQ(scene.cameras.size(), 1u);
+  const Camera& cam = scene.cameras[0];
+  EXPECT_EQ(cam.name, "cam0_L0.exr");
+  EXPECT_EQ(cam.model, CameraModel::kOpenCv);  // SIMPLE_RADIAL converts exactly
+  EXPECT_EQ(cam.params, (std::vector<double>{4, 4, 4, 3, -0.05, 0, 0, 0}));
+  EXPECT_NEAR((cam.CenterInWorld() - Eigen::Vector3d(1, 1, 1)).norm(), 0, 1e-12);
+  ASSERT_EQ(scene.photos.size(), 1u);
+  EXPECT_EQ(scene.photos[0].camera, 0);
+  EXPECT_TRUE(scene.colmap_model.has_value());
+
+  // A photo whose file name is not an image of the model is reported.
+  doc["photos"][0]["file"] = (mini / "photos/cam0_L1.exr").string();
+  WriteJsonFile(dir / "scene.json", doc);
+  try {
+    LoadScene(dir / "scene.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no image of this file name in the COLMAP model"),
+              std::string::npos) << e.what();
   }
   fs::remove_all(dir);
 }
