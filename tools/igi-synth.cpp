@@ -52,9 +52,11 @@ int main(int argc, char** argv) {
   app.add_option("--brackets", o.brackets.count, "LDR brackets per photo (0 = none)");
   app.add_option("--stops", o.brackets.stops, "EV between brackets");
   app.add_option("--response", response, "Bracket camera response: gamma|sigmoid|file");
-  app.add_option("--response-file", o.brackets.response_file, "igi-response JSON for --response file");
+  app.add_option("--response-file", o.brackets.response_file,
+                 "igi-response JSON for --response file");
   app.add_option("--gamma", o.brackets.gamma, "Gamma of --response gamma");
-  app.add_option("--sigmoid-contrast", o.brackets.sigmoid_contrast, "Contrast of --response sigmoid");
+  app.add_option("--sigmoid-contrast", o.brackets.sigmoid_contrast,
+                 "Contrast of --response sigmoid");
   app.add_option("--sigmoid-mid", o.brackets.sigmoid_mid, "Mid exposure of --response sigmoid");
   app.add_option("--bracket-bits", o.brackets.bits, "8 or 16");
   app.add_option("--bracket-format", o.brackets.format, "png or tif");
@@ -62,13 +64,20 @@ int main(int argc, char** argv) {
                  "Effect in the photos, not in scene.json: NAME[:key=value,...] (repeatable)");
   return igi::RunMain(app, flags, argc, argv, [&] {
     igi::ProblemList problems;
-    if (noise == "none") o.noise = igi::NoiseModel::kNone;
-    else if (noise == "realistic") o.noise = igi::NoiseModel::kRealistic;
-    else problems.Add("--noise", "", noise, "must be none or realistic");
-    if (response == "gamma") o.brackets.response = igi::ResponseKind::kGamma;
-    else if (response == "sigmoid") o.brackets.response = igi::ResponseKind::kSigmoid;
-    else if (response == "file") o.brackets.response = igi::ResponseKind::kFile;
-    else problems.Add("--response", "", response, "must be gamma, sigmoid or file");
+    if (noise == "none")
+      o.noise = igi::NoiseModel::kNone;
+    else if (noise == "realistic")
+      o.noise = igi::NoiseModel::kRealistic;
+    else
+      problems.Add("--noise", "", noise, "must be none or realistic");
+    if (response == "gamma")
+      o.brackets.response = igi::ResponseKind::kGamma;
+    else if (response == "sigmoid")
+      o.brackets.response = igi::ResponseKind::kSigmoid;
+    else if (response == "file")
+      o.brackets.response = igi::ResponseKind::kFile;
+    else
+      problems.Add("--response", "", response, "must be gamma, sigmoid or file");
     o.unknowns = List(unknowns);
     o.photo_lightings = List(photo_lightings);
     o.validation_lightings = List(validation_lightings);

@@ -35,9 +35,9 @@ std::pair<Vector3d, int> SampleRegionPoint(const SynthMesh& mesh, int region, Pc
   }
   const Vector3d w = SampleUniformTriangle(rng->Uniform2D());
   const Eigen::Vector3i& tri = mesh.triangles[chosen];
-  return {w[0] * mesh.positions[tri[0]] + w[1] * mesh.positions[tri[1]] +
-              w[2] * mesh.positions[tri[2]],
-          chosen};
+  return {
+      w[0] * mesh.positions[tri[0]] + w[1] * mesh.positions[tri[1]] + w[2] * mesh.positions[tri[2]],
+      chosen};
 }
 
 struct Candidate {
@@ -75,8 +75,8 @@ Candidate BestHighlightView(const SynthRoom& room, const std::string& region, Pc
 
 }  // namespace
 
-Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d& target,
-                    int width, int height, double fov_deg) {
+Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d& target, int width,
+                    int height, double fov_deg) {
   const Vector3d forward = (target - eye).normalized();
   const Vector3d up = std::abs(forward.z()) > 0.95 ? Vector3d::UnitY() : Vector3d::UnitZ();
   const Vector3d right = forward.cross(up).normalized();
@@ -107,8 +107,8 @@ std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions
     const Candidate c = BestHighlightView(room, region, &rng, eyes);
     if (c.score < 0) throw Error("igi-synth: no viewpoint sees the highlight on " + region);
     PlacedCamera pc;
-    pc.camera = LookAtCamera(name(), c.eye, c.point, options.width, options.height,
-                             options.fov_deg);
+    pc.camera =
+        LookAtCamera(name(), c.eye, c.point, options.width, options.height, options.fov_deg);
     pc.target_region = region;
     pc.highlight_point = c.point;
     pc.highlight_pixel = *pc.camera.ImgFromWorld(c.point);

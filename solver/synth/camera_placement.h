@@ -16,8 +16,8 @@
 namespace igi {
 
 struct PlacedCamera {
-  Camera camera;                    // PINHOLE, options' size and field of view
-  std::string target_region;        // glossy region whose highlight it sees; "" = overview
+  Camera camera;              // PINHOLE, options' size and field of view
+  std::string target_region;  // glossy region whose highlight it sees; "" = overview
   Eigen::Vector3d highlight_point = Eigen::Vector3d::Zero();  // world, metres
   Eigen::Vector2d highlight_pixel = Eigen::Vector2d::Zero();  // continuous pixel coordinates
 };

@@ -50,7 +50,8 @@ class Params {
     std::vector<std::string> out = SplitTokens(it->second, "/");
     for (const std::string& n : out) {
       if (std::find(allowed.begin(), allowed.end(), n) == allowed.end()) {
-        Fail(key, it->second, "each name must be one of " + Join(allowed, ", ") + " ('/'-separated)");
+        Fail(key, it->second,
+             "each name must be one of " + Join(allowed, ", ") + " ('/'-separated)");
       }
     }
     return out;
@@ -150,8 +151,8 @@ Json Anisotropy(Params& p, const SynthRoom& room, SynthScenes* s) {
   const double ax = p.Number("alpha_x", 0.03, 1e-3, 1.0);
   const double ay = p.Number("alpha_y", 0.15, 1e-3, 1.0);
   const double yaw = 25.0 * std::numbers::pi / 180.0;  // glossy_box's rotation
-  const Vector3d fallback = region == "glossy_box" ? Vector3d(std::cos(yaw), std::sin(yaw), 0)
-                                                   : Vector3d::UnitX();
+  const Vector3d fallback =
+      region == "glossy_box" ? Vector3d(std::cos(yaw), std::sin(yaw), 0) : Vector3d::UnitX();
   const Vector3d tangent = p.Direction("tangent").value_or(fallback);
   p.Finish();
   Json& m = s->true_scene["materials"][region];
@@ -160,9 +161,10 @@ Json Anisotropy(Params& p, const SynthRoom& room, SynthScenes* s) {
   m["alpha_x"] = ax;
   m["alpha_y"] = ay;
   m["tangent"] = Vec(tangent);
-  return Json{{"region", region},       {"true_brdf", m["brdf"]}, {"alpha_x", ax},
-              {"alpha_y", ay},          {"tangent", Vec(tangent)},
-              {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
+  return Json{
+      {"region", region},        {"true_brdf", m["brdf"]},
+      {"alpha_x", ax},           {"alpha_y", ay},
+      {"tangent", Vec(tangent)}, {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
 }
 
 Json SourceExtent(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -194,9 +196,12 @@ Json MissingGeometry(Params& p, SynthScenes* s) {
   s->true_scene["geometry"].push_back(Json{{"file", file}});
   s->true_scene["materials"]["missing_object"] =
       Json{{"brdf", "lambert"}, {"rho_d", Vec(Vector3d::Constant(rho))}};
-  return Json{{"file", file},         {"region", "missing_object"},
-              {"center", Vec({cx, cy, 0.5 * height})}, {"size_m", Vec({size, size, height})},
-              {"yaw_deg", 10.0},      {"rho_d", rho}};
+  return Json{{"file", file},
+              {"region", "missing_object"},
+              {"center", Vec({cx, cy, 0.5 * height})},
+              {"size_m", Vec({size, size, height})},
+              {"yaw_deg", 10.0},
+              {"rho_d", rho}};
 }
 
 Json Ambient(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -235,8 +240,7 @@ Json Response(Params& p, PhotoEffects* post) {
               {"applies_to", "every photo of scene.json (not brackets or validation renders)"}};
 }
 
-Json PoseError(Params& p, const std::vector<PlacedCamera>& cameras, uint64_t seed,
-               SynthScenes* s) {
+Json PoseError(Params& p, const std::vector<PlacedCamera>& cameras, uint64_t seed, SynthScenes* s) {
   std::vector<std::string> names;
   for (const PlacedCamera& c : cameras) names.push_back(c.camera.name);
   const std::string name = p.Name("camera", names.front(), names);
@@ -261,8 +265,9 @@ Json PoseError(Params& p, const std::vector<PlacedCamera>& cameras, uint64_t see
               {"axis_cam", Vec(axis)},
               {"translation_m", shift_m},
               {"direction_world", Vec(dir)},
-              {"model", "declared R = AngleAxis(rotation_deg, axis_cam) * true R; declared "
-                        "centre = true centre + translation_m * direction_world"},
+              {"model",
+               "declared R = AngleAxis(rotation_deg, axis_cam) * true R; declared "
+               "centre = true centre + translation_m * direction_world"},
               {"true", CameraJson(cam)},
               {"declared", CameraJson(declared)}};
 }
@@ -274,11 +279,10 @@ Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
   for (const std::string& region : regions) {
     Json& m = s->true_scene["materials"][region];
     const std::string brdf = m["brdf"].get<std::string>();
-    static const std::map<std::string, std::string> kSwap = {
-        {"ward", "ward_gmd"},
-        {"ward_gmd", "ward"},
-        {"ward_aniso", "ward_gmd_aniso"},
-        {"ward_gmd_aniso", "ward_aniso"}};
+    static const std::map<std::string, std::string> kSwap = {{"ward", "ward_gmd"},
+                                                             {"ward_gmd", "ward"},
+                                                             {"ward_aniso", "ward_gmd_aniso"},
+                                                             {"ward_gmd_aniso", "ward_aniso"}};
     m["brdf"] = kSwap.at(brdf);
     changes[region] = Json{{"true_brdf", m["brdf"]},
                            {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
@@ -325,8 +329,8 @@ Json CameraJson(const Camera& camera) {
 double PhotoEffects::VignettingFactor(const Camera& camera, double x, double y) const {
   if (!vignetting) return 1.0;
   const double dx = x - camera.principal_x_px(), dy = y - camera.principal_y_px();
-  const double half_diag2 = 0.25 * (double(camera.width) * camera.width +
-                                    double(camera.height) * camera.height);
+  const double half_diag2 =
+      0.25 * (double(camera.width) * camera.width + double(camera.height) * camera.height);
   const double r2 = (dx * dx + dy * dy) / half_diag2;
   return 1.0 + vignetting->first * r2 + vignetting->second * r2 * r2;
 }
@@ -356,26 +360,39 @@ void PhotoEffects::ApplyAfterSensor(Image* image) const {
 
 Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<PlacedCamera>& cameras,
-                  const std::vector<std::string>& photo_files, uint64_t seed,
-                  SynthScenes* s, PhotoEffects* post) {
+                  const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
+                  PhotoEffects* post) {
   Json list = Json::array();
   for (const EffectSpec& spec : specs) {
     Params p(spec);
     Json params;
     const std::string& n = spec.name;
-    if (n == "vignetting") params = Vignetting(p, post);
-    else if (n == "light_emission_profile") params = EmissionProfile(p, room, s);
-    else if (n == "anisotropic_reflection") params = Anisotropy(p, room, s);
-    else if (n == "light_source_extent") params = SourceExtent(p, room, s);
-    else if (n == "missing_geometry") params = MissingGeometry(p, s);
-    else if (n == "ambient_light") params = Ambient(p, room, s);
-    else if (n == "exposure_scale") params = ExposureScale(p, photo_files, post);
-    else if (n == "camera_response") params = Response(p, post);
-    else if (n == "pose_error") params = PoseError(p, cameras, seed, s);
-    else if (n == "specular_lobe_shape") params = LobeShape(p, room, s);
-    else if (n == "light_intensity") params = Intensity(p, room, s);
-    else if (n == "specular_reflection") params = SpecularAsDiffuse(p, room, s);
-    else p.Fail("", "", "unknown effect");
+    if (n == "vignetting")
+      params = Vignetting(p, post);
+    else if (n == "light_emission_profile")
+      params = EmissionProfile(p, room, s);
+    else if (n == "anisotropic_reflection")
+      params = Anisotropy(p, room, s);
+    else if (n == "light_source_extent")
+      params = SourceExtent(p, room, s);
+    else if (n == "missing_geometry")
+      params = MissingGeometry(p, s);
+    else if (n == "ambient_light")
+      params = Ambient(p, room, s);
+    else if (n == "exposure_scale")
+      params = ExposureScale(p, photo_files, post);
+    else if (n == "camera_response")
+      params = Response(p, post);
+    else if (n == "pose_error")
+      params = PoseError(p, cameras, seed, s);
+    else if (n == "specular_lobe_shape")
+      params = LobeShape(p, room, s);
+    else if (n == "light_intensity")
+      params = Intensity(p, room, s);
+    else if (n == "specular_reflection")
+      params = SpecularAsDiffuse(p, room, s);
+    else
+      p.Fail("", "", "unknown effect");
     list.push_back(Json{{"effect", n}, {"params", params}});
   }
   return list;

@@ -63,8 +63,8 @@ struct PhotoEffects {
 // Throws InputError "--effect: NAME: KEY=VALUE: RULE" for a bad or unknown parameter.
 Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<PlacedCamera>& cameras,
-                  const std::vector<std::string>& photo_files, uint64_t seed,
-                  SynthScenes* scenes, PhotoEffects* photo_effects);
+                  const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* scenes,
+                  PhotoEffects* photo_effects);
 
 // igi-scene JSON of a camera (model, size, params, qvec, tvec).
 Json CameraJson(const Camera& camera);

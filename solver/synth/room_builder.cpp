@@ -56,13 +56,13 @@ void AddRoomShell(const Vector3d& s, SynthMesh* mesh) {
                 uv(0, 0, 1, 1));
   mesh->AddQuad({0, 0, s.z()}, {0, s.y(), s.z()}, {s.x(), s.y(), s.z()}, {s.x(), 0, s.z()},
                 "ceiling", uv(0, 0, 1, 1));
-  mesh->AddQuad({0, s.y(), 0}, {0, 0, 0}, {0, 0, s.z()}, {0, s.y(), s.z()}, "wall_x0",
+  mesh->AddQuad({0, 0, 0}, {0, s.y(), 0}, {0, s.y(), s.z()}, {0, 0, s.z()}, "wall_x0",
                 uv(0, 0, 1, 1));
-  mesh->AddQuad({s.x(), 0, 0}, {s.x(), s.y(), 0}, {s.x(), s.y(), s.z()}, {s.x(), 0, s.z()},
+  mesh->AddQuad({s.x(), s.y(), 0}, {s.x(), 0, 0}, {s.x(), 0, s.z()}, {s.x(), s.y(), s.z()},
                 "wall_x4", uv(0, 0, 1, 1));
-  mesh->AddQuad({0, 0, 0}, {s.x(), 0, 0}, {s.x(), 0, s.z()}, {0, 0, s.z()}, "wall_y0",
+  mesh->AddQuad({s.x(), 0, 0}, {0, 0, 0}, {0, 0, s.z()}, {s.x(), 0, s.z()}, "wall_y0",
                 uv(0, 0, 1, 1));
-  mesh->AddQuad({s.x(), s.y(), 0}, {0, s.y(), 0}, {0, s.y(), s.z()}, {s.x(), s.y(), s.z()},
+  mesh->AddQuad({0, s.y(), 0}, {s.x(), s.y(), 0}, {s.x(), s.y(), s.z()}, {0, s.y(), s.z()},
                 "wall_y4", uv(0, 0, 1, 1));
 }
 
@@ -75,8 +75,9 @@ bool Contains(const std::vector<std::string>& list, const std::string& name) {
 Json LampJson(const SynthLamp& lamp) {
   const Json pos = Rgb(lamp.position);
   if (lamp.radius <= 0) {
-    return Json{{"type", "point"}, {"position", pos}, {"intensity", Rgb(Vector3d::Constant(
-                                                                      lamp.intensity))}};
+    return Json{{"type", "point"},
+                {"position", pos},
+                {"intensity", Rgb(Vector3d::Constant(lamp.intensity))}};
   }
   const double radiance = lamp.intensity / (std::numbers::pi * lamp.radius * lamp.radius);
   return Json{{"type", "sphere"},
@@ -99,7 +100,8 @@ Eigen::Vector3d ImageMean(const Image& image) {
   Vector3d sum = Vector3d::Zero();
   const size_t n = size_t(image.width) * image.height;
   for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) sum[c] += image.pixels[i * image.channels + std::min(c, image.channels - 1)];
+    for (int c = 0; c < 3; ++c)
+      sum[c] += image.pixels[i * image.channels + std::min(c, image.channels - 1)];
   }
   return sum / double(std::max<size_t>(n, 1));
 }

@@ -27,13 +27,13 @@ struct SynthLamp {
 };
 
 struct SynthRoom {
-  Eigen::Vector3d size{4, 4, 3};  // the room spans [0, size] on each axis
-  SynthMesh mesh;                 // geometry/room.obj (every region, UVs, normals)
-  Json materials;                 // igi-scene "materials", complete (the truth)
+  Eigen::Vector3d size{4, 4, 3};            // the room spans [0, size] on each axis
+  SynthMesh mesh;                           // geometry/room.obj (every region, UVs, normals)
+  Json materials;                           // igi-scene "materials", complete (the truth)
   std::vector<std::string> glossy_regions;  // regions with a specular lobe, in placement order
-  std::vector<SynthLamp> lamps;   // lamps[0] in L0, lamps[1] in L1
-  Image floor_albedo;             // linear RGB texture of the floor (rho_d_map)
-  std::string floor_albedo_file;  // where it is written, relative to the scene folder
+  std::vector<SynthLamp> lamps;             // lamps[0] in L0, lamps[1] in L1
+  Image floor_albedo;                       // linear RGB texture of the floor (rho_d_map)
+  std::string floor_albedo_file;            // where it is written, relative to the scene folder
 
   // igi-scene "lights" and "lightings" for the lamps as they are.
   Json LightsJson() const;

@@ -87,9 +87,12 @@ ResponseCurve ResponseCurve::FromFile(const std::filesystem::path& path) {
 
 ResponseCurve ResponseCurve::FromOptions(const BracketOptions& o) {
   switch (o.response) {
-    case ResponseKind::kGamma: return Gamma(o.gamma);
-    case ResponseKind::kSigmoid: return Sigmoid(o.sigmoid_contrast, o.sigmoid_mid);
-    case ResponseKind::kFile: return FromFile(o.response_file);
+    case ResponseKind::kGamma:
+      return Gamma(o.gamma);
+    case ResponseKind::kSigmoid:
+      return Sigmoid(o.sigmoid_contrast, o.sigmoid_mid);
+    case ResponseKind::kFile:
+      return FromFile(o.response_file);
   }
   return Gamma(o.gamma);
 }
@@ -97,7 +100,8 @@ ResponseCurve ResponseCurve::FromOptions(const BracketOptions& o) {
 double ResponseCurve::Forward(double x, int channel) const {
   x = std::clamp(x, 0.0, 1.0);
   switch (kind_) {
-    case ResponseKind::kGamma: return std::pow(x, 1.0 / gamma_);
+    case ResponseKind::kGamma:
+      return std::pow(x, 1.0 / gamma_);
     case ResponseKind::kSigmoid: {
       auto s = [&](double v) {
         const double vc = std::pow(v, contrast_);
@@ -120,7 +124,8 @@ double ResponseCurve::Forward(double x, int channel) const {
 double ResponseCurve::Inverse(double v, int channel) const {
   v = std::clamp(v, 0.0, 1.0);
   switch (kind_) {
-    case ResponseKind::kGamma: return std::pow(v, gamma_);
+    case ResponseKind::kGamma:
+      return std::pow(v, gamma_);
     case ResponseKind::kSigmoid: {
       // v·s(1) = x^c/(x^c + m^c)  =>  x^c = m^c·w/(1 − w), w = v·s(1).
       const double mc = std::pow(mid_, contrast_);
@@ -149,8 +154,11 @@ Json ResponseCurve::ToResponseJson(int levels) const {
     }
     g.push_back(std::move(row));
   }
-  return Json{{"format", "igi-response"}, {"version", 1},  {"method", "igi-synth truth"},
-              {"levels", levels},           {"channels", Json::array({"R", "G", "B"})},
+  return Json{{"format", "igi-response"},
+              {"version", 1},
+              {"method", "igi-synth truth"},
+              {"levels", levels},
+              {"channels", Json::array({"R", "G", "B"})},
               {"g", std::move(g)}};
 }
 
@@ -163,7 +171,8 @@ Json ResponseCurve::Describe() const {
                   {"contrast", contrast_},
                   {"mid", mid_},
                   {"formula", "v = s(x)/s(1), s(x) = x^c/(x^c + mid^c)"}};
-    case ResponseKind::kFile: return Json{{"kind", "file"}, {"file", file_}};
+    case ResponseKind::kFile:
+      return Json{{"kind", "file"}, {"file", file_}};
   }
   return Json::object();
 }

@@ -53,14 +53,14 @@ class ResponseCurve {
 double ChooseExposure(const Image& radiance, const SensorOptions& options);
 
 struct SensorResult {
-  Image photo;             // linear radiance units, RGB
-  Image mask;              // 1 channel: 0 where a channel saturated, 1 elsewhere
+  Image photo;  // linear radiance units, RGB
+  Image mask;   // 1 channel: 0 where a channel saturated, 1 elsewhere
   int64_t saturated_pixels = 0;
 };
 
 // One noisy exposure of `radiance` (linear RGB) at `exposure_s`; deterministic for `seed`.
-SensorResult SimulateSensor(const Image& radiance, const SensorOptions& options,
-                            double exposure_s, uint64_t seed, int num_threads = 0);
+SensorResult SimulateSensor(const Image& radiance, const SensorOptions& options, double exposure_s,
+                            uint64_t seed, int num_threads = 0);
 
 // Variance (radiance units²) of a photo pixel of true radiance L below saturation.
 double SensorVariance(double radiance, const SensorOptions& options, double exposure_s);

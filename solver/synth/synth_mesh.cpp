@@ -38,14 +38,14 @@ void SynthMesh::AddQuad(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
   triangle_region.push_back(region_index);
 }
 
-void SynthMesh::AddBox(const Eigen::Vector2d& center_xy, double base_z,
-                       const Eigen::Vector3d& size, double yaw_deg, const std::string& region) {
+void SynthMesh::AddBox(const Eigen::Vector2d& center_xy, double base_z, const Eigen::Vector3d& size,
+                       double yaw_deg, const std::string& region) {
   const double yaw = yaw_deg * std::numbers::pi / 180.0;
   const Eigen::Matrix3d rot = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d c(center_xy.x(), center_xy.y(), base_z + 0.5 * size.z());
   auto corner = [&](int sx, int sy, int sz) {
-    return Eigen::Vector3d(c + rot * Eigen::Vector3d(0.5 * sx * size.x(), 0.5 * sy * size.y(),
-                                                     0.5 * sz * size.z()));
+    return Eigen::Vector3d(
+        c + rot * Eigen::Vector3d(0.5 * sx * size.x(), 0.5 * sy * size.y(), 0.5 * sz * size.z()));
   };
   const std::array<Eigen::Vector2d, 4> uv = {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0),
                                              Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)};
@@ -92,15 +92,12 @@ void SynthMesh::AddSphere(const Eigen::Vector3d& center, double radius, int ring
 
 Eigen::Vector3d SynthMesh::FaceNormal(int triangle) const {
   const Eigen::Vector3i& t = triangles[triangle];
-  return (positions[t[1]] - positions[t[0]])
-      .cross(positions[t[2]] - positions[t[0]])
-      .normalized();
+  return (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]).normalized();
 }
 
 double SynthMesh::TriangleArea(int triangle) const {
   const Eigen::Vector3i& t = triangles[triangle];
-  return 0.5 *
-         (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]).norm();
+  return 0.5 * (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]).norm();
 }
 
 std::string SynthMesh::ToObj(const std::string& header) const {
@@ -127,8 +124,7 @@ std::string SynthMesh::ToObj(const std::string& header) const {
 }
 
 std::optional<RayHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d& origin,
-                                   const Eigen::Vector3d& direction, double t_min,
-                                   double t_max) {
+                                   const Eigen::Vector3d& direction, double t_min, double t_max) {
   std::optional<RayHit> best;
   double nearest = t_max;
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {

@@ -19,10 +19,10 @@ struct SynthMesh {
   std::vector<Eigen::Vector3d> normals;  // per vertex, unit
   std::vector<Eigen::Vector2d> uvs;      // per vertex
   std::vector<Eigen::Vector3i> triangles;
-  std::vector<int> triangle_region;        // index into region_names
+  std::vector<int> triangle_region;  // index into region_names
   std::vector<std::string> region_names;
 
-  int RegionIndex(const std::string& name);  // adds the region when new
+  int RegionIndex(const std::string& name);       // adds the region when new
   int FindRegion(const std::string& name) const;  // -1 when absent
 
   // A planar quad p0 p1 p2 p3 (counter-clockwise seen from the front), flat normal; the UVs of

@@ -41,8 +41,9 @@ EffectSpec ParseEffectSpec(const std::string& text) {
   };
   if (!Contains(SupportedEffects(), spec.name)) {
     if (spec.name == "fresnel" || spec.name == "indirect_illumination") {
-      fail("effect not available in igi-synth (the renderer has no Fresnel-weighted BRDF; "
-           "indirect illumination is always present)");
+      fail(
+          "effect not available in igi-synth (the renderer has no Fresnel-weighted BRDF; "
+          "indirect illumination is always present)");
     }
     fail("unknown effect (known: " + Join(SupportedEffects(), ", ") + ")");
   }
@@ -67,8 +68,8 @@ void SensorOptions::Validate() const {
   if (!(read_noise_e >= 0) || !std::isfinite(read_noise_e)) {
     p.Add("--read-noise", "", Str(read_noise_e), "must be >= 0");
   }
-  if (adc_bits < 8 || adc_bits > 16) p.Add("--adc-bits", "", std::to_string(adc_bits),
-                                           "must be in [8, 16]");
+  if (adc_bits < 8 || adc_bits > 16)
+    p.Add("--adc-bits", "", std::to_string(adc_bits), "must be in [8, 16]");
   if (black_level_dn < 0 || black_level_dn >= (1 << std::clamp(adc_bits, 8, 16)) / 4) {
     p.Add("--black-level", "", std::to_string(black_level_dn),
           "must be >= 0 and below a quarter of the ADC range");
@@ -97,8 +98,8 @@ void BracketOptions::Validate() const {
     p.Add("--response-file", "", "", "required with --response file");
   }
   if (bits != 8 && bits != 16) p.Add("--bracket-bits", "", std::to_string(bits), "must be 8 or 16");
-  if (format != "png" && format != "tif") p.Add("--bracket-format", "", format,
-                                                "must be png or tif");
+  if (format != "png" && format != "tif")
+    p.Add("--bracket-format", "", format, "must be png or tif");
   p.ThrowIfAny();
 }
 

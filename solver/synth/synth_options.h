@@ -36,21 +36,21 @@ enum class ResponseKind { kGamma, kSigmoid, kFile };
 //   N(0, read_noise_e²), clipped at full_well_e, quantised by an ADC of adc_bits bits with a
 //   black level; photos are converted back to radiance units (unbiased below saturation).
 struct SensorOptions {
-  double full_well_e = 20000;               // electrons at saturation, > 0
-  double read_noise_e = 4;                  // rms read noise in electrons, >= 0
-  int adc_bits = 14;                        // raw quantisation, 8..16
-  int black_level_dn = 64;                  // ADC offset (keeps read noise below 0 unbiased)
-  double electrons_per_radiance_s = 1000;   // sensitivity: e⁻ per (W·sr⁻¹·m⁻² · s), > 0
-  double exposure_s = 0;                    // 0 = auto: the photo's 99th percentile at 80% well
-  void Validate() const;                    // throws InputError naming the flag
+  double full_well_e = 20000;              // electrons at saturation, > 0
+  double read_noise_e = 4;                 // rms read noise in electrons, >= 0
+  int adc_bits = 14;                       // raw quantisation, 8..16
+  int black_level_dn = 64;                 // ADC offset (keeps read noise below 0 unbiased)
+  double electrons_per_radiance_s = 1000;  // sensitivity: e⁻ per (W·sr⁻¹·m⁻² · s), > 0
+  double exposure_s = 0;                   // 0 = auto: the photo's 99th percentile at 80% well
+  void Validate() const;                   // throws InputError naming the flag
 };
 
 // LDR exposure brackets for the HDR stage: each photo's radiance seen through `response`.
 struct BracketOptions {
-  int count = 0;        // brackets per photo; 0 = none
-  double stops = 2.0;   // EV between neighbouring brackets, > 0
+  int count = 0;       // brackets per photo; 0 = none
+  double stops = 2.0;  // EV between neighbouring brackets, > 0
   ResponseKind response = ResponseKind::kGamma;
-  double gamma = 2.2;   // kGamma: level = x^(1/gamma) for x = e/full_well
+  double gamma = 2.2;             // kGamma: level = x^(1/gamma) for x = e/full_well
   double sigmoid_contrast = 1.6;  // kSigmoid: x^c/(x^c + m^c), normalised to 1 at x = 1
   double sigmoid_mid = 0.18;
   std::filesystem::path response_file;  // kFile: an igi-response JSON (CONTRACT.md §5)
@@ -65,9 +65,9 @@ struct SynthOptions {
   int cameras = 5;            // >= 1; the first ones target the glossy regions' highlights
   int width = 160;            // photo size, pixels
   int height = 120;
-  double fov_deg = 60;        // horizontal field of view
-  int spp = 64;               // render samples per pixel
-  uint64_t seed = 1;          // same seed, same options -> same files
+  double fov_deg = 60;               // horizontal field of view
+  int spp = 64;                      // render samples per pixel
+  uint64_t seed = 1;                 // same seed, same options -> same files
   std::string glossy_brdf = "ward";  // ward or ward_gmd: the glossy regions' true model
   std::string lamp = "sphere";       // sphere (r = 4 cm) or point
   // Material keys left out of scene.json (unknowns for the solver), for every reflective

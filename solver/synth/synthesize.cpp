@@ -41,8 +41,8 @@ void CheckOutputFolder(const SynthOptions& options) {
     throw InputError(DescribeProblem("--out", "", out.string(), "exists and is not a folder"));
   }
   if (!options.overwrite && !fs::is_empty(out)) {
-    throw InputError(DescribeProblem("--out", "", out.string(),
-                                     "folder is not empty (use --overwrite)"));
+    throw InputError(
+        DescribeProblem("--out", "", out.string(), "folder is not empty (use --overwrite)"));
   }
 }
 
@@ -133,8 +133,10 @@ class Pipeline {
   void Photo(const PhotoJob& job, int index, Rendered* r) {
     Image linear = Render(job, uint64_t(index), r);
     post_.ApplyBeforeSensor(job.file, TrueCamera(job), &linear);
-    Json photo = {{"file", job.file}, {"camera", cameras_[job.camera].camera.name},
-                  {"lighting", job.lighting}, {"mask", nullptr}};
+    Json photo = {{"file", job.file},
+                  {"camera", cameras_[job.camera].camera.name},
+                  {"lighting", job.lighting},
+                  {"mask", nullptr}};
     Json truth = Json::object();
     const double exposure_s = ChooseExposure(linear, o_.sensor);
     Image out = linear;
@@ -162,10 +164,9 @@ class Pipeline {
                 Rendered* r) {
     const std::string stem = fs::path(job.file).stem().string();
     const std::string dir = "brackets/" + stem;
-    const auto brackets =
-        MakeBrackets(linear, o_.sensor, o_.brackets, *response_, exposure_s,
-                     o_.noise == NoiseModel::kRealistic,
-                     MixBits(o_.seed ^ (0xb7ac0000ULL + index)), o_.num_threads);
+    const auto brackets = MakeBrackets(linear, o_.sensor, o_.brackets, *response_, exposure_s,
+                                       o_.noise == NoiseModel::kRealistic,
+                                       MixBits(o_.seed ^ (0xb7ac0000ULL + index)), o_.num_threads);
     std::string times = "# exposure time (s) of each image of this folder, in file order\n";
     Json exposures = Json::array();
     for (size_t i = 0; i < brackets.size(); ++i) {
@@ -212,8 +213,9 @@ Json SensorTruth(const SynthOptions& o) {
               {"black_level_dn", s.black_level_dn},
               {"electrons_per_radiance_s", s.electrons_per_radiance_s},
               {"exposure", s.exposure_s > 0 ? "fixed" : "auto (99th percentile at 80% well)"},
-              {"model", "e = Poisson(L k t) + N(0, read^2), clipped at full well; "
-                        "photo = (DN - black) gain / (k t)"}};
+              {"model",
+               "e = Poisson(L k t) + N(0, read^2), clipped at full well; "
+               "photo = (DN - black) gain / (k t)"}};
 }
 
 Json CameraTruth(const std::vector<PlacedCamera>& cameras) {
@@ -222,8 +224,8 @@ Json CameraTruth(const std::vector<PlacedCamera>& cameras) {
     Json j = {{"target", c.target_region.empty() ? "overview" : "highlight"}};
     if (!c.target_region.empty()) {
       j["highlight_region"] = c.target_region;
-      j["highlight_point"] = Json::array(
-          {c.highlight_point.x(), c.highlight_point.y(), c.highlight_point.z()});
+      j["highlight_point"] =
+          Json::array({c.highlight_point.x(), c.highlight_point.y(), c.highlight_point.z()});
       j["highlight_pixel"] = Json::array({c.highlight_pixel.x(), c.highlight_pixel.y()});
     }
     out[c.camera.name] = j;
@@ -268,8 +270,8 @@ SynthSummary Synthesize(const SynthOptions& options) {
   scenes.true_scene = base;
   scenes.declared_scene = base;
   PhotoEffects post;
-  const Json effects = ApplyEffects(options.effects, room, cameras, photo_files, options.seed,
-                                    &scenes, &post);
+  const Json effects =
+      ApplyEffects(options.effects, room, cameras, photo_files, options.seed, &scenes, &post);
   scenes.declared_scene["materials"] =
       DeclaredMaterials(scenes.declared_scene["materials"], options.unknowns);
 
@@ -302,24 +304,26 @@ SynthSummary Synthesize(const SynthOptions& options) {
                 {"cameras", CameraTruth(cameras)},
                 {"photos", r.photo_truth},
                 {"sensor", SensorTruth(options)},
-                {"render", {{"renderer", "igi Renderer (path tracer)"},
-                            {"spp", options.spp},
-                            {"seed", options.seed},
-                            {"validation", "clean renders of truth/scene.json from the true poses: "
-                                           "no sensor noise, no camera effects"}}}};
+                {"render",
+                 {{"renderer", "igi Renderer (path tracer)"},
+                  {"spp", options.spp},
+                  {"seed", options.seed},
+                  {"validation",
+                   "clean renders of truth/scene.json from the true poses: "
+                   "no sensor noise, no camera effects"}}}};
   if (response) {
     const int levels = options.brackets.bits == 8 ? 256 : 65536;
     WriteJsonFile(out / "truth/response.json", response->ToResponseJson(levels));
-    truth["brackets"] = {
-        {"response", response->Describe()},
-        {"response_file", "truth/response.json"},
-        {"bits", options.brackets.bits},
-        {"stops", options.brackets.stops},
-        {"radiance_per_relative_exposure",
-         options.sensor.full_well_e / options.sensor.electrons_per_radiance_s},
-        {"note", "x = electrons / full well; radiance = (x / exposure_s) * "
-                 "radiance_per_relative_exposure"},
-        {"sets", r.bracket_sets}};
+    truth["brackets"] = {{"response", response->Describe()},
+                         {"response_file", "truth/response.json"},
+                         {"bits", options.brackets.bits},
+                         {"stops", options.brackets.stops},
+                         {"radiance_per_relative_exposure",
+                          options.sensor.full_well_e / options.sensor.electrons_per_radiance_s},
+                         {"note",
+                          "x = electrons / full well; radiance = (x / exposure_s) * "
+                          "radiance_per_relative_exposure"},
+                         {"sets", r.bracket_sets}};
   }
   WriteJsonFile(out / "truth.json", truth);
 
