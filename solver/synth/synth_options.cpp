@@ -39,12 +39,13 @@ EffectSpec ParseEffectSpec(const std::string& text) {
   auto fail = [&](const std::string& rule) {
     throw InputError(DescribeProblem("--effect", "", text, rule));
   };
+  if (spec.name == "fresnel") {
+    fail("effect not available: the renderer has no Fresnel-weighted BRDF yet");
+  }
+  if (spec.name == "indirect_illumination") {
+    fail("effect not available: indirect illumination is always in the photos");
+  }
   if (!Contains(SupportedEffects(), spec.name)) {
-    if (spec.name == "fresnel" || spec.name == "indirect_illumination") {
-      fail(
-          "effect not available in igi-synth (the renderer has no Fresnel-weighted BRDF; "
-          "indirect illumination is always present)");
-    }
     fail("unknown effect (known: " + Join(SupportedEffects(), ", ") + ")");
   }
   if (colon == std::string::npos) return spec;

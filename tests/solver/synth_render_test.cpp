@@ -124,6 +124,19 @@ TEST(SynthRender, EachGlossyRegionShowsAHighlight) {
   EXPECT_EQ(seen.size(), 4u);
 }
 
+// With no unknowns scene.json is complete: igi-render could render it as it is.
+TEST(SynthRender, NoUnknownsGivesACompleteScene) {
+  SynthOptions o = Small("", 1);
+  o.unknowns = {};
+  o.validation_lightings = {};
+  const fs::path& dir = Synth("complete", o);
+  SceneLoadOptions complete;
+  complete.require_complete_materials = true;
+  const Scene scene = LoadScene(dir / "scene.json", complete);
+  EXPECT_TRUE(scene.materials[scene.FindMaterial("floor")].rho_d_map.has_value());
+  EXPECT_TRUE(fs::exists(dir / "textures/floor_albedo.exr"));
+}
+
 TEST(SynthRender, DeterministicForASeed) {
   const fs::path& dir = Plain();
   const fs::path& again = Synth("again", Small(""));
