@@ -233,32 +233,22 @@ Json CameraTruth(const std::vector<PlacedCamera>& cameras) {
   return out;
 }
 
-}  // namespace
-
-SynthSummary Synthesize(const SynthOptions& options) {
-  const auto start = Clock::now();
-  options.Validate();
-  CheckOutputFolder(options);
-  std::optional<ResponseCurve> response;
-  if (options.brackets.count > 0) response = ResponseCurve::FromOptions(options.brackets);
-
-  const SynthRoom room = BuildRoom(options);
-  const std::vector<PlacedCamera> cameras = PlaceCameras(room, options);
-  std::vector<PhotoJob> photos, validation;
+// Photos (in scene.json) and validation renders (in truth.json) for every camera.
+void PlanJobs(const SynthOptions& options, const std::vector<PlacedCamera>& cameras,
+              std::vector<PhotoJob>* photos, std::vector<PhotoJob>* validation) {
   for (const std::string& lighting : {std::string("L0"), std::string("L1")}) {
     for (size_t c = 0; c < cameras.size(); ++c) {
       const std::string base = cameras[c].camera.name + "_" + lighting + ".exr";
       if (Has(options.photo_lightings, lighting)) {
-        photos.push_back({int(c), lighting, "photos/" + base});
+        photos->push_back({int(c), lighting, "photos/" + base});
       } else if (Has(options.validation_lightings, lighting)) {
-        validation.push_back({int(c), lighting, "validation/" + base});
+        validation->push_back({int(c), lighting, "validation/" + base});
       }
     }
   }
-  std::vector<std::string> photo_files;
-  for (const PhotoJob& p : photos) photo_files.push_back(p.file);
+}
 
-  SynthScenes scenes;
+Json BaseScene(const SynthRoom& room, const std::vector<PlacedCamera>& cameras) {
   Json base = {{"format", "igi-scene"},
                {"version", 1},
                {"geometry", Json::array({Json{{"file", "geometry/room.obj"}}})},
@@ -267,33 +257,12 @@ SynthSummary Synthesize(const SynthOptions& options) {
                {"lightings", room.LightingsJson()},
                {"cameras", Json::object()}};
   for (const PlacedCamera& c : cameras) base["cameras"][c.camera.name] = CameraJson(c.camera);
-  scenes.true_scene = base;
-  scenes.declared_scene = base;
-  PhotoEffects post;
-  const Json effects =
-      ApplyEffects(options.effects, room, cameras, photo_files, options.seed, &scenes, &post);
-  scenes.declared_scene["materials"] =
-      DeclaredMaterials(scenes.declared_scene["materials"], options.unknowns);
+  return base;
+}
 
-  // Everything is known and valid: write.
-  const fs::path& out = options.out;
-  fs::create_directories(out);
-  WriteText(out / "geometry/room.obj", room.mesh.ToObj("igi-synth room: regions by usemtl"));
-  for (const auto& [file, text] : scenes.extra_files) WriteText(out / file, text);
-  WriteExr(out / room.floor_albedo_file, room.floor_albedo);
-  fs::create_directories(out / "truth");
-  WriteJsonFile(out / "truth/scene.json", RelocateToTruthFolder(scenes.true_scene));
-  SceneLoadOptions load;
-  load.require_complete_materials = true;
-  const Scene true_scene = LoadScene(out / "truth/scene.json", load);
-
-  Rendered r;
-  Pipeline pipeline(options, true_scene, cameras, post, response ? &*response : nullptr);
-  for (size_t i = 0; i < photos.size(); ++i) pipeline.Photo(photos[i], int(i), &r);
-  for (size_t i = 0; i < validation.size(); ++i) pipeline.Validation(validation[i], int(i), &r);
-
-  scenes.declared_scene["photos"] = r.photos;
-  WriteJsonFile(out / "scene.json", scenes.declared_scene);
+Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Json& effects,
+               const std::vector<PlacedCamera>& cameras, const Rendered& r,
+               const ResponseCurve* response) {
   Json truth = {{"format", "igi-truth"},
                 {"version", 1},
                 {"materials", scenes.true_scene["materials"]},
@@ -312,8 +281,6 @@ SynthSummary Synthesize(const SynthOptions& options) {
                    "clean renders of truth/scene.json from the true poses: "
                    "no sensor noise, no camera effects"}}}};
   if (response) {
-    const int levels = options.brackets.bits == 8 ? 256 : 65536;
-    WriteJsonFile(out / "truth/response.json", response->ToResponseJson(levels));
     truth["brackets"] = {{"response", response->Describe()},
                          {"response_file", "truth/response.json"},
                          {"bits", options.brackets.bits},
@@ -325,10 +292,58 @@ SynthSummary Synthesize(const SynthOptions& options) {
                           "radiance_per_relative_exposure"},
                          {"sets", r.bracket_sets}};
   }
-  WriteJsonFile(out / "truth.json", truth);
+  return truth;
+}
 
+}  // namespace
+
+SynthSummary Synthesize(const SynthOptions& options) {
+  const auto start = Clock::now();
+  options.Validate();
+  CheckOutputFolder(options);
+  std::optional<ResponseCurve> response;
+  if (options.brackets.count > 0) response = ResponseCurve::FromOptions(options.brackets);
+
+  const SynthRoom room = BuildRoom(options);
+  const std::vector<PlacedCamera> cameras = PlaceCameras(room, options);
+  std::vector<PhotoJob> photos, validation;
+  PlanJobs(options, cameras, &photos, &validation);
+  std::vector<std::string> photo_files;
+  for (const PhotoJob& p : photos) photo_files.push_back(p.file);
+  SynthScenes scenes;
+  scenes.true_scene = scenes.declared_scene = BaseScene(room, cameras);
+  PhotoEffects post;
+  const Json effects =
+      ApplyEffects(options.effects, room, cameras, photo_files, options.seed, &scenes, &post);
+  scenes.declared_scene["materials"] =
+      DeclaredMaterials(scenes.declared_scene["materials"], options.unknowns);
+
+  // Everything is known and valid: write.
+  const fs::path& out = options.out;
+  fs::create_directories(out / "truth");
+  WriteText(out / "geometry/room.obj", room.mesh.ToObj("igi-synth room: regions by usemtl"));
+  for (const auto& [file, text] : scenes.extra_files) WriteText(out / file, text);
+  WriteExr(out / room.floor_albedo_file, room.floor_albedo);
+  WriteJsonFile(out / "truth/scene.json", RelocateToTruthFolder(scenes.true_scene));
+  SceneLoadOptions load;
+  load.require_complete_materials = true;
+  const Scene true_scene = LoadScene(out / "truth/scene.json", load);
+
+  Rendered r;
+  Pipeline pipeline(options, true_scene, cameras, post, response ? &*response : nullptr);
+  for (size_t i = 0; i < photos.size(); ++i) pipeline.Photo(photos[i], int(i), &r);
+  for (size_t i = 0; i < validation.size(); ++i) pipeline.Validation(validation[i], int(i), &r);
+
+  scenes.declared_scene["photos"] = r.photos;
+  WriteJsonFile(out / "scene.json", scenes.declared_scene);
+  if (response) {
+    const int levels = options.brackets.bits == 8 ? 256 : 65536;
+    WriteJsonFile(out / "truth/response.json", response->ToResponseJson(levels));
+  }
+  WriteJsonFile(out / "truth.json",
+                TruthJson(options, scenes, effects, cameras, r, response ? &*response : nullptr));
   SynthSummary summary;
-  for (const PhotoJob& p : photos) summary.photos.push_back(p.file);
+  summary.photos = photo_files;
   for (const PhotoJob& p : validation) summary.validation.push_back(p.file);
   summary.saturated_pixels = r.saturated;
   summary.render_seconds = r.render_seconds;
