@@ -1,0 +1,262 @@
+// The path tracer: next-event estimation with multiple importance sampling (power heuristic)
+// between light sampling and BRDF sampling, unbiased Russian roulette, two-sided surfaces,
+// pixel values as means over the pixel square.
+#include "solver/render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "solver/render_internal.h"
+#include "tools/common/parallel.h"
+#include "tools/common/progress.h"
+
+namespace igi {
+namespace {
+
+// Texture lookup: bilinear, u right and v up (v = 0 is the bottom row); coordinates outside
+// [0, 1] repeat, texels at the borders clamp.
+Eigen::Vector3d SampleTexture(const Image& tex, Eigen::Vector2d uv) {
+  for (int k = 0; k < 2; ++k) {
+    if (uv[k] < 0.0 || uv[k] > 1.0) uv[k] -= std::floor(uv[k]);
+  }
+  const double x = uv.x() * tex.width - 0.5;
+  const double y = (1.0 - uv.y()) * tex.height - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  auto texel = [&tex](int xi, int yi) {
+    xi = std::clamp(xi, 0, tex.width - 1);
+    yi = std::clamp(yi, 0, tex.height - 1);
+    return Eigen::Vector3d(tex.at(xi, yi, 0), tex.at(xi, yi, 1), tex.at(xi, yi, 2));
+  };
+  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
+         fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
+}
+
+struct PathState {
+  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d throughput = Eigen::Vector3d::Ones();
+  bool from_camera = true;  // no MIS weight on emitters seen directly
+  double bsdf_pdf = 0;      // pdf of the last BRDF-sampled direction
+  Eigen::Vector3d last_point = Eigen::Vector3d::Zero();
+  uint64_t rays = 0;
+};
+
+class PathTracer {
+ public:
+  PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
+      : impl_(impl), options_(options),
+        light_select_pdf_(impl.lights.empty() ? 0.0 : 1.0 / double(impl.lights.size())) {}
+
+  Eigen::Vector3d Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
+                        uint64_t* rays) const;
+
+ private:
+  // Adds an emitter's radiance seen along the path, MIS-weighted against light sampling.
+  void AddEmission(PathState* s, int light, const Eigen::Vector3d& le, const Eigen::Vector3d& dir,
+                   const Eigen::Vector3d& hit_point, const Eigen::Vector3d& hit_normal) const {
+    double w = 1.0;
+    if (!s->from_camera) {
+      const double light_pdf =
+          light_select_pdf_ * impl_.LightPdf(light, s->last_point, dir, hit_point, hit_normal);
+      w = PowerHeuristic(1, s->bsdf_pdf, 1, light_pdf);
+    }
+    s->radiance += s->throughput.cwiseProduct(le) * w;
+  }
+
+  // Next-event estimation from a shading point.
+  void SampleDirectLight(PathState* s, const Eigen::Vector3d& p, const Eigen::Vector3d& n_geo,
+                         const Frame& frame, const BrdfParams& params,
+                         const Eigen::Vector3d& wo_local, Pcg32& rng) const;
+
+  const Renderer::Impl& impl_;
+  const RenderOptions& options_;
+  double light_select_pdf_;
+};
+
+void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
+                                   const Eigen::Vector3d& n_geo, const Frame& frame,
+                                   const BrdfParams& params, const Eigen::Vector3d& wo_local,
+                                   Pcg32& rng) const {
+  const int n = static_cast<int>(impl_.lights.size());
+  const int light = std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
+  const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
+  const LightSample ls = impl_.SampleLight(light, p, u);
+  if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
+  const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
+  if (!(wi_local.z() > 0)) return;
+  const BrdfEval fe = EvalBrdfAndPdf(params, wo_local, wi_local);
+  if (!(fe.f.maxCoeff() > 0)) return;
+  const double eps = impl_.ray_epsilon;
+  // The segment stops short of the light's surface (area lights are Embree geometry too).
+  const double distance = std::isfinite(ls.distance)
+                              ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
+                              : ls.distance;
+  ++s->rays;
+  if (impl_.Occluded(p + n_geo * eps, ls.wi, distance, light)) return;
+  const double light_pdf = light_select_pdf_ * ls.pdf;
+  const double w = ls.delta ? 1.0 : PowerHeuristic(1, light_pdf, 1, fe.pdf);
+  s->radiance += s->throughput.cwiseProduct(fe.f).cwiseProduct(ls.value) *
+                 (wi_local.z() * w / light_pdf);
+}
+
+Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
+                                  uint64_t* rays) const {
+  const Scene& scene = *impl_.scene;
+  const TriangleMesh& mesh = scene.mesh;
+  PathState s;
+  for (int bounce = 0;; ++bounce) {
+    ++s.rays;
+    const std::optional<Hit> hit = impl_.Intersect(origin, dir);
+    if (!hit) break;
+    const Eigen::Vector3d p = origin + hit->t * dir;
+    if (hit->sphere_light >= 0) {
+      const Light& l = *impl_.lights[hit->sphere_light].light;
+      AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
+      break;
+    }
+    if (hit->geometry > 0) {  // an area light's own mesh: emits on its front, absorbs
+      const int light = impl_.area_light_of_geometry[hit->geometry];
+      const Light& l = *impl_.lights[light].light;
+      const Eigen::Vector3i& t = l.mesh.triangles[hit->primitive];
+      const Eigen::Vector3d n = (l.mesh.positions[t[1]] - l.mesh.positions[t[0]])
+                                    .cast<double>()
+                                    .cross((l.mesh.positions[t[2]] - l.mesh.positions[t[0]]).cast<double>())
+                                    .normalized();
+      if (n.dot(dir) < 0) AddEmission(&s, light, l.radiance, dir, p, n);
+      break;
+    }
+    const int tri_index = hit->primitive;
+    const Eigen::Vector3i& tri = mesh.triangles[tri_index];
+    const ShadingMaterial& m = impl_.materials[mesh.triangle_region[tri_index]];
+    Eigen::Vector3d n_geo = mesh.FaceNormal(tri_index).cast<double>();
+    if (impl_.emitter_triangle_index[tri_index] >= 0 && n_geo.dot(dir) < 0) {
+      AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
+    }
+    if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
+    const double b0 = 1.0 - hit->u - hit->v;
+    Eigen::Vector3d n_s = (b0 * mesh.normals[tri[0]] + hit->u * mesh.normals[tri[1]] +
+                           hit->v * mesh.normals[tri[2]]).cast<double>().normalized();
+    const Eigen::Vector3d wo = -dir;
+    if (n_geo.dot(wo) < 0) {  // two-sided: shade the side the ray came from
+      n_geo = -n_geo;
+      n_s = -n_s;
+    }
+    if (!(n_s.dot(wo) > 0)) n_s = n_geo;
+    const Frame frame = m.tangent ? Frame::FromNormalTangent(n_s, *m.tangent)
+                                  : Frame::FromNormal(n_s);
+    BrdfParams params = m.params;
+    if (m.rho_d_map && mesh.has_uvs()) {
+      const Eigen::Vector2d uv = (b0 * mesh.uvs[tri[0]] + hit->u * mesh.uvs[tri[1]] +
+                                  hit->v * mesh.uvs[tri[2]]).cast<double>();
+      params.rho_d = SampleTexture(*m.rho_d_map, uv);
+    }
+    const Eigen::Vector3d wo_local = frame.ToLocal(wo);
+    SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng);
+
+    const double u_lobe = rng.UniformDouble();
+    const Eigen::Vector2d u_dir = rng.Uniform2D();
+    const BrdfSample bs = SampleBrdf(params, wo_local, u_lobe, u_dir);
+    if (!bs.Valid()) break;
+    const Eigen::Vector3d wi = frame.ToWorld(bs.wi);
+    if (!(wi.dot(n_geo) > 0)) break;  // under the true surface (shading-normal artefact)
+    s.throughput = s.throughput.cwiseProduct(bs.weight);
+    s.from_camera = false;
+    s.bsdf_pdf = bs.pdf;
+    s.last_point = p;
+    if (bounce + 1 >= options_.max_bounces) break;
+    if (bounce + 1 >= options_.rr_start_bounce) {
+      const double q = std::min(0.95, s.throughput.maxCoeff());
+      if (!(rng.UniformDouble() < q)) break;
+      s.throughput /= q;
+    }
+    origin = p + n_geo * impl_.ray_epsilon;
+    dir = wi;
+  }
+  *rays += s.rays;
+  return s.radiance;
+}
+
+Camera ScaledCamera(const Camera& camera, int width, int height) {
+  Camera out = camera;
+  if (width <= 0 || height <= 0 || (width == camera.width && height == camera.height)) return out;
+  const double sx = double(width) / camera.width, sy = double(height) / camera.height;
+  out.params[0] *= sx;
+  out.params[2] *= sx;
+  out.params[1] *= sy;
+  out.params[3] *= sy;
+  out.width = width;
+  out.height = height;
+  return out;
+}
+
+}  // namespace
+
+void RenderOptions::Validate() const {
+  auto check = [](bool ok, const std::string& key, double value, const std::string& rule) {
+    if (!ok) throw InputError(DescribeProblem("", key, std::to_string(value), rule));
+  };
+  check(spp >= 1, "--spp", spp, "must be >= 1");
+  check(max_bounces >= 1, "--max-bounces", max_bounces, "must be >= 1");
+  check(rr_start_bounce >= 1, "--rr-start-bounce", rr_start_bounce, "must be >= 1");
+  check(width >= 0 && width <= 65536, "--width", width, "must be in [0, 65536] (0 = camera's)");
+  check(height >= 0 && height <= 65536, "--height", height, "must be in [0, 65536] (0 = camera's)");
+  check((width == 0) == (height == 0), "--width/--height", width, "give both or neither");
+}
+
+Renderer::Renderer(const Scene& scene, int lighting) : impl_(BuildRenderScene(scene, lighting)) {}
+Renderer::~Renderer() = default;
+
+Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
+                       RenderSummary* summary) const {
+  options.Validate();
+  const auto start = std::chrono::steady_clock::now();
+  const Camera camera = ScaledCamera(camera_in, options.width, options.height);
+  Image image(camera.width, camera.height, 3);
+  const PathTracer tracer(*impl_, options);
+  const Eigen::Vector3d center = camera.CenterInWorld();
+  std::atomic<uint64_t> total_rays{0};
+  Progress progress("igi-render", camera.height, 2.0, options.show_progress && ProgressAllowed());
+  ParallelFor(0, camera.height, [&](int64_t y) {
+    uint64_t rays = 0;
+    for (int x = 0; x < camera.width; ++x) {
+      const uint64_t pixel = uint64_t(y) * camera.width + x;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int k = 0; k < options.spp; ++k) {
+        Pcg32 rng = PixelSampleRng(options.seed, pixel, k);
+        const Eigen::Vector2d jitter = rng.Uniform2D();
+        const Eigen::Vector3d dir =
+            camera.WorldRayFromImg(Eigen::Vector2d(x + jitter.x(), y + jitter.y()));
+        const Eigen::Vector3d l = tracer.Trace(center, dir, rng, &rays);
+        if (l.allFinite()) sum += l;
+      }
+      const Eigen::Vector3d mean = sum / options.spp;
+      for (int c = 0; c < 3; ++c) image.at(x, int(y), c) = static_cast<float>(mean[c]);
+    }
+    total_rays += rays;
+    progress.Add(1);
+  }, options.num_threads);
+  progress.Finish();
+  if (summary != nullptr) {
+    summary->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary->camera_rays = uint64_t(camera.width) * camera.height * options.spp;
+    summary->rays = total_rays.load();
+  }
+  return image;
+}
+
+Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                   int spp, uint64_t seed) const {
+  RenderOptions options;
+  const PathTracer tracer(*impl_, options);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  uint64_t rays = 0;
+  for (int k = 0; k < spp; ++k) {
+    Pcg32 rng = PixelSampleRng(seed, 0, k);
+    sum += tracer.Trace(origin, direction.normalized(), rng, &rays);
+  }
+  return sum / std::max(1, spp);
+}
+
+}  // namespace igi

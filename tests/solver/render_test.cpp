@@ -1,0 +1,213 @@
+// The path tracer against closed-form answers: direct light from each light type, a furnace
+// (interreflection inside a sphere), textures, determinism, and bad input.
+#include "solver/render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/solver/test_scenes.h"
+
+namespace igi {
+namespace {
+
+using test::DownCamera;
+using test::LoadTestScene;
+using test::SquareObj;
+using test::TempSceneDir;
+using test::WriteText;
+
+double MeanChannel(const Image& im, int c, int x0 = 0, int y0 = 0, int x1 = -1, int y1 = -1) {
+  if (x1 < 0) x1 = im.width;
+  if (y1 < 0) y1 = im.height;
+  double sum = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) sum += im.at(x, y, c);
+  return sum / double((x1 - x0) * (y1 - y0));
+}
+
+// A Lambertian floor (rho = 0.5) lit from above, seen by a camera looking straight down at its
+// centre: with nothing else in the scene there is no interreflection, so the centre pixel is
+// rho/pi * E exactly, E the light's irradiance at the centre.
+Json FloorScene(const Json& light, const std::string& material = R"({"brdf":"lambert","rho_d":0.5})") {
+  return Json{{"format", "igi-scene"}, {"version", 1},
+              {"geometry", {{{"file", "floor.obj"}}}},
+              {"materials", {{"floor", ParseJson(material, "material")}}},
+              {"lights", {{"l", light}}},
+              {"lightings", {{"L", {"l"}}}},
+              {"cameras", {{"top", DownCamera(0, 0, 3, 9, 9, 400)}}}};
+}
+
+// Radiance from the floor's centre toward the camera above it, estimated with `spp` paths.
+Eigen::Vector3d CentreRadiance(const Scene& scene, int spp) {
+  const Renderer renderer(scene, 0);
+  return renderer.Radiance(scene.cameras[0].CenterInWorld(), Eigen::Vector3d(0, 0, -1), spp, 3);
+}
+
+// The centre pixel of the camera's image (a mean over the pixel's square).
+Eigen::Vector3d CentrePixel(const Scene& scene, int spp) {
+  const Renderer renderer(scene, 0);
+  RenderOptions options;
+  options.spp = spp;
+  options.show_progress = false;
+  const Image im = renderer.Render(scene.cameras[0], options);
+  return Eigen::Vector3d(im.at(4, 4, 0), im.at(4, 4, 1), im.at(4, 4, 2));
+}
+
+TEST(RenderTest, PointLightDirectIsExact) {
+  const auto dir = TempSceneDir("point");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  // I = 10 W/sr at height 2: E = 10 / 4 = 2.5, L = 0.5 / pi * 2.5.
+  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
+      R"({"type":"point","position":[0,0,2],"intensity":10})", "l")));
+  const Eigen::Vector3d l = CentrePixel(scene, 16);
+  // The centre pixel spans ±0.0025 m on the floor: E varies by < 1e-5 over it.
+  EXPECT_NEAR(l.x(), 0.5 / M_PI * 2.5, 1e-4 * l.x());
+}
+
+TEST(RenderTest, DirectionalLightAndSpotProfileAreExact) {
+  const auto dir = TempSceneDir("sun");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  // E = 3 W/m² perpendicular to the beam, arriving at 60° from the normal: 1.5 on the floor.
+  const double s = std::sin(M_PI / 3);
+  Json light{{"type", "directional"}, {"direction", {s, 0.0, -0.5}}, {"irradiance", 3}};
+  Scene scene = LoadTestScene(dir, FloorScene(light));
+  EXPECT_NEAR(CentrePixel(scene, 8).x(), 0.5 / M_PI * 1.5, 1e-6);
+  // A cos^4 spot aimed 30° away from the floor's centre: relative intensity cos(30°)^4.
+  Json spot{{"type", "spot"}, {"position", {0, 0, 2}},
+            {"direction", {std::sin(M_PI / 6), 0.0, -std::cos(M_PI / 6)}},
+            {"intensity", 10}, {"profile", {{"cos_power", 4}}}};
+  scene = LoadTestScene(dir, FloorScene(spot));
+  const double expected = 0.5 / M_PI * 2.5 * std::pow(std::cos(M_PI / 6), 4);
+  EXPECT_NEAR(CentreRadiance(scene, 4).x(), expected, 1e-6 * expected);
+  // Over the pixel's square the profile's slope averages out (1024 jittered samples: ~1e-4).
+  EXPECT_NEAR(CentrePixel(scene, 1024).x(), expected, 3e-4 * expected);
+}
+
+TEST(RenderTest, SphereLightIrradianceMatchesClosedForm) {
+  const auto dir = TempSceneDir("sphere");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  // A sphere of radiance L and radius r at distance d, seen at angle theta from the normal
+  // (wholly above the horizon): E = pi L (r/d)^2 cos(theta). Off the camera's line of sight.
+  Json light{{"type", "sphere"}, {"center", {1, 0, 1}}, {"radius", 0.2}, {"radiance", 100}};
+  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  const double expected = 0.5 / M_PI * M_PI * 100 * (0.04 / 2) * std::sqrt(0.5);
+  // Cone sampling varies little over this sphere: 20000 paths give ~0.05 % noise. 0.3 %
+  // catches a shadow ray clipping the light's own sphere (that bias was 1.3 %).
+  EXPECT_NEAR(CentreRadiance(scene, 20000).x(), expected, 0.003 * expected);
+}
+
+TEST(RenderTest, AreaLightIrradianceMatchesClosedForm) {
+  const auto dir = TempSceneDir("area");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  // The panel covers x in [1, 2], y in [-0.5, 0.5] at height 1, off the camera's view.
+  WriteText(dir / "panel.obj", SquareObj("panel", 0.5, 1.0, /*face_down=*/true, 1.5));
+  // Irradiance from a 1x1 m emitting square at height 1: E = pi L F, with F the
+  // view factor from a point to a parallel rectangle, 4 times the one for a point below a
+  // corner of an a x b rectangle (heights normalised):
+  //   F_corner = 1/(2 pi) [a/sqrt(1+a²) atan(b/sqrt(1+a²)) + b/sqrt(1+b²) atan(a/sqrt(1+b²))].
+  auto corner = [](double a, double b) {
+    const double sa = std::sqrt(1 + a * a), sb = std::sqrt(1 + b * b);
+    return (a / sa * std::atan(b / sa) + b / sb * std::atan(a / sb)) / (2 * M_PI);
+  };
+  // By superposition of rectangles with a corner above the point:
+  const double form = 2 * (corner(2.0, 0.5) - corner(1.0, 0.5));
+  Json light{{"type", "area"}, {"file", "panel.obj"}, {"radiance", 10}};
+  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  const double expected = 0.5 * form * 10;
+  // Area sampling of this panel has ~50 % relative spread per sample: 200000 paths give 0.1 %.
+  EXPECT_NEAR(CentreRadiance(scene, 200000).x(), expected, 0.005 * expected);
+}
+
+// Furnace: a closed sphere of albedo rho with a point light of intensity I at its centre. The
+// direct irradiance is I/R² everywhere, and every point sees the whole sphere alike, so the
+// irradiance is E = I/R² / (1 - rho) and the radiance rho E / pi, after infinitely many
+// bounces: this checks energy conservation, interreflection and Russian roulette together.
+// The sphere is a 20480-triangle icosphere (radius 1): its flat facets sit up to 3e-4 inside
+// the sphere, so the tolerance is 0.5 %, well above that and the noise of the mean.
+TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
+  const auto dir = TempSceneDir("furnace");
+  const std::filesystem::path ball =
+      std::filesystem::path(IGI_SHARED_DATA_DIR) / "real/diligent_ball/geometry/ball.obj";
+  for (double rho : {0.5, 0.8}) {
+    Json doc{{"format", "igi-scene"}, {"version", 1},
+             {"geometry", {{{"file", ball.string()}}}},
+             {"materials", {{"ball", {{"brdf", "lambert"}, {"rho_d", rho}}}}},
+             {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", 1}}}}},
+             {"lightings", {{"L", {"l"}}}},
+             {"cameras", {{"in", DownCamera(0, 0, 0, 16, 16, 10)}}}};
+    const Scene scene = LoadTestScene(dir, doc);
+    const Renderer renderer(scene, 0);
+    RenderOptions options;
+    options.spp = 256;
+    options.show_progress = false;
+    const Image im = renderer.Render(scene.cameras[0], options);
+    const double expected = rho / (1 - rho) / M_PI;
+    EXPECT_NEAR(MeanChannel(im, 1), expected, 0.005 * expected) << "rho " << rho;
+  }
+}
+
+TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
+  const auto dir = TempSceneDir("determinism");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
+      R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
+  const Renderer renderer(scene, 0);
+  RenderOptions options;
+  options.spp = 4;
+  options.show_progress = false;
+  options.num_threads = 1;
+  const Image one = renderer.Render(scene.cameras[0], options);
+  options.num_threads = 2;
+  const Image two = renderer.Render(scene.cameras[0], options);
+  EXPECT_EQ(one.pixels, two.pixels);
+  options.seed = 1;
+  EXPECT_NE(renderer.Render(scene.cameras[0], options).pixels, one.pixels);
+}
+
+TEST(RenderTest, TextureIsSampledWithVUp) {
+  const auto dir = TempSceneDir("texture");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  // 2x2 texture: bottom row (v = 0, south, world -y) dark, top row bright.
+  Image tex(2, 2, 3);
+  for (int x = 0; x < 2; ++x)
+    for (int c = 0; c < 3; ++c) {
+      tex.at(x, 0, c) = 0.8f;  // top row of the file
+      tex.at(x, 1, c) = 0.2f;
+    }
+  WriteImage(dir / "tex.exr", tex);
+  Json doc = FloorScene(ParseJson(R"({"type":"directional","direction":[0,0,-1],"irradiance":1})", "l"),
+                        R"({"brdf":"lambert","rho_d_map":"tex.exr"})");
+  // Rows 1 and 7 see y in ±[1.25, 1.75] m: v in [0.81, 0.94] and [0.06, 0.19], texel centres
+  // clamp there, so each row sees one texel value exactly.
+  doc["cameras"]["top"] = DownCamera(0, 0, 3, 9, 9, 6);
+  const Scene scene = LoadTestScene(dir, doc);
+  const Renderer renderer(scene, 0);
+  RenderOptions options;
+  options.spp = 4;
+  options.show_progress = false;
+  const Image im = renderer.Render(scene.cameras[0], options);
+  // Image row 1 looks at world +y (north, the texture's top row), row 7 at world -y.
+  EXPECT_NEAR(im.at(4, 1, 0), 0.8 / M_PI, 1e-5);
+  EXPECT_NEAR(im.at(4, 7, 0), 0.2 / M_PI, 1e-5);
+}
+
+TEST(RenderTest, LightingWithoutLightIsBadInput) {
+  const auto dir = TempSceneDir("nolight");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  Json doc = FloorScene(ParseJson(R"({"type":"point","position":[0,0,2],"intensity":1})", "l"));
+  doc["lightings"]["dark"] = Json::array();
+  const Scene scene = LoadTestScene(dir, doc);
+  try {
+    Renderer renderer(scene, scene.FindLighting("dark"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lightings.dark"), std::string::npos) << e.what();
+  }
+  RenderOptions bad;
+  bad.spp = 0;
+  EXPECT_THROW(bad.Validate(), InputError);
+}
+
+}  // namespace
+}  // namespace igi
