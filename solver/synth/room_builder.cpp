@@ -1,0 +1,143 @@
+#include "solver/synth/room_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "solver/sampling.h"
+
+namespace igi {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+Json Rgb(const Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json Lambert(const Vector3d& rho_d) { return Json{{"brdf", "lambert"}, {"rho_d", Rgb(rho_d)}}; }
+
+Json Glossy(const std::string& brdf, const Vector3d& rho_d, double rho_s, double alpha) {
+  return Json{{"brdf", brdf}, {"rho_d", Rgb(rho_d)}, {"rho_s", rho_s}, {"alpha", alpha}};
+}
+
+// Floor tiles: 4 × 4 tiles of 1 m, each with its own albedo, dark grout, and a faint grain.
+Image MakeFloorTexture(uint64_t seed) {
+  constexpr int kSize = 128;
+  constexpr int kTiles = 4;
+  Image img(kSize, kSize, 3);
+  Pcg32 tile_rng(seed, 0x7115);
+  std::vector<Vector3d> tile_albedo;
+  for (int i = 0; i < kTiles * kTiles; ++i) {
+    const double base = 0.30 + 0.30 * tile_rng.UniformDouble();
+    tile_albedo.emplace_back(base * 1.05, base * 0.95, base * 0.80);
+  }
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const int tile_px = kSize / kTiles;
+      const int tx = x / tile_px, ty = y / tile_px;
+      const int lx = x % tile_px, ly = y % tile_px;
+      const bool grout = lx < 1 || ly < 1;
+      Pcg32 grain_rng(seed ^ 0x9a11, uint64_t(y) * kSize + x);
+      const double grain = 1.0 + 0.06 * (grain_rng.UniformDouble() - 0.5);
+      const Vector3d a = grout ? Vector3d(0.12, 0.12, 0.11) : tile_albedo[ty * kTiles + tx] * grain;
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(a[c]);
+    }
+  }
+  return img;
+}
+
+void AddRoomShell(const Vector3d& s, SynthMesh* mesh) {
+  auto uv = [](double u0, double v0, double u1, double v1) {
+    return std::array<Vector2d, 4>{Vector2d(u0, v0), Vector2d(u1, v0), Vector2d(u1, v1),
+                                   Vector2d(u0, v1)};
+  };
+  // Inward-facing: counter-clockwise seen from inside the room. Floor UVs: u = x/sx, v = y/sy.
+  mesh->AddQuad({0, 0, 0}, {s.x(), 0, 0}, {s.x(), s.y(), 0}, {0, s.y(), 0}, "floor",
+                uv(0, 0, 1, 1));
+  mesh->AddQuad({0, 0, s.z()}, {0, s.y(), s.z()}, {s.x(), s.y(), s.z()}, {s.x(), 0, s.z()},
+                "ceiling", uv(0, 0, 1, 1));
+  mesh->AddQuad({0, 0, 0}, {0, s.y(), 0}, {0, s.y(), s.z()}, {0, 0, s.z()}, "wall_x0",
+                uv(0, 0, 1, 1));
+  mesh->AddQuad({s.x(), s.y(), 0}, {s.x(), 0, 0}, {s.x(), 0, s.z()}, {s.x(), s.y(), s.z()},
+                "wall_x4", uv(0, 0, 1, 1));
+  mesh->AddQuad({s.x(), 0, 0}, {0, 0, 0}, {0, 0, s.z()}, {s.x(), 0, s.z()}, "wall_y0",
+                uv(0, 0, 1, 1));
+  mesh->AddQuad({0, s.y(), 0}, {s.x(), s.y(), 0}, {s.x(), s.y(), s.z()}, {0, s.y(), s.z()},
+                "wall_y4", uv(0, 0, 1, 1));
+}
+
+bool Contains(const std::vector<std::string>& list, const std::string& name) {
+  return std::find(list.begin(), list.end(), name) != list.end();
+}
+
+}  // namespace
+
+Json LampJson(const SynthLamp& lamp) {
+  const Json pos = Rgb(lamp.position);
+  if (lamp.radius <= 0) {
+    return Json{{"type", "point"},
+                {"position", pos},
+                {"intensity", Rgb(Vector3d::Constant(lamp.intensity))}};
+  }
+  const double radiance = lamp.intensity / (std::numbers::pi * lamp.radius * lamp.radius);
+  return Json{{"type", "sphere"},
+              {"center", pos},
+              {"radius", lamp.radius},
+              {"radiance", Rgb(Vector3d::Constant(radiance))}};
+}
+
+Json SynthRoom::LightsJson() const {
+  Json lights = Json::object();
+  for (const SynthLamp& lamp : lamps) lights[lamp.name] = LampJson(lamp);
+  return lights;
+}
+
+Json SynthRoom::LightingsJson() const {
+  return Json{{"L0", Json::array({lamps[0].name})}, {"L1", Json::array({lamps[1].name})}};
+}
+
+Eigen::Vector3d ImageMean(const Image& image) {
+  Vector3d sum = Vector3d::Zero();
+  const size_t n = size_t(image.width) * image.height;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c)
+      sum[c] += image.pixels[i * image.channels + std::min(c, image.channels - 1)];
+  }
+  return sum / double(std::max<size_t>(n, 1));
+}
+
+SynthRoom BuildRoom(const SynthOptions& options) {
+  SynthRoom room;
+  const std::string& g = options.glossy_brdf;
+  AddRoomShell(room.size, &room.mesh);
+  room.mesh.AddBox({2.8, 2.6}, 0.0, {0.9, 0.7, 0.6}, 25.0, "glossy_box");
+  room.mesh.AddSphere({1.3, 1.4, 0.35}, 0.35, 16, 32, "glossy_sphere");
+  room.mesh.AddBox({0.9, 3.1}, 0.0, {0.6, 0.6, 1.4}, -15.0, "matte_box");
+
+  room.floor_albedo = MakeFloorTexture(options.seed);
+  const bool rho_d_known = !Contains(options.unknowns, "rho_d");
+  room.floor_albedo_file =
+      rho_d_known ? "textures/floor_albedo.exr" : "truth/textures/floor_albedo.exr";
+  Json floor = Glossy(g, ImageMean(room.floor_albedo), 0.04, 0.15);
+  floor["rho_d_map"] = room.floor_albedo_file;
+
+  Json& m = room.materials;
+  m = Json::object();
+  m["floor"] = floor;
+  m["ceiling"] = Lambert({0.8, 0.8, 0.8});
+  m["wall_x0"] = Lambert({0.6, 0.3, 0.25});
+  m["wall_x4"] = Lambert({0.3, 0.5, 0.35});
+  m["wall_y0"] = Lambert({0.5, 0.5, 0.5});
+  m["wall_y4"] = Glossy(g, {0.55, 0.55, 0.45}, 0.05, 0.07);
+  m["glossy_box"] = Glossy(g, {0.1, 0.2, 0.5}, 0.08, 0.05);
+  m["glossy_sphere"] = Glossy(g, {0.5, 0.15, 0.1}, 0.1, 0.1);
+  m["matte_box"] = Lambert({0.7, 0.7, 0.7});
+  room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
+
+  const double radius = options.lamp == "point" ? 0.0 : 0.04;
+  room.lamps.push_back({"lamp", {2.3, 1.7, 2.4}, 30.0, radius});
+  room.lamps.push_back({"lamp2", {0.8, 0.9, 2.2}, 25.0, radius});
+  return room;
+}
+
+}  // namespace igi

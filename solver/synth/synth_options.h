@@ -1,0 +1,88 @@
+#pragma once
+// Options of igi-synth: a synthetic capture with known truth (CONTRACT.md §4, §5 truth.json).
+//
+// A cubical room (metres, z up) with Lambertian and glossy regions, a textured floor, a small
+// lamp (lighting L0) and a second lamp (lighting L1, for relighting checks), rendered by the
+// forward model from cameras placed so that each glossy region shows the lamp's highlight.
+// Effects (CONTRACT.md §6 names) make the photos differ from what scene.json declares; each is
+// listed with its parameters in truth.json.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace igi {
+
+// One --effect switch: NAME or NAME:key=value,key=value (values are numbers, names or
+// number lists separated by '/', e.g. tangent=1/0/0).
+struct EffectSpec {
+  std::string name;
+  std::map<std::string, std::string> params;
+};
+
+// Parses the text of one --effect flag. Throws InputError "--effect: TEXT: RULE".
+EffectSpec ParseEffectSpec(const std::string& text);
+
+// The effects igi-synth can put into the photos (CONTRACT.md §6 names).
+const std::vector<std::string>& SupportedEffects();
+
+enum class NoiseModel { kNone, kRealistic };
+enum class ResponseKind { kGamma, kSigmoid, kFile };
+
+// The camera sensor of --noise realistic and of the LDR brackets. Signal in electrons:
+//   e = radiance · electrons_per_radiance_s · exposure_s, shot noise Poisson(e), read noise
+//   N(0, read_noise_e²), clipped at full_well_e, quantised by an ADC of adc_bits bits with a
+//   black level; photos are converted back to radiance units (unbiased below saturation).
+struct SensorOptions {
+  double full_well_e = 20000;              // electrons at saturation, > 0
+  double read_noise_e = 4;                 // rms read noise in electrons, >= 0
+  int adc_bits = 14;                       // raw quantisation, 8..16
+  int black_level_dn = 64;                 // ADC offset (keeps read noise below 0 unbiased)
+  double electrons_per_radiance_s = 1000;  // sensitivity: e⁻ per (W·sr⁻¹·m⁻² · s), > 0
+  double exposure_s = 0;                   // 0 = auto: the photo's 99th percentile at 80% well
+  void Validate() const;                   // throws InputError naming the flag
+};
+
+// LDR exposure brackets for the HDR stage: each photo's radiance seen through `response`.
+struct BracketOptions {
+  int count = 0;       // brackets per photo; 0 = none
+  double stops = 2.0;  // EV between neighbouring brackets, > 0
+  ResponseKind response = ResponseKind::kGamma;
+  double gamma = 2.2;             // kGamma: level = x^(1/gamma) for x = e/full_well
+  double sigmoid_contrast = 1.6;  // kSigmoid: x^c/(x^c + m^c), normalised to 1 at x = 1
+  double sigmoid_mid = 0.18;
+  std::filesystem::path response_file;  // kFile: an igi-response JSON (CONTRACT.md §5)
+  int bits = 8;                         // 8 or 16
+  std::string format = "png";           // png or tif
+  void Validate() const;
+};
+
+struct SynthOptions {
+  std::filesystem::path out;  // scene folder to write (must be empty or absent)
+  bool overwrite = false;     // allow a non-empty `out` (files of the same name are replaced)
+  int cameras = 5;            // >= 1; the first ones target the glossy regions' highlights
+  int width = 160;            // photo size, pixels
+  int height = 120;
+  double fov_deg = 60;               // horizontal field of view
+  int spp = 64;                      // render samples per pixel
+  uint64_t seed = 1;                 // same seed, same options -> same files
+  std::string glossy_brdf = "ward";  // ward or ward_gmd: the glossy regions' true model
+  std::string lamp = "sphere";       // sphere (r = 4 cm) or point
+  // Material keys left out of scene.json (unknowns for the solver), for every reflective
+  // region: any of rho_d (also removes rho_d_map), rho_s, alpha (also alpha_x/alpha_y/tangent).
+  std::vector<std::string> unknowns = {"rho_d", "rho_s", "alpha"};
+  std::vector<std::string> photo_lightings = {"L0"};       // photographed (in scene.json)
+  std::vector<std::string> validation_lightings = {"L1"};  // truth.json "validation"
+  NoiseModel noise = NoiseModel::kNone;
+  SensorOptions sensor;
+  BracketOptions brackets;
+  std::vector<EffectSpec> effects;
+  int num_threads = 0;  // 0 = process default
+
+  // Every problem as one InputError (flag name, value, rule).
+  void Validate() const;
+};
+
+}  // namespace igi

@@ -1,0 +1,260 @@
+// igi-synth's room, cameras, options and effects (no rendering).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+
+#include "recon/mesh.h"
+#include "solver/synth/camera_placement.h"
+#include "solver/synth/effects.h"
+#include "solver/synth/room_builder.h"
+#include "solver/synth/synth_mesh.h"
+#include "solver/synth/synth_options.h"
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+TEST(SynthOptions, ParsesEffectSpecs) {
+  EffectSpec e = ParseEffectSpec("vignetting:k1=-0.3,k2=-0.1");
+  EXPECT_EQ(e.name, "vignetting");
+  EXPECT_EQ(e.params.at("k1"), "-0.3");
+  EXPECT_EQ(e.params.at("k2"), "-0.1");
+  EXPECT_TRUE(ParseEffectSpec("pose_error").params.empty());
+  EXPECT_THROW(ParseEffectSpec("glare"), InputError);
+  EXPECT_THROW(ParseEffectSpec("fresnel"), InputError);
+  EXPECT_THROW(ParseEffectSpec("vignetting:k1"), InputError);
+  EXPECT_THROW(ParseEffectSpec("vignetting:k1=1,k1=2"), InputError);
+}
+
+TEST(SynthOptions, ValidateRejectsBadValues) {
+  SynthOptions o;
+  o.out = "x";
+  EXPECT_NO_THROW(o.Validate());
+  o.cameras = 0;
+  o.spp = 0;
+  o.unknowns = {"colour"};
+  try {
+    o.Validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().size(), 3u);
+  }
+}
+
+// The room's OBJ reads back through Assimp with every region, UVs and normals.
+TEST(SynthRoom, ObjLoadsWithRegionsUvsAndNormals) {
+  SynthOptions o;
+  const SynthRoom room = BuildRoom(o);
+  const fs::path path = fs::temp_directory_path() / "igi_synth_room_test.obj";
+  WriteFileAtomic(path, room.mesh.ToObj("test"));
+  ProblemList problems;
+  MeshLoadSummary summary;
+  const TriangleMesh mesh = LoadMesh(path, &problems, &summary);
+  fs::remove(path);
+  ASSERT_TRUE(problems.empty());
+  EXPECT_TRUE(summary.has_uvs);
+  EXPECT_TRUE(summary.has_normals);
+  EXPECT_EQ(mesh.num_triangles(), room.mesh.triangles.size());
+  for (const auto& [name, m] : room.materials.items()) {
+    EXPECT_NE(std::find(mesh.region_names.begin(), mesh.region_names.end(), name),
+              mesh.region_names.end())
+        << name;
+  }
+  // The room's shell (first 12 triangles) faces inward, the objects outward.
+  const Vector3d centre = 0.5 * room.size;
+  for (int t = 0; t < int(room.mesh.triangles.size()); ++t) {
+    const Vector3d p = room.mesh.positions[room.mesh.triangles[t][0]];
+    const double towards_centre = room.mesh.FaceNormal(t).dot(centre - p);
+    if (t < 12) {
+      EXPECT_GT(towards_centre, 0) << t;
+    }
+  }
+  EXPECT_NEAR(room.mesh.FaceNormal(0).z(), 1.0, 1e-12);
+}
+
+TEST(SynthRoom, HasGlossyAndLambertianRegionsATexturedFloorAndTwoLamps) {
+  SynthOptions o;
+  const SynthRoom room = BuildRoom(o);
+  EXPECT_EQ(room.glossy_regions.size(), 4u);
+  int lambert = 0;
+  for (const auto& [name, m] : room.materials.items()) lambert += m["brdf"] == "lambert";
+  EXPECT_GE(lambert, 4);
+  EXPECT_TRUE(room.materials["floor"].contains("rho_d_map"));
+  EXPECT_EQ(room.floor_albedo_file, "truth/textures/floor_albedo.exr");  // rho_d unknown
+  const Vector3d mean = ImageMean(room.floor_albedo);
+  EXPECT_NEAR(room.materials["floor"]["rho_d"][0].get<double>(), mean.x(), 1e-12);
+  EXPECT_EQ(room.lamps.size(), 2u);
+  o.unknowns = {"rho_s"};
+  EXPECT_EQ(BuildRoom(o).floor_albedo_file, "textures/floor_albedo.exr");
+}
+
+// Each highlight camera sits on the mirror direction of the lamp about the surface normal at its
+// target point, sees that point unoccluded near the image centre.
+TEST(SynthCameras, HighlightCamerasMirrorTheLamp) {
+  SynthOptions o;
+  o.cameras = 6;
+  const SynthRoom room = BuildRoom(o);
+  const auto cams = PlaceCameras(room, o);
+  ASSERT_EQ(cams.size(), 6u);
+  int highlight = 0;
+  for (const PlacedCamera& c : cams) {
+    const Vector3d eye = c.camera.CenterInWorld();
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_GT(eye[i], 0.1);
+      EXPECT_LT(eye[i], room.size[i] - 0.1);
+    }
+    if (c.target_region.empty()) continue;
+    ++highlight;
+    const Vector3d p = c.highlight_point;
+    const auto hit = IntersectRay(room.mesh, eye, (p - eye).normalized());
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->distance, (p - eye).norm(), 1e-6);  // nothing in between
+    EXPECT_EQ(room.mesh.region_names[room.mesh.triangle_region[hit->triangle]], c.target_region);
+    const Vector3d n = room.mesh.FaceNormal(hit->triangle);
+    const Vector3d l = (room.lamps[0].position - p).normalized();
+    const Vector3d v = (eye - p).normalized();
+    EXPECT_NEAR((2 * n.dot(l) * n - l).dot(v), 1.0, 1e-9);  // v is l mirrored about n
+    EXPECT_NEAR(c.highlight_pixel.x(), 0.5 * o.width, 1e-6);
+    EXPECT_NEAR(c.highlight_pixel.y(), 0.5 * o.height, 1e-6);
+  }
+  EXPECT_EQ(highlight, 4);
+  // Deterministic for a seed.
+  const auto again = PlaceCameras(room, o);
+  EXPECT_TRUE(
+      again[2].camera.cam_from_world.ToMatrix().isApprox(cams[2].camera.cam_from_world.ToMatrix()));
+}
+
+TEST(SynthCameras, LookAtFollowsColmapAxes) {
+  const Camera cam = LookAtCamera("c", {2, 0.3, 1.5}, {2, 3, 1.5}, 160, 120, 60);
+  // Looking along +y with z up: camera x = world +x, camera y = world -z.
+  const Eigen::Matrix3d r = cam.cam_from_world.rotation.toRotationMatrix();
+  EXPECT_TRUE(r.row(0).isApprox(Eigen::RowVector3d(1, 0, 0)));
+  EXPECT_TRUE(r.row(1).isApprox(Eigen::RowVector3d(0, 0, -1)));
+  EXPECT_TRUE(cam.CenterInWorld().isApprox(Vector3d(2, 0.3, 1.5)));
+  EXPECT_NEAR(cam.focal_x_px(), 80 / std::tan(3.14159265358979323846 / 6), 1e-9);
+}
+
+struct Fixture {
+  SynthOptions options;
+  SynthRoom room;
+  std::vector<PlacedCamera> cameras;
+  SynthScenes scenes;
+  PhotoEffects post;
+  std::vector<std::string> photos = {"photos/cam0_L0.exr", "photos/cam1_L0.exr"};
+
+  Fixture() : room(BuildRoom(options)), cameras(PlaceCameras(room, options)) {
+    Json base = {{"materials", room.materials},
+                 {"lights", room.LightsJson()},
+                 {"lightings", room.LightingsJson()},
+                 {"geometry", Json::array({Json{{"file", "geometry/room.obj"}}})},
+                 {"cameras", Json::object()}};
+    for (const PlacedCamera& c : cameras) base["cameras"][c.camera.name] = CameraJson(c.camera);
+    scenes.true_scene = base;
+    scenes.declared_scene = base;
+  }
+  Json Apply(const std::string& spec) {
+    return ApplyEffects({ParseEffectSpec(spec)}, room, cameras, photos, 5, &scenes, &post);
+  }
+};
+
+TEST(SynthEffects, VignettingDarkensCornersByTheStatedFactor) {
+  Fixture f;
+  const Json list = f.Apply("vignetting:k1=-0.2,k2=-0.1");
+  EXPECT_EQ(list[0]["effect"], "vignetting");
+  EXPECT_NEAR(list[0]["params"]["corner_factor"].get<double>(), 0.7, 1e-12);
+  const Camera& cam = f.cameras[0].camera;
+  Image img(cam.width, cam.height, 3, 1.0f);
+  f.post.ApplyBeforeSensor("photos/cam0_L0.exr", cam, &img);
+  // The corner pixel's centre is half a pixel in from the corner.
+  const double dx = 0.5 * cam.width - 0.5, dy = 0.5 * cam.height - 0.5;
+  const double r2 =
+      (dx * dx + dy * dy) / (0.25 * (cam.width * cam.width + cam.height * cam.height));
+  EXPECT_NEAR(img.at(0, 0), 1 - 0.2 * r2 - 0.1 * r2 * r2, 1e-6);
+  EXPECT_NEAR(img.at(cam.width / 2, cam.height / 2), 1.0, 1e-4);
+  EXPECT_TRUE(f.scenes.true_scene == f.scenes.declared_scene);  // scene untouched
+}
+
+TEST(SynthEffects, ExposureScaleMultipliesOnePhoto) {
+  Fixture f;
+  f.Apply("exposure_scale:photo=photos/cam1_L0.exr,scale=1.5");
+  Image a(8, 8, 3, 2.0f), b(8, 8, 3, 2.0f);
+  f.post.ApplyBeforeSensor("photos/cam0_L0.exr", f.cameras[0].camera, &a);
+  f.post.ApplyBeforeSensor("photos/cam1_L0.exr", f.cameras[1].camera, &b);
+  EXPECT_EQ(a.at(3, 3), 2.0f);
+  EXPECT_FLOAT_EQ(b.at(3, 3), 3.0f);
+}
+
+TEST(SynthEffects, CameraResponseIsAPowerLaw) {
+  Fixture f;
+  f.Apply("camera_response:exponent=0.5,reference=4");
+  Image img(2, 1, 3, 16.0f);
+  f.post.ApplyAfterSensor(&img);
+  EXPECT_FLOAT_EQ(img.at(0, 0), 8.0f);  // 4·(16/4)^0.5
+}
+
+TEST(SynthEffects, PoseErrorDeclaresAPoseOffByTheStatedAngle) {
+  Fixture f;
+  const Json list = f.Apply("pose_error:camera=cam1,rotation_deg=2,translation_m=0.05");
+  const Json& d = f.scenes.declared_scene["cameras"]["cam1"];
+  const Json& t = f.scenes.true_scene["cameras"]["cam1"];
+  auto quat = [](const Json& c) {
+    return Eigen::Quaterniond(c["qvec"][0].get<double>(), c["qvec"][1].get<double>(),
+                              c["qvec"][2].get<double>(), c["qvec"][3].get<double>());
+  };
+  auto centre = [&](const Json& c) {
+    const Vector3d tv(c["tvec"][0].get<double>(), c["tvec"][1].get<double>(),
+                      c["tvec"][2].get<double>());
+    return Vector3d(-(quat(c).conjugate() * tv));
+  };
+  EXPECT_NEAR(quat(d).angularDistance(quat(t)) * 180 / 3.14159265358979323846, 2.0, 1e-9);
+  EXPECT_NEAR((centre(d) - centre(t)).norm(), 0.05, 1e-9);
+  EXPECT_EQ(f.scenes.declared_scene["cameras"]["cam0"], f.scenes.true_scene["cameras"]["cam0"]);
+  EXPECT_EQ(list[0]["params"]["camera"], "cam1");
+}
+
+TEST(SynthEffects, SceneEffectsChangeOnlyTheTrueScene) {
+  Fixture f;
+  const Json list = f.Apply("anisotropic_reflection");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["glossy_box"]["brdf"], "ward_aniso");
+  EXPECT_EQ(f.scenes.declared_scene["materials"]["glossy_box"]["brdf"], "ward");
+  EXPECT_FALSE(f.scenes.true_scene["materials"]["glossy_box"].contains("alpha"));
+  f.Apply("light_source_extent:radius=0.2");
+  EXPECT_EQ(f.scenes.true_scene["lights"]["lamp"]["radius"], 0.2);
+  EXPECT_EQ(f.scenes.declared_scene["lights"]["lamp"]["radius"], 0.04);
+  f.Apply("missing_geometry");
+  EXPECT_EQ(f.scenes.true_scene["geometry"].size(), 2u);
+  EXPECT_EQ(f.scenes.declared_scene["geometry"].size(), 1u);
+  EXPECT_EQ(f.scenes.extra_files.count("truth/geometry/missing_object.obj"), 1u);
+  f.Apply("ambient_light:radiance=0.5");
+  EXPECT_EQ(f.scenes.true_scene["lightings"]["L0"].size(), 2u);
+  EXPECT_FALSE(f.scenes.declared_scene["lights"].contains("ambient"));
+  f.Apply("light_emission_profile:cos_power=3");
+  EXPECT_EQ(f.scenes.true_scene["lights"]["lamp"]["type"], "spot");
+  EXPECT_EQ(f.scenes.declared_scene["lights"]["lamp"]["type"], "sphere");
+  f.Apply("specular_lobe_shape:regions=floor/wall_y4");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_gmd");
+  EXPECT_EQ(f.scenes.declared_scene["materials"]["floor"]["brdf"], "ward");
+  f.Apply("light_intensity:light=lamp2,factor=2");
+  EXPECT_DOUBLE_EQ(f.scenes.true_scene["lights"]["lamp2"]["radiance"][0].get<double>(),
+                   2 * f.scenes.declared_scene["lights"]["lamp2"]["radiance"][0].get<double>());
+  f.Apply("specular_reflection:region=glossy_sphere");
+  EXPECT_EQ(f.scenes.declared_scene["materials"]["glossy_sphere"]["brdf"], "lambert");
+  EXPECT_FALSE(f.scenes.declared_scene["materials"]["glossy_sphere"].contains("rho_s"));
+}
+
+TEST(SynthEffects, BadParametersAreInputErrors) {
+  Fixture f;
+  EXPECT_THROW(f.Apply("vignetting:k3=1"), InputError);
+  EXPECT_THROW(f.Apply("vignetting:k1=-0.9,k2=-0.1"), InputError);
+  EXPECT_THROW(f.Apply("pose_error:camera=nope"), InputError);
+  EXPECT_THROW(f.Apply("anisotropic_reflection:tangent=0/0/0"), InputError);
+  EXPECT_THROW(f.Apply("exposure_scale:scale=abc"), InputError);
+}
+
+}  // namespace
+}  // namespace igi
