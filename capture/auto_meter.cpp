@@ -40,14 +40,15 @@ double FindShortest(const std::function<MeterReading(double)>& measure, double l
     if (level >= kClipped) {
       factor = 1.0 / kMaxStep;
     } else if (level > 0.0) {
-      factor = Clamp(options.highlight_target / level, 1.0 / kMaxStep, kMaxStep);
+      // Aim at the middle of the accepted band [0.84, 1] x target.
+      factor = Clamp(0.92 * options.highlight_target / level, 1.0 / kMaxStep, kMaxStep);
     }
     double next = Clamp(exposure * factor, lo, hi);
     if (fine > 0 && std::isfinite(too_bright)) {
       if (too_bright / fine < std::exp2(0.25)) break;
       if (next <= fine || next >= too_bright) next = std::sqrt(fine * too_bright);
     }
-    if (std::abs(std::log2(next / exposure)) < 0.05) break;  // pinned at a camera limit
+    if (next == exposure) break;  // pinned at a camera limit
     exposure = next;
   }
   if (fine > 0) {
