@@ -101,15 +101,20 @@ struct Camera::Impl {
   int settle_left = 0;         // frames still to drop after the change
   bool streaming = false;
 
+  bool abandoned = false;      // the camera stopped answering: see ~Impl
+
   ~Impl() {
+    if (camera != nullptr && control_lost_handler != 0) {
+      g_signal_handler_disconnect(arv_camera_get_device(camera), control_lost_handler);
+    }
+    // Finalising the stream and the device of a camera that is gone blocks for about 5 s
+    // each (Aravis 0.8 retries every GVCP command 5 times with a 500 ms timeout, with no
+    // public setting to shorten it). An abandoned camera's objects are left to the end of
+    // the process instead: igi-capture exits right after.
+    if (abandoned) return;
     if (streaming) arv_camera_stop_acquisition(camera, nullptr);
     if (stream != nullptr) g_object_unref(stream);
-    if (camera != nullptr) {
-      if (control_lost_handler != 0) {
-        g_signal_handler_disconnect(arv_camera_get_device(camera), control_lost_handler);
-      }
-      g_object_unref(camera);
-    }
+    if (camera != nullptr) g_object_unref(camera);
   }
 
   void Open();
@@ -208,7 +213,8 @@ Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
     throw CameraStreamError(Name() + ": frame " + std::to_string(frame.frame_id) + " holds " +
                             std::to_string(size) + " bytes, too few for " +
                             std::to_string(frame.width) + "x" + std::to_string(frame.height) +
-                            " " + format.name);
+                            " " + format.name,
+                            false);
   }
   frame.levels.resize(samples);
   if (format.bytes_per_sample == 1) {
@@ -250,7 +256,7 @@ double Camera::SetExposureUs(double exposure_us, int settle_frames) {
   arv_camera_set_exposure_time(impl_->camera, exposure_us, &error);
   if (error != nullptr) {
     const std::string message = TakeMessage(error);
-    if (impl_->control_lost.load()) throw CameraStreamError(impl_->Name() + ": " + message);
+    if (impl_->control_lost.load()) throw CameraStreamError(impl_->Name() + ": " + message, true);
     throw Error(impl_->Name() + ": cannot set exposure " + FormatNumber(exposure_us) +
                 " us: " + message);
   }
@@ -259,7 +265,7 @@ double Camera::SetExposureUs(double exposure_us, int settle_frames) {
   impl_->changed_at_ns = HostTimeNs();
   impl_->settle_left = impl_->streaming ? settle_frames : 0;
   impl_->exposure_us = arv_camera_get_exposure_time(impl_->camera, &error);
-  if (error != nullptr) throw CameraStreamError(impl_->Name() + ": " + TakeMessage(error));
+  if (error != nullptr) throw CameraStreamError(impl_->Name() + ": " + TakeMessage(error), true);
   return impl_->exposure_us;
 }
 
@@ -268,7 +274,9 @@ double Camera::exposure_us() const { return impl_->exposure_us; }
 void Camera::Start() {
   GError* error = nullptr;
   arv_camera_start_acquisition(impl_->camera, &error);
-  if (error != nullptr) throw CameraStreamError(impl_->Name() + ": cannot start: " + TakeMessage(error));
+  if (error != nullptr) {
+    throw CameraStreamError(impl_->Name() + ": cannot start: " + TakeMessage(error), true);
+  }
   impl_->streaming = true;
   impl_->settle_left = 0;
 }
@@ -281,6 +289,11 @@ void Camera::Stop() {
   if (error != nullptr) spdlog::warn("{}: stopping: {}", impl_->Name(), TakeMessage(error));
 }
 
+void Camera::Abandon() {
+  impl_->streaming = false;
+  impl_->abandoned = true;
+}
+
 Frame Camera::NextFrame() {
   Impl& impl = *impl_;
   const uint64_t timeout_us =
@@ -291,7 +304,8 @@ Frame Camera::NextFrame() {
       throw CameraStreamError(
           impl.Name() + ": no frame within " + std::to_string(timeout_us / 1000) + " ms" +
           (impl.control_lost.load() ? " and the camera stopped answering (disconnected?)"
-                                    : " (disconnected, or not streaming?)"));
+                                    : " (disconnected, or not streaming?)"),
+          true);
     }
     const ArvBufferStatus status = arv_buffer_get_status(buffer);
     const uint64_t arrived_ns = arv_buffer_get_system_timestamp(buffer);
@@ -303,7 +317,8 @@ Frame Camera::NextFrame() {
                         : status == ARV_BUFFER_STATUS_SIZE_MISMATCH ? "had the wrong size"
                                                                     : "failed";
       throw CameraStreamError(impl.Name() + ": frame " + std::to_string(frame_id) + " " + why +
-                              " (buffer status " + std::to_string(int(status)) + ")");
+                              " (buffer status " + std::to_string(int(status)) + ")",
+                              false);
     }
     if (arrived_ns < impl.changed_at_ns) {
       arv_stream_push_buffer(impl.stream, buffer);

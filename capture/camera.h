@@ -34,7 +34,14 @@ std::vector<CameraInfo> ListCameras();
 // The stream broke: timeout, lost packets, or the camera stopped answering.
 class CameraStreamError : public Error {
  public:
-  explicit CameraStreamError(std::string message) : Error(std::move(message), ExitCode::kPartial) {}
+  CameraStreamError(std::string message, bool camera_may_be_gone)
+      : Error(std::move(message), ExitCode::kPartial), camera_may_be_gone_(camera_may_be_gone) {}
+  // True after a timeout or a failed command: talking to the camera again (to stop it) would
+  // only wait for GVCP timeouts (Aravis retries each command for seconds).
+  bool camera_may_be_gone() const { return camera_may_be_gone_; }
+
+ private:
+  bool camera_may_be_gone_;
 };
 
 struct CameraOptions {
@@ -86,6 +93,10 @@ class Camera {
 
   void Start();
   void Stop();
+  // Forgets the stream without sending AcquisitionStop, for a camera that stopped answering
+  // (a GigE camera stops streaming by itself when its control heartbeat lapses). The Aravis
+  // objects are then not finalised (that would wait ~10 s for acks) but left to process exit.
+  void Abandon();
   // The next frame exposed at the current setting. Throws CameraStreamError.
   Frame NextFrame();
 

@@ -225,6 +225,7 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
     TakeFrames(options, summary.plan, done, camera, &summary);
   } catch (const CameraStreamError& e) {
     summary.stopped_because = e.what();
+    if (e.camera_may_be_gone()) camera.Abandon();
   }
   camera.Stop();
   summary.complete = summary.frames_already_done + summary.frames_written == summary.frames_planned;

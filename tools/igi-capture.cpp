@@ -94,6 +94,8 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
 int main(int argc, char** argv) {
   CLI::App app{"Acquire exposure brackets from a GigE Vision camera, or import raw files",
                "igi-capture"};
+  // A flag given twice takes its last value (scripts append overrides).
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, /*computes=*/false);
   Flags flags;
