@@ -121,6 +121,21 @@ struct Camera::Impl {
   void Configure();
   void CreateStream();
   Frame CopyFrame(ArvBuffer* buffer) const;
+
+  // Drops every frame that comes out of the stream until it has been quiet for a while
+  // (30 ms + twice the exposure), at most 2 s.
+  void Drain() {
+    const uint64_t quiet_us = 30000u + uint64_t(2.0 * exposure_us);
+    const int64_t deadline_us = g_get_monotonic_time() + 2000000;
+    int dropped = 0;
+    while (g_get_monotonic_time() < deadline_us) {
+      ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream, quiet_us);
+      if (buffer == nullptr) break;
+      arv_stream_push_buffer(stream, buffer);
+      ++dropped;
+    }
+    spdlog::debug("{}: drained {} frames after stopping", Name(), dropped);
+  }
   std::string Name() const { return "camera " + options.id_or_address; }
 };
 
@@ -252,6 +267,23 @@ void Camera::ExposureBoundsUs(double* min_us, double* max_us) const {
 }
 
 double Camera::SetExposureUs(double exposure_us, int settle_frames) {
+  // The stream is stopped and drained around the change. Changing the exposure while
+  // streaming leaves frames exposed at the old setting queued or in flight, and Aravis stamps a
+  // frame's system time when its stream thread handles it, not when it arrived: with that
+  // thread behind (1000 frames/s on a busy host), old frames come out after the change with
+  // later stamps than it. Stopped, no new frame starts; every frame still on its way is
+  // drained and dropped; after the restart, `settle_frames` more are dropped for cameras that
+  // apply a setting one frame late.
+  const bool was_streaming = impl_->streaming;
+  if (was_streaming) {
+    GError* error = nullptr;
+    arv_camera_stop_acquisition(impl_->camera, &error);
+    impl_->streaming = false;
+    if (error != nullptr) {
+      throw CameraStreamError(impl_->Name() + ": cannot stop: " + TakeMessage(error), true);
+    }
+    impl_->Drain();
+  }
   GError* error = nullptr;
   arv_camera_set_exposure_time(impl_->camera, exposure_us, &error);
   if (error != nullptr) {
@@ -260,12 +292,11 @@ double Camera::SetExposureUs(double exposure_us, int settle_frames) {
     throw Error(impl_->Name() + ": cannot set exposure " + FormatNumber(exposure_us) +
                 " us: " + message);
   }
-  // The write is acknowledged: any frame that arrives from now on may carry the new exposure;
-  // frames still in flight or in the queue may not, hence the time mark and the extra frames.
-  impl_->changed_at_ns = HostTimeNs();
-  impl_->settle_left = impl_->streaming ? settle_frames : 0;
   impl_->exposure_us = arv_camera_get_exposure_time(impl_->camera, &error);
   if (error != nullptr) throw CameraStreamError(impl_->Name() + ": " + TakeMessage(error), true);
+  if (was_streaming) Start();
+  impl_->changed_at_ns = HostTimeNs();
+  impl_->settle_left = was_streaming ? settle_frames : 0;
   return impl_->exposure_us;
 }
 

@@ -86,8 +86,8 @@ class Camera {
   void ExposureBoundsUs(double* min_us, double* max_us) const;
 
   // Sets the exposure time and returns the value the camera reports back (cameras round).
-  // While streaming, frames that arrived before the camera acknowledged the change are dropped
-  // by NextFrame, and then `settle_frames` more (frames already exposing at the change).
+  // While streaming, the stream is stopped for the change and restarted; NextFrame then drops
+  // frames that arrived before the restart was acknowledged, and `settle_frames` more.
   double SetExposureUs(double exposure_us, int settle_frames);
   double exposure_us() const;
 
