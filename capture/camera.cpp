@@ -55,6 +55,16 @@ std::atomic<bool>* ControlLostFlag(gpointer data) { return static_cast<std::atom
 
 void OnControlLost(ArvDevice* /*device*/, gpointer data) { ControlLostFlag(data)->store(true); }
 
+// Runs in Aravis's stream thread: raise its priority so that writing frames in the main
+// thread cannot starve packet reception (a frame whose packets come too late is lost). Needs
+// CAP_SYS_NICE or rtkit; without them the thread keeps its normal priority.
+void OnStreamEvent(void* /*data*/, ArvStreamCallbackType type, ArvBuffer* /*buffer*/) {
+  if (type != ARV_STREAM_CALLBACK_TYPE_INIT) return;
+  if (!arv_make_thread_high_priority(-10)) {
+    spdlog::debug("stream thread: could not raise its priority");
+  }
+}
+
 }  // namespace
 
 uint64_t HostTimeNs() { return static_cast<uint64_t>(g_get_real_time()) * 1000u; }
@@ -82,6 +92,9 @@ void CameraOptions::Validate() const {
   if (width < 0) problems.Add("", "--width", std::to_string(width), "must be >= 0");
   if (height < 0) problems.Add("", "--height", std::to_string(height), "must be >= 0");
   if (num_buffers < 2) problems.Add("", "--buffers", std::to_string(num_buffers), "must be >= 2");
+  if (frame_retention_ms < 10) {
+    problems.Add("", "--frame-retention-ms", std::to_string(frame_retention_ms), "must be >= 10");
+  }
   if (frame_timeout_ms < 10) {
     problems.Add("", "--timeout-ms", std::to_string(frame_timeout_ms), "must be >= 10");
   }
@@ -198,13 +211,15 @@ void Camera::Impl::Configure() {
 
 void Camera::Impl::CreateStream() {
   GError* error = nullptr;
-  stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  stream = arv_camera_create_stream(camera, OnStreamEvent, nullptr, &error);
   Check(error, Name() + ": cannot open a stream");
   if (ARV_IS_GV_STREAM(stream)) {
     g_object_set(stream, "packet-resend",
                  options.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS
                                        : ARV_GV_STREAM_PACKET_RESEND_NEVER,
                  nullptr);
+    // Frames whose packets are still incomplete after this long are given up (lost).
+    g_object_set(stream, "frame-retention", guint(options.frame_retention_ms) * 1000u, nullptr);
   }
   const guint payload = arv_camera_get_payload(camera, &error);
   Check(error, Name() + ": cannot read the payload size");

@@ -56,6 +56,7 @@ struct CameraOptions {
   int num_buffers = 64;            // stream buffers queued in Aravis (absorbs write bursts)
   int frame_timeout_ms = 3000;     // a frame later than this (+ exposure) ends the run
   bool packet_resend = true;       // GigE: ask the camera to resend lost packets
+  int frame_retention_ms = 500;    // GigE: a frame still missing packets this long is lost
 
   // InputError naming the flag when a value is out of range.
   void Validate() const;

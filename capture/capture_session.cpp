@@ -144,14 +144,19 @@ void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
     }
     if (todo.empty()) continue;
     camera.SetExposureUs(plan.exposures_us[size_t(bracket)], plan.settle_frames);
+    std::optional<uint64_t> previous_id;
     for (const PlanSlot& slot : todo) {
       if (StopRequested(options)) {
         summary->stopped_because = "stopped on request (signal)";
         return;
       }
       const Frame frame = camera.NextFrame();
-      WriteFrame(options.out_dir / SlotFileName(plan, slot), frame);
-      AppendManifest(manifest, MakeEntry(plan, slot, camera, frame));
+      if (previous_id && frame.frame_id > *previous_id + 1) {
+        summary->frames_skipped += int64_t(frame.frame_id - *previous_id - 1);
+      }
+      previous_id = frame.frame_id;
+      WriteFrame(options.out_dir / SlotFileName(plan, slot), frame, options.fsync_each_frame);
+      AppendManifest(manifest, MakeEntry(plan, slot, camera, frame), options.fsync_each_frame);
       ++summary->frames_written;
       summary->seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -228,6 +233,7 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
     if (e.camera_may_be_gone()) camera.Abandon();
   }
   camera.Stop();
+  if (!options.fsync_each_frame) SyncFileSystem(options.out_dir);  // all frames at once
   summary.complete = summary.frames_already_done + summary.frames_written == summary.frames_planned;
   return summary;
 }

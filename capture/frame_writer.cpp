@@ -18,7 +18,7 @@ uint16_t WidenTo16Bits(uint16_t level, int significant_bits) {
   return static_cast<uint16_t>(wide);
 }
 
-void WriteFrame(const std::filesystem::path& path, const Frame& frame) {
+void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool durable) {
   const int channels = frame.format.channels;
   std::vector<uint16_t> wide(frame.levels.size());
   for (size_t i = 0; i < wide.size(); ++i) {
@@ -42,7 +42,13 @@ void WriteFrame(const std::filesystem::path& path, const Frame& frame) {
       !out->write_image(OIIO::TypeDesc::UINT16, wide.data()) || !out->close()) {
     throw Error(path.string() + ": cannot write: " + out->geterror());
   }
-  output.Commit();
+  if (durable) {
+    output.Commit();
+    return;
+  }
+  std::error_code error;
+  std::filesystem::rename(output.temp_path(), path, error);
+  if (error) throw Error(path.string() + ": cannot write: " + error.message());
 }
 
 }  // namespace igi::capture

@@ -16,7 +16,9 @@ namespace igi::capture {
 uint16_t WidenTo16Bits(uint16_t level, int significant_bits);
 
 // Writes `frame` to `path` (format from the extension: .png or .tif/.tiff). PNG uses fast zlib
-// compression, TIFF none. Throws igi::Error if the file cannot be written.
-void WriteFrame(const std::filesystem::path& path, const Frame& frame);
+// compression, TIFF none. Always through a temporary file renamed into place; `durable` also
+// fsyncs it first (survives a power cut, not only a crash; costs a disk flush per frame).
+// Throws igi::Error if the file cannot be written.
+void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool durable = true);
 
 }  // namespace igi::capture

@@ -2,6 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 
 #include "tools/common/atomic_file.h"
@@ -23,8 +28,29 @@ Json ManifestEntryToJson(const ManifestEntry& entry) {
   return json;
 }
 
-void AppendManifest(const std::filesystem::path& manifest_path, const ManifestEntry& entry) {
-  AppendLineDurable(manifest_path, ManifestEntryToJson(entry).dump());
+void AppendManifest(const std::filesystem::path& manifest_path, const ManifestEntry& entry,
+                    bool durable) {
+  const std::string line = ManifestEntryToJson(entry).dump();
+  if (durable) {
+    AppendLineDurable(manifest_path, line);
+    return;
+  }
+  const int fd = ::open(manifest_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(manifest_path.string() + ": cannot append: " + std::strerror(errno));
+  const std::string buffer = line + "\n";
+  const ssize_t written = ::write(fd, buffer.data(), buffer.size());  // O_APPEND: one piece
+  const int write_errno = errno;
+  ::close(fd);
+  if (written != ssize_t(buffer.size())) {
+    throw Error(manifest_path.string() + ": cannot append: " + std::strerror(write_errno));
+  }
+}
+
+void SyncFileSystem(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::syncfs(fd);
+  ::close(fd);
 }
 
 namespace {

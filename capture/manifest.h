@@ -28,8 +28,14 @@ struct ManifestEntry {
 
 Json ManifestEntryToJson(const ManifestEntry& entry);
 
-// Appends one line and flushes it to disk.
-void AppendManifest(const std::filesystem::path& manifest_path, const ManifestEntry& entry);
+// Appends one line with a single write (a crash of this process loses nothing written);
+// `durable` also flushes it to disk (fsync) before returning, which survives a power cut.
+void AppendManifest(const std::filesystem::path& manifest_path, const ManifestEntry& entry,
+                    bool durable = true);
+
+// Flushes everything written to the file system holding `path` to disk (syncfs); for the end
+// of a run that wrote without `durable`.
+void SyncFileSystem(const std::filesystem::path& path);
 
 struct ManifestContents {
   std::vector<ManifestEntry> entries;

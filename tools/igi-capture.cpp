@@ -75,9 +75,18 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
   std::signal(SIGTERM, OnSignal);
   const auto summary = igi::capture::RunCapture(options);
   const double fps = summary.seconds > 0 ? summary.frames_written / summary.seconds : 0.0;
-  std::printf("%s: %d of %d frames written by this run (%d already done), %.1f frames/s\n",
-              summary.camera.id.c_str(), summary.frames_written, summary.frames_planned,
-              summary.frames_already_done, fps);
+  std::printf(
+      "%s: %d of %d frames written by this run (%d already done), %.1f frames/s, %lld frames "
+      "skipped\n",
+      summary.camera.id.c_str(), summary.frames_written, summary.frames_planned,
+      summary.frames_already_done, fps, static_cast<long long>(summary.frames_skipped));
+  if (summary.meter) {
+    std::printf("--auto: %zu exposures from %g to %g us; highlights %s, shadows %s\n",
+                summary.meter->exposures_us.size(), summary.meter->shortest_us,
+                summary.meter->longest_us,
+                summary.meter->highlights_covered ? "covered" : "NOT covered",
+                summary.meter->shadows_covered ? "covered" : "NOT covered");
+  }
   if (summary.complete) return 0;
   std::fprintf(stderr, "igi-capture: error: %s\n", summary.stopped_because.c_str());
   if (summary.frames_planned == 0) return 1;  // failed before the plan: nothing written
@@ -123,7 +132,11 @@ int main(int argc, char** argv) {
   app.add_option("--height", options.camera.height, "Region of interest height in pixels (default: keep)");
   app.add_option("--buffers", options.camera.num_buffers, "Stream buffers (default 64)");
   app.add_option("--timeout-ms", options.camera.frame_timeout_ms, "A frame later than this ends the run (default 3000)");
+  app.add_option("--frame-retention-ms", options.camera.frame_retention_ms,
+                 "A frame still missing packets after this long is lost (default 500)");
   app.add_flag("!--no-packet-resend", options.camera.packet_resend, "Do not ask for lost packets again");
+  app.add_flag("!--no-fsync", options.fsync_each_frame,
+               "Flush to disk once at the end, not after every frame (high frame rates)");
   list->excludes(camera)->excludes(raw);
   camera->excludes(raw);
   exposures->excludes(auto_flag);
