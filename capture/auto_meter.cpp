@@ -11,21 +11,23 @@
 namespace igi::capture {
 namespace {
 
-// Largest change of exposure per metering step (a factor): keeps a wild prediction from a
-// nearly black or clipped frame from overshooting the camera's range in one jump.
+// Largest change of exposure per metering step (a factor): keeps a wild
+// prediction from a nearly black or clipped frame from overshooting the
+// camera's range in one jump.
 constexpr double kMaxStep = 16.0;
-// A level this close to full scale counts as clipped: its true value is unknown.
+// A level this close to full scale counts as clipped: its true value is
+// unknown.
 constexpr double kClipped = 0.98;
 
 double Clamp(double value, double lo, double hi) { return std::min(std::max(value, lo), hi); }
 
-// The longest exposure whose highlights stay at or under the target: predicts from the last
-// reading, and bisects (in stops) between the longest exposure known to be fine and the
-// shortest known to be too bright once both are known.
+// The longest exposure whose highlights stay at or under the target: predicts
+// from the last reading, and bisects (in stops) between the longest exposure
+// known to be fine and the shortest known to be too bright once both are known.
 double FindShortest(const std::function<MeterReading(double)>& measure, double lo, double hi,
                     double start, const AutoMeterOptions& options, AutoMeterReport* report) {
   double exposure = Clamp(start, lo, hi);
-  double fine = 0.0;                                       // longest exposure under the target
+  double fine = 0.0;                                            // longest exposure under the target
   double too_bright = std::numeric_limits<double>::infinity();  // shortest one over it
   for (int i = 0; i < options.max_iterations; ++i) {
     const double level = measure(exposure).highlight;
@@ -55,15 +57,16 @@ double FindShortest(const std::function<MeterReading(double)>& measure, double l
     report->highlights_covered = true;
     return fine;
   }
-  report->notes.push_back(fmt::format(
-      "highlights clip even at the shortest exposure tried ({:g} us, camera minimum {:g} us)",
-      exposure, lo));
+  report->notes.push_back(
+      fmt::format("highlights clip even at the shortest exposure tried ({:g} "
+                  "us, camera minimum {:g} us)",
+                  exposure, lo));
   return exposure;
 }
 
 // The shortest exposure (from `shortest` up) whose shadows reach the target.
-double FindLongest(const std::function<MeterReading(double)>& measure, double shortest,
-                   double hi, const AutoMeterOptions& options, AutoMeterReport* report) {
+double FindLongest(const std::function<MeterReading(double)>& measure, double shortest, double hi,
+                   const AutoMeterOptions& options, AutoMeterReport* report) {
   double exposure = shortest;
   for (int i = 0; i < options.max_iterations; ++i) {
     const MeterReading reading = measure(exposure);
@@ -78,9 +81,10 @@ double FindLongest(const std::function<MeterReading(double)>& measure, double sh
                               : kMaxStep;
     exposure = std::min(exposure * factor, hi);
   }
-  report->notes.push_back(fmt::format(
-      "shadows stay under {:g} of full scale up to {:g} us (the longest allowed)",
-      options.shadow_target, exposure));
+  report->notes.push_back(
+      fmt::format("shadows stay under {:g} of full scale up to {:g} us (the "
+                  "longest allowed)",
+                  options.shadow_target, exposure));
   return exposure;
 }
 
@@ -88,9 +92,11 @@ double FindLongest(const std::function<MeterReading(double)>& measure, double sh
 
 void AutoMeterOptions::Validate() const {
   ProblemList problems;
-  if (!(stop_spacing > 0)) problems.Add("", "--stop-spacing", fmt::format("{}", stop_spacing), "must be > 0");
+  if (!(stop_spacing > 0))
+    problems.Add("", "--stop-spacing", fmt::format("{}", stop_spacing), "must be > 0");
   if (!(highlight_percentile > 0 && highlight_percentile <= 100)) {
-    problems.Add("", "highlight_percentile", fmt::format("{}", highlight_percentile), "must be in (0, 100]");
+    problems.Add("", "highlight_percentile", fmt::format("{}", highlight_percentile),
+                 "must be in (0, 100]");
   }
   if (!(shadow_percentile >= 0 && shadow_percentile < highlight_percentile)) {
     problems.Add("", "shadow_percentile", fmt::format("{}", shadow_percentile),
@@ -106,7 +112,8 @@ void AutoMeterOptions::Validate() const {
   if (!(max_exposure_us > 0)) {
     problems.Add("", "--max-exposure-us", fmt::format("{}", max_exposure_us), "must be > 0");
   }
-  if (max_brackets < 1) problems.Add("", "max_brackets", std::to_string(max_brackets), "must be >= 1");
+  if (max_brackets < 1)
+    problems.Add("", "max_brackets", std::to_string(max_brackets), "must be >= 1");
   if (max_iterations < 1) {
     problems.Add("", "max_iterations", std::to_string(max_iterations), "must be >= 1");
   }
@@ -128,9 +135,8 @@ MeterReading ReadMeter(const Frame& frame, const AutoMeterOptions& options) {
   return reading;
 }
 
-AutoMeterReport ChooseExposures(const std::function<MeterReading(double)>& measure,
-                                double min_us, double max_us, double start_us,
-                                const AutoMeterOptions& options) {
+AutoMeterReport ChooseExposures(const std::function<MeterReading(double)>& measure, double min_us,
+                                double max_us, double start_us, const AutoMeterOptions& options) {
   options.Validate();
   const double hi = std::min(max_us, options.max_exposure_us);
   const double lo = std::min(min_us, hi);
@@ -148,7 +154,8 @@ AutoMeterReport ChooseExposures(const std::function<MeterReading(double)>& measu
     const double exposure = report.shortest_us * std::exp2(options.stop_spacing * i);
     report.exposures_us.push_back(std::min(exposure, hi));
   }
-  // The last step may overshoot the camera's limit: keep the exposures distinct.
+  // The last step may overshoot the camera's limit: keep the exposures
+  // distinct.
   report.exposures_us.erase(std::unique(report.exposures_us.begin(), report.exposures_us.end()),
                             report.exposures_us.end());
   return report;

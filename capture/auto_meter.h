@@ -1,14 +1,16 @@
 #pragma once
-// --auto: meters the scene through the camera and chooses a bracket that covers its highlights
-// and shadows with a chosen spacing in stops.
+// --auto: meters the scene through the camera and chooses a bracket that covers
+// its highlights and shadows with a chosen spacing in stops.
 //
-// The shortest exposure is the longest one that keeps the highlight percentile at or below
-// `highlight_target` of full scale (so nothing that matters clips); the longest exposure is the
-// shortest one that lifts the shadow percentile to `shadow_target` of full scale (so the dark
-// parts get well-exposed levels). Between them the exposures step by `stop_spacing` stops.
-// The search is iterative (predict from a linear response, measure, correct), so it also
-// converges on cameras whose levels are not proportional to exposure. Exposures stay inside
-// the camera's range; when the range cannot reach a target the report says so.
+// The shortest exposure is the longest one that keeps the highlight percentile
+// at or below `highlight_target` of full scale (so nothing that matters clips);
+// the longest exposure is the shortest one that lifts the shadow percentile to
+// `shadow_target` of full scale (so the dark parts get well-exposed levels).
+// Between them the exposures step by `stop_spacing` stops. The search is
+// iterative (predict from a linear response, measure, correct), so it also
+// converges on cameras whose levels are not proportional to exposure. Exposures
+// stay inside the camera's range; when the range cannot reach a target the
+// report says so.
 
 #include <functional>
 #include <string>
@@ -31,7 +33,8 @@ struct AutoMeterOptions {
   void Validate() const;
 };
 
-// The highlight and shadow levels of one metering frame, as fractions of full scale.
+// The highlight and shadow levels of one metering frame, as fractions of full
+// scale.
 struct MeterReading {
   double highlight = 0.0;
   double shadow = 0.0;
@@ -50,10 +53,10 @@ struct AutoMeterReport {
   std::vector<std::string> notes;  // why a target was not reached
 };
 
-// `measure(exposure_us)` sets the exposure and returns the reading of a settled frame; the
-// camera's exposure range is [min_us, max_us]; metering starts at `start_us`.
-AutoMeterReport ChooseExposures(const std::function<MeterReading(double)>& measure,
-                                double min_us, double max_us, double start_us,
-                                const AutoMeterOptions& options);
+// `measure(exposure_us)` sets the exposure and returns the reading of a settled
+// frame; the camera's exposure range is [min_us, max_us]; metering starts at
+// `start_us`.
+AutoMeterReport ChooseExposures(const std::function<MeterReading(double)>& measure, double min_us,
+                                double max_us, double start_us, const AutoMeterOptions& options);
 
 }  // namespace igi::capture

@@ -1,7 +1,8 @@
 #pragma once
-// A bracket plan: which exposures to take, how many frames each, in which pixel format, gain and
-// file format. It is written to DIR/plan.json before the first frame, so that --resume finishes
-// exactly the same plan (an --auto plan is metered once, not again on resume).
+// A bracket plan: which exposures to take, how many frames each, in which pixel
+// format, gain and file format. It is written to DIR/plan.json before the first
+// frame, so that --resume finishes exactly the same plan (an --auto plan is
+// metered once, not again on resume).
 
 #include <filesystem>
 #include <string>
@@ -21,12 +22,14 @@ struct BracketPlan {
   std::string file_format = "png";   // "png" or "tiff": 16-bit, lossless
   bool auto_metered = false;         // the exposures came from --auto
 
-  // InputError (one line per problem, `source` as the file) when a field is out of range.
+  // InputError (one line per problem, `source` as the file) when a field is out
+  // of range.
   void Validate(const std::string& source) const;
   int total_frames() const { return int(exposures_us.size()) * frames; }
 };
 
-// One frame of a plan: bracket (exposure index) and frame index within the exposure.
+// One frame of a plan: bracket (exposure index) and frame index within the
+// exposure.
 struct PlanSlot {
   int bracket = 0;
   int frame = 0;
@@ -40,8 +43,8 @@ struct PlanSlot {
 // "frames/b00_e000010000us_f000.png" (bracket, exposure in µs, frame).
 std::string SlotFileName(const BracketPlan& plan, const PlanSlot& slot);
 
-// Parses "--exposures-us 1000,4000,16000" (commas or spaces). InputError on a bad list: empty,
-// a value that is not a positive number, or a repeated value.
+// Parses "--exposures-us 1000,4000,16000" (commas or spaces). InputError on a
+// bad list: empty, a value that is not a positive number, or a repeated value.
 std::vector<double> ParseExposureList(const std::string& text);
 
 Json PlanToJson(const BracketPlan& plan);

@@ -38,9 +38,9 @@ bool LooksLikeIpv4(const std::string& text) {
   return ipv4;
 }
 
-// The address to open `id_or_address` by: itself when it is an address; the discovered
-// address of a GigE camera whose id, serial, physical id or "model-serial" matches; else
-// itself (Aravis then matches USB devices by id).
+// The address to open `id_or_address` by: itself when it is an address; the
+// discovered address of a GigE camera whose id, serial, physical id or
+// "model-serial" matches; else itself (Aravis then matches USB devices by id).
 std::string ResolveCamera(const std::string& id_or_address) {
   if (LooksLikeIpv4(id_or_address)) return id_or_address;
   for (const CameraInfo& info : ListCameras()) {
@@ -55,9 +55,10 @@ std::atomic<bool>* ControlLostFlag(gpointer data) { return static_cast<std::atom
 
 void OnControlLost(ArvDevice* /*device*/, gpointer data) { ControlLostFlag(data)->store(true); }
 
-// Runs in Aravis's stream thread: raise its priority so that writing frames in the main
-// thread cannot starve packet reception (a frame whose packets come too late is lost). Needs
-// CAP_SYS_NICE or rtkit; without them the thread keeps its normal priority.
+// Runs in Aravis's stream thread: raise its priority so that writing frames in
+// the main thread cannot starve packet reception (a frame whose packets come
+// too late is lost). Needs CAP_SYS_NICE or rtkit; without them the thread keeps
+// its normal priority.
 void OnStreamEvent(void* /*data*/, ArvStreamCallbackType type, ArvBuffer* /*buffer*/) {
   if (type != ARV_STREAM_CALLBACK_TYPE_INIT) return;
   if (!arv_make_thread_high_priority(-10)) {
@@ -88,7 +89,8 @@ void CameraOptions::Validate() const {
     problems.Add("", "--pixel-format", pixel_format,
                  "must be one of " + Join(SupportedPixelFormatNames(), ", "));
   }
-  if (frame_rate_hz < 0) problems.Add("", "--frame-rate", FormatNumber(frame_rate_hz), "must be >= 0");
+  if (frame_rate_hz < 0)
+    problems.Add("", "--frame-rate", FormatNumber(frame_rate_hz), "must be >= 0");
   if (width < 0) problems.Add("", "--width", std::to_string(width), "must be >= 0");
   if (height < 0) problems.Add("", "--height", std::to_string(height), "must be >= 0");
   if (num_buffers < 2) problems.Add("", "--buffers", std::to_string(num_buffers), "must be >= 2");
@@ -114,16 +116,17 @@ struct Camera::Impl {
   int settle_left = 0;         // frames still to drop after the change
   bool streaming = false;
 
-  bool abandoned = false;      // the camera stopped answering: see ~Impl
+  bool abandoned = false;  // the camera stopped answering: see ~Impl
 
   ~Impl() {
     if (camera != nullptr && control_lost_handler != 0) {
       g_signal_handler_disconnect(arv_camera_get_device(camera), control_lost_handler);
     }
-    // Finalising the stream and the device of a camera that is gone blocks for about 5 s
-    // each (Aravis 0.8 retries every GVCP command 5 times with a 500 ms timeout, with no
-    // public setting to shorten it). An abandoned camera's objects are left to the end of
-    // the process instead: igi-capture exits right after.
+    // Finalising the stream and the device of a camera that is gone blocks for
+    // about 5 s each (Aravis 0.8 retries every GVCP command 5 times with a 500
+    // ms timeout, with no public setting to shorten it). An abandoned camera's
+    // objects are left to the end of the process instead: igi-capture exits
+    // right after.
     if (abandoned) return;
     if (streaming) arv_camera_stop_acquisition(camera, nullptr);
     if (stream != nullptr) g_object_unref(stream);
@@ -135,8 +138,8 @@ struct Camera::Impl {
   void CreateStream();
   Frame CopyFrame(ArvBuffer* buffer) const;
 
-  // Drops every frame that comes out of the stream until it has been quiet for a while
-  // (30 ms + twice the exposure), at most 2 s.
+  // Drops every frame that comes out of the stream until it has been quiet for
+  // a while (30 ms + twice the exposure), at most 2 s.
   void Drain() {
     const uint64_t quiet_us = 30000u + uint64_t(2.0 * exposure_us);
     const int64_t deadline_us = g_get_monotonic_time() + 2000000;
@@ -218,7 +221,8 @@ void Camera::Impl::CreateStream() {
                  options.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS
                                        : ARV_GV_STREAM_PACKET_RESEND_NEVER,
                  nullptr);
-    // Frames whose packets are still incomplete after this long are given up (lost).
+    // Frames whose packets are still incomplete after this long are given up
+    // (lost).
     g_object_set(stream, "frame-retention", guint(options.frame_retention_ms) * 1000u, nullptr);
   }
   const guint payload = arv_camera_get_payload(camera, &error);
@@ -241,9 +245,9 @@ Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
   const size_t samples = size_t(frame.width) * frame.height * format.channels;
   if (data == nullptr || size < samples * format.bytes_per_sample) {
     throw CameraStreamError(Name() + ": frame " + std::to_string(frame.frame_id) + " holds " +
-                            std::to_string(size) + " bytes, too few for " +
-                            std::to_string(frame.width) + "x" + std::to_string(frame.height) +
-                            " " + format.name,
+                                std::to_string(size) + " bytes, too few for " +
+                                std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                                " " + format.name,
                             false);
   }
   frame.levels.resize(samples);
@@ -282,13 +286,14 @@ void Camera::ExposureBoundsUs(double* min_us, double* max_us) const {
 }
 
 double Camera::SetExposureUs(double exposure_us, int settle_frames) {
-  // The stream is stopped and drained around the change. Changing the exposure while
-  // streaming leaves frames exposed at the old setting queued or in flight, and Aravis stamps a
-  // frame's system time when its stream thread handles it, not when it arrived: with that
-  // thread behind (1000 frames/s on a busy host), old frames come out after the change with
-  // later stamps than it. Stopped, no new frame starts; every frame still on its way is
-  // drained and dropped; after the restart, `settle_frames` more are dropped for cameras that
-  // apply a setting one frame late.
+  // The stream is stopped and drained around the change. Changing the exposure
+  // while streaming leaves frames exposed at the old setting queued or in
+  // flight, and Aravis stamps a frame's system time when its stream thread
+  // handles it, not when it arrived: with that thread behind (1000 frames/s on
+  // a busy host), old frames come out after the change with later stamps than
+  // it. Stopped, no new frame starts; every frame still on its way is drained
+  // and dropped; after the restart, `settle_frames` more are dropped for
+  // cameras that apply a setting one frame late.
   const bool was_streaming = impl_->streaming;
   if (was_streaming) {
     GError* error = nullptr;
@@ -349,8 +354,8 @@ Frame Camera::NextFrame() {
     if (buffer == nullptr) {
       throw CameraStreamError(
           impl.Name() + ": no frame within " + std::to_string(timeout_us / 1000) + " ms" +
-          (impl.control_lost.load() ? " and the camera stopped answering (disconnected?)"
-                                    : " (disconnected, or not streaming?)"),
+              (impl.control_lost.load() ? " and the camera stopped answering (disconnected?)"
+                                        : " (disconnected, or not streaming?)"),
           true);
     }
     const ArvBufferStatus status = arv_buffer_get_status(buffer);
@@ -363,7 +368,7 @@ Frame Camera::NextFrame() {
                         : status == ARV_BUFFER_STATUS_SIZE_MISMATCH ? "had the wrong size"
                                                                     : "failed";
       throw CameraStreamError(impl.Name() + ": frame " + std::to_string(frame_id) + " " + why +
-                              " (buffer status " + std::to_string(int(status)) + ")",
+                                  " (buffer status " + std::to_string(int(status)) + ")",
                               false);
     }
     if (arrived_ns < impl.changed_at_ns) {

@@ -1,13 +1,14 @@
 #pragma once
-// A GigE Vision (or USB3 Vision) camera through Aravis. Aravis and GLib types stay in
-// camera.cpp. A Camera streams continuously once Start()ed; NextFrame() hands out one frame at
-// a time, copied out of Aravis's buffer, which goes straight back to the stream.
+// A GigE Vision (or USB3 Vision) camera through Aravis. Aravis and GLib types
+// stay in camera.cpp. A Camera streams continuously once Start()ed; NextFrame()
+// hands out one frame at a time, copied out of Aravis's buffer, which goes
+// straight back to the stream.
 //
-// Failures are errors, never silent: a camera that does not answer when opened throws
-// igi::Error (exit 1); a bad setting (unknown pixel format, exposure out of range) throws
-// igi::InputError (exit 2); a frame that does not come in time, arrives with lost packets, or
-// a camera that stops answering throws CameraStreamError, which the capture turns into a
-// partial result (exit 3).
+// Failures are errors, never silent: a camera that does not answer when opened
+// throws igi::Error (exit 1); a bad setting (unknown pixel format, exposure out
+// of range) throws igi::InputError (exit 2); a frame that does not come in
+// time, arrives with lost packets, or a camera that stops answering throws
+// CameraStreamError, which the capture turns into a partial result (exit 3).
 
 #include <cstdint>
 #include <memory>
@@ -28,7 +29,8 @@ struct CameraInfo {
   std::string protocol;  // "GigEVision", "USB3Vision"
 };
 
-// Every camera Aravis finds on every interface (GigE discovery broadcast, USB enumeration).
+// Every camera Aravis finds on every interface (GigE discovery broadcast, USB
+// enumeration).
 std::vector<CameraInfo> ListCameras();
 
 // The stream broke: timeout, lost packets, or the camera stopped answering.
@@ -36,8 +38,9 @@ class CameraStreamError : public Error {
  public:
   CameraStreamError(std::string message, bool camera_may_be_gone)
       : Error(std::move(message), ExitCode::kPartial), camera_may_be_gone_(camera_may_be_gone) {}
-  // True after a timeout or a failed command: talking to the camera again (to stop it) would
-  // only wait for GVCP timeouts (Aravis retries each command for seconds).
+  // True after a timeout or a failed command: talking to the camera again (to
+  // stop it) would only wait for GVCP timeouts (Aravis retries each command for
+  // seconds).
   bool camera_may_be_gone() const { return camera_may_be_gone_; }
 
  private:
@@ -45,18 +48,19 @@ class CameraStreamError : public Error {
 };
 
 struct CameraOptions {
-  // An IPv4 address, or an id/serial/model-serial as ListCameras() shows. GigE cameras found by
-  // id are opened through their address (Aravis streams over loopback only when opened so).
+  // An IPv4 address, or an id/serial/model-serial as ListCameras() shows. GigE
+  // cameras found by id are opened through their address (Aravis streams over
+  // loopback only when opened so).
   std::string id_or_address;
-  std::string pixel_format;        // GenICam name; empty = keep the camera's current format
-  double gain = -1.0;              // camera gain units (dB on most cameras); < 0 = keep
-  double frame_rate_hz = 0.0;      // > 0 sets AcquisitionFrameRate; 0 = keep
-  int width = 0;                   // > 0 sets the region of interest width (pixels), from x = 0
-  int height = 0;                  // > 0 sets the region height (pixels), from y = 0
-  int num_buffers = 64;            // stream buffers queued in Aravis (absorbs write bursts)
-  int frame_timeout_ms = 3000;     // a frame later than this (+ exposure) ends the run
-  bool packet_resend = true;       // GigE: ask the camera to resend lost packets
-  int frame_retention_ms = 500;    // GigE: a frame still missing packets this long is lost
+  std::string pixel_format;      // GenICam name; empty = keep the camera's current format
+  double gain = -1.0;            // camera gain units (dB on most cameras); < 0 = keep
+  double frame_rate_hz = 0.0;    // > 0 sets AcquisitionFrameRate; 0 = keep
+  int width = 0;                 // > 0 sets the region of interest width (pixels), from x = 0
+  int height = 0;                // > 0 sets the region height (pixels), from y = 0
+  int num_buffers = 64;          // stream buffers queued in Aravis (absorbs write bursts)
+  int frame_timeout_ms = 3000;   // a frame later than this (+ exposure) ends the run
+  bool packet_resend = true;     // GigE: ask the camera to resend lost packets
+  int frame_retention_ms = 500;  // GigE: a frame still missing packets this long is lost
 
   // InputError naming the flag when a value is out of range.
   void Validate() const;
@@ -86,17 +90,19 @@ class Camera {
   double gain() const;  // as read back from the camera
   void ExposureBoundsUs(double* min_us, double* max_us) const;
 
-  // Sets the exposure time and returns the value the camera reports back (cameras round).
-  // While streaming, the stream is stopped for the change and restarted; NextFrame then drops
-  // frames that arrived before the restart was acknowledged, and `settle_frames` more.
+  // Sets the exposure time and returns the value the camera reports back
+  // (cameras round). While streaming, the stream is stopped for the change and
+  // restarted; NextFrame then drops frames that arrived before the restart was
+  // acknowledged, and `settle_frames` more.
   double SetExposureUs(double exposure_us, int settle_frames);
   double exposure_us() const;
 
   void Start();
   void Stop();
-  // Forgets the stream without sending AcquisitionStop, for a camera that stopped answering
-  // (a GigE camera stops streaming by itself when its control heartbeat lapses). The Aravis
-  // objects are then not finalised (that would wait ~10 s for acks) but left to process exit.
+  // Forgets the stream without sending AcquisitionStop, for a camera that
+  // stopped answering (a GigE camera stops streaming by itself when its control
+  // heartbeat lapses). The Aravis objects are then not finalised (that would
+  // wait ~10 s for acks) but left to process exit.
   void Abandon();
   // The next frame exposed at the current setting. Throws CameraStreamError.
   Frame NextFrame();
@@ -106,7 +112,8 @@ class Camera {
   std::unique_ptr<Impl> impl_;
 };
 
-// Host wall clock in ns since the Unix epoch (the clock of Frame::system_timestamp_ns).
+// Host wall clock in ns since the Unix epoch (the clock of
+// Frame::system_timestamp_ns).
 uint64_t HostTimeNs();
 
 }  // namespace igi::capture

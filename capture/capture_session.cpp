@@ -19,7 +19,8 @@ namespace {
 constexpr const char* kPlanFile = "plan.json";
 constexpr const char* kManifestFile = "manifest.jsonl";
 
-// The settings a fresh run asks for, checked against the camera before anything is written.
+// The settings a fresh run asks for, checked against the camera before anything
+// is written.
 BracketPlan MakePlan(const CaptureOptions& options, Camera& camera, CaptureSummary* summary) {
   BracketPlan plan;
   plan.camera = camera.info().id;
@@ -35,8 +36,8 @@ BracketPlan MakePlan(const CaptureOptions& options, Camera& camera, CaptureSumma
       camera.SetExposureUs(exposure_us, options.settle_frames);
       return ReadMeter(camera.NextFrame(), options.auto_meter);
     };
-    summary->meter = ChooseExposures(measure, min_us, max_us, camera.exposure_us(),
-                                     options.auto_meter);
+    summary->meter =
+        ChooseExposures(measure, min_us, max_us, camera.exposure_us(), options.auto_meter);
     for (const std::string& note : summary->meter->notes) spdlog::warn("--auto: {}", note);
     plan.exposures_us = summary->meter->exposures_us;
     plan.auto_metered = true;
@@ -55,7 +56,8 @@ BracketPlan MakePlan(const CaptureOptions& options, Camera& camera, CaptureSumma
   return plan;
 }
 
-// On resume: the flags given must agree with the stored plan (they may be left out).
+// On resume: the flags given must agree with the stored plan (they may be left
+// out).
 void CheckResumeFlags(const CaptureOptions& options, const BracketPlan& plan,
                       const std::string& source) {
   ProblemList problems;
@@ -72,13 +74,15 @@ void CheckResumeFlags(const CaptureOptions& options, const BracketPlan& plan,
   problems.ThrowIfAny();
 }
 
-// Slots the manifest lists whose file is on disk; warns about listed files that vanished.
+// Slots the manifest lists whose file is on disk; warns about listed files that
+// vanished.
 std::set<PlanSlot> DoneSlots(const fs::path& out_dir, const BracketPlan& plan) {
   std::set<PlanSlot> done;
   const fs::path manifest = out_dir / kManifestFile;
   if (!fs::exists(manifest)) return done;
   const ManifestContents contents = ReadManifest(manifest);
-  if (contents.truncated_last_line) spdlog::warn("{}: last line cut short; ignored", manifest.string());
+  if (contents.truncated_last_line)
+    spdlog::warn("{}: last line cut short; ignored", manifest.string());
   for (const ManifestEntry& entry : contents.entries) {
     const PlanSlot slot{entry.bracket, entry.frame};
     if (slot.bracket >= int(plan.exposures_us.size()) || slot.frame >= plan.frames) continue;
@@ -130,8 +134,8 @@ bool StopRequested(const CaptureOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
 }
 
-// Takes every slot not in `done`, bracket by bracket. Returns normally when finished or
-// stopped; CameraStreamError escapes.
+// Takes every slot not in `done`, bracket by bracket. Returns normally when
+// finished or stopped; CameraStreamError escapes.
 void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
                 const std::set<PlanSlot>& done, Camera& camera, CaptureSummary* summary) {
   const fs::path manifest = options.out_dir / kManifestFile;
@@ -199,8 +203,8 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
                                      "choose another --out"));
   }
   if (options.resume && !fs::exists(plan_path)) {
-    throw InputError(DescribeProblem(plan_path.string(), "", "",
-                                     "no capture to resume (plan.json is missing)"));
+    throw InputError(
+        DescribeProblem(plan_path.string(), "", "", "no capture to resume (plan.json is missing)"));
   }
   CaptureSummary summary;
   std::optional<BracketPlan> stored;
@@ -214,9 +218,9 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
   Camera camera(camera_options);
   summary.camera = camera.info();
   if (stored && stored->camera != camera.info().id) {
-    throw InputError(DescribeProblem(plan_path.string(), "camera", stored->camera,
-                                     "the plan was made for another camera than " +
-                                         camera.info().id));
+    throw InputError(
+        DescribeProblem(plan_path.string(), "camera", stored->camera,
+                        "the plan was made for another camera than " + camera.info().id));
   }
   camera.Start();
   try {

@@ -1,8 +1,7 @@
 #include "capture/manifest.h"
 
-#include <fmt/format.h>
-
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -70,7 +69,7 @@ ManifestEntry ParseLine(const std::string& line, const std::string& source) {
   entry.frame = int(root["frame"].Integer(NumberRule::NonNegative()).value_or(0));
   problems.ThrowIfAny();
   for (const auto& [key, value] : json.items()) {
-    static const char* kFixed[] = {"file",      "camera",    "exposure_us", "gain",
+    static const char* kFixed[] = {"file",         "camera",    "exposure_us", "gain",
                                    "pixel_format", "timestamp", "bracket",     "frame"};
     bool fixed = false;
     for (const char* name : kFixed) fixed = fixed || key == name;

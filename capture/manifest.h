@@ -1,9 +1,10 @@
 #pragma once
-// DIR/manifest.jsonl (CONTRACT.md §4): append-only, one JSON object per frame, written after the
-// frame's file is complete, each line flushed to disk before the next frame. Keys: file
-// (relative to DIR), camera, exposure_us, gain, pixel_format, timestamp (ISO 8601 UTC), and
-// igi's additions: bracket, frame, requested_exposure_us, frame_id, camera_timestamp_ns, width,
-// height, significant_bits (raw imports: iso, black_level, white_level, source).
+// DIR/manifest.jsonl (CONTRACT.md §4): append-only, one JSON object per frame,
+// written after the frame's file is complete, each line flushed to disk before
+// the next frame. Keys: file (relative to DIR), camera, exposure_us, gain,
+// pixel_format, timestamp (ISO 8601 UTC), and igi's additions: bracket, frame,
+// requested_exposure_us, frame_id, camera_timestamp_ns, width, height,
+// significant_bits (raw imports: iso, black_level, white_level, source).
 
 #include <filesystem>
 #include <optional>
@@ -28,13 +29,14 @@ struct ManifestEntry {
 
 Json ManifestEntryToJson(const ManifestEntry& entry);
 
-// Appends one line with a single write (a crash of this process loses nothing written);
-// `durable` also flushes it to disk (fsync) before returning, which survives a power cut.
+// Appends one line with a single write (a crash of this process loses nothing
+// written); `durable` also flushes it to disk (fsync) before returning, which
+// survives a power cut.
 void AppendManifest(const std::filesystem::path& manifest_path, const ManifestEntry& entry,
                     bool durable = true);
 
-// Flushes everything written to the file system holding `path` to disk (syncfs); for the end
-// of a run that wrote without `durable`.
+// Flushes everything written to the file system holding `path` to disk
+// (syncfs); for the end of a run that wrote without `durable`.
 void SyncFileSystem(const std::filesystem::path& path);
 
 struct ManifestContents {
@@ -43,7 +45,8 @@ struct ManifestContents {
   bool truncated_last_line = false;
 };
 
-// Reads every line strictly; a malformed complete line is an InputError naming the line.
+// Reads every line strictly; a malformed complete line is an InputError naming
+// the line.
 ManifestContents ReadManifest(const std::filesystem::path& manifest_path);
 
 // "2025-01-31T12:00:00.123456Z" from ns since the Unix epoch.

@@ -1,6 +1,7 @@
 #pragma once
-// The camera pixel formats igi-capture can store losslessly, by their GenICam (PFNC) names.
-// Every supported format is unpacked: one 8-bit or one little-endian 16-bit container per sample.
+// The camera pixel formats igi-capture can store losslessly, by their GenICam
+// (PFNC) names. Every supported format is unpacked: one 8-bit or one
+// little-endian 16-bit container per sample.
 
 #include <optional>
 #include <string>
@@ -16,7 +17,8 @@ struct PixelFormatInfo {
   bool bayer = false;        // a colour filter mosaic, stored undemosaiced
 };
 
-// The format named `name`, or nullopt when igi-capture cannot store it (packed formats, YUV, …).
+// The format named `name`, or nullopt when igi-capture cannot store it (packed
+// formats, YUV, …).
 std::optional<PixelFormatInfo> FindPixelFormat(const std::string& name);
 
 // Names of every supported format, for messages.

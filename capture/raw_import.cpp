@@ -57,7 +57,8 @@ std::vector<RawItem> ReadFolder(const fs::path& raw_dir, RawImportSummary* summa
   return items;
 }
 
-// Brackets are the distinct exposures, shortest first; frames count up within each.
+// Brackets are the distinct exposures, shortest first; frames count up within
+// each.
 void AssignSlots(std::vector<RawItem>* items) {
   std::set<double> exposures;
   for (const RawItem& item : *items) exposures.insert(item.info.exposure_us);
@@ -90,10 +91,10 @@ ManifestEntry MakeEntry(const RawItem& item) {
 }  // namespace
 
 bool IsRawExtension(const std::string& extension) {
-  static const std::set<std::string> kRaw = {
-      "3fr", "ari", "arw", "bay", "cr2", "cr3", "crw", "dcr", "dng", "erf", "fff", "iiq",
-      "k25", "kdc", "mef", "mos", "mrw", "nef", "nrw", "orf", "pef", "raf", "raw", "rw2",
-      "rwl", "sr2", "srf", "srw", "x3f"};
+  static const std::set<std::string> kRaw = {"3fr", "ari", "arw", "bay", "cr2", "cr3", "crw", "dcr",
+                                             "dng", "erf", "fff", "iiq", "k25", "kdc", "mef", "mos",
+                                             "mrw", "nef", "nrw", "orf", "pef", "raf", "raw", "rw2",
+                                             "rwl", "sr2", "srf", "srw", "x3f"};
   return kRaw.count(extension) > 0;
 }
 

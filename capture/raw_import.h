@@ -1,14 +1,16 @@
 #pragma once
-// --from-raw DIR: imports a folder of camera raw files into the capture layout, so that igi-hdr
-// reads a raw bracket and an igi-capture bracket alike. The raw files are copied unchanged
-// (atomically) into OUT/frames/, and each gets a manifest line (manifest.h) with the camera,
-// exposure and ISO read by LibRaw from the file's metadata: gain = ISO / 100 (null when the
-// file gives no ISO), pixel_format "raw:<extension>", plus iso, black_level, white_level, width,
-// height and source (the original path). Brackets are the distinct exposures, shortest first;
-// frames within a bracket follow file-name order.
+// --from-raw DIR: imports a folder of camera raw files into the capture layout,
+// so that igi-hdr reads a raw bracket and an igi-capture bracket alike. The raw
+// files are copied unchanged (atomically) into OUT/frames/, and each gets a
+// manifest line (manifest.h) with the camera, exposure and ISO read by LibRaw
+// from the file's metadata: gain = ISO / 100 (null when the file gives no ISO),
+// pixel_format "raw:<extension>", plus iso, black_level, white_level, width,
+// height and source (the original path). Brackets are the distinct exposures,
+// shortest first; frames within a bracket follow file-name order.
 //
-// Every raw file is read before anything is written: a file LibRaw cannot open, or one without
-// a positive exposure time, is an InputError (exit 2) and nothing is written.
+// Every raw file is read before anything is written: a file LibRaw cannot open,
+// or one without a positive exposure time, is an InputError (exit 2) and
+// nothing is written.
 
 #include <filesystem>
 #include <optional>
@@ -17,7 +19,8 @@
 
 namespace igi::capture {
 
-// Files with these extensions are raw candidates ("dng", "cr2", "nef", "kdc", …; lower case).
+// Files with these extensions are raw candidates ("dng", "cr2", "nef", "kdc",
+// …; lower case).
 bool IsRawExtension(const std::string& extension);
 
 struct RawFileInfo {
@@ -27,11 +30,12 @@ struct RawFileInfo {
   std::string timestamp;      // ISO 8601 UTC, empty when unknown
   int black_level = 0;
   int white_level = 0;
-  int width = 0;   // raw sensor pixels
+  int width = 0;  // raw sensor pixels
   int height = 0;
 };
 
-// Reads the metadata of one raw file through LibRaw; InputError "FILE: cannot read raw: …".
+// Reads the metadata of one raw file through LibRaw; InputError "FILE: cannot
+// read raw: …".
 RawFileInfo ReadRawInfo(const std::filesystem::path& path);
 
 struct RawImportOptions {
@@ -43,8 +47,8 @@ struct RawImportOptions {
 
 struct RawImportSummary {
   int files_found = 0;
-  int files_imported = 0;      // by this run
-  int files_already_done = 0;  // listed before (resume)
+  int files_imported = 0;            // by this run
+  int files_already_done = 0;        // listed before (resume)
   std::vector<std::string> ignored;  // files without a raw extension
 };
 

@@ -1,5 +1,6 @@
-// --auto on synthetic scenes with known truth: a linear 12-bit sensor viewing a scene whose
-// radiances span a known range, so the right shortest and longest exposures are known.
+// --auto on synthetic scenes with known truth: a linear 12-bit sensor viewing a
+// scene whose radiances span a known range, so the right shortest and longest
+// exposures are known.
 #include "capture/auto_meter.h"
 
 #include <gtest/gtest.h>
@@ -9,9 +10,10 @@
 namespace igi::capture {
 namespace {
 
-// Scene: radiances log-uniform in [dark, bright]; level = radiance * exposure_us, clipped at 1.
+// Scene: radiances log-uniform in [dark, bright]; level = radiance *
+// exposure_us, clipped at 1.
 struct LinearScene {
-  double dark = 1e-6;   // full scale per µs at the darkest pixel
+  double dark = 1e-6;  // full scale per µs at the darkest pixel
   double bright = 1e-3;
   int samples = 4096;
   Frame Take(double exposure_us) const {
@@ -54,8 +56,9 @@ TEST(ChooseExposures, CoversHighlightsAndShadowsOfALinearScene) {
   ASSERT_TRUE(report.highlights_covered);
   ASSERT_TRUE(report.shadows_covered);
   EXPECT_EQ(report.frames_metered, frames);
-  // Highlight percentile radiance r_h: the shortest exposure puts it at or under the target,
-  // within a quarter stop (the stopping rule), so r_h * e in [0.84, 1] * target (± a level).
+  // Highlight percentile radiance r_h: the shortest exposure puts it at or
+  // under the target, within a quarter stop (the stopping rule), so r_h * e in
+  // [0.84, 1] * target (± a level).
   const double r_high = scene.dark * std::pow(scene.bright / scene.dark, 0.995);
   const double high = r_high * report.shortest_us;
   EXPECT_LE(high, options.highlight_target + 1.0 / 4095);

@@ -72,7 +72,8 @@ bool GvcpPortInUse() {
   std::ifstream udp("/proc/self/net/udp");
   std::string line;
   while (std::getline(udp, line)) {
-    // "  sl  local_address rem_address ..." with addresses as hex "0100007F:0F74".
+    // "  sl  local_address rem_address ..." with addresses as hex
+    // "0100007F:0F74".
     if (line.find(":0F74 ") != std::string::npos &&
         (line.find("0100007F:0F74") != std::string::npos ||
          line.find("00000000:0F74") != std::string::npos)) {
@@ -110,8 +111,7 @@ bool ChildProcess::Running() {
 }
 
 int ChildProcess::Wait(double timeout_s) {
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (Running()) {
     if (std::chrono::steady_clock::now() > deadline) {
       Kill();
@@ -139,9 +139,8 @@ std::string ReadText(const std::filesystem::path& path) {
 }
 
 int RunProcess(const std::vector<std::string>& args, double timeout_s, std::string* output) {
-  const std::filesystem::path log =
-      std::filesystem::temp_directory_path() /
-      ("igi_capture_run_" + std::to_string(::getpid()) + ".log");
+  const std::filesystem::path log = std::filesystem::temp_directory_path() /
+                                    ("igi_capture_run_" + std::to_string(::getpid()) + ".log");
   std::filesystem::remove(log);
   ChildProcess process(args, log);
   const int code = process.Wait(timeout_s);
@@ -164,7 +163,8 @@ FakeCamera::FakeCamera(const std::string& serial, const std::filesystem::path& l
   while (std::chrono::steady_clock::now() < deadline && process_.Running()) {
     if (GvcpPortInUse()) {
       ready_ = true;
-      // The control socket is bound; give the stream thread a moment to come up too.
+      // The control socket is bound; give the stream thread a moment to come up
+      // too.
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       return;
     }

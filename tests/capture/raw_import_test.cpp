@@ -1,6 +1,7 @@
-// Raw import on the real raw files of ../shared/data/real/raw (a Canon EOS Kiss X4 DNG and a
-// Kodak DC50 KDC; see the data README). Their metadata, as LibRaw reads it: the DNG records
-// ExposureTime 1 s and no ISO; the KDC 1/230 s (0.00435 s) at ISO 84.
+// Raw import on the real raw files of ../shared/data/real/raw (a Canon EOS Kiss
+// X4 DNG and a Kodak DC50 KDC; see the data README). Their metadata, as LibRaw
+// reads it: the DNG records ExposureTime 1 s and no ISO; the KDC 1/230 s
+// (0.00435 s) at ISO 84.
 #include "capture/raw_import.h"
 
 #include <gtest/gtest.h>
@@ -21,7 +22,8 @@ const fs::path kRawDir = fs::path(IGI_SHARED_DATA_DIR) / "real" / "raw";
 TEST(ReadRawInfo, ReadsExposureIsoAndCameraOfRealFiles) {
   const RawFileInfo kodak = ReadRawInfo(kRawDir / "kodak_dc50.kdc");
   EXPECT_EQ(kodak.camera, "Kodak DC50");
-  EXPECT_NEAR(kodak.exposure_us, 4350.0, 0.01);  // LibRaw's float shutter: ~1e-6 relative
+  EXPECT_NEAR(kodak.exposure_us, 4350.0,
+              0.01);  // LibRaw's float shutter: ~1e-6 relative
   ASSERT_TRUE(kodak.iso);
   EXPECT_DOUBLE_EQ(*kodak.iso, 84.0);
   EXPECT_FALSE(kodak.timestamp.empty());
@@ -46,10 +48,12 @@ class RawImportTest : public ::testing::Test {
 TEST_F(RawImportTest, CopiesRawFilesUnchangedAndListsThem) {
   const RawImportSummary summary = ImportRaw({kRawDir, out_, false});
   EXPECT_EQ(summary.files_imported, 2);
-  EXPECT_EQ(summary.ignored.size(), 4u);  // the ColorChecker .cht/.cie references
+  EXPECT_EQ(summary.ignored.size(),
+            4u);  // the ColorChecker .cht/.cie references
   const ManifestContents manifest = ReadManifest(out_ / "manifest.jsonl");
   ASSERT_EQ(manifest.entries.size(), 2u);
-  // Shortest exposure first: the Kodak (4350 µs) is bracket 0, the Canon (1 s) bracket 1.
+  // Shortest exposure first: the Kodak (4350 µs) is bracket 0, the Canon (1 s)
+  // bracket 1.
   const ManifestEntry& kodak = manifest.entries[1];
   EXPECT_EQ(kodak.file, "frames/kodak_dc50.kdc");
   EXPECT_EQ(kodak.bracket, 0);
@@ -63,7 +67,8 @@ TEST_F(RawImportTest, CopiesRawFilesUnchangedAndListsThem) {
   for (const char* name : {"colorchart.dng", "kodak_dc50.kdc"}) {
     EXPECT_EQ(ReadFileToString(out_ / "frames" / name), ReadFileToString(kRawDir / name)) << name;
   }
-  // A second import into the same folder must not overwrite; --resume adds nothing new.
+  // A second import into the same folder must not overwrite; --resume adds
+  // nothing new.
   EXPECT_THROW(ImportRaw({kRawDir, out_, false}), InputError);
   const RawImportSummary again = ImportRaw({kRawDir, out_, true});
   EXPECT_EQ(again.files_imported, 0);
