@@ -232,5 +232,28 @@ TEST_F(CaptureE2eTest, AutoChoosesABracketFromUnclippedHighlights) {
   EXPECT_EQ(Manifest().size(), exposures.size());
 }
 
+TEST_F(CaptureE2eTest, FromRawImportsIntoTheSameLayout) {
+  std::string output;
+  const std::string raw_dir = std::string(IGI_SHARED_DATA_DIR) + "/real/raw";
+  ASSERT_EQ(RunProcess({kCapture, "--from-raw", raw_dir, "--out", out_.string()}, 20, &output), 0)
+      << output;
+  const std::vector<Json> lines = Manifest();
+  ASSERT_EQ(lines.size(), 2u);
+  for (const Json& line : lines) {
+    for (const char* key : {"file", "camera", "exposure_us", "gain", "pixel_format", "timestamp"}) {
+      EXPECT_TRUE(line.contains(key)) << key << " in " << line.dump();
+    }
+    EXPECT_TRUE(fs::exists(out_ / line["file"].get<std::string>()));
+  }
+  // A folder that does not exist is bad usage: exit 2, nothing written.
+  const fs::path other = dir_ / "other";
+  EXPECT_EQ(
+      RunProcess({kCapture, "--from-raw", (dir_ / "missing").string(), "--out", other.string()}, 20,
+                 &output),
+      2)
+      << output;
+  EXPECT_FALSE(fs::exists(other));
+}
+
 }  // namespace
 }  // namespace igi::capture::testing
