@@ -232,6 +232,35 @@ TEST_F(CaptureE2eTest, AutoChoosesABracketFromUnclippedHighlights) {
   EXPECT_EQ(Manifest().size(), exposures.size());
 }
 
+TEST_F(CaptureE2eTest, GainAndPixelFormatAreSettable) {
+  StartCamera("IGIG1");
+  std::string output;
+  // Gain 1 raises the pattern's scale by 1: the content proves the camera applied it.
+  ASSERT_EQ(RunProcess(CaptureArgs({"--exposures-us", "5000", "--gain", "1"}), 20, &output), 0)
+      << output;
+  std::vector<Json> lines = Manifest();
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_DOUBLE_EQ(lines[0]["gain"].get<double>(), 1.0);
+  EXPECT_EQ(PatternMatch(out_, lines[0]), 1.0);
+  fs::remove_all(out_);
+  ASSERT_EQ(
+      RunProcess(CaptureArgs({"--exposures-us", "5000", "--pixel-format", "Mono16"}), 20, &output),
+      0)
+      << output;
+  lines = Manifest();
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0]["pixel_format"], "Mono16");
+  EXPECT_EQ(lines[0]["significant_bits"], 16);
+  EXPECT_EQ(ReadImageInfo(out_ / lines[0]["file"].get<std::string>()).bits_per_sample, 16);
+  // A format the camera lacks is bad usage: exit 2, nothing written.
+  fs::remove_all(out_);
+  EXPECT_EQ(
+      RunProcess(CaptureArgs({"--exposures-us", "5000", "--pixel-format", "Mono12"}), 20, &output),
+      2)
+      << output;
+  EXPECT_FALSE(fs::exists(out_ / "manifest.jsonl"));
+}
+
 TEST_F(CaptureE2eTest, FromRawImportsIntoTheSameLayout) {
   std::string output;
   const std::string raw_dir = std::string(IGI_SHARED_DATA_DIR) + "/real/raw";
