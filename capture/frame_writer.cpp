@@ -1,0 +1,54 @@
+#include "capture/frame_writer.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+
+namespace igi::capture {
+
+uint16_t WidenTo16Bits(uint16_t level, int significant_bits) {
+  if (significant_bits >= 16) return level;
+  const int shift = 16 - significant_bits;
+  uint32_t wide = uint32_t(level) << shift;
+  // Repeat the top bits into the freed low bits until they are filled.
+  for (int filled = significant_bits; filled < 16; filled += significant_bits) {
+    wide |= uint32_t(level) << shift >> filled;
+  }
+  return static_cast<uint16_t>(wide);
+}
+
+void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool durable) {
+  const int channels = frame.format.channels;
+  std::vector<uint16_t> wide(frame.levels.size());
+  for (size_t i = 0; i < wide.size(); ++i) {
+    wide[i] = WidenTo16Bits(frame.levels[i], frame.format.significant_bits);
+  }
+  AtomicOutput output(path);
+  auto out = OIIO::ImageOutput::create(output.temp_path().string());
+  if (!out) {
+    throw Error(path.string() + ": cannot write: " + OIIO::geterror());
+  }
+  OIIO::ImageSpec spec(frame.width, frame.height, channels, OIIO::TypeDesc::UINT16);
+  const std::string extension = path.extension().string();
+  if (extension == ".png") {
+    spec.attribute("png:compressionLevel", 1);
+  } else {
+    spec.attribute("compression", "none");
+  }
+  spec.attribute("igi:pixel_format", frame.format.name);
+  spec.attribute("igi:significant_bits", frame.format.significant_bits);
+  if (!out->open(output.temp_path().string(), spec) ||
+      !out->write_image(OIIO::TypeDesc::UINT16, wide.data()) || !out->close()) {
+    throw Error(path.string() + ": cannot write: " + out->geterror());
+  }
+  if (durable) {
+    output.Commit();
+    return;
+  }
+  std::error_code error;
+  std::filesystem::rename(output.temp_path(), path, error);
+  if (error) throw Error(path.string() + ": cannot write: " + error.message());
+}
+
+}  // namespace igi::capture
