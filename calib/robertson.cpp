@@ -1,0 +1,119 @@
+#include "calib/robertson.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "tools/common/error.h"
+
+namespace igi::calib {
+namespace {
+
+// Robertson's certainty weight: a Gaussian bump over the level range, 0 where unusable.
+std::vector<double> Weights(int levels, const ResponseOptions& options) {
+  std::vector<double> w(static_cast<size_t>(levels));
+  const double mid = 0.5 * (levels - 1);
+  for (int z = 0; z < levels; ++z) {
+    const double v = double(z) / (levels - 1);
+    const double d = (z - mid) / mid;
+    w[size_t(z)] = (v <= options.black || v >= options.saturated) ? 0.0 : std::exp(-4.0 * d * d);
+  }
+  return w;
+}
+
+// Levels of a regular subsample of pixels: [pixel][image].
+std::vector<std::vector<int>> SubsampleLevels(const Bracket& bracket, int channel, int levels,
+                                              int max_pixels) {
+  const int64_t total = int64_t(bracket.width()) * bracket.height();
+  const int stride = std::max(1, int(std::ceil(std::sqrt(double(total) / max_pixels))));
+  std::vector<std::vector<int>> out;
+  for (int y = stride / 2; y < bracket.height(); y += stride) {
+    for (int x = stride / 2; x < bracket.width(); x += stride) {
+      std::vector<int> z;
+      for (const Image& image : bracket.images) {
+        z.push_back(int(std::lround(image.at(x, y, channel) * (levels - 1))));
+      }
+      out.push_back(std::move(z));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& options,
+                                 int levels) {
+  const std::vector<double> w = Weights(levels, options);
+  const std::vector<double>& t = bracket.exposures_s;
+  ResponseSummary summary;
+  summary.curve.method = "robertson";
+  summary.curve.levels = levels;
+  summary.curve.channels = DefaultChannelNames(bracket.channels());
+  summary.converged = true;
+  for (int c = 0; c < bracket.channels(); ++c) {
+    const auto z = SubsampleLevels(bracket, c, levels, options.max_robertson_pixels);
+    summary.samples = int(z.size());
+    std::vector<double> inv(static_cast<size_t>(levels));  // I(z), linear start
+    for (int k = 0; k < levels; ++k) inv[size_t(k)] = (k + 0.5) / (0.5 * levels);
+    std::vector<double> radiance(z.size());
+    int iteration = 0;
+    double change = 1e30;
+    std::vector<int> count(static_cast<size_t>(levels));
+    for (; iteration < options.max_iterations && change > options.tolerance; ++iteration) {
+      for (size_t i = 0; i < z.size(); ++i) {
+        double num = 0.0, den = 0.0;
+        for (size_t j = 0; j < t.size(); ++j) {
+          const double wz = w[size_t(z[i][j])];
+          num += wz * t[j] * inv[size_t(z[i][j])];
+          den += wz * t[j] * t[j];
+        }
+        radiance[i] = den > 0.0 ? num / den : -1.0;
+      }
+      std::vector<double> sum(static_cast<size_t>(levels), 0.0);
+      std::fill(count.begin(), count.end(), 0);
+      for (size_t i = 0; i < z.size(); ++i) {
+        if (radiance[i] < 0.0) continue;
+        for (size_t j = 0; j < t.size(); ++j) {
+          sum[size_t(z[i][j])] += radiance[i] * t[j];
+          ++count[size_t(z[i][j])];
+        }
+      }
+      std::vector<double> next = inv;
+      for (int k = 0; k < levels; ++k) {
+        if (count[size_t(k)] > 0) next[size_t(k)] = sum[size_t(k)] / count[size_t(k)];
+      }
+      const double mid = next[size_t(levels / 2)];
+      double sq = 0.0;
+      for (int k = 0; k < levels; ++k) {
+        next[size_t(k)] /= mid;
+        const double d = std::log(std::max(next[size_t(k)], 1e-12)) -
+                         std::log(std::max(inv[size_t(k)], 1e-12));
+        sq += d * d;
+      }
+      change = std::sqrt(sq / levels);
+      inv = std::move(next);
+    }
+    summary.iterations = std::max(summary.iterations, iteration);
+    summary.converged = summary.converged && change <= options.tolerance;
+    int used = 0;
+    for (int k = 0; k < levels; ++k) used += (count[size_t(k)] > 0 && w[size_t(k)] > 0) ? 1 : 0;
+    if (used < levels / 4) {
+      throw InputError(DescribeProblem(
+          bracket.names.front(), fmt::format("channel {}", c),
+          fmt::format("{} of {} levels observed", used, levels),
+          "too few usable pixels: Robertson needs values neither black nor saturated over at "
+          "least a quarter of the levels"));
+    }
+    std::vector<double> g(static_cast<size_t>(levels));
+    for (int k = 0; k < levels; ++k) g[size_t(k)] = std::log(std::max(inv[size_t(k)], 1e-12));
+    for (size_t k = 1; k < g.size(); ++k) g[k] = std::max(g[k], g[k - 1]);
+    summary.curve.g.push_back(std::move(g));
+  }
+  summary.equations = summary.samples * int(t.size());
+  spdlog::info("robertson: {} pixels, {} iterations{}", summary.samples, summary.iterations,
+               summary.converged ? "" : " (not converged)");
+  return summary;
+}
+
+}  // namespace igi::calib
