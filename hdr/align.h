@@ -1,0 +1,34 @@
+#pragma once
+// Alignment of hand-held brackets by median threshold bitmaps (Ward, "Fast, robust image
+// registration for compositing high dynamic range photographs from hand-held exposures",
+// JGT 2003): each image is thresholded at its own median, so the bitmaps agree across exposures
+// whatever the response; translations are found coarse to fine on an image pyramid, ignoring
+// pixels within `exclude_range` levels of the median. (OpenCV's AlignMTB does the search.)
+// Translation only: rotation between frames is not modelled.
+
+#include <vector>
+
+#include "tools/common/image.h"
+
+namespace igi::hdr {
+
+struct AlignOptions {
+  int max_bits = 6;       // pyramid levels: shifts up to about 2^max_bits pixels
+  int exclude_range = 4;  // 8-bit levels around the median ignored in the bitmaps
+  void Validate() const;
+};
+
+struct PixelShift {
+  int dx = 0;  // shift to apply to the image so it lines up with the reference, pixels
+  int dy = 0;
+};
+
+// Shifts that align each image to images[reference] (whose shift is 0). Images are normalised
+// levels in [0, 1] (any response).
+std::vector<PixelShift> ComputeMtbShifts(const std::vector<Image>& images, int reference,
+                                         const AlignOptions& options = {});
+
+// Moves the content of `image` by `shift`; pixels shifted in from outside repeat the border.
+Image ShiftImage(const Image& image, const PixelShift& shift);
+
+}  // namespace igi::hdr
