@@ -1,7 +1,6 @@
 #include "calib/response_recovery.h"
 
-#include <Eigen/Sparse>
-#include <Eigen/SparseQR>
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -63,29 +62,64 @@ void CheckEnoughEquations(const Bracket& bracket, int equations, int levels, int
   }
 }
 
+// One data equation w * (g(z) - ln E_i - ln t_j) = 0 with g(z) interpolated between levels
+// k and k + 1 (fraction a).
+struct Equation {
+  int k;
+  double a;
+  double w;
+  double ln_t;
+};
+
+// Solves Debevec–Malik's weighted least squares by normal equations with the per-sample
+// unknowns ln E_i eliminated exactly (Schur complement): what remains is a dense
+// levels x levels symmetric system, solved by LDLT in double precision. The smoothness rows and
+// the gauge row g(middle) = 0 keep it positive definite.
 std::vector<double> SolveDebevecChannel(const Bracket& bracket,
                                         const std::vector<int64_t>& pixels, int channel,
                                         int levels, const ResponseOptions& options,
                                         double* rms) {
-  const int n = int(pixels.size());
   const int p = int(bracket.images.size());
-  const int unknowns = levels + n;
-  std::vector<Eigen::Triplet<double>> triplets;
-  std::vector<double> rhs;
-  int row = 0;
-  for (int i = 0; i < n; ++i) {
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(levels, levels);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(levels);
+  std::vector<std::vector<Equation>> equations(pixels.size());
+  for (size_t i = 0; i < pixels.size(); ++i) {
     for (int j = 0; j < p; ++j) {
       const Image& image = bracket.images[size_t(j)];
-      const double z = image.pixels[size_t(pixels[size_t(i)]) * image.channels + channel] *
+      const double z = image.pixels[size_t(pixels[i]) * image.channels + channel] *
                        double(levels - 1);
       const int k = std::min(int(z), levels - 2);
-      const double a = z - k;
-      const double w = HatWeight(z, levels);
-      triplets.emplace_back(row, k, w * (1.0 - a));
-      triplets.emplace_back(row, k + 1, w * a);
-      triplets.emplace_back(row, levels + i, -w);
-      rhs.push_back(w * std::log(bracket.exposures_s[size_t(j)]));
-      ++row;
+      equations[i].push_back({k, z - k, HatWeight(z, levels),
+                              std::log(bracket.exposures_s[size_t(j)])});
+    }
+    // Row r = w (a^T g - e - ln t). Normal equations in (g, e); eliminate e:
+    // H_gg += w^2 a a^T, H_ge = -w^2 a, H_ee = w^2; b_g += w^2 ln t a, b_e = -w^2 ln t.
+    Eigen::VectorXd cross = Eigen::VectorXd::Zero(levels);
+    double h_ee = 0.0, b_e = 0.0;
+    for (const Equation& eq : equations[i]) {
+      const double w2 = eq.w * eq.w;
+      const double c0 = 1.0 - eq.a, c1 = eq.a;
+      h(eq.k, eq.k) += w2 * c0 * c0;
+      h(eq.k, eq.k + 1) += w2 * c0 * c1;
+      h(eq.k + 1, eq.k) += w2 * c0 * c1;
+      h(eq.k + 1, eq.k + 1) += w2 * c1 * c1;
+      rhs(eq.k) += w2 * eq.ln_t * c0;
+      rhs(eq.k + 1) += w2 * eq.ln_t * c1;
+      cross(eq.k) -= w2 * c0;
+      cross(eq.k + 1) -= w2 * c1;
+      h_ee += w2;
+      b_e -= w2 * eq.ln_t;
+    }
+    // S = H_gg - H_ge H_ee^-1 H_eg, b = b_g - H_ge H_ee^-1 b_e (cross is sparse: <= 2P entries).
+    std::vector<int> nz;
+    for (const Equation& eq : equations[i]) {
+      for (int k : {eq.k, eq.k + 1}) {
+        if (std::find(nz.begin(), nz.end(), k) == nz.end()) nz.push_back(k);
+      }
+    }
+    for (int r : nz) {
+      for (int c : nz) h(r, c) -= cross(r) * cross(c) / h_ee;
+      rhs(r) -= cross(r) * b_e / h_ee;
     }
   }
   // Smoothness: lambda * w(z) * (g(z-1) - 2 g(z) + g(z+1)), scaled so lambda keeps its meaning
@@ -93,36 +127,34 @@ std::vector<double> SolveDebevecChannel(const Bracket& bracket,
   const double scale = std::pow((levels - 1) / 255.0, 2) * std::sqrt(256.0 / levels);
   for (int z = 1; z < levels - 1; ++z) {
     const double w = options.lambda * HatWeight(z, levels) * scale;
-    triplets.emplace_back(row, z - 1, w);
-    triplets.emplace_back(row, z, -2.0 * w);
-    triplets.emplace_back(row, z + 1, w);
-    rhs.push_back(0.0);
-    ++row;
+    const int idx[3] = {z - 1, z, z + 1};
+    const double coef[3] = {w, -2.0 * w, w};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) h(idx[r], idx[c]) += coef[r] * coef[c];
+    }
   }
-  triplets.emplace_back(row, levels / 2, 1.0);  // g(middle) = 0 fixes the free constant
-  rhs.push_back(0.0);
-  ++row;
-  Eigen::SparseMatrix<double> a(row, unknowns);
-  a.setFromTriplets(triplets.begin(), triplets.end());
-  a.makeCompressed();
-  const Eigen::Map<const Eigen::VectorXd> b(rhs.data(), row);
-  Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr(a);
-  if (qr.info() != Eigen::Success) throw Error("Debevec least squares: factorisation failed");
-  const Eigen::VectorXd x = qr.solve(b);
-  std::vector<double> g(x.data(), x.data() + levels);
-  // Residual RMS over the usable data equations, in ln units (unweighted).
+  h(levels / 2, levels / 2) += 1.0;  // g(middle) = 0 fixes the free constant
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
+  if (ldlt.info() != Eigen::Success) throw Error("Debevec least squares: factorisation failed");
+  const Eigen::VectorXd g_solved = ldlt.solve(rhs);
+  std::vector<double> g(g_solved.data(), g_solved.data() + levels);
+  // Residual RMS over the usable data equations, in ln units (unweighted), with each ln E_i at
+  // its weighted optimum.
   double sum = 0.0;
   int count = 0;
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < p; ++j) {
-      const Image& image = bracket.images[size_t(j)];
-      const float v = image.pixels[size_t(pixels[size_t(i)]) * image.channels + channel];
+  for (const auto& sample : equations) {
+    double num = 0.0, den = 0.0;
+    for (const Equation& eq : sample) {
+      const double gz = (1.0 - eq.a) * g[size_t(eq.k)] + eq.a * g[size_t(eq.k) + 1];
+      num += eq.w * eq.w * (gz - eq.ln_t);
+      den += eq.w * eq.w;
+    }
+    const double ln_e = num / den;
+    for (const Equation& eq : sample) {
+      const double v = (eq.k + eq.a) / (levels - 1);
       if (v <= options.black || v >= options.saturated) continue;
-      const double z = v * double(levels - 1);
-      const int k = std::min(int(z), levels - 2);
-      const double gz = (1.0 - (z - k)) * x[k] + (z - k) * x[k + 1];
-      const double r = gz - x[levels + i] - std::log(bracket.exposures_s[size_t(j)]);
-      sum += r * r;
+      const double gz = (1.0 - eq.a) * g[size_t(eq.k)] + eq.a * g[size_t(eq.k) + 1];
+      sum += (gz - ln_e - eq.ln_t) * (gz - ln_e - eq.ln_t);
       ++count;
     }
   }
@@ -148,6 +180,9 @@ void ResponseOptions::Validate() const {
   if (!(black >= 0.0 && black < saturated && saturated <= 1.0)) {
     problems.Add("--black/--saturated", "", fmt::format("{}/{}", black, saturated),
                  "need 0 <= black < saturated <= 1");
+  }
+  if (!(robertson_smoothing >= 0.0)) {
+    problems.Add("--robertson-smoothing", "", fmt::format("{}", robertson_smoothing), "must be >= 0");
   }
   if (max_iterations < 1) {
     problems.Add("--max-iterations", "", fmt::format("{}", max_iterations), "must be >= 1");

@@ -26,6 +26,10 @@ struct ResponseOptions {
   int samples = 0;                 // sampled pixels (debevec); 0 = max(100, 3 levels / (P-1))
   double black = 0.02;             // normalised value at or below which a value is unusable
   double saturated = 0.98;         // normalised value at or above which a value is unusable
+  // robertson: weight of a second-difference penalty on ln I(z) applied at every iteration
+  // (0 = none, Robertson's original). A bracket with one constant exposure ratio leaves
+  // components of ln I that are periodic in ln exposure undetermined; ~10..30 damps them.
+  double robertson_smoothing = 0.0;
   int max_iterations = 50;         // robertson
   double tolerance = 1e-5;         // robertson: stop when g changes less (RMS, ln units)
   int max_robertson_pixels = 60000;  // robertson: pixels used (a regular subsample)

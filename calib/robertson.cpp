@@ -1,5 +1,7 @@
 #include "calib/robertson.h"
 
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -38,6 +40,31 @@ std::vector<std::vector<int>> SubsampleLevels(const Bracket& bracket, int channe
     }
   }
   return out;
+}
+
+// Whittaker smoother: argmin_g sum_k c_k (y_k - g_k)^2 + mu sum_k (g_{k-1} - 2 g_k + g_{k+1})^2.
+// Removes the sawtooth that a bracket with one constant exposure ratio leaves undetermined
+// (any ln I periodic in ln exposure with that ratio fits the data equally well).
+std::vector<double> Smooth(const std::vector<double>& y, const std::vector<double>& c, double mu) {
+  const int n = int(y.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::VectorXd rhs(n);
+  for (int k = 0; k < n; ++k) {
+    triplets.emplace_back(k, k, c[size_t(k)] + 1e-9);
+    rhs(k) = c[size_t(k)] * y[size_t(k)];
+  }
+  for (int k = 1; k < n - 1; ++k) {
+    const int idx[3] = {k - 1, k, k + 1};
+    const double coef[3] = {1.0, -2.0, 1.0};
+    for (int r = 0; r < 3; ++r) {
+      for (int q = 0; q < 3; ++q) triplets.emplace_back(idx[r], idx[q], mu * coef[r] * coef[q]);
+    }
+  }
+  Eigen::SparseMatrix<double> a(n, n);
+  a.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
+  const Eigen::VectorXd g = solver.solve(rhs);
+  return std::vector<double>(g.data(), g.data() + n);
 }
 
 }  // namespace
@@ -82,6 +109,20 @@ ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& 
       std::vector<double> next = inv;
       for (int k = 0; k < levels; ++k) {
         if (count[size_t(k)] > 0) next[size_t(k)] = sum[size_t(k)] / count[size_t(k)];
+      }
+      if (options.robertson_smoothing > 0.0) {
+        // Smooth ln I with weights from the counts and certainties of the levels.
+        std::vector<double> y(static_cast<size_t>(levels)), cw(static_cast<size_t>(levels));
+        double total = 0.0;
+        for (int k = 0; k < levels; ++k) {
+          y[size_t(k)] = std::log(std::max(next[size_t(k)], 1e-12));
+          cw[size_t(k)] = count[size_t(k)] * w[size_t(k)];  // unusable levels: no data
+          total += cw[size_t(k)];
+        }
+        for (double& ck : cw) ck *= levels / std::max(total, 1e-12);
+        const double scale = std::pow((levels - 1) / 255.0, 4);
+        const std::vector<double> smooth = Smooth(y, cw, options.robertson_smoothing * options.robertson_smoothing * scale);
+        for (int k = 0; k < levels; ++k) next[size_t(k)] = std::exp(smooth[size_t(k)]);
       }
       const double mid = next[size_t(levels / 2)];
       double sq = 0.0;
