@@ -38,7 +38,8 @@ ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int l
     const double v = double(q) / (levels - 1);
     if (v <= options.black || v >= options.saturated) continue;
     if (options.weighting == "hat") {
-      t.weight[size_t(q)] = float(std::min(v - options.black, options.saturated - v));
+      // Debevec & Malik's hat over the levels (+1, as OpenCV's triangleWeights).
+      t.weight[size_t(q)] = float((std::min(q, levels - 1 - q) + 1) / (0.5 * levels));
       continue;
     }
     const double slope =
@@ -91,77 +92,115 @@ void MergeOptions::Validate() const {
   problems.ThrowIfAny();
 }
 
+namespace {
+
+// The per-pixel merge over lookup tables; one instance is shared by all threads (read only).
+class MergeKernel {
+ public:
+  MergeKernel(const std::vector<Image>& images, const std::vector<double>& exposures_s,
+              const calib::ResponseCurve& response, const MergeOptions& options)
+      : options_(options),
+        levels_(1 << options.bits),
+        channels_(images[0].channels),
+        scale_(float(levels_ - 1)),
+        hat_(options.weighting == "hat") {
+    for (int c = 0; c < channels_; ++c) {
+      tables_.push_back(
+          BuildTables(response, response.num_channels() == 1 ? 0 : c, levels_, options));
+    }
+    shortest_ = size_t(std::min_element(exposures_s.begin(), exposures_s.end()) -
+                       exposures_s.begin());
+    longest_ = size_t(std::max_element(exposures_s.begin(), exposures_s.end()) -
+                      exposures_s.begin());
+    for (size_t j = 0; j < images.size(); ++j) {
+      t_.push_back(float(exposures_s[j]));
+      ln_t_.push_back(float(std::log(exposures_s[j])));
+      src_.push_back(images[j].pixels.data());
+    }
+  }
+
+  // Merges pixel `pixel` into `out` (channels_ values); returns bit 1 = saturated, 2 = black.
+  int Pixel(size_t pixel, float* out) const {
+    constexpr int kMaxChannels = 8;
+    float num[kMaxChannels] = {}, den[kMaxChannels] = {};
+    const size_t base = pixel * size_t(channels_);
+    const size_t p = src_.size();
+    for (size_t j = 0; j < p; ++j) {
+      float w_shared = 0.0f;
+      int q[kMaxChannels];
+      for (int c = 0; c < channels_; ++c) {
+        q[c] = Level(src_[j][base + size_t(c)]);
+        w_shared += tables_[size_t(c)].weight[size_t(q[c])];
+      }
+      w_shared /= float(channels_);
+      for (int c = 0; c < channels_; ++c) {
+        const ChannelTables& tab = tables_[size_t(c)];
+        const float w = options_.shared_weights ? w_shared : tab.weight[size_t(q[c])];
+        if (hat_) {
+          num[c] += w * (tab.ln[size_t(q[c])] - ln_t_[j]);
+          den[c] += w;
+        } else {
+          num[c] += w * t_[j] * tab.lin[size_t(q[c])];
+          den[c] += w * t_[j] * t_[j];
+        }
+      }
+    }
+    int flags = 0;
+    for (int c = 0; c < channels_; ++c) {
+      if (den[c] > 0.0f) {
+        out[c] = hat_ ? std::exp(num[c] / den[c]) : num[c] / den[c];
+        continue;
+      }
+      // No usable value: saturated (judged on the shortest exposure) or black everywhere.
+      const int q_short = Level(src_[shortest_][base + size_t(c)]);
+      const bool saturated = double(q_short) / (levels_ - 1) >= options_.saturated;
+      const size_t j = saturated ? shortest_ : longest_;
+      out[c] = tables_[size_t(c)].lin[size_t(Level(src_[j][base + size_t(c)]))] / t_[j];
+      flags |= saturated ? 1 : 2;
+    }
+    return flags;
+  }
+
+ private:
+  int Level(float v) const { return std::clamp(int(v * scale_ + 0.5f), 0, levels_ - 1); }
+
+  const MergeOptions& options_;
+  int levels_;
+  int channels_;
+  float scale_;
+  bool hat_;
+  std::vector<ChannelTables> tables_;
+  size_t shortest_ = 0, longest_ = 0;
+  std::vector<float> t_, ln_t_;
+  std::vector<const float*> src_;
+};
+
+}  // namespace
+
 MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<double>& exposures_s,
                          const calib::ResponseCurve& response, const MergeOptions& options) {
   options.Validate();
   CheckInputs(images, exposures_s, response);
+  if (images[0].channels > 8) {
+    throw InputError(DescribeProblem("bracket", "channels", fmt::format("{}", images[0].channels),
+                                     "at most 8 channels"));
+  }
   const auto start = std::chrono::steady_clock::now();
   const int width = images[0].width, height = images[0].height, channels = images[0].channels;
-  const int levels = 1 << options.bits;
-  std::vector<ChannelTables> tables;
-  for (int c = 0; c < channels; ++c) {
-    tables.push_back(BuildTables(response, response.num_channels() == 1 ? 0 : c, levels, options));
-  }
-  const size_t p = images.size();
-  const size_t shortest = size_t(std::min_element(exposures_s.begin(), exposures_s.end()) -
-                                 exposures_s.begin());
-  const size_t longest = size_t(std::max_element(exposures_s.begin(), exposures_s.end()) -
-                                exposures_s.begin());
-  std::vector<float> t(p), t2(p), ln_t(p);
-  std::vector<const float*> src(p);
-  for (size_t j = 0; j < p; ++j) {
-    t[j] = float(exposures_s[j]);
-    t2[j] = t[j] * t[j];
-    ln_t[j] = float(std::log(exposures_s[j]));
-    src[j] = images[j].pixels.data();
-  }
+  const MergeKernel kernel(images, exposures_s, response, options);
   MergeResult result;
   result.radiance = Image(width, height, channels);
   result.mask = Image(width, height, 1, 1.0f);
   std::atomic<int64_t> saturated{0}, black{0};
-  const float scale = float(levels - 1);
-  const bool hat = options.weighting == "hat";
   ParallelForRange(
       0, height,
       [&](int64_t y0, int64_t y1) {
         int64_t row_saturated = 0, row_black = 0;
-        for (int64_t y = y0; y < y1; ++y) {
-          for (int x = 0; x < width; ++x) {
-            const size_t pixel = size_t(y) * width + x;
-            bool flagged_saturated = false, flagged_black = false;
-            for (int c = 0; c < channels; ++c) {
-              const size_t i = pixel * channels + c;
-              const ChannelTables& tab = tables[size_t(c)];
-              float num = 0.0f, den = 0.0f;
-              for (size_t j = 0; j < p; ++j) {
-                const int q = std::clamp(int(src[j][i] * scale + 0.5f), 0, levels - 1);
-                const float w = tab.weight[size_t(q)];
-                if (hat) {
-                  num += w * (tab.ln[size_t(q)] - ln_t[j]);
-                  den += w;
-                } else {
-                  num += w * t[j] * tab.lin[size_t(q)];
-                  den += w * t2[j];
-                }
-              }
-              float value;
-              if (den > 0.0f) {
-                value = hat ? std::exp(num / den) : num / den;
-              } else {
-                const int q_short = std::clamp(int(src[shortest][i] * scale + 0.5f), 0, levels - 1);
-                const bool is_saturated = double(q_short) / (levels - 1) >= options.saturated;
-                const size_t j = is_saturated ? shortest : longest;
-                const int q = std::clamp(int(src[j][i] * scale + 0.5f), 0, levels - 1);
-                value = tab.lin[size_t(q)] / t[j];
-                flagged_saturated |= is_saturated;
-                flagged_black |= !is_saturated;
-              }
-              result.radiance.pixels[i] = value;
-            }
-            if (flagged_saturated || flagged_black) result.mask.pixels[pixel] = 0.0f;
-            row_saturated += flagged_saturated ? 1 : 0;
-            row_black += flagged_black ? 1 : 0;
-          }
+        for (size_t pixel = size_t(y0) * width; pixel < size_t(y1) * width; ++pixel) {
+          const int flags = kernel.Pixel(pixel, &result.radiance.pixels[pixel * channels]);
+          if (flags != 0) result.mask.pixels[pixel] = 0.0f;
+          row_saturated += flags & 1;
+          row_black += (flags >> 1) & 1;
         }
         saturated += row_saturated;
         black += row_black;
@@ -171,8 +210,8 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
   result.black_pixels = black;
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  spdlog::debug("merge: {}x{}x{}, {} images, {} weights, {:.3f} s", width, height, channels, p,
-                options.weighting, result.seconds);
+  spdlog::debug("merge: {}x{}x{}, {} images, {} weights, {:.3f} s", width, height, channels,
+                images.size(), options.weighting, result.seconds);
   return result;
 }
 

@@ -8,6 +8,7 @@
 //   with shot noise, read noise and the quantisation of the levels mapped through the response:
 //   var = shot_noise * I + read_noise^2 + (I'(z) / 2^bits)^2 / 12, I in units of full scale
 //   (I(top level) = 1). This is Granados et al. (CVPR 2010) / Hasinoff et al. (CVPR 2010).
+//   The variance is evaluated at the measured value, through a lookup table per level.
 // - "hat": Debevec & Malik's merge, ln E = sum w(z) (g(z) - ln t) / sum w(z) with the hat w.
 // Values at or below `black` or at or above `saturated` (normalised) get no weight. A pixel
 // with no usable value in a channel is saturated (in the shortest exposure) or black (in the
@@ -30,6 +31,9 @@ struct MergeOptions {
   double saturated = 0.98;          // normalised value at or above which a value is unusable
   double shot_noise = 1.0 / 4000;   // variance per unit signal (1 / full well in electrons)
   double read_noise = 1.0 / 2000;   // standard deviation, units of full scale
+  // One weight per pixel and exposure, the mean of the channels' weights (as OpenCV's
+  // MergeDebevec does), instead of one per channel.
+  bool shared_weights = false;
   int bits = 8;                     // quantisation of the input levels (8 or 16)
   int num_threads = 0;              // 0 = the process default
 
