@@ -3,7 +3,13 @@
 // registration for compositing high dynamic range photographs from hand-held exposures",
 // JGT 2003): each image is thresholded at its own median, so the bitmaps agree across exposures
 // whatever the response; translations are found coarse to fine on an image pyramid, ignoring
-// pixels within `exclude_range` levels of the median. (OpenCV's AlignMTB does the search.)
+// pixels within `exclude_range` levels of the median. igi's own implementation: OpenCV's
+// AlignMTB drifts to its largest shift on the Memorial bracket (ties pick the first candidate).
+// Two changes to Ward's method: (1) each image is aligned to its neighbour in brightness and the
+// shifts are chained out from the reference (the ends of a long bracket share no well-exposed
+// pixels); (2) a pair is thresholded at a common percentile whose levels lie between 32 and 223
+// in both images rather than at the median, which in a dark scene sits in the noise floor.
+// Percentiles do not depend on the response, so the bitmaps of both exposures still correspond.
 // Translation only: rotation between frames is not modelled.
 
 #include <vector>
