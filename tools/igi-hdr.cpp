@@ -28,6 +28,7 @@ struct Flags {
   std::string out;
   std::string mask_out;  // empty = OUT_mask.png
   bool align = false;
+  bool black_given = false;  // --black on the command line (else raw input uses 0)
   igi::hdr::HdrInputOptions input;
   igi::hdr::MergeOptions merge;
 };
@@ -112,6 +113,8 @@ int Run(const Flags& flags) {
     if (flags.align) AlignJob(&job.input);
     igi::hdr::MergeOptions merge = flags.merge;
     merge.bits = job.input.bits;
+    // Raw data has its black level subtracted: only a zero value carries no signal.
+    if (job.input.raw && !flags.black_given) merge.black = 0.0;
     const igi::hdr::MergeResult result =
         igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
     const fs::path mask = MaskPath(job.out, flags.mask_out, jobs.size() == 1);
@@ -155,12 +158,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"noise", "hat"}));
   app.add_option("--shot-noise", flags.merge.shot_noise, "Variance per unit signal (full scale 1)");
   app.add_option("--read-noise", flags.merge.read_noise, "Read noise std, full scale 1");
-  app.add_option("--black", flags.merge.black, "Normalised level at or below which = black");
+  CLI::Option* black =
+      app.add_option("--black", flags.merge.black,
+                     "Normalised level at or below which = black (default 0.02; raw: 0)");
   app.add_option("--saturated", flags.merge.saturated, "Normalised level at or above = saturated");
   app.add_flag("--align", flags.align, "Align hand-held brackets (median threshold bitmaps)");
   app.add_option("--mask-out", flags.mask_out, "Mask of bad pixels (default OUT_mask.png)");
   app.add_option("--raw-white-balance", flags.input.raw.white_balance, "camera or none");
   app.add_option("--raw-color", flags.input.raw.color, "srgb (linear) or raw (camera RGB)");
   app.add_flag("--half-size", flags.input.raw.half_size, "Raw: 2x2 binning, no demosaicing");
-  return igi::RunMain(app, common, argc, argv, [&]() { return Run(flags); });
+  return igi::RunMain(app, common, argc, argv, [&]() {
+    flags.black_given = black->count() > 0;
+    return Run(flags);
+  });
 }
