@@ -1,6 +1,7 @@
 #include "hdr/merge.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -18,6 +19,8 @@ struct ChannelTables {
   std::vector<float> lin;     // I(q) = exp(g(q)), response units
   std::vector<float> ln;      // g(q)
   std::vector<float> weight;  // 0 where unusable
+  // {w * x, w} with x = I(q) (noise) or g(q) (hat): one load per sample in the hot loop.
+  std::vector<std::array<float, 2>> weighted;
 };
 
 ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int levels,
@@ -47,6 +50,11 @@ ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int l
     const double variance = options.shot_noise * normalised[size_t(q)] +
                             options.read_noise * options.read_noise + slope * slope / 12.0;
     t.weight[size_t(q)] = float(1.0 / variance);
+  }
+  t.weighted.resize(size_t(levels));
+  const bool hat = options.weighting == "hat";
+  for (size_t q = 0; q < size_t(levels); ++q) {
+    t.weighted[q] = {t.weight[q] * (hat ? t.ln[q] : t.lin[q]), t.weight[q]};
   }
   return t;
 }
@@ -113,40 +121,40 @@ class MergeKernel {
     longest_ = size_t(std::max_element(exposures_s.begin(), exposures_s.end()) -
                       exposures_s.begin());
     for (size_t j = 0; j < images.size(); ++j) {
-      t_.push_back(float(exposures_s[j]));
-      ln_t_.push_back(float(std::log(exposures_s[j])));
+      const float t = float(exposures_s[j]);
+      t_.push_back(t);
+      a_.push_back(hat_ ? 1.0f : t);
+      b_.push_back(hat_ ? -float(std::log(exposures_s[j])) : 0.0f);
+      c_.push_back(hat_ ? 1.0f : t * t);
       src_.push_back(images[j].pixels.data());
     }
   }
 
   // Merges pixel `pixel` into `out` (channels_ values); returns bit 1 = saturated, 2 = black.
+  // Every sample adds a_j * (w x) + b_j * w to the numerator and c_j * w to the denominator:
+  // noise a = t, b = 0, c = t^2 (then E = num / den); hat a = 1, b = -ln t, c = 1
+  // (then E = exp(num / den)). kChannels = 0: any count (runtime).
+  template <int kChannels>
   int Pixel(size_t pixel, float* out) const {
     constexpr int kMaxChannels = 8;
+    const int channels = kChannels > 0 ? kChannels : channels_;
     float num[kMaxChannels] = {}, den[kMaxChannels] = {};
-    const size_t base = pixel * size_t(channels_);
+    const size_t base = pixel * size_t(channels);
     const size_t p = src_.size();
-    for (size_t j = 0; j < p; ++j) {
-      float w_shared = 0.0f;
-      int q[kMaxChannels];
-      for (int c = 0; c < channels_; ++c) {
-        q[c] = Level(src_[j][base + size_t(c)]);
-        w_shared += tables_[size_t(c)].weight[size_t(q[c])];
-      }
-      w_shared /= float(channels_);
-      for (int c = 0; c < channels_; ++c) {
-        const ChannelTables& tab = tables_[size_t(c)];
-        const float w = options_.shared_weights ? w_shared : tab.weight[size_t(q[c])];
-        if (hat_) {
-          num[c] += w * (tab.ln[size_t(q[c])] - ln_t_[j]);
-          den[c] += w;
-        } else {
-          num[c] += w * t_[j] * tab.lin[size_t(q[c])];
-          den[c] += w * t_[j] * t_[j];
+    if (options_.shared_weights) {
+      SharedWeightSums(base, num, den);
+    } else {
+      for (size_t j = 0; j < p; ++j) {
+        const float* src = src_[j] + base;
+        for (int c = 0; c < channels; ++c) {
+          const std::array<float, 2>& wx = tables_[size_t(c)].weighted[size_t(Level(src[c]))];
+          num[c] += a_[j] * wx[0] + b_[j] * wx[1];
+          den[c] += c_[j] * wx[1];
         }
       }
     }
     int flags = 0;
-    for (int c = 0; c < channels_; ++c) {
+    for (int c = 0; c < channels; ++c) {
       if (den[c] > 0.0f) {
         out[c] = hat_ ? std::exp(num[c] / den[c]) : num[c] / den[c];
         continue;
@@ -161,6 +169,81 @@ class MergeKernel {
     return flags;
   }
 
+  int channels() const { return channels_; }
+
+  // Merges `count` consecutive values (whole pixels) starting at value index `begin`, image by
+  // image so that each image is read as one sequential stream. `num`/`den` are scratch of size
+  // `count`. Fills out[begin .. begin + count) and returns per-pixel flags in `flags`.
+  void Span(size_t begin, size_t count, float* num, float* den, float* out,
+            uint8_t* flags) const {
+    std::fill(num, num + count, 0.0f);
+    std::fill(den, den + count, 0.0f);
+    const size_t channels = size_t(channels_);
+    for (size_t j = 0; j < src_.size(); ++j) {
+      if (channels == 3) {
+        Accumulate<3>(j, begin, count, num, den);
+      } else if (channels == 1) {
+        Accumulate<1>(j, begin, count, num, den);
+      } else {
+        Accumulate<0>(j, begin, count, num, den);
+      }
+    }
+    for (size_t i = 0; i < count; i += channels) {
+      uint8_t f = 0;
+      for (size_t k = 0; k < channels; ++k) {
+        const size_t v = i + k;
+        if (den[v] > 0.0f) {
+          out[begin + v] = hat_ ? std::exp(num[v] / den[v]) : num[v] / den[v];
+          continue;
+        }
+        const int q_short = Level(src_[shortest_][begin + v]);
+        const bool saturated = double(q_short) / (levels_ - 1) >= options_.saturated;
+        const size_t j = saturated ? shortest_ : longest_;
+        out[begin + v] = tables_[k].lin[size_t(Level(src_[j][begin + v]))] / t_[j];
+        f |= saturated ? 1 : 2;
+      }
+      flags[i / channels] = f;
+    }
+  }
+
+ private:
+  // Adds image j's samples of values [begin, begin + count) to num and den (the hot loop).
+  template <int kChannels>
+  void Accumulate(size_t j, size_t begin, size_t count, float* num, float* den) const {
+    const size_t channels = kChannels > 0 ? size_t(kChannels) : size_t(channels_);
+    constexpr int kMaxChannels = 8;
+    const std::array<float, 2>* tab[kMaxChannels];
+    for (size_t k = 0; k < channels; ++k) tab[k] = tables_[k].weighted.data();
+    const float* src = src_[j] + begin;
+    const float a = a_[j], b = b_[j], c = c_[j];
+    const int top = levels_ - 1;
+    for (size_t i = 0; i < count; i += channels) {
+      for (size_t k = 0; k < channels; ++k) {
+        const int q = std::min(std::max(int(src[i + k] * scale_ + 0.5f), 0), top);
+        const std::array<float, 2> wx = tab[k][q];
+        num[i + k] += a * wx[0] + b * wx[1];
+        den[i + k] += c * wx[1];
+      }
+    }
+  }
+
+  // The sums with one weight per sample shared by the channels (their mean), as MergeDebevec.
+  void SharedWeightSums(size_t base, float* num, float* den) const {
+    for (size_t j = 0; j < src_.size(); ++j) {
+      float w = 0.0f;
+      for (int c = 0; c < channels_; ++c) {
+        w += tables_[size_t(c)].weight[size_t(Level(src_[j][base + size_t(c)]))];
+      }
+      w /= float(channels_);
+      for (int c = 0; c < channels_; ++c) {
+        const ChannelTables& tab = tables_[size_t(c)];
+        const size_t q = size_t(Level(src_[j][base + size_t(c)]));
+        num[c] += a_[j] * w * (hat_ ? tab.ln[q] : tab.lin[q]) + b_[j] * w;
+        den[c] += c_[j] * w;
+      }
+    }
+  }
+
  private:
   int Level(float v) const { return std::clamp(int(v * scale_ + 0.5f), 0, levels_ - 1); }
 
@@ -171,7 +254,7 @@ class MergeKernel {
   bool hat_;
   std::vector<ChannelTables> tables_;
   size_t shortest_ = 0, longest_ = 0;
-  std::vector<float> t_, ln_t_;
+  std::vector<float> t_, a_, b_, c_;
   std::vector<const float*> src_;
 };
 
@@ -196,11 +279,25 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
       0, height,
       [&](int64_t y0, int64_t y1) {
         int64_t row_saturated = 0, row_black = 0;
-        for (size_t pixel = size_t(y0) * width; pixel < size_t(y1) * width; ++pixel) {
-          const int flags = kernel.Pixel(pixel, &result.radiance.pixels[pixel * channels]);
-          if (flags != 0) result.mask.pixels[pixel] = 0.0f;
-          row_saturated += flags & 1;
-          row_black += (flags >> 1) & 1;
+        const size_t row_values = size_t(width) * channels;
+        std::vector<float> num(row_values), den(row_values);
+        std::vector<uint8_t> flags(static_cast<size_t>(width));
+        for (int64_t y = y0; y < y1; ++y) {
+          const size_t first_pixel = size_t(y) * width;
+          if (options.shared_weights) {
+            for (int x = 0; x < width; ++x) {
+              flags[size_t(x)] = uint8_t(kernel.Pixel<0>(
+                  first_pixel + x, &result.radiance.pixels[(first_pixel + x) * channels]));
+            }
+          } else {
+            kernel.Span(first_pixel * channels, row_values, num.data(), den.data(),
+                        result.radiance.pixels.data(), flags.data());
+          }
+          for (int x = 0; x < width; ++x) {
+            if (flags[size_t(x)] != 0) result.mask.pixels[first_pixel + x] = 0.0f;
+            row_saturated += flags[size_t(x)] & 1;
+            row_black += (flags[size_t(x)] >> 1) & 1;
+          }
         }
         saturated += row_saturated;
         black += row_black;
