@@ -45,6 +45,8 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
   sub->add_option("--levels", cmd->options.levels,
                   "Levels of the curve (0 = 256 for 8-bit, 1024 for 16-bit)");
   sub->add_option("--max-iterations", cmd->options.max_iterations, "Robertson iterations");
+  sub->add_option("--robertson-smoothing", cmd->options.robertson_smoothing,
+                  "Robertson: second-difference penalty on ln I (0 = none)");
   return sub;
 }
 

@@ -91,6 +91,28 @@ TEST_F(HdrE2e, ExposureFileAndAlignment) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+// Exposure times from the images' EXIF: 16-bit TIFFs written with ExposureTime. (TIFF, because
+// OpenImageIO 2.4.7 writes a float ExposureTime into JPEG EXIF wrongly: 0.5 reads back as inf;
+// camera JPEGs store a rational and read fine.)
+TEST_F(HdrE2e, ExposureTimesFromExif) {
+  std::string files;
+  const double times[3] = {1.0, 0.5, 0.25};
+  for (int k = 0; k < 3; ++k) {
+    Image frame = ReadImage(kMemorial + "memorial00" + std::to_string(66 + k) + ".png");
+    frame.metadata["ExposureTime"] = times[k];
+    const fs::path path = dir_ / ("exif" + std::to_string(k) + ".tif");
+    WriteImage(path, frame);
+    files += path.string() + " ";
+  }
+  const RunResult r =
+      Run("igi-calib", "response " + files + "--out " + (dir_ / "exif.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const Json doc = ReadJsonFile(dir_ / "exif.json");
+  EXPECT_EQ(doc["info"]["exposures_s"][1], 0.5);
+  EXPECT_EQ(doc["info"]["bits_per_sample"], 16);
+  EXPECT_EQ(doc["levels"], 1024);
+}
+
 TEST_F(HdrE2e, RawIsMergedWithoutAResponse) {
   const fs::path out = dir_ / "chart.exr";
   const RunResult r = Run("igi-hdr", std::string(IGI_SHARED_DATA_DIR) +
