@@ -33,18 +33,15 @@ void CheckSameShape(const std::vector<Image>& images, const std::vector<std::str
     if (images[i].width != images[0].width || images[i].height != images[0].height ||
         images[i].channels != images[0].channels) {
       problems.Add(names[i], "size",
-                   fmt::format("{}x{}x{}", images[i].width, images[i].height,
-                               images[i].channels),
+                   fmt::format("{}x{}x{}", images[i].width, images[i].height, images[i].channels),
                    fmt::format("every image of a bracket must have the size of {} ({}x{}x{})",
-                               names[0], images[0].width, images[0].height,
-                               images[0].channels));
+                               names[0], images[0].width, images[0].height, images[0].channels));
     }
   }
   problems.ThrowIfAny();
 }
 
-Bracket LoadBracket(const std::vector<std::filesystem::path>& paths,
-                    const ExposureSource& source) {
+Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const ExposureSource& source) {
   Bracket bracket;
   if (paths.size() < 2) {
     throw InputError(DescribeProblem(paths.empty() ? "" : paths[0].string(), "images",
@@ -68,9 +65,9 @@ Bracket LoadBracket(const std::vector<std::filesystem::path>& paths,
       }
       if (i == 0) bracket.bits_per_sample = bits;
       if (bits != bracket.bits_per_sample) {
-        problems.Add(name, "pixel type", fmt::format("{} bits", bits),
-                     fmt::format("must match {} ({} bits)", bracket.names[0],
-                                 bracket.bits_per_sample));
+        problems.Add(
+            name, "pixel type", fmt::format("{} bits", bits),
+            fmt::format("must match {} ({} bits)", bracket.names[0], bracket.bits_per_sample));
         continue;
       }
       metadata.push_back(info.metadata);

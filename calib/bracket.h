@@ -24,7 +24,7 @@ struct Bracket {
   std::vector<Image> images;       // encoded levels / (2^bits - 1), same size and channels
   std::vector<std::string> names;  // file paths, for messages
   std::vector<double> exposures_s;
-  int bits_per_sample = 8;         // 8 or 16
+  int bits_per_sample = 8;  // 8 or 16
 
   int width() const { return images.empty() ? 0 : images[0].width; }
   int height() const { return images.empty() ? 0 : images[0].height; }
@@ -41,7 +41,6 @@ std::vector<double> ResolveExposures(const ExposureSource& source,
 void CheckSameShape(const std::vector<Image>& images, const std::vector<std::string>& names);
 
 // Loads 8- or 16-bit images (PNG, TIFF, JPEG, …) with their exposure times.
-Bracket LoadBracket(const std::vector<std::filesystem::path>& paths,
-                    const ExposureSource& source);
+Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const ExposureSource& source);
 
 }  // namespace igi::calib

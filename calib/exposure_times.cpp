@@ -1,7 +1,8 @@
 #include "calib/exposure_times.h"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -53,8 +54,7 @@ std::vector<double> ReadExposureFile(const std::filesystem::path& path) {
     start = end + 1;
     if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     if (Trim(line).empty()) continue;
-    out.push_back(
-        ParseExposureTime(line, path.string(), fmt::format("line {}", line_number)));
+    out.push_back(ParseExposureTime(line, path.string(), fmt::format("line {}", line_number)));
   }
   return out;
 }
@@ -73,9 +73,8 @@ double ExposureFromMetadata(const ImageMetadata& metadata, const std::string& im
     throw InputError(DescribeProblem(image_name, "ExposureTime", fmt::format("{}", value),
                                      "EXIF exposure time must be > 0 s"));
   }
-  throw InputError(DescribeProblem(
-      image_name, "ExposureTime", "missing",
-      "no EXIF exposure time: give --exposures or --exposure-file"));
+  throw InputError(DescribeProblem(image_name, "ExposureTime", "missing",
+                                   "no EXIF exposure time: give --exposures or --exposure-file"));
 }
 
 void ValidateExposures(const std::vector<double>& exposures_s,

@@ -37,8 +37,7 @@ std::vector<int64_t> SelectSamplePixels(const Bracket& bracket, const SamplingOp
   const int width = mid.width;
   const int height = mid.height;
   const double cells_wanted = 4.0 * std::max(options.samples, 1);
-  const int grid_x = std::clamp(int(std::ceil(std::sqrt(cells_wanted * width / height))), 1,
-                                width);
+  const int grid_x = std::clamp(int(std::ceil(std::sqrt(cells_wanted * width / height))), 1, width);
   const int grid_y = std::clamp(int(std::ceil(cells_wanted / grid_x)), 1, height);
   std::vector<Candidate> winners;
   for (int gy = 0; gy < grid_y; ++gy) {

@@ -15,9 +15,9 @@
 namespace igi::calib {
 
 struct SamplingOptions {
-  int samples = 100;       // pixels wanted (fewer come back when the image has fewer good ones)
-  double black = 0.02;     // normalised value at or below which a pixel counts as black
-  double saturated = 0.98; // normalised value at or above which a pixel counts as saturated
+  int samples = 100;        // pixels wanted (fewer come back when the image has fewer good ones)
+  double black = 0.02;      // normalised value at or below which a pixel counts as black
+  double saturated = 0.98;  // normalised value at or above which a pixel counts as saturated
 };
 
 // Pixel indices (y * width + x), sorted. Deterministic.

@@ -1,8 +1,9 @@
 #include "calib/response_curve.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "tools/common/error.h"
 
@@ -41,11 +42,16 @@ ResponseCurve LinearResponse(int levels, int channels) {
 
 std::vector<std::string> DefaultChannelNames(int channels) {
   switch (channels) {
-    case 1: return {"Y"};
-    case 2: return {"Y", "A"};
-    case 3: return {"R", "G", "B"};
-    case 4: return {"R", "G", "B", "A"};
-    default: break;
+    case 1:
+      return {"Y"};
+    case 2:
+      return {"Y", "A"};
+    case 3:
+      return {"R", "G", "B"};
+    case 4:
+      return {"R", "G", "B", "A"};
+    default:
+      break;
   }
   std::vector<std::string> names;
   for (int c = 0; c < channels; ++c) names.push_back(fmt::format("C{}", c));

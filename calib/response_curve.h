@@ -17,10 +17,10 @@
 namespace igi::calib {
 
 struct ResponseCurve {
-  std::string method = "debevec";        // "debevec", "robertson" or "linear"
-  int levels = 256;                      // number of pixel levels (256 for 8-bit)
-  std::vector<std::string> channels;     // e.g. {"R", "G", "B"}
-  std::vector<std::vector<double>> g;    // [channel][level]: ln exposure, any additive constant
+  std::string method = "debevec";      // "debevec", "robertson" or "linear"
+  int levels = 256;                    // number of pixel levels (256 for 8-bit)
+  std::vector<std::string> channels;   // e.g. {"R", "G", "B"}
+  std::vector<std::vector<double>> g;  // [channel][level]: ln exposure, any additive constant
 
   int num_channels() const { return int(g.size()); }
   // ln exposure of normalised pixel value `v` in [0, 1] of `channel`, interpolated.
@@ -33,7 +33,8 @@ struct ResponseCurve {
 // The response of a linear sensor: g(z) = ln(max(z, 0.5) / (levels - 1)).
 ResponseCurve LinearResponse(int levels, int channels);
 
-// Default channel names for `channels` channels: {"Y"}, {"Y","A"}, {"R","G","B"}, {"R","G","B","A"}.
+// Default channel names for `channels` channels: {"Y"}, {"Y","A"}, {"R","G","B"},
+// {"R","G","B","A"}.
 std::vector<std::string> DefaultChannelNames(int channels);
 
 // response.json I/O. `info` (may be null) is written under "info".

@@ -1,8 +1,9 @@
 #include "calib/response_plot.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "tools/common/atomic_file.h"
 
@@ -52,9 +53,9 @@ std::string ResponsePlotSvg(const ResponseCurve& curve, int width, int height) {
       const double y = margin + ph - double(z) / (curve.levels - 1) * ph;
       points += fmt::format("{:.1f},{:.1f} ", x, y);
     }
-    svg += fmt::format(
-        "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" points=\"{}\"/>\n",
-        ChannelColour(name), points);
+    svg +=
+        fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" points=\"{}\"/>\n",
+                    ChannelColour(name), points);
   }
   svg += "</svg>\n";
   return svg;

@@ -1,10 +1,11 @@
 #include "calib/response_recovery.h"
 
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include "calib/pixel_sampling.h"
 #include "calib/robertson.h"
@@ -75,9 +76,8 @@ struct Equation {
 // unknowns ln E_i eliminated exactly (Schur complement): what remains is a dense
 // levels x levels symmetric system, solved by LDLT in double precision. The smoothness rows and
 // the gauge row g(middle) = 0 keep it positive definite.
-std::vector<double> SolveDebevecChannel(const Bracket& bracket,
-                                        const std::vector<int64_t>& pixels, int channel,
-                                        int levels, const ResponseOptions& options,
+std::vector<double> SolveDebevecChannel(const Bracket& bracket, const std::vector<int64_t>& pixels,
+                                        int channel, int levels, const ResponseOptions& options,
                                         double* rms) {
   const int p = int(bracket.images.size());
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(levels, levels);
@@ -86,11 +86,11 @@ std::vector<double> SolveDebevecChannel(const Bracket& bracket,
   for (size_t i = 0; i < pixels.size(); ++i) {
     for (int j = 0; j < p; ++j) {
       const Image& image = bracket.images[size_t(j)];
-      const double z = image.pixels[size_t(pixels[i]) * image.channels + channel] *
-                       double(levels - 1);
+      const double z =
+          image.pixels[size_t(pixels[i]) * image.channels + channel] * double(levels - 1);
       const int k = std::min(int(z), levels - 2);
-      equations[i].push_back({k, z - k, HatWeight(z, levels),
-                              std::log(bracket.exposures_s[size_t(j)])});
+      equations[i].push_back(
+          {k, z - k, HatWeight(z, levels), std::log(bracket.exposures_s[size_t(j)])});
     }
     // Row r = w (a^T g - e - ln t). Normal equations in (g, e); eliminate e:
     // H_gg += w^2 a a^T, H_ge = -w^2 a, H_ee = w^2; b_g += w^2 ln t a, b_e = -w^2 ln t.
@@ -182,14 +182,14 @@ void ResponseOptions::Validate() const {
                  "need 0 <= black < saturated <= 1");
   }
   if (!(robertson_smoothing >= 0.0)) {
-    problems.Add("--robertson-smoothing", "", fmt::format("{}", robertson_smoothing), "must be >= 0");
+    problems.Add("--robertson-smoothing", "", fmt::format("{}", robertson_smoothing),
+                 "must be >= 0");
   }
   if (max_iterations < 1) {
     problems.Add("--max-iterations", "", fmt::format("{}", max_iterations), "must be >= 1");
   }
   problems.ThrowIfAny();
 }
-
 
 ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& options) {
   options.Validate();

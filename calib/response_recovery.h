@@ -30,8 +30,8 @@ struct ResponseOptions {
   // (0 = none, Robertson's original). A bracket with one constant exposure ratio leaves
   // components of ln I that are periodic in ln exposure undetermined; ~10..30 damps them.
   double robertson_smoothing = 0.0;
-  int max_iterations = 50;         // robertson
-  double tolerance = 1e-5;         // robertson: stop when g changes less (RMS, ln units)
+  int max_iterations = 50;           // robertson
+  double tolerance = 1e-5;           // robertson: stop when g changes less (RMS, ln units)
   int max_robertson_pixels = 60000;  // robertson: pixels used (a regular subsample)
 
   // Throws InputError "option: VALUE: RULE" on a bad value.
@@ -40,9 +40,9 @@ struct ResponseOptions {
 
 struct ResponseSummary {
   ResponseCurve curve;
-  int samples = 0;                // pixels used
-  int equations = 0;              // independent data equations (per channel, the smallest)
-  int iterations = 0;             // robertson
+  int samples = 0;     // pixels used
+  int equations = 0;   // independent data equations (per channel, the smallest)
+  int iterations = 0;  // robertson
   bool converged = true;
   std::vector<double> rms_residual;  // per channel, ln units, over usable data equations
 };

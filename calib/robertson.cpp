@@ -1,11 +1,12 @@
 #include "calib/robertson.h"
 
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include "tools/common/error.h"
 
@@ -121,15 +122,16 @@ ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& 
         }
         for (double& ck : cw) ck *= levels / std::max(total, 1e-12);
         const double scale = std::pow((levels - 1) / 255.0, 4);
-        const std::vector<double> smooth = Smooth(y, cw, options.robertson_smoothing * options.robertson_smoothing * scale);
+        const std::vector<double> smooth =
+            Smooth(y, cw, options.robertson_smoothing * options.robertson_smoothing * scale);
         for (int k = 0; k < levels; ++k) next[size_t(k)] = std::exp(smooth[size_t(k)]);
       }
       const double mid = next[size_t(levels / 2)];
       double sq = 0.0;
       for (int k = 0; k < levels; ++k) {
         next[size_t(k)] /= mid;
-        const double d = std::log(std::max(next[size_t(k)], 1e-12)) -
-                         std::log(std::max(inv[size_t(k)], 1e-12));
+        const double d =
+            std::log(std::max(next[size_t(k)], 1e-12)) - std::log(std::max(inv[size_t(k)], 1e-12));
         sq += d * d;
       }
       change = std::sqrt(sq / levels);

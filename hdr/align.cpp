@@ -1,8 +1,9 @@
 #include "hdr/align.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdint>
-#include <fmt/format.h>
 #include <limits>
 
 #include "tools/common/error.h"
@@ -160,7 +161,8 @@ std::vector<PixelShift> ComputeMtbShifts(const std::vector<Image>& images, int r
   for (size_t j = 0; j < order.size(); ++j) order[j] = int(j);
   std::vector<double> mean;
   for (const Grey& g : grey) mean.push_back(MeanLevel(g));
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return mean[size_t(a)] < mean[size_t(b)]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return mean[size_t(a)] < mean[size_t(b)]; });
   const int at = int(std::find(order.begin(), order.end(), reference) - order.begin());
   std::vector<PixelShift> shifts(images.size());
   for (int step : {-1, 1}) {

@@ -78,11 +78,9 @@ HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
   if (!options.response.empty()) {
     input.response = calib::ReadResponseJson(options.response);
     input.response_source = options.response.string();
-    if (input.response.num_channels() != 1 &&
-        input.response.num_channels() != bracket.channels()) {
+    if (input.response.num_channels() != 1 && input.response.num_channels() != bracket.channels()) {
       throw InputError(DescribeProblem(
-          options.response.string(), "channels",
-          fmt::format("{}", input.response.num_channels()),
+          options.response.string(), "channels", fmt::format("{}", input.response.num_channels()),
           fmt::format("must be 1 or the images' channel count ({})", bracket.channels())));
     }
   } else if (options.linear) {

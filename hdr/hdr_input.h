@@ -35,7 +35,6 @@ struct HdrInput {
 
 // `exposures_s` (non-empty, e.g. from a manifest) overrides options.exposures and metadata.
 HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
-                      const HdrInputOptions& options,
-                      const std::vector<double>& exposures_s = {});
+                      const HdrInputOptions& options, const std::vector<double>& exposures_s = {});
 
 }  // namespace igi::hdr

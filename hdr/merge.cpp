@@ -1,12 +1,13 @@
 #include "hdr/merge.h"
 
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
@@ -62,9 +63,9 @@ ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int l
 void CheckInputs(const std::vector<Image>& images, const std::vector<double>& exposures_s,
                  const calib::ResponseCurve& response) {
   if (images.size() < 1 || images.size() != exposures_s.size()) {
-    throw InputError(DescribeProblem("bracket", "images", fmt::format("{}", images.size()),
-                                     fmt::format("need one exposure time per image ({} given)",
-                                                 exposures_s.size())));
+    throw InputError(DescribeProblem(
+        "bracket", "images", fmt::format("{}", images.size()),
+        fmt::format("need one exposure time per image ({} given)", exposures_s.size())));
   }
   for (size_t j = 1; j < images.size(); ++j) {
     if (images[j].width != images[0].width || images[j].height != images[0].height ||
@@ -116,10 +117,10 @@ class MergeKernel {
       tables_.push_back(
           BuildTables(response, response.num_channels() == 1 ? 0 : c, levels_, options));
     }
-    shortest_ = size_t(std::min_element(exposures_s.begin(), exposures_s.end()) -
-                       exposures_s.begin());
-    longest_ = size_t(std::max_element(exposures_s.begin(), exposures_s.end()) -
-                      exposures_s.begin());
+    shortest_ =
+        size_t(std::min_element(exposures_s.begin(), exposures_s.end()) - exposures_s.begin());
+    longest_ =
+        size_t(std::max_element(exposures_s.begin(), exposures_s.end()) - exposures_s.begin());
     for (size_t j = 0; j < images.size(); ++j) {
       const float t = float(exposures_s[j]);
       t_.push_back(t);
@@ -174,8 +175,7 @@ class MergeKernel {
   // Merges `count` consecutive values (whole pixels) starting at value index `begin`, image by
   // image so that each image is read as one sequential stream. `num`/`den` are scratch of size
   // `count`. Fills out[begin .. begin + count) and returns per-pixel flags in `flags`.
-  void Span(size_t begin, size_t count, float* num, float* den, float* out,
-            uint8_t* flags) const {
+  void Span(size_t begin, size_t count, float* num, float* den, float* out, uint8_t* flags) const {
     std::fill(num, num + count, 0.0f);
     std::fill(den, den + count, 0.0f);
     const size_t channels = size_t(channels_);
@@ -305,8 +305,7 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
       options.num_threads, 8);
   result.saturated_pixels = saturated;
   result.black_pixels = black;
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::debug("merge: {}x{}x{}, {} images, {} weights, {:.3f} s", width, height, channels,
                 images.size(), options.weighting, result.seconds);
   return result;

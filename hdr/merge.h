@@ -34,8 +34,8 @@ struct MergeOptions {
   // One weight per pixel and exposure, the mean of the channels' weights (as OpenCV's
   // MergeDebevec does), instead of one per channel.
   bool shared_weights = false;
-  int bits = 8;                     // quantisation of the input levels (8 or 16)
-  int num_threads = 0;              // 0 = the process default
+  int bits = 8;         // quantisation of the input levels (8 or 16)
+  int num_threads = 0;  // 0 = the process default
 
   // Throws InputError "option: VALUE: RULE".
   void Validate() const;

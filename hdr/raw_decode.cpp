@@ -1,11 +1,11 @@
 #include "hdr/raw_decode.h"
 
+#include <fmt/format.h>
 #include <libraw/libraw.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
-#include <fmt/format.h>
 #include <memory>
-#include <spdlog/spdlog.h>
 
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
@@ -15,9 +15,9 @@ namespace {
 
 void Check(int code, const std::filesystem::path& path, const char* step) {
   if (code != LIBRAW_SUCCESS) {
-    throw InputError(DescribeProblem(path.string(), "raw", step,
-                                     fmt::format("LibRaw cannot decode it: {}",
-                                                 libraw_strerror(code))));
+    throw InputError(
+        DescribeProblem(path.string(), "raw", step,
+                        fmt::format("LibRaw cannot decode it: {}", libraw_strerror(code))));
   }
 }
 
@@ -27,7 +27,7 @@ void SetLinearParams(LibRaw* raw, const RawDecodeOptions& options) {
   p.gamm[0] = 1.0;  // no gamma
   p.gamm[1] = 1.0;
   p.no_auto_bright = 1;
-  p.highlight = 0;  // clip at the white level
+  p.highlight = 0;              // clip at the white level
   p.adjust_maximum_thr = 0.0f;  // keep the file's white level (no lowering to the data maximum)
   p.use_auto_wb = 0;
   p.use_camera_wb = options.white_balance == "camera" ? 1 : 0;
@@ -46,7 +46,8 @@ void RawDecodeOptions::Validate() const {
   if (white_balance != "camera" && white_balance != "none") {
     problems.Add("--raw-white-balance", "", white_balance, "must be camera or none");
   }
-  if (color != "srgb" && color != "raw") problems.Add("--raw-color", "", color, "must be srgb or raw");
+  if (color != "srgb" && color != "raw")
+    problems.Add("--raw-color", "", color, "must be srgb or raw");
   problems.ThrowIfAny();
 }
 
@@ -87,7 +88,8 @@ RawImage DecodeRaw(const std::filesystem::path& path, const RawDecodeOptions& op
   const auto* data = reinterpret_cast<const uint16_t*>(processed->data);
   for (int64_t i = 0; i < int64_t(w) * h; ++i) {
     for (int k = 0; k < 3; ++k) {
-      out.image.pixels[size_t(i) * 3 + k] = float(data[size_t(i) * c + std::min(k, c - 1)]) / 65535.0f;
+      out.image.pixels[size_t(i) * 3 + k] =
+          float(data[size_t(i) * c + std::min(k, c - 1)]) / 65535.0f;
     }
   }
   const auto& d = raw->imgdata;

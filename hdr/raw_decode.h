@@ -24,14 +24,14 @@ struct RawDecodeOptions {
 };
 
 struct RawImage {
-  Image image;             // linear RGB, 1 = white level; metadata has ExposureTime etc.
-  double exposure_s = 0;   // shutter time from the file (0 if unknown)
+  Image image;            // linear RGB, 1 = white level; metadata has ExposureTime etc.
+  double exposure_s = 0;  // shutter time from the file (0 if unknown)
   double iso = 0;
-  double aperture = 0;     // f-number
-  int black_level = 0;     // raw counts
-  int white_level = 0;     // raw counts
-  int raw_bits = 0;        // bits per raw sample (from the white level)
-  std::string camera;      // "Make Model"
+  double aperture = 0;  // f-number
+  int black_level = 0;  // raw counts
+  int white_level = 0;  // raw counts
+  int raw_bits = 0;     // bits per raw sample (from the white level)
+  std::string camera;   // "Make Model"
 };
 
 // True for the extensions of raw formats LibRaw reads.

@@ -27,8 +27,8 @@ struct ResponseCommand {
 };
 
 CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
-  CLI::App* sub = app.add_subcommand(
-      "response", "Recover the camera response curve from an exposure bracket");
+  CLI::App* sub =
+      app.add_subcommand("response", "Recover the camera response curve from an exposure bracket");
   sub->add_option("images", cmd->images, "8- or 16-bit images of one bracket")->required();
   auto* list = sub->add_option("--exposures", cmd->exposures.list,
                                "Exposure times in seconds, comma-separated (0.004 or 1/250)");

@@ -51,7 +51,8 @@ void Validate(const Flags& flags) {
     throw igi::InputError("give either IMAGES or --manifest (exactly one of them)");
   }
   if (igi::ToLower(fs::path(flags.out).extension().string()) != ".exr") {
-    throw igi::InputError(igi::DescribeProblem(flags.out, "--out", fs::path(flags.out).extension().string(),
+    throw igi::InputError(igi::DescribeProblem(flags.out, "--out",
+                                               fs::path(flags.out).extension().string(),
                                                "radiance maps are written as OpenEXR (.exr)"));
   }
 }
@@ -129,11 +130,10 @@ int Run(const Flags& flags) {
     std::printf(
         "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
         "(%.3f %%), black in every exposure: %lld px (%.3f %%), masked in %s\n",
-        job.out.string().c_str(), int(job.input.images.size()),
-        job.input.response_source.c_str(), merge.weighting.c_str(),
-        (long long)result.saturated_pixels, 100.0 * result.saturated_pixels / total,
-        (long long)result.black_pixels, 100.0 * result.black_pixels / total,
-        mask.string().c_str());
+        job.out.string().c_str(), int(job.input.images.size()), job.input.response_source.c_str(),
+        merge.weighting.c_str(), (long long)result.saturated_pixels,
+        100.0 * result.saturated_pixels / total, (long long)result.black_pixels,
+        100.0 * result.black_pixels / total, mask.string().c_str());
   }
   return 0;
 }

@@ -57,13 +57,11 @@ int main(int argc, char** argv) {
   std::vector<float> times(bracket.exposures_s.begin(), bracket.exposures_s.end());
 
   igi::calib::ResponseCurve response;
-  const double igi_calib_s = MedianSeconds(3, [&] {
-    response = igi::calib::RecoverResponse(bracket, {}).curve;
-  });
+  const double igi_calib_s =
+      MedianSeconds(3, [&] { response = igi::calib::RecoverResponse(bracket, {}).curve; });
   cv::Mat cv_response;
-  const double cv_calib_s = MedianSeconds(3, [&] {
-    cv::createCalibrateDebevec()->process(mats, cv_response, times);
-  });
+  const double cv_calib_s =
+      MedianSeconds(3, [&] { cv::createCalibrateDebevec()->process(mats, cv_response, times); });
 
   igi::hdr::MergeOptions noise;
   noise.num_threads = threads;
@@ -76,12 +74,10 @@ int main(int argc, char** argv) {
   std::vector<double> cv_s, noise_s, hat_s, noise_ratio, hat_ratio;
   for (int r = 0; r < repeats; ++r) {
     cv_s.push_back(MedianSeconds(1, [&] { merge->process(mats, hdr, times, cv_response); }));
-    noise_s.push_back(MedianSeconds(1, [&] {
-      igi::hdr::MergeBracket(bracket.images, bracket.exposures_s, response, noise);
-    }));
-    hat_s.push_back(MedianSeconds(1, [&] {
-      igi::hdr::MergeBracket(bracket.images, bracket.exposures_s, response, hat);
-    }));
+    noise_s.push_back(MedianSeconds(
+        1, [&] { igi::hdr::MergeBracket(bracket.images, bracket.exposures_s, response, noise); }));
+    hat_s.push_back(MedianSeconds(
+        1, [&] { igi::hdr::MergeBracket(bracket.images, bracket.exposures_s, response, hat); }));
     noise_ratio.push_back(cv_s.back() / noise_s.back());
     hat_ratio.push_back(cv_s.back() / hat_s.back());
   }
@@ -89,8 +85,7 @@ int main(int argc, char** argv) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
-  const double cv_merge_s = median(cv_s), igi_noise_s = median(noise_s),
-               igi_hat_s = median(hat_s);
+  const double cv_merge_s = median(cv_s), igi_noise_s = median(noise_s), igi_hat_s = median(hat_s);
 
   std::printf("HDR merge, 16 x 512x768 8-bit RGB (Memorial), %d threads, median of %d runs\n",
               threads, repeats);
@@ -101,7 +96,7 @@ int main(int argc, char** argv) {
               median(hat_ratio));
   std::printf("Response recovery, median of 3\n");
   std::printf("  OpenCV CalibrateDebevec (70 samples)     %8.1f ms\n", 1e3 * cv_calib_s);
-  std::printf("  igi Debevec (%d samples, Schur + LDLT)  %8.1f ms   %.2fx\n", 100, 1e3 * igi_calib_s,
-              cv_calib_s / igi_calib_s);
+  std::printf("  igi Debevec (%d samples, Schur + LDLT)  %8.1f ms   %.2fx\n", 100,
+              1e3 * igi_calib_s, cv_calib_s / igi_calib_s);
   return 0;
 }

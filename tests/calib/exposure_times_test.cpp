@@ -59,11 +59,13 @@ TEST(ExposureTimes, FileCommentsAndLineNumbers) {
 TEST(ExposureTimes, ValidateNamesDuplicatesAndCounts) {
   const std::vector<std::string> names = {"a.png", "b.png", "c.png"};
   EXPECT_NO_THROW(ValidateExposures({1, 2, 4}, names, "--exposures"));
-  EXPECT_NE(ErrorOf([&] { ValidateExposures({1, 2, 2}, names, "x"); })
-                .find("c.png: exposure: 2 s: duplicate exposure time (same as b.png)"),
+  EXPECT_NE(ErrorOf([&] {
+              ValidateExposures({1, 2, 2}, names, "x");
+            }).find("c.png: exposure: 2 s: duplicate exposure time (same as b.png)"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ValidateExposures({1, 2}, names, "times.txt"); })
-                .find("must give one exposure time per image (3 images)"),
+  EXPECT_NE(ErrorOf([&] {
+              ValidateExposures({1, 2}, names, "times.txt");
+            }).find("must give one exposure time per image (3 images)"),
             std::string::npos);
 }
 

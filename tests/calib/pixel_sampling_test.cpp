@@ -43,7 +43,7 @@ TEST(PixelSampling, SpreadUnsaturatedFlatAndOverTheRange) {
     high += mid.at(x, y, 1) > 0.6f ? 1 : 0;
   }
   EXPECT_EQ(quadrants.size(), 4u);
-  EXPECT_GE(low, 15);   // intensity bins are visited round-robin
+  EXPECT_GE(low, 15);  // intensity bins are visited round-robin
   EXPECT_GE(high, 15);
 }
 

@@ -16,8 +16,8 @@ TEST(ResponseCurve, LinearAndInterpolation) {
   EXPECT_NEAR(linear.LnExposure(1, 1.0), 0.0, 1e-12);
   EXPECT_NEAR(linear.LnExposure(0, 128.0 / 255), std::log(128.0 / 255), 1e-12);
   // Halfway between levels 10 and 11: the mean of their g.
-  EXPECT_NEAR(linear.LnExposure(2, 10.5 / 255),
-              0.5 * (std::log(10.0 / 255) + std::log(11.0 / 255)), 1e-12);
+  EXPECT_NEAR(linear.LnExposure(2, 10.5 / 255), 0.5 * (std::log(10.0 / 255) + std::log(11.0 / 255)),
+              1e-12);
 }
 
 TEST(ResponseCurve, JsonRoundTripKeepsTheContractKeys) {

@@ -2,9 +2,10 @@
 // Test helper (header only, shared by tests/calib and tests/hdr): a synthetic exposure bracket
 // with known truth, standing in for igi-synth brackets until igi-synth exists.
 //
-// The scene is a grid of 8x8 tiles (each a gentle horizontal ramp) of log-uniform radiance over 3.5 decades (per-channel
-// factors 1, 0.8, 0.6). Exposure X = E * t (1 = full scale) is recorded with shot noise
-// (full_well electrons at full scale), Gaussian read noise, then a known film-like response
+// The scene is a grid of 8x8 tiles (each a gentle horizontal ramp) of log-uniform radiance over 3.5
+// decades (per-channel factors 1, 0.8, 0.6). Exposure X = E * t (1 = full scale) is recorded with
+// shot noise (full_well electrons at full scale), Gaussian read noise, then a known film-like
+// response
 //   v = f(X) = (1 - exp(-3 X^0.6)) / (1 - exp(-3)),  X clipped to [0, 1],
 // and quantised to `bits`. The true g is ln f^-1(v).
 

@@ -34,8 +34,8 @@ class HdrE2e : public ::testing::Test {
 
   RunResult Run(const std::string& tool, const std::string& args) {
     const fs::path log = dir_ / "log.txt";
-    const std::string command = std::string(IGI_BIN_DIR) + "/" + tool + " " + args + " > " +
-                                log.string() + " 2>&1";
+    const std::string command =
+        std::string(IGI_BIN_DIR) + "/" + tool + " " + args + " > " + log.string() + " 2>&1";
     const int status = std::system(command.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -65,8 +65,8 @@ TEST_F(HdrE2e, CalibrateThenMerge) {
   EXPECT_TRUE(fs::exists(dir_ / "response.svg"));
 
   const fs::path out = dir_ / "radiance.exr";
-  r = Run("igi-hdr", Frames() + kTimes + " --response " + response.string() + " --out " +
-                         out.string());
+  r = Run("igi-hdr",
+          Frames() + kTimes + " --response " + response.string() + " --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("saturated in every exposure"), std::string::npos) << r.output;
   const ImageInfo info = ReadImageInfo(out);
@@ -115,9 +115,9 @@ TEST_F(HdrE2e, ExposureTimesFromExif) {
 
 TEST_F(HdrE2e, RawIsMergedWithoutAResponse) {
   const fs::path out = dir_ / "chart.exr";
-  const RunResult r = Run("igi-hdr", std::string(IGI_SHARED_DATA_DIR) +
-                                         "/real/raw/colorchart.dng --half-size --out " +
-                                         out.string());
+  const RunResult r =
+      Run("igi-hdr", std::string(IGI_SHARED_DATA_DIR) +
+                         "/real/raw/colorchart.dng --half-size --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("raw (linear)"), std::string::npos) << r.output;
   EXPECT_EQ(ReadImageInfo(out).width, 867);
@@ -137,9 +137,9 @@ TEST_F(HdrE2e, ManifestMergesEachCamera) {
       }
       const std::string name = "frames/" + camera + std::to_string(k) + ".png";
       WriteImage(dir_ / name, frame, u16);
-      manifest << R"({"file":")" << name << R"(","camera":")" << camera
-               << R"(","exposure_us":)" << times_us[k]
-               << R"(,"gain":0,"pixel_format":"Mono16","timestamp":"t"})" << "\n";
+      manifest << R"({"file":")" << name << R"(","camera":")" << camera << R"(","exposure_us":)"
+               << times_us[k] << R"(,"gain":0,"pixel_format":"Mono16","timestamp":"t"})"
+               << "\n";
     }
   }
   manifest.close();
@@ -172,15 +172,15 @@ TEST_F(HdrE2e, BadInputIsExitTwoWithOneLine) {
       << r.output;
   Image small(10, 10, 3, 0.5f);
   WriteImage(dir_ / "small.png", small);
-  r = Run("igi-hdr", two + (dir_ / "small.png").string() + " --exposures 1,2,3 --out " +
-                         out.string());
+  r = Run("igi-hdr",
+          two + (dir_ / "small.png").string() + " --exposures 1,2,3 --out " + out.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("small.png: size: 10x10x3: every image of a bracket must have the size"),
             std::string::npos)
       << r.output;
   std::ofstream(dir_ / "corrupt.png") << "garbage";
-  r = Run("igi-hdr", two + (dir_ / "corrupt.png").string() + " --exposures 1,2,3 --out " +
-                         out.string());
+  r = Run("igi-hdr",
+          two + (dir_ / "corrupt.png").string() + " --exposures 1,2,3 --out " + out.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("corrupt.png"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
@@ -192,9 +192,9 @@ TEST_F(HdrE2e, TooFewUsablePixelsAndUsage) {
   Image dark(64, 64, 3, 0.0f);
   WriteImage(dir_ / "d1.png", dark);
   WriteImage(dir_ / "d2.png", dark);
-  RunResult r = Run("igi-calib", "response " + (dir_ / "d1.png").string() + " " +
-                                     (dir_ / "d2.png").string() + " --exposures 1,2 --out " +
-                                     (dir_ / "r.json").string());
+  RunResult r =
+      Run("igi-calib", "response " + (dir_ / "d1.png").string() + " " + (dir_ / "d2.png").string() +
+                           " --exposures 1,2 --out " + (dir_ / "r.json").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("too few usable pixels"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "r.json"));

@@ -34,11 +34,11 @@ std::string Frame(const std::string& file, const std::string& camera, double us,
 }
 
 TEST_F(ManifestTest, GroupsByCameraGainAndBracketKey) {
-  const fs::path path = Write(Frame("frames/a0.png", "cam A", 1000, 0) +
-                              Frame("frames/b0.png", "camB", 1000, 0) +
-                              Frame("frames/a1.png", "cam A", 4000, 0, R"(,"extra_key":1)") +
-                              Frame("frames/a2.png", "cam A", 1000, 6) + "\n" +
-                              Frame("frames/a3.png", "camB", 500, 0, R"(,"bracket":2)"));
+  const fs::path path =
+      Write(Frame("frames/a0.png", "cam A", 1000, 0) + Frame("frames/b0.png", "camB", 1000, 0) +
+            Frame("frames/a1.png", "cam A", 4000, 0, R"(,"extra_key":1)") +
+            Frame("frames/a2.png", "cam A", 1000, 6) + "\n" +
+            Frame("frames/a3.png", "camB", 500, 0, R"(,"bracket":2)"));
   const auto brackets = ReadManifest(path);
   ASSERT_EQ(brackets.size(), 4u);
   EXPECT_EQ(brackets[0].camera, "cam A");

@@ -36,8 +36,8 @@ calib::ResponseCurve TrueResponse(int levels) {
 }
 
 struct Errors {
-  double rms = 0.0;            // per-pixel relative error, free scale removed
-  double worst_bin_bias = 0.0; // largest |median ratio - 1| over half-decade radiance bins
+  double rms = 0.0;             // per-pixel relative error, free scale removed
+  double worst_bin_bias = 0.0;  // largest |median ratio - 1| over half-decade radiance bins
 };
 
 Errors Compare(const Image& radiance, const std::vector<double>& truth) {
@@ -59,10 +59,10 @@ Errors Compare(const Image& radiance, const std::vector<double>& truth) {
   return e;
 }
 
-// The whole radiance range of the scene (0.02 x 0.8 x 0.6 .. 30 x 1.25) is well exposed (1 % .. 50 % of
-// full scale) in at least one exposure of the x4 bracket, so every pixel counts. Per-pixel noise
-// (shot noise of a 20000 e- sensor, ~0.5 % after merging) is in the RMS; the recovery claim is
-// on the bias: the median ratio in each half-decade of radiance within 1 %.
+// The whole radiance range of the scene (0.02 x 0.8 x 0.6 .. 30 x 1.25) is well exposed (1 % .. 50
+// % of full scale) in at least one exposure of the x4 bracket, so every pixel counts. Per-pixel
+// noise (shot noise of a 20000 e- sensor, ~0.5 % after merging) is in the RMS; the recovery claim
+// is on the bias: the median ratio in each half-decade of radiance within 1 %.
 TEST(Merge, RecoversKnownRadianceWithin1PercentWithRecoveredResponse) {
   testing::SyntheticOptions o;
   o.max_radiance = 30;  // brightest tile x ramp x 1/64 s stays below full scale
@@ -98,12 +98,10 @@ TEST(Merge, NoiseAwareWeightsBeatTheHat) {
   noise.read_noise = 10.0 / 5000;
   MergeOptions hat = noise;
   hat.weighting = "hat";
-  const Errors e_noise =
-      Compare(MergeBracket(s.bracket.images, s.bracket.exposures_s, response, noise).radiance,
-              s.radiance);
-  const Errors e_hat =
-      Compare(MergeBracket(s.bracket.images, s.bracket.exposures_s, response, hat).radiance,
-              s.radiance);
+  const Errors e_noise = Compare(
+      MergeBracket(s.bracket.images, s.bracket.exposures_s, response, noise).radiance, s.radiance);
+  const Errors e_hat = Compare(
+      MergeBracket(s.bracket.images, s.bracket.exposures_s, response, hat).radiance, s.radiance);
   std::printf("rms error: noise-aware %.3f %%, hat %.3f %%\n", 100 * e_noise.rms, 100 * e_hat.rms);
   EXPECT_LT(e_noise.rms, 0.85 * e_hat.rms);
 }
@@ -155,7 +153,8 @@ TEST(Merge, MemorialAgreesWithOpenCvMergeDebevec) {
   theirs_curve.channels = {"R", "G", "B"};
   theirs_curve.g.assign(3, std::vector<double>(256));
   for (int c = 0; c < 3; ++c) {
-    for (int z = 0; z < 256; ++z) theirs_curve.g[size_t(c)][size_t(z)] = std::log(cv_response.at<cv::Vec3f>(z)[2 - c]);
+    for (int z = 0; z < 256; ++z)
+      theirs_curve.g[size_t(c)][size_t(z)] = std::log(cv_response.at<cv::Vec3f>(z)[2 - c]);
   }
   calib::ResponseOptions response_options;
   response_options.lambda = 50;

@@ -75,7 +75,8 @@ TEST(RawDecode, ColorCheckerGreyPatchesAreLinearInLuminance) {
   }
   const double a = (6 * sym - sy * sm) / (6 * syy - sy * sy);
   const double b = (sm - a * sy) / 6;
-  std::printf("grey patches (raw R+G+B): offset %.3f %% of white; deviation from the line:", 100 * b / m[0]);
+  std::printf("grey patches (raw R+G+B): offset %.3f %% of white; deviation from the line:",
+              100 * b / m[0]);
   for (int k = 0; k < 6; ++k) {
     const double deviation = m[k] / (a * kReferenceY[k] + b) - 1.0;
     std::printf(" D%d %+.2f %%", k + 1, 100 * deviation);
