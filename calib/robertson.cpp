@@ -70,72 +70,83 @@ std::vector<double> Smooth(const std::vector<double>& y, const std::vector<doubl
 
 }  // namespace
 
+namespace {
+
+// One Robertson iteration: radiances given I, then I given the radiances (the mean of E_i t_j
+// over the samples at each level), optionally smoothed, normalised to I(middle) = 1. Returns the
+// RMS change of ln I; `count` gets the samples per level.
+double Iterate(const std::vector<std::vector<int>>& z, const std::vector<double>& t,
+               const std::vector<double>& w, const ResponseOptions& options,
+               std::vector<double>* inv, std::vector<int>* count) {
+  const size_t levels = inv->size();
+  std::vector<double> radiance(z.size());
+  for (size_t i = 0; i < z.size(); ++i) {
+    double num = 0.0, den = 0.0;
+    for (size_t j = 0; j < t.size(); ++j) {
+      const double wz = w[size_t(z[i][j])];
+      num += wz * t[j] * (*inv)[size_t(z[i][j])];
+      den += wz * t[j] * t[j];
+    }
+    radiance[i] = den > 0.0 ? num / den : -1.0;
+  }
+  std::vector<double> sum(levels, 0.0);
+  std::fill(count->begin(), count->end(), 0);
+  for (size_t i = 0; i < z.size(); ++i) {
+    if (radiance[i] < 0.0) continue;
+    for (size_t j = 0; j < t.size(); ++j) {
+      sum[size_t(z[i][j])] += radiance[i] * t[j];
+      ++(*count)[size_t(z[i][j])];
+    }
+  }
+  std::vector<double> next = *inv;
+  for (size_t k = 0; k < levels; ++k) {
+    if ((*count)[k] > 0) next[k] = sum[k] / (*count)[k];
+  }
+  if (options.robertson_smoothing > 0.0) {
+    // Smooth ln I with weights from the counts and certainties of the levels.
+    std::vector<double> y(levels), cw(levels);
+    double total = 0.0;
+    for (size_t k = 0; k < levels; ++k) {
+      y[k] = std::log(std::max(next[k], 1e-12));
+      cw[k] = (*count)[k] * w[k];  // unusable levels: no data
+      total += cw[k];
+    }
+    for (double& ck : cw) ck *= double(levels) / std::max(total, 1e-12);
+    const double scale = std::pow((double(levels) - 1) / 255.0, 4);
+    const double mu = options.robertson_smoothing * options.robertson_smoothing * scale;
+    const std::vector<double> smooth = Smooth(y, cw, mu);
+    for (size_t k = 0; k < levels; ++k) next[k] = std::exp(smooth[k]);
+  }
+  const double mid = next[levels / 2];
+  double sq = 0.0;
+  for (size_t k = 0; k < levels; ++k) {
+    next[k] /= mid;
+    const double d = std::log(std::max(next[k], 1e-12)) - std::log(std::max((*inv)[k], 1e-12));
+    sq += d * d;
+  }
+  *inv = std::move(next);
+  return std::sqrt(sq / double(levels));
+}
+
+}  // namespace
+
 ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& options,
                                  int levels) {
   const std::vector<double> w = Weights(levels, options);
-  const std::vector<double>& t = bracket.exposures_s;
   ResponseSummary summary;
   summary.curve.method = "robertson";
   summary.curve.levels = levels;
   summary.curve.channels = DefaultChannelNames(bracket.channels());
-  summary.converged = true;
   for (int c = 0; c < bracket.channels(); ++c) {
     const auto z = SubsampleLevels(bracket, c, levels, options.max_robertson_pixels);
     summary.samples = int(z.size());
     std::vector<double> inv(static_cast<size_t>(levels));  // I(z), linear start
     for (int k = 0; k < levels; ++k) inv[size_t(k)] = (k + 0.5) / (0.5 * levels);
-    std::vector<double> radiance(z.size());
+    std::vector<int> count(static_cast<size_t>(levels));
     int iteration = 0;
     double change = 1e30;
-    std::vector<int> count(static_cast<size_t>(levels));
     for (; iteration < options.max_iterations && change > options.tolerance; ++iteration) {
-      for (size_t i = 0; i < z.size(); ++i) {
-        double num = 0.0, den = 0.0;
-        for (size_t j = 0; j < t.size(); ++j) {
-          const double wz = w[size_t(z[i][j])];
-          num += wz * t[j] * inv[size_t(z[i][j])];
-          den += wz * t[j] * t[j];
-        }
-        radiance[i] = den > 0.0 ? num / den : -1.0;
-      }
-      std::vector<double> sum(static_cast<size_t>(levels), 0.0);
-      std::fill(count.begin(), count.end(), 0);
-      for (size_t i = 0; i < z.size(); ++i) {
-        if (radiance[i] < 0.0) continue;
-        for (size_t j = 0; j < t.size(); ++j) {
-          sum[size_t(z[i][j])] += radiance[i] * t[j];
-          ++count[size_t(z[i][j])];
-        }
-      }
-      std::vector<double> next = inv;
-      for (int k = 0; k < levels; ++k) {
-        if (count[size_t(k)] > 0) next[size_t(k)] = sum[size_t(k)] / count[size_t(k)];
-      }
-      if (options.robertson_smoothing > 0.0) {
-        // Smooth ln I with weights from the counts and certainties of the levels.
-        std::vector<double> y(static_cast<size_t>(levels)), cw(static_cast<size_t>(levels));
-        double total = 0.0;
-        for (int k = 0; k < levels; ++k) {
-          y[size_t(k)] = std::log(std::max(next[size_t(k)], 1e-12));
-          cw[size_t(k)] = count[size_t(k)] * w[size_t(k)];  // unusable levels: no data
-          total += cw[size_t(k)];
-        }
-        for (double& ck : cw) ck *= levels / std::max(total, 1e-12);
-        const double scale = std::pow((levels - 1) / 255.0, 4);
-        const std::vector<double> smooth =
-            Smooth(y, cw, options.robertson_smoothing * options.robertson_smoothing * scale);
-        for (int k = 0; k < levels; ++k) next[size_t(k)] = std::exp(smooth[size_t(k)]);
-      }
-      const double mid = next[size_t(levels / 2)];
-      double sq = 0.0;
-      for (int k = 0; k < levels; ++k) {
-        next[size_t(k)] /= mid;
-        const double d =
-            std::log(std::max(next[size_t(k)], 1e-12)) - std::log(std::max(inv[size_t(k)], 1e-12));
-        sq += d * d;
-      }
-      change = std::sqrt(sq / levels);
-      inv = std::move(next);
+      change = Iterate(z, bracket.exposures_s, w, options, &inv, &count);
     }
     summary.iterations = std::max(summary.iterations, iteration);
     summary.converged = summary.converged && change <= options.tolerance;
@@ -153,7 +164,7 @@ ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& 
     for (size_t k = 1; k < g.size(); ++k) g[k] = std::max(g[k], g[k - 1]);
     summary.curve.g.push_back(std::move(g));
   }
-  summary.equations = summary.samples * int(t.size());
+  summary.equations = summary.samples * int(bracket.exposures_s.size());
   spdlog::info("robertson: {} pixels, {} iterations{}", summary.samples, summary.iterations,
                summary.converged ? "" : " (not converged)");
   return summary;
