@@ -1,0 +1,190 @@
+// Response recovery on synthetic brackets with a known response (1 % claims of issue 4) and on
+// the real Memorial bracket against OpenCV's CalibrateDebevec.
+#include "calib/response_recovery.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/photo.hpp>
+
+#include "calib/exposure_times.h"
+#include "tests/calib/synthetic_bracket.h"
+#include "tools/common/error.h"
+
+namespace igi::calib {
+namespace {
+
+// Largest |exp(g - g_true - offset) - 1| over normalised values in [lo, hi], the free additive
+// constant removed by the median difference over that range.
+double MaxExposureError(const ResponseCurve& curve, int channel, double lo, double hi) {
+  std::vector<double> diff;
+  std::vector<double> values;
+  for (int z = 0; z < curve.levels; ++z) {
+    const double v = double(z) / (curve.levels - 1);
+    if (v < lo || v > hi) continue;
+    diff.push_back(curve.g[size_t(channel)][size_t(z)] - testing::SyntheticLnExposure(v));
+    values.push_back(v);
+  }
+  std::vector<double> sorted = diff;
+  std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+  const double offset = sorted[sorted.size() / 2];
+  double worst = 0.0;
+  for (double d : diff) worst = std::max(worst, std::abs(std::exp(d - offset) - 1.0));
+  return worst;
+}
+
+// Well-exposed range: exposures from 1 % to 50 % of full scale, i.e. levels f(0.01) = 0.18 to
+// f(0.5) = 0.93. The film-like toe below packs two decades of exposure into 18 % of the levels
+// and the shoulder above packs 50..100 % into 7 %; there the smoothness prior flattens the strong
+// curvature of g and clipped noise biases the top, by 2-5 % (measured).
+const double kLo = testing::SyntheticResponse(0.01);
+const double kHi = testing::SyntheticResponse(0.5);
+
+// The synthetic brackets step the exposure by one constant ratio (x4), as real brackets do. The
+// data then cannot tell g from g + p with p periodic in ln exposure with period ln 4 (every
+// sample's ln E absorbs it): only the smoothness term fixes such ripples. So the recovery uses
+// many samples and a stronger lambda than OpenCV's default of 10 (lambda 10 leaves ~2-4 %
+// ripples with this noise; see the report of issue 4).
+ResponseOptions SyntheticDebevecOptions() {
+  ResponseOptions options;
+  options.lambda = 300;
+  options.samples = 1000;
+  return options;
+}
+
+TEST(ResponseRecovery, DebevecRecoversKnownResponseWithin1Percent) {
+  const testing::SyntheticBracket s = testing::MakeSyntheticBracket();
+  const ResponseOptions options = SyntheticDebevecOptions();
+  const ResponseSummary summary = RecoverResponse(s.bracket, options);
+  ASSERT_EQ(summary.curve.g.size(), 3u);
+  for (int c = 0; c < 3; ++c) {
+    const double error = MaxExposureError(summary.curve, c, kLo, kHi);
+    EXPECT_LT(error, 0.01) << "channel " << c;
+    std::printf("debevec 8-bit channel %d: max exposure error %.3f %%\n", c, 100 * error);
+  }
+}
+
+TEST(ResponseRecovery, Debevec16BitUsesInterpolatedLevels) {
+  testing::SyntheticOptions o;
+  o.bits = 16;
+  const testing::SyntheticBracket s = testing::MakeSyntheticBracket(o);
+  ResponseOptions options = SyntheticDebevecOptions();
+  options.samples = 0;  // auto: 3 * 1024 / 4 = 768 samples
+  const ResponseSummary summary = RecoverResponse(s.bracket, options);
+  EXPECT_EQ(summary.curve.levels, 1024);
+  for (int c = 0; c < 3; ++c) {
+    const double error = MaxExposureError(summary.curve, c, kLo, kHi);
+    EXPECT_LT(error, 0.01) << "channel " << c;
+    std::printf("debevec 16-bit channel %d: max exposure error %.3f %%\n", c, 100 * error);
+  }
+}
+
+// Robertson has no smoothness term, so the constant-ratio ambiguity above stays in its result
+// (~15 % ripples from the linear start); on a bracket with uneven ratios (as a camera's
+// 1/50 … 3.7 s series rounds them) the data pin g down and Robertson is within 1 %.
+TEST(ResponseRecovery, RobertsonRecoversKnownResponseWithin1Percent) {
+  testing::SyntheticOptions o;
+  o.exposures_s = {1.0 / 50, 1.0 / 13, 1.0 / 4, 1.2, 3.7};
+  const testing::SyntheticBracket s = testing::MakeSyntheticBracket(o);
+  ResponseOptions options;
+  options.method = "robertson";
+  const ResponseSummary summary = RecoverResponse(s.bracket, options);
+  for (int c = 0; c < 3; ++c) {
+    const double error = MaxExposureError(summary.curve, c, kLo, kHi);
+    EXPECT_LT(error, 0.01) << "channel " << c;
+    std::printf("robertson channel %d: max exposure error %.3f %%\n", c, 100 * error);
+  }
+}
+
+// On the constant-ratio bracket, the smoothing option damps Robertson's undetermined ripples.
+TEST(ResponseRecovery, RobertsonSmoothingDampsConstantRatioRipples) {
+  const testing::SyntheticBracket s = testing::MakeSyntheticBracket();
+  ResponseOptions options;
+  options.method = "robertson";
+  double plain = 0.0, smoothed = 0.0;
+  const ResponseCurve plain_curve = RecoverResponse(s.bracket, options).curve;
+  options.robertson_smoothing = 30;
+  const ResponseCurve smoothed_curve = RecoverResponse(s.bracket, options).curve;
+  for (int c = 0; c < 3; ++c) {
+    plain = std::max(plain, MaxExposureError(plain_curve, c, kLo, kHi));
+    smoothed = std::max(smoothed, MaxExposureError(smoothed_curve, c, kLo, kHi));
+  }
+  std::printf("robertson, x4 bracket: max error %.2f %% plain, %.2f %% smoothed\n", 100 * plain,
+              100 * smoothed);
+  EXPECT_LT(smoothed, 0.5 * plain);
+}
+
+TEST(ResponseRecovery, TooFewUsablePixelsIsInputError) {
+  testing::SyntheticOptions o;
+  o.width = 16;
+  o.height = 16;
+  o.exposures_s = {1.0, 1.5};
+  const testing::SyntheticBracket s = testing::MakeSyntheticBracket(o);
+  try {
+    RecoverResponse(s.bracket, {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("too few usable pixels"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ResponseRecovery, OptionsAreValidated) {
+  ResponseOptions options;
+  options.method = "magic";
+  EXPECT_THROW(options.Validate(), InputError);
+  options = {};
+  options.lambda = -1;
+  EXPECT_THROW(options.Validate(), InputError);
+}
+
+// Debevec's Memorial Church (real camera, real response): igi's curve against OpenCV's
+// CalibrateDebevec on the same 16 images, the free constant removed (median over the compared
+// range). Both run with lambda 50 and about 200 samples (OpenCV: a 14x14 grid; igi: its own
+// sampling). Compared over levels 32..216, where both have data from many exposures (the
+// Memorial PNGs have a floor near level 18, and above 216 the blue channel has few samples;
+// there the two curves differ by up to 30 %). Measured: max 5.0 %, mean 1.6 %; the tolerance
+// (6 %) allows for the different pixel samples of the two solvers.
+TEST(ResponseRecovery, MemorialAgreesWithOpenCvCalibrateDebevec) {
+  const std::string dir = std::string(IGI_SHARED_DATA_DIR) + "/real/memorial/";
+  std::vector<std::filesystem::path> paths;
+  std::vector<cv::Mat> mats;
+  for (int i = 61; i <= 76; ++i) {
+    paths.push_back(dir + "memorial00" + std::to_string(i) + ".png");
+    mats.push_back(cv::imread(paths.back().string(), cv::IMREAD_COLOR));  // BGR
+  }
+  ExposureSource source;
+  source.file = dir + "shutter_times.txt";
+  const Bracket bracket = LoadBracket(paths, source);
+  ResponseOptions options;
+  options.lambda = 50;
+  options.samples = 200;
+  const ResponseCurve ours = RecoverResponse(bracket, options).curve;
+  std::vector<float> times(bracket.exposures_s.begin(), bracket.exposures_s.end());
+  cv::Mat response;
+  cv::createCalibrateDebevec(200, 50.0f, false)->process(mats, response, times);
+  double worst = 0.0, sum = 0.0;
+  int count = 0;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> diff;
+    for (int z = 32; z <= 216; ++z) {
+      const double theirs = std::log(response.at<cv::Vec3f>(z)[2 - c]);
+      diff.push_back(ours.g[size_t(c)][size_t(z)] - theirs);
+    }
+    std::vector<double> sorted = diff;
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    for (double d : diff) {
+      const double e = std::abs(std::exp(d - sorted[sorted.size() / 2]) - 1.0);
+      worst = std::max(worst, e);
+      sum += e;
+      ++count;
+    }
+  }
+  std::printf("memorial vs OpenCV CalibrateDebevec, levels 32..216: max %.2f %%, mean %.2f %%\n",
+              100 * worst, 100 * sum / count);
+  EXPECT_LT(worst, 0.06);
+}
+
+}  // namespace
+}  // namespace igi::calib

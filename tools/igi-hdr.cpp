@@ -1,0 +1,174 @@
+// igi-hdr: assembles exposure brackets into linear radiance maps (CONTRACT.md §4).
+//   igi-hdr IMAGES… --out radiance.exr [--response response.json] [--exposures LIST |
+//           --exposure-file FILE] [--linear] [--weighting noise|hat] [--align] [--mask-out FILE]
+//   igi-hdr RAW_FILES… --out radiance.exr          (DNG, CR2, NEF, …: decoded linearly)
+//   igi-hdr --manifest DIR/manifest.jsonl --out radiance.exr   (one output per bracket)
+// Pixels saturated or black in every exposure are counted, printed and masked (mask: 0 = bad).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "hdr/align.h"
+#include "hdr/hdr_input.h"
+#include "hdr/manifest.h"
+#include "hdr/merge.h"
+#include "tools/common/cli.h"
+#include "tools/common/error.h"
+#include "tools/common/strings.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Flags {
+  std::vector<std::string> images;
+  std::string manifest;
+  std::string out;
+  std::string mask_out;  // empty = OUT_mask.png
+  bool align = false;
+  bool black_given = false;  // --black on the command line (else raw input uses 0)
+  igi::hdr::HdrInputOptions input;
+  igi::hdr::MergeOptions merge;
+};
+
+struct Job {
+  fs::path out;
+  igi::hdr::HdrInput input;
+};
+
+fs::path MaskPath(const fs::path& out, const std::string& mask_out, bool single) {
+  if (!mask_out.empty() && single) return mask_out;
+  fs::path mask = out;
+  return mask.replace_filename(out.stem().string() + "_mask.png");
+}
+
+void Validate(const Flags& flags) {
+  flags.merge.Validate();
+  flags.input.raw.Validate();
+  if (flags.images.empty() == flags.manifest.empty()) {
+    throw igi::InputError("give either IMAGES or --manifest (exactly one of them)");
+  }
+  if (igi::ToLower(fs::path(flags.out).extension().string()) != ".exr") {
+    throw igi::InputError(igi::DescribeProblem(flags.out, "--out",
+                                               fs::path(flags.out).extension().string(),
+                                               "radiance maps are written as OpenEXR (.exr)"));
+  }
+}
+
+// Loads every bracket (all problems found before anything is written).
+std::vector<Job> LoadJobs(const Flags& flags) {
+  std::vector<Job> jobs;
+  if (!flags.images.empty()) {
+    std::vector<fs::path> paths(flags.images.begin(), flags.images.end());
+    jobs.push_back({flags.out, igi::hdr::LoadHdrInput(paths, flags.input)});
+    return jobs;
+  }
+  const auto brackets = igi::hdr::ReadManifest(flags.manifest);
+  igi::hdr::HdrInputOptions options = flags.input;
+  options.linear = options.response.empty();  // machine-vision frames are linear
+  igi::ProblemList problems;
+  for (const auto& bracket : brackets) {
+    std::vector<fs::path> paths;
+    std::vector<double> exposures;
+    for (const auto& frame : bracket.frames) {
+      paths.push_back(frame.file);
+      exposures.push_back(frame.exposure_s);
+    }
+    fs::path out = flags.out;
+    if (brackets.size() > 1) {
+      out.replace_filename(fs::path(flags.out).stem().string() + "_" + bracket.label + ".exr");
+    }
+    try {
+      jobs.push_back({out, igi::hdr::LoadHdrInput(paths, options, exposures)});
+    } catch (igi::Error& e) {
+      problems.Append(e.AddContext("bracket " + bracket.label + " of " + flags.manifest));
+    }
+  }
+  problems.ThrowIfAny();
+  return jobs;
+}
+
+void AlignJob(igi::hdr::HdrInput* input) {
+  int reference = 0;
+  for (size_t j = 0; j < input->exposures_s.size(); ++j) {
+    // The median exposure is the best-exposed reference.
+    int below = 0;
+    for (double t : input->exposures_s) below += t < input->exposures_s[j] ? 1 : 0;
+    if (below == int(input->exposures_s.size()) / 2) reference = int(j);
+  }
+  const auto shifts = igi::hdr::ComputeMtbShifts(input->images, reference);
+  for (size_t j = 0; j < shifts.size(); ++j) {
+    if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
+    std::printf("%s: aligned by (%d, %d) px\n", input->names[j].c_str(), shifts[j].dx,
+                shifts[j].dy);
+    input->images[j] = igi::hdr::ShiftImage(input->images[j], shifts[j]);
+  }
+}
+
+int Run(const Flags& flags) {
+  Validate(flags);
+  std::vector<Job> jobs = LoadJobs(flags);
+  for (Job& job : jobs) {
+    if (flags.align) AlignJob(&job.input);
+    igi::hdr::MergeOptions merge = flags.merge;
+    merge.bits = job.input.bits;
+    // Raw data has its black level subtracted: only a zero value carries no signal.
+    if (job.input.raw && !flags.black_given) merge.black = 0.0;
+    const igi::hdr::MergeResult result =
+        igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
+    const fs::path mask = MaskPath(job.out, flags.mask_out, jobs.size() == 1);
+    igi::Image radiance = result.radiance;
+    radiance.metadata["igi:response"] = job.input.response_source;
+    radiance.metadata["igi:weighting"] = merge.weighting;
+    igi::WriteImage(job.out, radiance);
+    igi::WriteImageOptions mask_options;
+    mask_options.type = igi::PixelType::kUInt8;
+    igi::WriteImage(mask, result.mask, mask_options);
+    const double total = double(result.radiance.width) * result.radiance.height;
+    std::printf(
+        "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
+        "(%.3f %%), black in every exposure: %lld px (%.3f %%), masked in %s\n",
+        job.out.string().c_str(), int(job.input.images.size()), job.input.response_source.c_str(),
+        merge.weighting.c_str(), (long long)result.saturated_pixels,
+        100.0 * result.saturated_pixels / total, (long long)result.black_pixels,
+        100.0 * result.black_pixels / total, mask.string().c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("igi-hdr: merge exposure brackets into linear radiance maps (OpenEXR)", "igi-hdr");
+  igi::CommonFlags common;
+  igi::AddCommonFlags(app, &common);
+  Flags flags;
+  app.add_option("images", flags.images, "Images of one bracket (8/16-bit or raw files)");
+  app.add_option("--manifest", flags.manifest, "igi-capture manifest.jsonl to merge");
+  app.add_option("--out", flags.out, "Output radiance map (.exr)")->required();
+  app.add_option("--response", flags.input.response, "response.json (igi-calib response)");
+  auto* list = app.add_option("--exposures", flags.input.exposures.list,
+                              "Exposure times in seconds, comma-separated (0.004 or 1/250)");
+  app.add_option("--exposure-file", flags.input.exposures.file, "One exposure time per line")
+      ->excludes(list);
+  app.add_flag("--linear", flags.input.linear, "Non-raw input is linear (no response needed)");
+  app.add_option("--weighting", flags.merge.weighting, "noise (inverse variance) or hat")
+      ->check(CLI::IsMember({"noise", "hat"}));
+  app.add_option("--shot-noise", flags.merge.shot_noise, "Variance per unit signal (full scale 1)");
+  app.add_option("--read-noise", flags.merge.read_noise, "Read noise std, full scale 1");
+  CLI::Option* black =
+      app.add_option("--black", flags.merge.black,
+                     "Normalised level at or below which = black (default 0.02; raw: 0)");
+  app.add_option("--saturated", flags.merge.saturated, "Normalised level at or above = saturated");
+  app.add_flag("--align", flags.align, "Align hand-held brackets (median threshold bitmaps)");
+  app.add_option("--mask-out", flags.mask_out, "Mask of bad pixels (default OUT_mask.png)");
+  app.add_option("--raw-white-balance", flags.input.raw.white_balance, "camera or none");
+  app.add_option("--raw-color", flags.input.raw.color, "srgb (linear) or raw (camera RGB)");
+  app.add_flag("--half-size", flags.input.raw.half_size, "Raw: 2x2 binning, no demosaicing");
+  return igi::RunMain(app, common, argc, argv, [&]() {
+    flags.black_given = black->count() > 0;
+    return Run(flags);
+  });
+}
