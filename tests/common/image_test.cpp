@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "tests/temp_dir.h"
 #include "tools/common/error.h"
 
 namespace igi {
@@ -14,9 +15,7 @@ namespace {
 class ImageTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("igi_image_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-    std::filesystem::create_directories(dir_);
+    dir_ = test::UniqueTempDir("igi_image_test");
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   static Image Gradient(int w, int h, int c) {

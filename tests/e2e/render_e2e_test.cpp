@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "tests/e2e/run.h"
+#include "tests/temp_dir.h"
 #include "tools/common/image.h"
 
 namespace igi {
@@ -20,9 +21,7 @@ const std::string kScenes = std::string(IGI_SOURCE_DIR) + "/tests/data/scenes/";
 class RenderE2E : public ::testing::Test {
  protected:
   void SetUp() override {
-    out_ = fs::temp_directory_path() / "igi_render_e2e";
-    fs::remove_all(out_);
-    fs::create_directories(out_);
+    out_ = test::UniqueTempDir("igi_render_e2e");
   }
   void TearDown() override { fs::remove_all(out_); }
   std::string Args(const std::string& scene, const std::string& rest) const {

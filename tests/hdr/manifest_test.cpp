@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/temp_dir.h"
+
 #include <filesystem>
 #include <fstream>
 
@@ -15,8 +17,7 @@ namespace fs = std::filesystem;
 class ManifestTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "igi_manifest_test";
-    fs::create_directories(dir_);
+    dir_ = test::UniqueTempDir("igi_manifest_test");
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path Write(const std::string& text) {

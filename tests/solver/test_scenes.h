@@ -7,15 +7,13 @@
 #include <string>
 
 #include "recon/scene.h"
+#include "tests/temp_dir.h"
 #include "tools/common/json.h"
 
 namespace igi::test {
 
 inline std::filesystem::path TempSceneDir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("igi_render_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return UniqueTempDir("igi_render_" + name);
 }
 
 // A square of half-size `half` in the plane z = `z`, centred on (center_x, 0), facing +z (or -z),
