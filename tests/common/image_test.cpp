@@ -45,6 +45,16 @@ TEST_F(ImageTest, ExrFloatRoundTripIsExactAndKeepsMetadata) {
   EXPECT_EQ(std::get<int64_t>(back.metadata.at("igi:frame")), 7);
 }
 
+TEST_F(ImageTest, ExposureTimeSurvivesTiffExif) {
+  // igi-calib reads exposure times from EXIF: a TIFF's ExposureTime must come back as 1/250.
+  Image im = Gradient(4, 4, 3);
+  im.metadata["ExposureTime"] = 0.004;
+  WriteImage(dir_ / "e.tif", im);
+  const ImageInfo info = ReadImageInfo(dir_ / "e.tif");
+  ASSERT_TRUE(info.metadata.count("ExposureTime"));
+  EXPECT_NEAR(std::get<double>(info.metadata.at("ExposureTime")), 0.004, 1e-7);
+}
+
 TEST_F(ImageTest, HalfExrRoundTripWithinHalfPrecision) {
   Image im = Gradient(8, 8, 3);
   WriteImageOptions half;

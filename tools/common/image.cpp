@@ -35,16 +35,15 @@ ImageMetadata MetadataFromSpec(const OIIO::ImageSpec& spec) {
     const std::string name = p.name().string();
     if (t == OIIO::TypeDesc::STRING) {
       out[name] = std::string(p.get_ustring().string());
+    } else if (t == OIIO::TypeRational) {  // e.g. EXIF ExposureTime in TIFF: numerator/denominator
+      const int* r = static_cast<const int*>(p.data());
+      if (r[1] != 0) out[name] = double(r[0]) / double(r[1]);
     } else if (t.basetype == OIIO::TypeDesc::FLOAT || t.basetype == OIIO::TypeDesc::DOUBLE ||
                t.basetype == OIIO::TypeDesc::HALF) {
       if (t.aggregate == OIIO::TypeDesc::SCALAR && t.arraylen == 0) out[name] = p.get_float();
     } else if (t.aggregate == OIIO::TypeDesc::SCALAR && t.arraylen == 0 &&
                t.basetype != OIIO::TypeDesc::PTR) {
-      if (t == OIIO::TypeRational) {
-        out[name] = double(p.get_float());
-      } else {
-        out[name] = int64_t(p.get_int());
-      }
+      out[name] = int64_t(p.get_int());
     }
   }
   return out;
