@@ -11,10 +11,17 @@ struct BrdfName {
   std::string_view name;
 };
 constexpr BrdfName kBrdfNames[] = {
-    {BrdfModel::kLambert, "lambert"},     {BrdfModel::kWard, "ward"},
-    {BrdfModel::kWardGmd, "ward_gmd"},    {BrdfModel::kWardAniso, "ward_aniso"},
-    {BrdfModel::kWardGmdAniso, "ward_gmd_aniso"}, {BrdfModel::kEmitter, "emitter"},
+    {BrdfModel::kLambert, "lambert"},
+    {BrdfModel::kWard, "ward"},
+    {BrdfModel::kWardGmd, "ward_gmd"},
+    {BrdfModel::kWardAniso, "ward_aniso"},
+    {BrdfModel::kWardGmdAniso, "ward_gmd_aniso"},
+    {BrdfModel::kEmitter, "emitter"},
     {BrdfModel::kBlack, "black"},
+    {BrdfModel::kWardFresnel, "ward_fresnel"},
+    {BrdfModel::kWardGmdFresnel, "ward_gmd_fresnel"},
+    {BrdfModel::kWardAnisoFresnel, "ward_aniso_fresnel"},
+    {BrdfModel::kWardGmdAnisoFresnel, "ward_gmd_aniso_fresnel"},
 };
 
 template <typename T>
@@ -63,18 +70,24 @@ std::vector<std::string> Material::MissingForRendering() const {
 
 std::string_view LightTypeName(LightType type) {
   switch (type) {
-    case LightType::kPoint: return "point";
-    case LightType::kSpot: return "spot";
-    case LightType::kDirectional: return "directional";
-    case LightType::kSphere: return "sphere";
-    case LightType::kArea: return "area";
+    case LightType::kPoint:
+      return "point";
+    case LightType::kSpot:
+      return "spot";
+    case LightType::kDirectional:
+      return "directional";
+    case LightType::kSphere:
+      return "sphere";
+    case LightType::kArea:
+      return "area";
   }
   return "unknown";
 }
 
 double SpotProfile::Relative(double theta, double phi) const {
   switch (kind) {
-    case Kind::kNone: return 1.0;
+    case Kind::kNone:
+      return 1.0;
     case Kind::kCosPower: {
       const double c = std::cos(theta);
       return c > 0 ? std::pow(c, cos_power) : 0.0;

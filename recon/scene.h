@@ -29,13 +29,17 @@ namespace igi {
 struct Material {
   std::string name;
   BrdfModel brdf = BrdfModel::kLambert;
-  std::optional<Eigen::Vector3d> rho_d;              // diffuse albedo (region mean), RGB
-  std::optional<std::filesystem::path> rho_d_map;    // albedo texture (linear), indexed by UVs
-  std::optional<Eigen::Vector3d> rho_s;              // specular albedo, RGB
-  std::optional<double> alpha;                       // isotropic roughness
-  std::optional<double> alpha_x, alpha_y;            // anisotropic roughness along t and b
-  std::optional<Eigen::Vector3d> tangent;            // unit x direction of the lobe (world)
-  std::optional<Eigen::Vector3d> radiance;           // "emitter" only, W·sr⁻¹·m⁻²
+  std::optional<Eigen::Vector3d> rho_d;            // diffuse albedo (region mean), RGB
+  std::optional<std::filesystem::path> rho_d_map;  // albedo texture (linear), indexed by UVs
+  std::optional<Eigen::Vector3d> rho_s;            // specular albedo, RGB
+  std::optional<double> alpha;                     // isotropic roughness
+  std::optional<double> alpha_x, alpha_y;          // anisotropic roughness along t and b
+  std::optional<Eigen::Vector3d> tangent;          // unit x direction of the lobe (world)
+  std::optional<Eigen::Vector3d> radiance;         // "emitter" only, W·sr⁻¹·m⁻²
+  // Index of refraction of the *_fresnel models (Schlick F0 = ((ior-1)/(ior+1))²); optional,
+  // kDefaultIor when absent (never an unknown to estimate).
+  std::optional<double> ior;
+  static constexpr double kDefaultIor = 1.5;
 
   // Names of the values that rendering needs but this material lacks (empty = complete).
   std::vector<std::string> MissingForRendering() const;
@@ -64,16 +68,16 @@ struct SpotProfile {
 struct Light {
   std::string name;
   LightType type = LightType::kPoint;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();   // point, spot
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ(); // spot axis; directional: travel dir.
-  Eigen::Vector3d intensity = Eigen::Vector3d::Zero();  // point, spot: W·sr⁻¹
-  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero(); // directional: W·m⁻² ⟂ to direction
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();     // sphere
-  double radius = 0;                                    // sphere, metres
-  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();   // sphere, area: W·sr⁻¹·m⁻²
-  std::filesystem::path file;                           // area: mesh (front = CCW)
-  TriangleMesh mesh;                                    // area: loaded mesh
-  SpotProfile profile;                                  // spot
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();    // point, spot
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // spot axis; directional: travel dir.
+  Eigen::Vector3d intensity = Eigen::Vector3d::Zero();   // point, spot: W·sr⁻¹
+  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // directional: W·m⁻² ⟂ to direction
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();      // sphere
+  double radius = 0;                                     // sphere, metres
+  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();    // sphere, area: W·sr⁻¹·m⁻²
+  std::filesystem::path file;                            // area: mesh (front = CCW)
+  TriangleMesh mesh;                                     // area: loaded mesh
+  SpotProfile profile;                                   // spot
 };
 
 struct Lighting {

@@ -63,23 +63,38 @@ std::set<std::string> ReadGeometry(const SceneLoader& ld, const JsonCursor& root
       }
     }
     if (!mesh_problems.empty()) continue;
-    if (!mesh.has_uvs()) regions_without_uvs.insert(mesh.region_names.begin(), mesh.region_names.end());
+    if (!mesh.has_uvs())
+      regions_without_uvs.insert(mesh.region_names.begin(), mesh.region_names.end());
     scene->mesh.Append(mesh);
   }
   return regions_without_uvs;
 }
 
+// A dielectric's index of refraction: > 1 (so Schlick's F0 > 0) and at most 5 (beyond any
+// dielectric; metals need a complex index, which this model does not take).
+const NumberRule kIorRule{1.0, 5.0, true, false};
+
 // Keys a material of each model may have.
 std::vector<std::string_view> MaterialKeys(BrdfModel model) {
   switch (model) {
-    case BrdfModel::kLambert: return {"brdf", "rho_d", "rho_d_map"};
+    case BrdfModel::kLambert:
+      return {"brdf", "rho_d", "rho_d_map"};
     case BrdfModel::kWard:
-    case BrdfModel::kWardGmd: return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha"};
+    case BrdfModel::kWardGmd:
+      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha"};
+    case BrdfModel::kWardFresnel:
+    case BrdfModel::kWardGmdFresnel:
+      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha", "ior"};
     case BrdfModel::kWardAniso:
     case BrdfModel::kWardGmdAniso:
       return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha_x", "alpha_y", "tangent"};
-    case BrdfModel::kEmitter: return {"brdf", "radiance"};
-    case BrdfModel::kBlack: return {"brdf"};
+    case BrdfModel::kWardAnisoFresnel:
+    case BrdfModel::kWardGmdAnisoFresnel:
+      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha_x", "alpha_y", "tangent", "ior"};
+    case BrdfModel::kEmitter:
+      return {"brdf", "radiance"};
+    case BrdfModel::kBlack:
+      return {"brdf"};
   }
   return {"brdf"};
 }
@@ -95,7 +110,8 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
   auto model = brdf_name ? BrdfModelFromName(*brdf_name) : std::nullopt;
   if (brdf_name && !model) {
     c["brdf"].Problem(
-        "unknown brdf (known: lambert, ward, ward_gmd, ward_aniso, ward_gmd_aniso, emitter, black)");
+        "unknown brdf (known: lambert, ward, ward_gmd, ward_aniso, ward_gmd_aniso, emitter, black, "
+        "ward_fresnel, ward_gmd_fresnel, ward_aniso_fresnel, ward_gmd_aniso_fresnel)");
   }
   if (!model) return m;
   m.brdf = *model;
@@ -108,6 +124,7 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
   if (c["alpha_x"].present()) m.alpha_x = c["alpha_x"].Number(roughness);
   if (c["alpha_y"].present()) m.alpha_y = c["alpha_y"].Number(roughness);
   if (c["tangent"].present()) m.tangent = c["tangent"].Direction();
+  if (c["ior"].present()) m.ior = c["ior"].Number(kIorRule);
   if (c["radiance"].present() || m.brdf == BrdfModel::kEmitter) {
     m.radiance = c["radiance"].Rgb(NumberRule::NonNegative());
   }

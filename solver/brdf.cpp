@@ -8,7 +8,6 @@
 namespace igi {
 namespace {
 
-
 void CheckRgb(const Eigen::Vector3d& rho, const std::string& key,
               std::vector<BrdfParamProblem>* problems) {
   for (int c = 0; c < 3; ++c) {
@@ -38,6 +37,9 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
       CheckAlpha(params.alpha_y, "alpha_y", &problems);
     } else {
       CheckAlpha(params.alpha, "alpha", &problems);
+    }
+    if (HasFresnel(params.model) && !(std::isfinite(params.ior) && params.ior > 1.0)) {
+      problems.push_back({"ior", params.ior, "must be finite and > 1"});
     }
   }
   return problems;
@@ -75,9 +77,9 @@ BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
   // cosθh = h.z/|h| and wo·ĥ = |h|/2 (since |wo + wi|² = 2 + 2 wo·wi).
   out.pdf += p_specular * lobe * h2 / (2.0 * kPi * ax * ay * hz2 * h.z());
   if (above) {
-    const double s = IsGmd(params.model)
-                         ? h2 * lobe / (kPi * ax * ay * hz2 * hz2)
-                         : lobe / (4.0 * kPi * ax * ay * std::sqrt(wo.z() * wi.z()));
+    double s = IsGmd(params.model) ? h2 * lobe / (kPi * ax * ay * hz2 * hz2)
+                                   : lobe / (4.0 * kPi * ax * ay * std::sqrt(wo.z() * wi.z()));
+    if (HasFresnel(params.model)) s *= FresnelWeight<double>(params.ior, wo, wi);
     out.f += params.rho_s * s;
   }
   return out;

@@ -18,10 +18,23 @@
 //   ward_gmd_aniso  f = ρd/π + ρs (h·h) exp(-((h.x/αx)² + (h.y/αy)²)/h.z²) / (π αx αy h.z⁴)
 // i.e. f = ρd/π + ρs·S(wo, wi) with the colourless specular factor S of SpecularFactor().
 //
+// The Fresnel-weighted models ward_fresnel, ward_gmd_fresnel, ward_aniso_fresnel and
+// ward_gmd_aniso_fresnel (igi's additions) multiply the specular term of the model without the
+// suffix by Schlick's Fresnel factor divided by its value at normal incidence:
+//   f = ρd/π + ρs·S(wo, wi)·W(c),   W(c) = F(c)/F0 = 1 + (1/F0 − 1)(1 − c)⁵,
+//   F0 = ((η − 1)/(η + 1))² with η the material's "ior" (default 1.5: F0 = 0.04),
+//   c = ĥ·wi = ĥ·wo = |wi + wo|/2 (ĥ the normalised half vector).
+// So ρs is the specular reflectance at normal incidence on the microfacet (c = 1, i.e. wi = wo,
+// which includes the mirror configuration at the normal): there f equals the plain model's, and
+// W rises toward 1/F0 (25 for η = 1.5) as wi and wo approach opposite grazing directions. As
+// η → ∞ (F0 → 1) W → 1 and the model becomes the plain one. W is symmetric in wi and wo, so the
+// models stay reciprocal. The diffuse term is not weighted.
+//
 // Sampling picks the diffuse lobe (cosine-weighted) or the specular lobe (Ward's half-vector
 // sampling: the slopes (h.x/h.z, h.y/h.z) are Gaussian with deviations αx/√2, αy/√2, and wi is wo
-// mirrored about h) with probabilities from the lobes' mean RGB albedos. BrdfPdf() is the exact
-// combined density of that procedure over the whole sphere of wi, so it serves MIS directly.
+// mirrored about h) with probabilities from the lobes' mean RGB albedos (ρs, without the
+// Fresnel weight: the *_fresnel models sample exactly as their plain models do). BrdfPdf() is the
+// exact combined density of that procedure over the whole sphere of wi, so it serves MIS directly.
 //
 // EvalBrdf/SpecularFactor are templates so Ceres Jets flow through the parameters (and the
 // directions); their branches compare values only, which Jets support.
@@ -54,6 +67,7 @@ struct BrdfParamsT {
   T alpha = T(0.1);
   T alpha_x = T(0.1);
   T alpha_y = T(0.1);
+  T ior = T(1.5);  // index of refraction, read by the *_fresnel models only; > 1
 
   // The roughness along t and along b that the model uses.
   T AlphaX() const { return IsAnisotropic(model) ? alpha_x : alpha; }
@@ -67,12 +81,14 @@ struct BrdfParamProblem {
   double value = 0.0;
   std::string rule;
 };
-// Every problem of `params` (ρ finite and >= 0; the α the model reads finite and > 0); empty if
-// none. The caller turns them into InputErrors naming its file and material.
+// Every problem of `params` (ρ finite and >= 0; the α the model reads finite and > 0; for the
+// *_fresnel models ior finite and > 1); empty if none. The caller turns them into InputErrors
+// naming its file and material.
 std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params);
 
 // S(wo, wi) of the header comment for a model with specular lobe; 0 for lambert or when wo or
-// wi is at or below the surface. Isotropic models take alpha_x = alpha_y = alpha.
+// wi is at or below the surface. Isotropic models take alpha_x = alpha_y = alpha. For a
+// *_fresnel model it is S of the plain model (without the Fresnel weight W).
 template <typename T>
 T SpecularFactor(BrdfModel model, const T& alpha_x, const T& alpha_y,
                  const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
@@ -88,6 +104,19 @@ T SpecularFactor(BrdfModel model, const T& alpha_x, const T& alpha_y,
   return lobe / (T(4.0 * kPi) * alpha_x * alpha_y * sqrt(wo.z() * wi.z()));
 }
 
+// W(c) of the header comment: Schlick's Fresnel factor over its normal-incidence value, with
+// F0 = ((ior − 1)/(ior + 1))² and c = |wo + wi|/2 = ĥ·wi.
+template <typename T>
+T FresnelWeight(const T& ior, const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
+  using std::sqrt;
+  const T r = (ior - T(1.0)) / (ior + T(1.0));
+  const T f0 = r * r;
+  const T c = T(0.5) * sqrt((wo + wi).squaredNorm());
+  const T m = T(1.0) - c;
+  const T m2 = m * m;
+  return T(1.0) + (T(1.0) / f0 - T(1.0)) * (m2 * m2 * m);
+}
+
 // f(wo, wi), RGB per steradian; zero when wo or wi is at or below the surface.
 template <typename T>
 Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,
@@ -95,7 +124,9 @@ Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matri
   if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) return Eigen::Matrix<T, 3, 1>::Zero();
   Eigen::Matrix<T, 3, 1> f = params.rho_d * T(kInvPi);
   if (HasSpecularLobe(params.model)) {
-    f += params.rho_s * SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
+    T s = SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
+    if (HasFresnel(params.model)) s *= FresnelWeight<T>(params.ior, wo, wi);
+    f += params.rho_s * s;
   }
   return f;
 }

@@ -54,6 +54,7 @@ ShadingMaterial MakeShadingMaterial(const Material& m) {
   s.params.alpha = m.alpha.value_or(0.1);
   s.params.alpha_x = m.alpha_x.value_or(0.1);
   s.params.alpha_y = m.alpha_y.value_or(0.1);
+  s.params.ior = m.ior.value_or(Material::kDefaultIor);
   s.tangent = m.tangent;
   if (m.brdf == BrdfModel::kEmitter) s.emission = m.radiance.value_or(Eigen::Vector3d::Zero());
   if (m.rho_d_map) {
@@ -101,7 +102,8 @@ std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lightin
 
   // Scene extent sets the self-intersection offset.
   double extent = 1.0;
-  for (const Eigen::Vector3f& p : mesh.positions) extent = std::max(extent, double(p.cwiseAbs().maxCoeff()));
+  for (const Eigen::Vector3f& p : mesh.positions)
+    extent = std::max(extent, double(p.cwiseAbs().maxCoeff()));
   impl->ray_epsilon = 1e-5 * extent;
 
   for (int index : scene.lightings[lighting].lights) {

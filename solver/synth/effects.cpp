@@ -142,8 +142,18 @@ Json EmissionProfile(Params& p, const SynthRoom& room, SynthScenes* s) {
               {"note", "peak intensity equals the declared light's intensity"}};
 }
 
+// "ward_gmd_fresnel" -> {"ward_gmd", "_fresnel"}; "ward" -> {"ward", ""}.
+std::pair<std::string, std::string> SplitFresnel(const std::string& brdf) {
+  const std::string suffix = "_fresnel";
+  if (brdf.size() > suffix.size() && brdf.ends_with(suffix)) {
+    return {brdf.substr(0, brdf.size() - suffix.size()), suffix};
+  }
+  return {brdf, ""};
+}
+
 std::string Anisotropic(const std::string& brdf) {
-  return brdf == "ward_gmd" ? "ward_gmd_aniso" : "ward_aniso";
+  const auto [base, fresnel] = SplitFresnel(brdf);
+  return (base == "ward_gmd" ? "ward_gmd_aniso" : "ward_aniso") + fresnel;
 }
 
 Json Anisotropy(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -283,7 +293,8 @@ Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
                                                              {"ward_gmd", "ward"},
                                                              {"ward_aniso", "ward_gmd_aniso"},
                                                              {"ward_gmd_aniso", "ward_aniso"}};
-    m["brdf"] = kSwap.at(brdf);
+    const auto [base, fresnel] = SplitFresnel(brdf);
+    m["brdf"] = kSwap.at(base) + fresnel;
     changes[region] = Json{{"true_brdf", m["brdf"]},
                            {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
   }
@@ -300,6 +311,30 @@ Json Intensity(Params& p, const SynthRoom& room, SynthScenes* s) {
     for (auto& v : j[key]) v = v.get<double>() * factor;
   }
   return Json{{"light", light}, {"factor", factor}, {"true_light", j}};
+}
+
+Json Fresnel(Params& p, const SynthRoom& room, SynthScenes* s) {
+  const auto regions = p.Names("regions", room.glossy_regions, room.glossy_regions);
+  const double ior = p.Number("ior", 1.5, 1.01, 5.0);
+  p.Finish();
+  const double f0 = std::pow((ior - 1) / (ior + 1), 2);
+  Json changes = Json::object();
+  for (const std::string& region : regions) {
+    Json& m = s->true_scene["materials"][region];
+    const std::string brdf = m["brdf"].get<std::string>();
+    if (SplitFresnel(brdf).second.empty()) m["brdf"] = brdf + "_fresnel";
+    m["ior"] = ior;
+    changes[region] = Json{{"true_brdf", m["brdf"]},
+                           {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
+  }
+  return Json{
+      {"regions", changes},
+      {"ior", ior},
+      {"f0", f0},
+      {"model",
+       "specular term x F(c)/F0, F = F0 + (1 - F0)(1 - c)^5 (Schlick), F0 = ((ior - 1)/(ior "
+       "+ 1))^2, c = |wi + wo|/2; equal to the declared model at c = 1 (wi = wo)"},
+      {"note", "same rho_d, rho_s and alpha values"}};
 }
 
 Json SpecularAsDiffuse(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -391,6 +426,8 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
       params = Intensity(p, room, s);
     else if (n == "specular_reflection")
       params = SpecularAsDiffuse(p, room, s);
+    else if (n == "fresnel")
+      params = Fresnel(p, room, s);
     else
       p.Fail("", "", "unknown effect");
     list.push_back(Json{{"effect", n}, {"params", params}});

@@ -23,6 +23,9 @@
 //                           reverse (regions=a/b/c)
 //   light_intensity         the lamp is truly `factor` (1.25) times brighter
 //   specular_reflection     a glossy region (region=wall_y4) is declared lambert
+//   fresnel                 the glossy regions (regions=a/b/c) are truly Fresnel-weighted
+//                           (ward -> ward_fresnel, … : specular × F(c)/F0, Schlick, ior=1.5);
+//                           declared without Fresnel (solver/brdf.h defines the models)
 
 #include <map>
 #include <optional>

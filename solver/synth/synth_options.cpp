@@ -25,10 +25,10 @@ bool Contains(const std::vector<std::string>& list, const std::string& name) {
 
 const std::vector<std::string>& SupportedEffects() {
   static const std::vector<std::string> kEffects = {
-      "vignetting",          "light_emission_profile", "anisotropic_reflection",
-      "light_source_extent", "missing_geometry",       "ambient_light",
-      "exposure_scale",      "camera_response",        "pose_error",
-      "specular_lobe_shape", "light_intensity",        "specular_reflection"};
+      "vignetting",       "light_emission_profile", "anisotropic_reflection", "light_source_extent",
+      "missing_geometry", "ambient_light",          "exposure_scale",         "camera_response",
+      "pose_error",       "specular_lobe_shape",    "light_intensity",        "specular_reflection",
+      "fresnel"};
   return kEffects;
 }
 
@@ -39,9 +39,6 @@ EffectSpec ParseEffectSpec(const std::string& text) {
   auto fail = [&](const std::string& rule) {
     throw InputError(DescribeProblem("--effect", "", text, rule));
   };
-  if (spec.name == "fresnel") {
-    fail("effect not available: the renderer has no Fresnel-weighted BRDF yet");
-  }
   if (spec.name == "indirect_illumination") {
     fail("effect not available: indirect illumination is always in the photos");
   }

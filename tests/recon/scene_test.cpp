@@ -1,9 +1,11 @@
 #include "recon/scene.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include "recon/colmap_model.h"
 
@@ -91,8 +93,9 @@ TEST(SceneTest, SharedReferenceAndRealScenesLoad) {
   EXPECT_EQ(room.materials[room.FindMaterial("glossy_box")].brdf, BrdfModel::kWardGmd);
   EXPECT_NEAR(room.lights[room.FindLight("lamp")].radius, 0.1, 1e-12);
   // cam0 stands at (2, 0.3, 1.5) (README of radiance_room).
-  EXPECT_NEAR((room.cameras[room.FindCamera("cam0")].CenterInWorld() -
-               Eigen::Vector3d(2, 0.3, 1.5)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(
+      (room.cameras[room.FindCamera("cam0")].CenterInWorld() - Eigen::Vector3d(2, 0.3, 1.5)).norm(),
+      0.0, 1e-6);
 
   const Scene ball = LoadScene(kData / "real/diligent_ball/scene.json");
   EXPECT_EQ(ball.photos.size(), 48u);
@@ -107,15 +110,16 @@ TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
   const fs::path dir = fs::temp_directory_path() / "igi_scene_many_problems";
   fs::create_directories(dir);
   Json doc = ReadJsonFile(kMini);
-  for (auto& g : doc["geometry"]) g["file"] = (kMini.parent_path() / g["file"].get<std::string>()).string();
+  for (auto& g : doc["geometry"])
+    g["file"] = (kMini.parent_path() / g["file"].get<std::string>()).string();
   doc["materials"]["floor"].erase("rho_d_map");
-  doc["materials"]["walls"]["rho_d"] = 2.0;                 // out of range
-  doc["lights"]["bulb"]["radius"] = -1;                     // must be > 0
-  doc["cameras"]["cam0"]["qvec"] = {1, 1, 0, 0};            // not unit
+  doc["materials"]["walls"]["rho_d"] = 2.0;       // out of range
+  doc["lights"]["bulb"]["radius"] = -1;           // must be > 0
+  doc["cameras"]["cam0"]["qvec"] = {1, 1, 0, 0};  // not unit
   doc["lights"].erase("spot");
   doc["lightings"]["L1"] = {"panel"};
   doc["photos"] = Json::array();
-  doc["lights"]["panel"]["file"] = "nowhere.obj";           // missing file
+  doc["lights"]["panel"]["file"] = "nowhere.obj";  // missing file
   WriteJsonFile(dir / "scene.json", doc);
   try {
     LoadScene(dir / "scene.json");
@@ -123,6 +127,57 @@ TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.problems().size(), 4u) << e.what();
   }
+  fs::remove_all(dir);
+}
+
+// The Fresnel-weighted models (igi's additions to CONTRACT.md §2) take an optional "ior" in
+// (1, 5], default 1.5; the plain models do not accept the key.
+TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("igi_scene_fresnel_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Json doc = ReadJsonFile(kMini);
+  const fs::path mini = kMini.parent_path();
+  for (auto& g : doc["geometry"]) g["file"] = (mini / g["file"].get<std::string>()).string();
+  doc["materials"]["floor"]["rho_d_map"] = (mini / "textures/floor.exr").string();
+  doc["lights"]["spot"]["profile"]["ies"] = (mini / "lights/spot.ies").string();
+  doc["lights"]["panel"]["file"] = (mini / "geometry/panel.obj").string();
+  for (auto& photo : doc["photos"]) {
+    photo["file"] = (mini / photo["file"].get<std::string>()).string();
+    if (photo.contains("mask") && photo["mask"].is_string()) {
+      photo["mask"] = (mini / photo["mask"].get<std::string>()).string();
+    }
+  }
+  doc["materials"]["floor"]["brdf"] = "ward_gmd_fresnel";
+  doc["materials"]["floor"]["ior"] = 1.33;
+  doc["materials"]["box"]["brdf"] = "ward_aniso_fresnel";  // no ior: the default
+  WriteJsonFile(dir / "scene.json", doc);
+  const Scene scene = LoadScene(dir / "scene.json");
+  const Material& floor = scene.materials[scene.FindMaterial("floor")];
+  EXPECT_EQ(floor.brdf, BrdfModel::kWardGmdFresnel);
+  EXPECT_EQ(floor.ior, 1.33);
+  EXPECT_TRUE(floor.MissingForRendering().empty());  // ior is never missing
+  const Material& box = scene.materials[scene.FindMaterial("box")];
+  EXPECT_EQ(box.brdf, BrdfModel::kWardAnisoFresnel);
+  EXPECT_FALSE(box.ior.has_value());
+  EXPECT_EQ(box.MissingForRendering(),
+            (std::vector<std::string>{"rho_d", "rho_s", "alpha_x", "alpha_y"}));
+
+  for (double bad : {1.0, 0.5, 5.01, -2.0}) {
+    doc["materials"]["floor"]["ior"] = bad;
+    WriteJsonFile(dir / "scene.json", doc);
+    try {
+      LoadScene(dir / "scene.json");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.problems().size(), 1u) << e.what();
+      EXPECT_NE(e.problems()[0].find("materials.floor.ior"), std::string::npos) << e.what();
+      EXPECT_NE(e.problems()[0].find("must be in (1, 5]"), std::string::npos) << e.what();
+    }
+  }
+  doc["materials"]["floor"]["ior"] = 5.0;  // the upper bound is included
+  WriteJsonFile(dir / "scene.json", doc);
+  EXPECT_EQ(LoadScene(dir / "scene.json").materials[scene.FindMaterial("floor")].ior, 5.0);
   fs::remove_all(dir);
 }
 
@@ -156,8 +211,8 @@ TEST(SceneTest, CamerasFromColmapModel) {
   doc["lights"]["spot"]["profile"]["ies"] = (mini / "lights/spot.ies").string();
   doc["lights"]["panel"]["file"] = (mini / "geometry/panel.obj").string();
   doc["cameras"] = Json{{"colmap", "sparse/0"}};
-  doc["photos"] = Json::array({Json{{"file", (mini / "photos/cam0_L0.exr").string()},
-                                    {"lighting", "L0"}}});
+  doc["photos"] =
+      Json::array({Json{{"file", (mini / "photos/cam0_L0.exr").string()}, {"lighting", "L0"}}});
   WriteJsonFile(dir / "scene.json", doc);
   const Scene scene = LoadScene(dir / "scene.json");
   ASSERT_EQ(scene.cameras.size(), 1u);
@@ -178,7 +233,8 @@ TEST(SceneTest, CamerasFromColmapModel) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no image of this file name in the COLMAP model"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
   fs::remove_all(dir);
 }

@@ -18,3 +18,13 @@ for (wo,wi) in [((30,20),(40,215)),((60,0),(55,170)),((10,90),(80,-45))]:
   for m in ['ward','ward_gmd','ward_aniso','ward_gmd_aniso']:
     s=spec(m,d(*wo),d(*wi),0.2,0.15,0.3)
     print(wo,wi,m,'S=%.17g'%s,'f=',['%.17g'%(rd[c]/pi+rs[c]*s) for c in range(3)])
+# The Fresnel-weighted models (solver/brdf.h): S of the plain model times Schlick's F over F0,
+# written through the angle between wi and the normalised half vector; ior = 1.7.
+def fresnel_weight(wo,wi,ior):
+    h=[wo[k]+wi[k] for k in range(3)]; n=sqrt(sum(x*x for x in h))
+    c=sum(wi[k]*h[k]/n for k in range(3)); f0=((ior-1)/(ior+1))**2
+    return (f0+(1-f0)*(1-c)**5)/f0
+for (wo,wi) in [((30,20),(40,215)),((60,0),(55,170)),((80,0),(75,180))]:
+  for m in ['ward','ward_gmd','ward_aniso','ward_gmd_aniso']:
+    s=spec(m,d(*wo),d(*wi),0.2,0.15,0.3)*fresnel_weight(d(*wo),d(*wi),1.7)
+    print(wo,wi,m+'_fresnel','S*W=%.17g'%s,'f=',['%.17g'%(rd[c]/pi+rs[c]*s) for c in range(3)])

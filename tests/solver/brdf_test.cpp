@@ -19,8 +19,18 @@ using test::SidakLevel;
 using test::SphereHistogram;
 using test::TestDirections;
 
-constexpr BrdfModel kAllModels[] = {BrdfModel::kLambert, BrdfModel::kWard, BrdfModel::kWardGmd,
-                                    BrdfModel::kWardAniso, BrdfModel::kWardGmdAniso};
+constexpr BrdfModel kAllModels[] = {BrdfModel::kLambert,
+                                    BrdfModel::kWard,
+                                    BrdfModel::kWardGmd,
+                                    BrdfModel::kWardAniso,
+                                    BrdfModel::kWardGmdAniso,
+                                    BrdfModel::kWardFresnel,
+                                    BrdfModel::kWardGmdFresnel,
+                                    BrdfModel::kWardAnisoFresnel,
+                                    BrdfModel::kWardGmdAnisoFresnel};
+constexpr BrdfModel kFresnelModels[] = {BrdfModel::kWardFresnel, BrdfModel::kWardGmdFresnel,
+                                        BrdfModel::kWardAnisoFresnel,
+                                        BrdfModel::kWardGmdAnisoFresnel};
 
 Eigen::Vector3d Dir(double theta_deg, double phi_deg) {
   const double t = theta_deg * kPi / 180.0;
@@ -46,7 +56,8 @@ BrdfParams Grey(BrdfModel model, double rho_d, double rho_s, double alpha_x, dou
 }
 
 // The specular part of CONTRACT.md §2 written a second way: through the angles θh, φh of the
-// normalised half vector, and for Ward-GMD through (h·h)/(h·n)⁴ = 1/(4 (wi·ĥ)² cos⁴θh).
+// normalised half vector, and for Ward-GMD through (h·h)/(h·n)⁴ = 1/(4 (wi·ĥ)² cos⁴θh). For a
+// *_fresnel model: the plain model's (the Fresnel weight is ReferenceFresnelWeight).
 double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vector3d& wo,
                          const Eigen::Vector3d& wi) {
   const Eigen::Vector3d h_hat = (wo + wi).normalized();
@@ -61,6 +72,16 @@ double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vec
   return lobe / (4.0 * kPi * ax * ay * std::sqrt(wi.z() * wo.z()));
 }
 
+// Schlick's F(θd) = F0 + (1 - F0)(1 - cosθd)⁵ over F0, θd the angle between wo and the
+// normalised half vector (written with wo, where the code uses |wo + wi|/2); 1 without Fresnel.
+double ReferenceFresnelWeight(BrdfModel model, double ior, const Eigen::Vector3d& wo,
+                              const Eigen::Vector3d& wi) {
+  if (!HasFresnel(model)) return 1.0;
+  const double f0 = std::pow((ior - 1.0) / (ior + 1.0), 2);
+  const double cos_d = wo.dot((wo + wi).normalized());
+  return (f0 + (1.0 - f0) * std::pow(1.0 - cos_d, 5)) / f0;
+}
+
 // ---- names and parameters -------------------------------------------------------------------
 
 TEST(BrdfModelTest, NamesRoundTrip) {
@@ -69,6 +90,19 @@ TEST(BrdfModelTest, NamesRoundTrip) {
   EXPECT_FALSE(IsReflective(*BrdfModelFromName("emitter")));
   EXPECT_FALSE(IsReflective(*BrdfModelFromName("black")));
   EXPECT_FALSE(BrdfModelFromName("Ward").has_value());
+  EXPECT_EQ(BrdfModelName(BrdfModel::kWardFresnel), "ward_fresnel");
+  EXPECT_EQ(BrdfModelName(BrdfModel::kWardGmdFresnel), "ward_gmd_fresnel");
+  EXPECT_EQ(BrdfModelName(BrdfModel::kWardAnisoFresnel), "ward_aniso_fresnel");
+  EXPECT_EQ(BrdfModelName(BrdfModel::kWardGmdAnisoFresnel), "ward_gmd_aniso_fresnel");
+  for (BrdfModel m : kFresnelModels) {
+    EXPECT_TRUE(HasSpecularLobe(m) && IsReflective(m) && HasFresnel(m));
+    EXPECT_FALSE(HasFresnel(WithoutFresnel(m)));
+    EXPECT_EQ(IsGmd(m), IsGmd(WithoutFresnel(m)));
+    EXPECT_EQ(IsAnisotropic(m), IsAnisotropic(WithoutFresnel(m)));
+  }
+  EXPECT_TRUE(IsGmd(BrdfModel::kWardGmdAnisoFresnel) &&
+              IsAnisotropic(BrdfModel::kWardGmdAnisoFresnel));
+  EXPECT_EQ(WithoutFresnel(BrdfModel::kWardGmd), BrdfModel::kWardGmd);
 }
 
 TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
@@ -93,6 +127,18 @@ TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
   EXPECT_TRUE(CheckBrdfParams(p).empty());
   p.rho_d[2] = INFINITY;
   EXPECT_EQ(CheckBrdfParams(p).size(), 1u);
+  // ior: read by the *_fresnel models only, must be > 1 (F0 > 0).
+  BrdfParams f = Grey(BrdfModel::kWard, 0.5, 0.1, 0.2, 0.2);
+  f.ior = 1.0;
+  EXPECT_TRUE(CheckBrdfParams(f).empty());
+  f.model = BrdfModel::kWardGmdFresnel;
+  problems = CheckBrdfParams(f);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].key, "ior");
+  f.ior = NAN;
+  EXPECT_EQ(CheckBrdfParams(f).size(), 1u);
+  f.ior = 1.0001;
+  EXPECT_TRUE(CheckBrdfParams(f).empty());
 }
 
 TEST(BrdfParamsTest, SpecularLobeProbabilityFollowsMeanAlbedos) {
@@ -136,10 +182,28 @@ TEST(BrdfEvalTest, MatchesLiteralValuesFromTheContractFormulas) {
        {0.15915511988962203, 0.12732430806896966, 0.095493673046043975}},
       {10, 90, 80, -45, BrdfModel::kWardGmdAniso,
        {0.15915494764538407, 0.12732396358049375, 0.095492984069092138}},
+      // The Fresnel-weighted models with ior = 1.7 (c = |wo + wi|/2 = 0.822, 0.542, 0.216).
+      {30, 20, 40, 215, BrdfModel::kWardFresnel,
+       {0.24147140274572448, 0.29195687378117452, 0.42475880447045378}},
+      {30, 20, 40, 215, BrdfModel::kWardGmdAnisoFresnel,
+       {0.26803516444640774, 0.34508439718254114, 0.5310138512731869}},
+      {60, 0, 55, 170, BrdfModel::kWardGmdFresnel,
+       {0.42830857775844577, 0.66563122380661721, 1.1721075045213389}},
+      {60, 0, 55, 170, BrdfModel::kWardAnisoFresnel,
+       {0.31083337308670023, 0.43068081446312612, 0.70220668583435686}},
+      {80, 0, 75, 180, BrdfModel::kWardFresnel,
+       {2.4402983469669537, 4.6896107622236327, 9.2200665813553702}},
+      {80, 0, 75, 180, BrdfModel::kWardGmdFresnel,
+       {10.521701932311395, 20.852417932912516, 41.545680922733133}},
+      {80, 0, 75, 180, BrdfModel::kWardAnisoFresnel,
+       {2.1130547162013773, 4.0351235006924799, 7.9110920582930655}},
+      {80, 0, 75, 180, BrdfModel::kWardGmdAnisoFresnel,
+       {9.0351327429432065, 17.87927955417614, 35.599404165260381}},
   };
   // clang-format on
   for (const Case& c : cases) {
-    const BrdfParams p = Make(c.model, {0.5, 0.4, 0.3}, {0.05, 0.1, 0.2}, 0.15, 0.3);
+    BrdfParams p = Make(c.model, {0.5, 0.4, 0.3}, {0.05, 0.1, 0.2}, 0.15, 0.3);
+    p.ior = 1.7;  // read by the *_fresnel models only
     BrdfParams iso = p;
     iso.alpha = 0.2;
     const BrdfParams& params = IsAnisotropic(c.model) ? p : iso;
@@ -154,13 +218,16 @@ TEST(BrdfEvalTest, MatchesTheAngleFormOfEveryModel) {
   Pcg32 rng(1, 2);
   for (BrdfModel model : kAllModels) {
     for (double alpha : {0.05, 0.2, 0.6}) {
-      const BrdfParams p = Make(model, {0.3, 0.2, 0.1}, {0.04, 0.08, 0.5}, alpha, 1.7 * alpha);
+      BrdfParams p = Make(model, {0.3, 0.2, 0.1}, {0.04, 0.08, 0.5}, alpha, 1.7 * alpha);
+      p.ior = 1.33 + alpha;
       for (int i = 0; i < 200; ++i) {
         const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
         const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
         double s = 0.0;
         if (HasSpecularLobe(model)) s = ReferenceSpecular(model, p.AlphaX(), p.AlphaY(), wo, wi);
-        const Eigen::Vector3d expected = p.rho_d / kPi + p.rho_s * s;
+        const double w = ReferenceFresnelWeight(model, p.ior, wo, wi);
+        EXPECT_NEAR(HasFresnel(model) ? FresnelWeight(p.ior, wo, wi) : 1.0, w, 1e-12 * w);
+        const Eigen::Vector3d expected = p.rho_d / kPi + p.rho_s * s * w;
         const Eigen::Vector3d f = EvalBrdf(p, wo, wi);
         // 1e-10 relative: acos/tan near θh = 0 lose a few digits in the reference.
         EXPECT_NEAR((f - expected).norm(), 0.0, 1e-10 * expected.norm()) << BrdfModelName(model);
@@ -186,6 +253,40 @@ TEST(BrdfEvalTest, IsZeroBelowTheSurfaceAndOneSided) {
               0.6 / kPi, 1e-16);
 }
 
+TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicrofacet) {
+  // W(c) = 1 exactly where c = |wo + wi|/2 = 1, i.e. wi = wo (the mirror configuration at the
+  // normal included), and W -> 1 everywhere as ior -> ∞ (F0 -> 1). Elsewhere W >= 1. Tolerances:
+  // 1e-14 relative (rounding) at c = 1; at ior = 1e6, 1 - F0 = 4e-6, so W - 1 < 4e-6.
+  Pcg32 rng(11, 12);
+  for (BrdfModel model : kFresnelModels) {
+    BrdfParams fresnel = Make(model, {0.3, 0.2, 0.1}, {0.2, 0.3, 0.4}, 0.12, 0.35);
+    BrdfParams plain = fresnel;
+    plain.model = WithoutFresnel(model);
+    for (int i = 0; i < 200; ++i) {
+      const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
+      const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
+      fresnel.ior = 1.5;
+      const Eigen::Vector3d same = EvalBrdf(plain, wo, wo);
+      EXPECT_NEAR((EvalBrdf(fresnel, wo, wo) - same).norm(), 0.0, 1e-14 * same.norm());
+      const Eigen::Vector3d f = EvalBrdf(plain, wo, wi);
+      EXPECT_TRUE((EvalBrdf(fresnel, wo, wi).array() >= f.array()).all());
+      fresnel.ior = 1e6;
+      EXPECT_NEAR((EvalBrdf(fresnel, wo, wi) - f).norm(), 0.0, 4e-6 * f.norm());
+    }
+    const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+    fresnel.ior = 1.5;
+    EXPECT_EQ(EvalBrdf(fresnel, n, n), EvalBrdf(plain, n, n)) << BrdfModelName(model);
+  }
+  // ior = 1.5: F0 = 0.04, so W = 1 + 24 (1 - c)⁵; opposite grazing directions (θ = 89°) have
+  // c = cos 89° = 0.017452, W = 1 + 24 · 0.982548⁵ = 22.97755 (Python; 1e-6 relative: the printed
+  // digits).
+  const Eigen::Vector3d a = Dir(89, 0);
+  const Eigen::Vector3d b = Dir(89, 180);
+  EXPECT_NEAR(FresnelWeight(1.5, a, b), 1.0 + 24.0 * std::pow(1.0 - std::cos(89 * kPi / 180), 5),
+              1e-13);
+  EXPECT_NEAR(FresnelWeight(1.5, a, b), 22.97755, 22.98e-6);
+}
+
 TEST(BrdfEvalTest, IsReciprocal) {
   Pcg32 rng(3, 4);
   for (BrdfModel model : kAllModels) {
@@ -201,8 +302,11 @@ TEST(BrdfEvalTest, IsReciprocal) {
 
 TEST(BrdfEvalTest, AnisotropicModelsReduceToIsotropicAndRotateWithTheTangent) {
   Pcg32 rng(5, 6);
-  const std::pair<BrdfModel, BrdfModel> pairs[] = {{BrdfModel::kWardAniso, BrdfModel::kWard},
-                                                   {BrdfModel::kWardGmdAniso, BrdfModel::kWardGmd}};
+  const std::pair<BrdfModel, BrdfModel> pairs[] = {
+      {BrdfModel::kWardAniso, BrdfModel::kWard},
+      {BrdfModel::kWardGmdAniso, BrdfModel::kWardGmd},
+      {BrdfModel::kWardAnisoFresnel, BrdfModel::kWardFresnel},
+      {BrdfModel::kWardGmdAnisoFresnel, BrdfModel::kWardGmdFresnel}};
   for (const auto& [aniso, iso] : pairs) {
     for (int i = 0; i < 200; ++i) {
       const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
@@ -226,14 +330,15 @@ TEST(BrdfEvalTest, AnisotropicModelsReduceToIsotropicAndRotateWithTheTangent) {
 // ---- derivatives through Ceres Jets ---------------------------------------------------------
 
 TEST(BrdfEvalTest, JetDerivativesMatchFiniteDifferences) {
-  using Jet = ceres::Jet<double, 4>;
+  using Jet = ceres::Jet<double, 5>;
   const Eigen::Vector3d wo = Dir(35, 10);
   const Eigen::Vector3d wi = Dir(42, 200);
   for (BrdfModel model : kAllModels) {
-    // Parameters: 0 = rho_d[0], 1 = rho_s[0], 2 = alpha or alpha_x, 3 = alpha_y.
-    const double x0[4] = {0.4, 0.2, 0.18, 0.27};
+    // Parameters: 0 = rho_d[0], 1 = rho_s[0], 2 = alpha or alpha_x, 3 = alpha_y, 4 = ior.
+    const double x0[5] = {0.4, 0.2, 0.18, 0.27, 1.6};
     auto eval = [&](const double* x) {
       BrdfParams p = Make(model, {x[0], 0.3, 0.3}, {x[1], 0.1, 0.1}, x[2], x[3]);
+      p.ior = x[4];
       return EvalBrdf(p, wo, wi)[0];
     };
     BrdfParamsT<Jet> pj;
@@ -243,14 +348,15 @@ TEST(BrdfEvalTest, JetDerivativesMatchFiniteDifferences) {
     pj.alpha = Jet(x0[2], 2);
     pj.alpha_x = Jet(x0[2], 2);
     pj.alpha_y = Jet(x0[3], 3);
+    pj.ior = Jet(x0[4], 4);
     const Jet f = EvalBrdf<Jet>(pj, wo.cast<Jet>(), wi.cast<Jet>())[0];
     EXPECT_NEAR(f.a, eval(x0), 1e-15);
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < 5; ++k) {
       // Central differences with step 1e-6: truncation ~1e-12 and rounding ~1e-10 relative to
       // derivatives of order 1-10, so 1e-7 relative + 1e-9 absolute is safe.
-      double xp[4], xm[4];
-      std::copy(x0, x0 + 4, xp);
-      std::copy(x0, x0 + 4, xm);
+      double xp[5], xm[5];
+      std::copy(x0, x0 + 5, xp);
+      std::copy(x0, x0 + 5, xm);
       xp[k] += 1e-6;
       xm[k] -= 1e-6;
       const double fd = (eval(xp) - eval(xm)) / 2e-6;
@@ -258,6 +364,11 @@ TEST(BrdfEvalTest, JetDerivativesMatchFiniteDifferences) {
     }
     if (HasSpecularLobe(model)) {
       EXPECT_GT(std::abs(f.v[2]), 1e-3);  // α really moves f
+    }
+    if (HasFresnel(model)) {
+      EXPECT_LT(f.v[4], -1e-4);  // a higher ior raises F0, so lowers F/F0 off normal incidence
+    } else {
+      EXPECT_EQ(f.v[4], 0.0);
     }
   }
 }
@@ -314,6 +425,26 @@ TEST(BrdfEnergyTest, NoModelCreatesEnergyForPlausibleParameters) {
   }
 }
 
+TEST(BrdfEnergyTest, FresnelWeightRaisesTheSpecularAlbedoMostTowardGrazing) {
+  // The albedo ratio fresnel/plain (ρd = 0, ρs = 1, α = 0.1, ior 1.5) is ~1 at normal viewing
+  // (c ≈ 1 over the whole lobe) and grows toward grazing, as Schlick's factor does at the mirror
+  // direction (W(cos θo) = 1 + 24 (1 - cos θo)⁵: 1.0000, 1.0008, 1.75, 8.1 at 0, 30, 60, 80°).
+  // Tolerance: the quadrature's 1e-6 becomes 1e-4 on ratios of spread-out lobes; the bounds are
+  // loose brackets around W(cos θo) (the lobe averages W over its width).
+  double previous = 0.0;
+  for (double theta : {0.0, 30.0, 60.0, 80.0}) {
+    const double plain = Albedo(Grey(BrdfModel::kWardGmd, 0.0, 1.0, 0.1, 0.1), Dir(theta, 0));
+    BrdfParams p = Grey(BrdfModel::kWardGmdFresnel, 0.0, 1.0, 0.1, 0.1);
+    p.ior = 1.5;
+    const double ratio = Albedo(p, Dir(theta, 0)) / plain;
+    const double w_mirror = 1.0 + 24.0 * std::pow(1.0 - std::cos(theta * kPi / 180), 5);
+    EXPECT_GT(ratio, previous) << theta;
+    EXPECT_GE(ratio, 1.0) << theta;
+    EXPECT_NEAR(ratio, w_mirror, 0.25 * w_mirror) << theta;
+    previous = ratio;
+  }
+}
+
 TEST(BrdfEnergyTest, Ward1992LosesEnergyTowardGrazingWhereGmdDoesNot) {
   // The 1/√(cosθi cosθo) normalisation makes the specular albedo of a narrow lobe fall like
   // cosθo (measured, ρs = 1, α = 0.05: 0.99, 0.86, 0.50, 0.26 at 0°, 30°, 60°, 75°); Ward-GMD
@@ -344,6 +475,13 @@ std::vector<SamplingCase> SamplingCases() {
     params.push_back(Grey(model, 0.4, 0.3, 0.05, 0.25));
     params.push_back(Grey(model, 0.0, 0.5, 0.4, 0.1));
   }
+  // The *_fresnel models draw as their plain models do; f (and so the weights) differ.
+  for (BrdfModel model : {BrdfModel::kWardFresnel, BrdfModel::kWardGmdFresnel}) {
+    params.push_back(Grey(model, 0.4, 0.3, 0.05, 0.05));
+    params.back().ior = 1.4;
+    params.push_back(Grey(model, 0.0, 0.5, 0.3, 0.3));
+  }
+  params.push_back(Grey(BrdfModel::kWardGmdAnisoFresnel, 0.2, 0.3, 0.05, 0.25));
   std::vector<SamplingCase> cases;
   for (const BrdfParams& p : params) {
     for (double theta : {0.0, 35.0, 70.0}) cases.push_back({p, Dir(theta, 30)});

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 
 #include "recon/mesh.h"
@@ -26,7 +27,8 @@ TEST(SynthOptions, ParsesEffectSpecs) {
   EXPECT_EQ(e.params.at("k2"), "-0.1");
   EXPECT_TRUE(ParseEffectSpec("pose_error").params.empty());
   EXPECT_THROW(ParseEffectSpec("glare"), InputError);
-  EXPECT_THROW(ParseEffectSpec("fresnel"), InputError);
+  EXPECT_EQ(ParseEffectSpec("fresnel:ior=1.7").params.at("ior"), "1.7");
+  EXPECT_THROW(ParseEffectSpec("indirect_illumination"), InputError);
   EXPECT_THROW(ParseEffectSpec("vignetting:k1"), InputError);
   EXPECT_THROW(ParseEffectSpec("vignetting:k1=1,k1=2"), InputError);
 }
@@ -245,6 +247,34 @@ TEST(SynthEffects, SceneEffectsChangeOnlyTheTrueScene) {
   f.Apply("specular_reflection:region=glossy_sphere");
   EXPECT_EQ(f.scenes.declared_scene["materials"]["glossy_sphere"]["brdf"], "lambert");
   EXPECT_FALSE(f.scenes.declared_scene["materials"]["glossy_sphere"].contains("rho_s"));
+}
+
+// fresnel: the glossy regions become *_fresnel in the true scene only, with the ior; it
+// composes with the effects that rename the model (before or after them).
+TEST(SynthEffects, FresnelWeightsTheTrueGlossyRegionsOnly) {
+  Fixture f;
+  const Json list = f.Apply("fresnel:regions=floor/glossy_box,ior=1.6");
+  const Json& params = list[0]["params"];
+  EXPECT_EQ(list[0]["effect"], "fresnel");
+  EXPECT_EQ(params["ior"], 1.6);
+  EXPECT_NEAR(params["f0"].get<double>(), std::pow(0.6 / 2.6, 2), 1e-15);
+  EXPECT_EQ(params["regions"]["floor"]["true_brdf"], "ward_fresnel");
+  EXPECT_EQ(params["regions"]["floor"]["declared_brdf"], "ward");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_fresnel");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["ior"], 1.6);
+  EXPECT_EQ(f.scenes.declared_scene["materials"]["floor"]["brdf"], "ward");
+  EXPECT_FALSE(f.scenes.declared_scene["materials"]["floor"].contains("ior"));
+  EXPECT_EQ(f.scenes.true_scene["materials"]["glossy_sphere"]["brdf"], "ward");  // not listed
+  // Effects that rename the model keep the Fresnel weight.
+  f.Apply("anisotropic_reflection");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["glossy_box"]["brdf"], "ward_aniso_fresnel");
+  f.Apply("specular_lobe_shape:regions=floor");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_gmd_fresnel");
+  f.Apply("fresnel:regions=floor,ior=2");  // again: the model stays, the ior changes
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_gmd_fresnel");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["ior"], 2.0);
+  EXPECT_THROW(f.Apply("fresnel:ior=1"), InputError);
+  EXPECT_THROW(f.Apply("fresnel:regions=matte_box"), InputError);
 }
 
 TEST(SynthEffects, BadParametersAreInputErrors) {

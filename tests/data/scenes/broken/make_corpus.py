@@ -54,6 +54,8 @@ case('duplicate_light_in_lighting', 'lightings.L1[1]', 'listed twice', lambda d:
 case('photos_not_array', 'photos', 'must be an array', lambda d: d.update(photos={'file': 'x.exr'}))
 case('negative_intensity', 'lights.spot3.intensity', 'must be >= 0', lambda d: d['lights']['spot3'].update(intensity=-5))
 case('negative_rho_s', 'materials.floor.rho_s', 'must be in [0, 1]', lambda d: d['materials']['floor'].update(rho_s=-0.04))
+case('ior_out_of_range', 'materials.floor.ior', 'must be in (1, 5]', lambda d: d['materials']['floor'].update(brdf='ward_gmd_fresnel', ior=0.9))
+case('ior_on_plain_ward', 'materials.floor.ior', 'unknown key', lambda d: d['materials']['floor'].update(ior=1.5))
 os.makedirs('broken', exist_ok=True)
 with open('broken/EXPECTED.tsv', 'w') as f:
     f.write('# file\tkey path named in the error\trule named in the error (one line, exit 2)\n')
