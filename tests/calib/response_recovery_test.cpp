@@ -174,7 +174,7 @@ TEST(ResponseRecovery, OptionsAreValidated) {
   options.method = "magic";
   EXPECT_THROW(options.Validate(), InputError);
   options = {};
-  options.lambda = -1;
+  options.lambda = -2;  // -1 is kLambdaAuto
   EXPECT_THROW(options.Validate(), InputError);
 }
 
