@@ -1,6 +1,7 @@
 #include "calib/response_recovery.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
@@ -149,47 +150,128 @@ double ResidualRms(const std::vector<std::vector<Equation>>& equations,
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
 
-// Solves Debevec–Malik's weighted least squares by normal equations with the per-sample
-// unknowns ln E_i eliminated exactly (Schur complement): what remains is a dense
-// levels x levels symmetric system, solved by LDLT in double precision. The smoothness rows and
-// the gauge row g(middle) = 0 keep it positive definite. (Same solution as a sparse QR of the
-// full system, which was 40x slower at 1024 levels.)
-std::vector<double> SolveDebevecChannel(const Bracket& bracket, const std::vector<int64_t>& pixels,
-                                        int channel, int levels, const ResponseOptions& options,
-                                        double* rms) {
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(levels, levels);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(levels);
-  std::vector<std::vector<Equation>> equations(pixels.size());
+// Debevec–Malik's weighted least squares by normal equations, with the per-sample unknowns
+// ln E_i eliminated exactly (Schur complement): what remains is a dense levels x levels symmetric
+// system in g. The data part is kept in two halves (samples alternately) so that automatic
+// lambda can compare the curves the halves give; the full data term is their sum.
+struct ChannelSystem {
+  Eigen::MatrixXd h[2];
+  Eigen::VectorXd rhs[2];
+  Eigen::MatrixXd smooth;  // smoothness term for lambda = 1
+  std::vector<std::vector<Equation>> equations;
+};
+
+ChannelSystem BuildChannelSystem(const Bracket& bracket, const std::vector<int64_t>& pixels,
+                                 int channel, int levels) {
+  ChannelSystem s;
+  for (int half = 0; half < 2; ++half) {
+    s.h[half] = Eigen::MatrixXd::Zero(levels, levels);
+    s.rhs[half] = Eigen::VectorXd::Zero(levels);
+  }
+  s.equations.resize(pixels.size());
   for (size_t i = 0; i < pixels.size(); ++i) {
     for (size_t j = 0; j < bracket.images.size(); ++j) {
       const Image& image = bracket.images[j];
       const double z =
           image.pixels[size_t(pixels[i]) * image.channels + channel] * double(levels - 1);
       const int k = std::min(int(z), levels - 2);
-      equations[i].push_back({k, z - k, HatWeight(z, levels), std::log(bracket.exposures_s[j])});
+      s.equations[i].push_back({k, z - k, HatWeight(z, levels), std::log(bracket.exposures_s[j])});
     }
-    AddSample(equations[i], &h, &rhs);
+    AddSample(s.equations[i], &s.h[i % 2], &s.rhs[i % 2]);
   }
-  AddSmoothness(options.lambda, levels, &h);
-  h(levels / 2, levels / 2) += 1.0;  // g(middle) = 0 fixes the free constant
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
-  if (ldlt.info() != Eigen::Success) throw Error("Debevec least squares: factorisation failed");
-  const Eigen::VectorXd g_solved = ldlt.solve(rhs);
-  std::vector<double> g(g_solved.data(), g_solved.data() + levels);
-  *rms = ResidualRms(equations, g, levels, options);
+  s.smooth = Eigen::MatrixXd::Zero(levels, levels);
+  AddSmoothness(1.0, levels, &s.smooth);
+  return s;
+}
+
+// g minimising data + lambda^2 smoothness, g(middle) = 0 fixing the free constant (the
+// smoothness rows and that gauge keep the matrix positive definite: Cholesky).
+std::vector<double> SolveCurve(const Eigen::MatrixXd& data, const Eigen::VectorXd& rhs,
+                               const Eigen::MatrixXd& smooth, double lambda) {
+  const int levels = int(data.rows());
+  Eigen::MatrixXd h = data + (lambda * lambda) * smooth;
+  h(levels / 2, levels / 2) += 1.0;
+  const Eigen::LLT<Eigen::MatrixXd> llt(h);
+  if (llt.info() != Eigen::Success) throw Error("Debevec least squares: factorisation failed");
+  const Eigen::VectorXd g = llt.solve(rhs);
+  return std::vector<double>(g.data(), g.data() + levels);
+}
+
+// Split-half noise of the curve: RMS over the levels with data (inside black..saturated) of the
+// difference between the two halves' curves, offset removed, halved. Each half has half the
+// data, so its noise is sqrt(2) that of the full curve, and the difference of two independent
+// halves sqrt(2) more: half the difference estimates the full curve's noise, ripples included
+// (constant-ratio ripples are noise the data barely constrain, and they differ between halves).
+double SplitHalfNoise(const ChannelSystem& s, double lambda, const ResponseOptions& options) {
+  const int levels = int(s.smooth.rows());
+  const std::vector<double> a = SolveCurve(s.h[0], s.rhs[0], s.smooth, lambda);
+  const std::vector<double> b = SolveCurve(s.h[1], s.rhs[1], s.smooth, lambda);
+  const Eigen::VectorXd coverage = (s.h[0] + s.h[1]).diagonal();  // data weight per level
+  double weight = 0.0, mean = 0.0, sum = 0.0;
+  for (int z = 0; z < levels; ++z) {
+    const double v = double(z) / (levels - 1);
+    if (v <= options.black || v >= options.saturated) continue;
+    weight += coverage(z);
+    mean += coverage(z) * (a[size_t(z)] - b[size_t(z)]);
+  }
+  if (!(weight > 0.0)) return 0.0;
+  mean /= weight;
+  for (int z = 0; z < levels; ++z) {
+    const double v = double(z) / (levels - 1);
+    if (v <= options.black || v >= options.saturated) continue;
+    const double d = a[size_t(z)] - b[size_t(z)] - mean;
+    sum += coverage(z) * d * d;
+  }
+  return 0.5 * std::sqrt(sum / weight);
+}
+
+// Automatic lambda: the smallest of kAutoLambdas whose split-half noise is at most
+// max(kAutoLambdaNoise, 1.25 x the least noise over kAutoLambdas): the least smoothing bias
+// among the curves that are reproducible (to the target, or as well as this data allows).
+double ChooseLambda(const ChannelSystem& s, const ResponseOptions& options) {
+  std::vector<double> noise;
+  for (double lambda : kAutoLambdas) {
+    noise.push_back(SplitHalfNoise(s, lambda, options));
+    spdlog::debug("debevec: lambda {} split-half noise {:.5f}", lambda, noise.back());
+  }
+  const double bound =
+      std::max(kAutoLambdaNoise, kAutoLambdaSlack * *std::min_element(noise.begin(), noise.end()));
+  for (size_t i = 0; i < noise.size(); ++i) {
+    if (noise[i] <= bound) return kAutoLambdas[i];
+  }
+  return kAutoLambdas.back();
+}
+
+std::vector<double> SolveDebevecChannel(const Bracket& bracket, const std::vector<int64_t>& pixels,
+                                        int channel, int levels, const ResponseOptions& options,
+                                        double* lambda, double* rms) {
+  const ChannelSystem s = BuildChannelSystem(bracket, pixels, channel, levels);
+  *lambda = options.lambda == kLambdaAuto ? ChooseLambda(s, options) : options.lambda;
+  std::vector<double> g = SolveCurve(s.h[0] + s.h[1], s.rhs[0] + s.rhs[1], s.smooth, *lambda);
+  *rms = ResidualRms(s.equations, g, levels, options);
   MakeMonotonic(&g);
   return g;
 }
 
 }  // namespace
 
+double ParseLambda(const std::string& text) {
+  const std::string trimmed(Trim(text));
+  if (ToLower(trimmed) == "auto") return kLambdaAuto;
+  const std::optional<double> value = ParseDouble(trimmed);
+  if (!value || !(*value >= 0.0) || !std::isfinite(*value)) {
+    throw InputError(DescribeProblem("--lambda", "", text, "must be auto or a number >= 0"));
+  }
+  return *value;
+}
+
 void ResponseOptions::Validate() const {
   ProblemList problems;
   if (method != "debevec" && method != "robertson") {
     problems.Add("--method", "", method, "must be debevec or robertson");
   }
-  if (!(lambda >= 0.0) || !std::isfinite(lambda)) {
-    problems.Add("--lambda", "", fmt::format("{}", lambda), "must be >= 0");
+  if (lambda != kLambdaAuto && (!(lambda >= 0.0) || !std::isfinite(lambda))) {
+    problems.Add("--lambda", "", fmt::format("{}", lambda), "must be auto or >= 0");
   }
   if (levels != 0 && (levels < 16 || levels > 65536)) {
     problems.Add("--levels", "", fmt::format("{}", levels), "must be 0 (auto) or 16..65536");
@@ -217,7 +299,7 @@ ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& o
   SamplingOptions sampling;
   sampling.samples = options.samples > 0
                          ? options.samples
-                         : std::min(4000, std::max(100, 3 * levels / std::max(p - 1, 1)));
+                         : std::min(4000, std::max(1000, 3 * levels / std::max(p - 1, 1)));
   sampling.black = options.black;
   sampling.saturated = options.saturated;
   const std::vector<int64_t> pixels = SelectSamplePixels(bracket, sampling);
@@ -231,12 +313,15 @@ ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& o
     const int equations = CountEquations(bracket, pixels, c, options);
     CheckEnoughEquations(bracket, equations, levels, c);
     summary.equations = std::min(summary.equations, equations);
-    double rms = 0.0;
-    summary.curve.g.push_back(SolveDebevecChannel(bracket, pixels, c, levels, options, &rms));
+    double rms = 0.0, lambda = 0.0;
+    summary.curve.g.push_back(
+        SolveDebevecChannel(bracket, pixels, c, levels, options, &lambda, &rms));
     summary.rms_residual.push_back(rms);
+    summary.lambda.push_back(lambda);
   }
-  spdlog::info("debevec: {} samples, {} equations, lambda {}, rms {:.4f}", summary.samples,
-               summary.equations, options.lambda, summary.rms_residual.front());
+  spdlog::info("debevec: {} samples, {} equations, lambda {}{}, rms {:.4f}", summary.samples,
+               summary.equations, fmt::join(summary.lambda, "/"),
+               options.lambda == kLambdaAuto ? " (auto)" : "", summary.rms_residual.front());
   return summary;
 }
 

@@ -11,6 +11,7 @@
 
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
+#include "tools/common/progress.h"
 
 namespace igi::hdr {
 namespace {
@@ -275,6 +276,7 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
   result.radiance = Image(width, height, channels);
   result.mask = Image(width, height, 1, 1.0f);
   std::atomic<int64_t> saturated{0}, black{0};
+  Progress progress("merge rows", height);  // on a terminal, for merges longer than ~2 s
   ParallelForRange(
       0, height,
       [&](int64_t y0, int64_t y1) {
@@ -301,8 +303,10 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
         }
         saturated += row_saturated;
         black += row_black;
+        progress.Add(y1 - y0);
       },
       options.num_threads, 8);
+  progress.Finish();
   result.saturated_pixels = saturated;
   result.black_pixels = black;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -15,7 +15,8 @@
 // longest) everywhere: it gets the bound that exposure gives (I(z) / t) and is masked.
 //
 // The output is linear radiance in the response's units (exp(g) per second): relative, not
-// absolute. Work is a per-pixel loop over lookup tables, parallel over rows (ParallelFor).
+// absolute. Work is a per-pixel loop over lookup tables, parallel over rows (ParallelFor), with
+// an igi::Progress bar over the rows (drawn on a terminal once a merge runs past ~2 s).
 
 #include <string>
 #include <vector>

@@ -1,6 +1,7 @@
 // igi-calib: camera calibration (CONTRACT.md §4). Subcommands, one per calibration:
 //   igi-calib response IMAGES… (--exposures LIST | --exposure-file FILE | EXIF) --out response.json
-//             [--method debevec|robertson] [--lambda L] [--samples N] [--levels N] [--plot FILE]
+//             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N] [--plot
+//             FILE]
 // (intrinsics and vignetting are added beside `response` as subcommands of their own.)
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -23,6 +24,7 @@ struct ResponseCommand {
   std::string out;
   std::string plot;  // empty = OUT with the extension .svg
   bool no_plot = false;
+  std::string lambda = "auto";
   igi::calib::ResponseOptions options;
 };
 
@@ -40,17 +42,24 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
   sub->add_flag("--no-plot", cmd->no_plot, "Do not write the plot");
   sub->add_option("--method", cmd->options.method, "debevec or robertson")
       ->check(CLI::IsMember({"debevec", "robertson"}));
-  sub->add_option("--lambda", cmd->options.lambda, "Debevec smoothness weight");
+  sub->add_option("--lambda", cmd->lambda,
+                  "Debevec smoothness weight, or auto (default): the smallest whose curve is "
+                  "reproducible to 0.2 % (split-half test)");
   sub->add_option("--samples", cmd->options.samples, "Debevec sample pixels (0 = auto)");
   sub->add_option("--levels", cmd->options.levels,
                   "Levels of the curve (0 = 256 for 8-bit, 1024 for 16-bit)");
+  sub->add_option("--black", cmd->options.black,
+                  "Normalised level at or below which a value is unusable (default 0.02)");
+  sub->add_option("--saturated", cmd->options.saturated,
+                  "Normalised level at or above which a value is unusable (default 0.98)");
   sub->add_option("--max-iterations", cmd->options.max_iterations, "Robertson iterations");
   sub->add_option("--robertson-smoothing", cmd->options.robertson_smoothing,
                   "Robertson: second-difference penalty on ln I (0 = none)");
   return sub;
 }
 
-int RunResponse(const ResponseCommand& cmd) {
+int RunResponse(ResponseCommand cmd) {
+  cmd.options.lambda = igi::calib::ParseLambda(cmd.lambda);
   cmd.options.Validate();
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
   const igi::calib::Bracket bracket = igi::calib::LoadBracket(paths, cmd.exposures);
@@ -61,7 +70,10 @@ int RunResponse(const ResponseCommand& cmd) {
   info["bits_per_sample"] = bracket.bits_per_sample;
   info["samples"] = summary.samples;
   info["equations"] = summary.equations;
-  if (cmd.options.method == "debevec") info["lambda"] = cmd.options.lambda;
+  if (cmd.options.method == "debevec") {
+    info["lambda"] = summary.lambda;  // per channel
+    info["lambda_mode"] = cmd.options.lambda == igi::calib::kLambdaAuto ? "auto" : "given";
+  }
   if (cmd.options.method == "robertson") {
     info["iterations"] = summary.iterations;
     info["converged"] = summary.converged;

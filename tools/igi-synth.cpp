@@ -49,7 +49,9 @@ int main(int argc, char** argv) {
   app.add_option("--black-level", o.sensor.black_level_dn, "ADC black level, DN");
   app.add_option("--sensitivity", o.sensor.electrons_per_radiance_s,
                  "Electrons per (W sr^-1 m^-2 s)");
-  app.add_option("--brackets", o.brackets.count, "LDR brackets per photo (0 = none)");
+  app.add_option(
+      "--brackets", o.brackets.count,
+      "LDR brackets per photo (0 = none); their noise-free radiance goes to truth/radiance/");
   app.add_option("--stops", o.brackets.stops, "EV between brackets");
   app.add_option("--response", response, "Bracket camera response: gamma|sigmoid|file");
   app.add_option("--response-file", o.brackets.response_file,

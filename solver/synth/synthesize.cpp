@@ -181,7 +181,12 @@ class Pipeline {
       exposures.push_back(brackets[i].exposure_s);
     }
     WriteText(o_.out / dir / "exposures.txt", times);
-    r->bracket_sets.push_back(Json{{"photo", job.file}, {"dir", dir}, {"exposures_s", exposures}});
+    // The noise-free radiance the brackets expose (before shot/read noise, clipping, response
+    // and quantisation): the truth an HDR merge of this folder should recover.
+    const std::string radiance = "truth/radiance/" + stem + ".exr";
+    WriteExr(o_.out / radiance, linear);
+    r->bracket_sets.push_back(Json{
+        {"photo", job.file}, {"dir", dir}, {"exposures_s", exposures}, {"radiance", radiance}});
   }
 
   void Validation(const PhotoJob& job, int index, Rendered* r) {
@@ -289,7 +294,8 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
                           options.sensor.full_well_e / options.sensor.electrons_per_radiance_s},
                          {"note",
                           "x = electrons / full well; radiance = (x / exposure_s) * "
-                          "radiance_per_relative_exposure"},
+                          "radiance_per_relative_exposure; sets[].radiance: the noise-free "
+                          "radiance of the set (float EXR)"},
                          {"sets", r.bracket_sets}};
   }
   return truth;

@@ -10,6 +10,7 @@
 //   truth.json               true materials, effects with parameters, validation images,
 //                            per-camera highlight targets, sensor and bracket truth
 //   truth/scene.json         the TRUE scene, complete (renderable with igi-render)
+//   truth/radiance/CAM_L.exr the noise-free radiance each bracket folder exposes (with brackets)
 //   truth/...                files only the truth needs (textures, extra geometry, response)
 
 #include <cstdint>
