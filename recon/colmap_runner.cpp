@@ -199,13 +199,20 @@ ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
           {options.executable, "exhaustive_matcher", "--database_path", db.string(),
            "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", Threads(options.threads)},
           summary.log);
-  RunStep("mapper", MapperArgs(images_dir, db, models, options), summary.log);
+  // COLMAP 3.8's mapper exits 1 when no image pair has enough matches: that, like an empty
+  // output, is "reconstructed nothing".
+  spdlog::info("colmap mapper …");
+  const int mapper_status = RunLogged(MapperArgs(images_dir, db, models, options), summary.log);
   auto [model, count] = LargestModel(models);
   summary.num_models = count;
   if (model.images.empty()) {
     throw Error("COLMAP reconstructed nothing from " + std::to_string(summary.images.size()) +
-                " photos in " + images_dir.string() + " (too few matches between them?); see " +
-                summary.log.string());
+                " photos in " + images_dir.string() + " (too few matches between them?; mapper " +
+                "exit status " + std::to_string(mapper_status) + "); see " + summary.log.string());
+  }
+  if (mapper_status != 0) {
+    spdlog::warn("colmap mapper exited with status {} but wrote a model; see {}", mapper_status,
+                 summary.log.string());
   }
   summary.model = std::move(model);
   for (const std::string& name : summary.images) {
