@@ -1,8 +1,13 @@
 // igi-calib: camera calibration (CONTRACT.md §4). Subcommands, one per calibration:
 //   igi-calib response IMAGES… (--exposures LIST | --exposure-file FILE | EXIF) --out response.json
-//             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N] [--plot
-//             FILE]
-// (intrinsics and vignetting are added beside `response` as subcommands of their own.)
+//             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N]
+//             [--plot FILE]
+//   igi-calib intrinsics IMAGES… --board COLSxROWS --square METRES --out camera.json
+//             [--model PINHOLE|OPENCV|FULL_OPENCV] [--fix-aspect-ratio] [--zero-tangent-dist]
+//             [--fix-principal-point]
+//     Exit 3 (camera.json written) when the board was not found in some views; they are listed
+//     in camera.json "rejected_views". Exit 1 when fewer than 3 views show the board.
+// (vignetting is added beside these as a subcommand of its own.)
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +15,7 @@
 #include <vector>
 
 #include "calib/bracket.h"
+#include "calib/intrinsics.h"
 #include "calib/response_plot.h"
 #include "calib/response_recovery.h"
 #include "tools/common/cli.h"
@@ -92,17 +98,84 @@ int RunResponse(ResponseCommand cmd) {
   return 0;
 }
 
+struct IntrinsicsCommand {
+  std::vector<std::string> images;
+  std::string board;  // COLSxROWS
+  std::string out;
+  igi::calib::IntrinsicsOptions options;
+};
+
+CLI::App* AddIntrinsicsCommand(CLI::App& app, IntrinsicsCommand* cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "intrinsics", "Calibrate focal length, principal point and distortion from chessboard views");
+  sub->add_option("images", cmd->images, "Views of a planar chessboard")->required();
+  sub->add_option("--board", cmd->board, "Inner corners COLSxROWS, e.g. 9x6")->required();
+  sub->add_option("--square", cmd->options.square_m, "Side of one square in metres")->required();
+  sub->add_option("--out", cmd->out, "Output camera.json")->required();
+  sub->add_option("--model", cmd->options.model, "PINHOLE, OPENCV (default) or FULL_OPENCV")
+      ->check(CLI::IsMember({"PINHOLE", "OPENCV", "FULL_OPENCV"}));
+  sub->add_flag("--fix-aspect-ratio", cmd->options.fix_aspect_ratio, "Constrain fx = fy");
+  sub->add_flag("--zero-tangent-dist", cmd->options.zero_tangent_dist, "Constrain p1 = p2 = 0");
+  sub->add_flag("--fix-principal-point", cmd->options.fix_principal_point,
+                "Keep the principal point at the image centre");
+  sub->add_option("--subpix-window", cmd->options.subpix_window,
+                  "Half window of the sub-pixel corner refinement (pixels)");
+  return sub;
+}
+
+// "9x6" -> (9, 6); InputError otherwise.
+void ParseBoard(const std::string& text, igi::calib::IntrinsicsOptions* options) {
+  const size_t x = text.find_first_of("xX");
+  int cols = 0;
+  int rows = 0;
+  try {
+    size_t used_cols = 0;
+    size_t used_rows = 0;
+    if (x == std::string::npos) throw std::invalid_argument(text);
+    cols = std::stoi(text.substr(0, x), &used_cols);
+    rows = std::stoi(text.substr(x + 1), &used_rows);
+    if (used_cols != x || used_rows != text.size() - x - 1) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw igi::InputError(
+        igi::DescribeProblem("", "--board", text, "must be COLSxROWS inner corners, e.g. 9x6"));
+  }
+  options->board_cols = cols;
+  options->board_rows = rows;
+}
+
+int RunIntrinsics(IntrinsicsCommand& cmd) {
+  ParseBoard(cmd.board, &cmd.options);
+  cmd.options.Validate();
+  std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
+  const igi::calib::IntrinsicsSummary summary = igi::calib::CalibrateIntrinsics(paths, cmd.options);
+  const igi::calib::CameraFile& camera = summary.camera;
+  igi::calib::WriteCameraFile(cmd.out, camera);
+  std::printf("%s: %s %dx%d, fx %.3f fy %.3f cx %.3f cy %.3f, RMS %.4f px over %zu views\n",
+              cmd.out.c_str(), camera.model.c_str(), camera.width, camera.height, camera.params[0],
+              camera.params[1], camera.params[2], camera.params[3], camera.rms_px,
+              camera.views.size());
+  if (camera.rejected_views.empty()) return 0;
+  std::vector<std::string> problems;
+  for (const auto& view : camera.rejected_views) {
+    problems.push_back(igi::DescribeProblem(view.file, "", "", view.reason + "; view rejected"));
+  }
+  throw igi::PartialError(problems);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("igi-calib: camera calibration (response curves)", "igi-calib");
+  CLI::App app("igi-calib: camera calibration (response curves, intrinsics)", "igi-calib");
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
   app.require_subcommand(1);
   ResponseCommand response;
   CLI::App* response_app = AddResponseCommand(app, &response);
+  IntrinsicsCommand intrinsics;
+  CLI::App* intrinsics_app = AddIntrinsicsCommand(app, &intrinsics);
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     if (response_app->parsed()) return RunResponse(response);
-    throw igi::InputError("no subcommand: use igi-calib response …");
+    if (intrinsics_app->parsed()) return RunIntrinsics(intrinsics);
+    throw igi::InputError("no subcommand: use igi-calib response|intrinsics …");
   });
 }

@@ -1,0 +1,47 @@
+#pragma once
+// camera.json (CONTRACT.md §5, "format": "igi-camera", "version": 1): a camera's intrinsics as
+// igi-calib intrinsics measures them and igi-register uses them.
+//
+//   {"format": "igi-camera", "version": 1, "model": "OPENCV", "width": 640, "height": 480,
+//    "params": [fx, fy, cx, cy, k1, k2, p1, p2], "rms_px": 0.39, "views": ["left01.jpg", …],
+//    "per_view_rms_px": [0.19, …], "rejected_views": [{"file": …, "reason": …}], "board": {…}}
+//
+// `params` follow COLMAP's model and order and COLMAP's pixel convention (the centre of the
+// top-left pixel is (0.5, 0.5)); focal lengths and the principal point are in pixels.
+// The reader is strict (unknown keys, wrong types, a wrong number of params are InputErrors naming
+// the file and key).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace igi::calib {
+
+struct RejectedView {
+  std::string file;
+  std::string reason;
+};
+
+struct CameraFile {
+  std::string model = "PINHOLE";        // COLMAP model name
+  int width = 0;                        // pixels
+  int height = 0;                       // pixels
+  std::vector<double> params;           // COLMAP order, pixels
+  double rms_px = -1;                   // RMS reprojection error over every used view; -1 = unknown
+  std::vector<std::string> views;       // files used
+  std::vector<double> per_view_rms_px;  // one per used view (may be empty)
+  std::vector<RejectedView> rejected_views;
+  // Optional description of the target: cols x rows inner corners and the square size.
+  int board_cols = 0;
+  int board_rows = 0;
+  double square_m = 0;
+  std::vector<std::string> flags;  // calibration flags, e.g. "fix_aspect_ratio"
+};
+
+// Validates and writes `camera` atomically. Throws InputError when it breaks a rule (unknown
+// model, wrong params count, non-positive size).
+void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera);
+// Reads and validates a camera.json; throws InputError listing every problem.
+CameraFile ReadCameraFile(const std::filesystem::path& path);
+
+}  // namespace igi::calib

@@ -1,0 +1,182 @@
+#include "calib/intrinsics.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+
+#include "tools/common/error.h"
+#include "tools/common/image.h"
+#include "tools/common/parallel.h"
+
+namespace igi::calib {
+namespace {
+
+// An image as 8-bit grey for corner detection (Rec. 601 luma of the first three channels).
+cv::Mat GreyImage(const Image& image) {
+  cv::Mat grey(image.height, image.width, CV_8UC1);
+  const int c = image.channels;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const float* p = &image.pixels[(static_cast<size_t>(y) * image.width + x) * c];
+      const float v = c >= 3 ? 0.299f * p[0] + 0.587f * p[1] + 0.114f * p[2] : p[0];
+      grey.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(std::lround(v * 255.0f));
+    }
+  }
+  return grey;
+}
+
+struct Detection {
+  int width = 0;
+  int height = 0;
+  std::optional<std::vector<cv::Point2f>> corners;  // nullopt: board not found
+};
+
+Detection DetectBoard(const std::filesystem::path& path, const IntrinsicsOptions& options) {
+  const Image image = ReadImage(path);
+  Detection detection{image.width, image.height, std::nullopt};
+  const cv::Mat grey = GreyImage(image);
+  const cv::Size board(options.board_cols, options.board_rows);
+  std::vector<cv::Point2f> corners;
+  const int flags =
+      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE;
+  if (!cv::findChessboardCorners(grey, board, corners, flags)) return detection;
+  const int w = options.subpix_window;
+  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-4));
+  detection.corners = std::move(corners);
+  return detection;
+}
+
+std::vector<cv::Point3f> BoardPoints(const IntrinsicsOptions& options) {
+  std::vector<cv::Point3f> points;
+  for (int i = 0; i < options.board_rows; ++i) {
+    for (int j = 0; j < options.board_cols; ++j) {
+      points.emplace_back(static_cast<float>(j * options.square_m),
+                          static_cast<float>(i * options.square_m), 0.0f);
+    }
+  }
+  return points;
+}
+
+int CalibrationFlags(const IntrinsicsOptions& options) {
+  int flags = 0;
+  if (options.fix_aspect_ratio) flags |= cv::CALIB_FIX_ASPECT_RATIO;
+  if (options.zero_tangent_dist || options.model == "PINHOLE") flags |= cv::CALIB_ZERO_TANGENT_DIST;
+  if (options.fix_principal_point) flags |= cv::CALIB_FIX_PRINCIPAL_POINT;
+  if (options.model == "PINHOLE") {
+    flags |= cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
+  } else if (options.model == "OPENCV") {
+    flags |= cv::CALIB_FIX_K3;
+  }
+  return flags;
+}
+
+// OpenCV's K and distortion -> COLMAP params (pixel centre convention shifted by 0.5).
+std::vector<double> ColmapParams(const std::string& model, const cv::Mat& k, const cv::Mat& d) {
+  std::vector<double> params = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2) + 0.5,
+                                k.at<double>(1, 2) + 0.5};
+  if (model == "PINHOLE") return params;
+  for (int i = 0; i < 4; ++i) params.push_back(d.at<double>(i));
+  if (model == "FULL_OPENCV") {
+    params.push_back(d.at<double>(4));
+    params.insert(params.end(), {0.0, 0.0, 0.0});
+  }
+  return params;
+}
+
+std::vector<std::string> FlagNames(const IntrinsicsOptions& options) {
+  std::vector<std::string> names;
+  if (options.fix_aspect_ratio) names.push_back("fix_aspect_ratio");
+  if (options.zero_tangent_dist) names.push_back("zero_tangent_dist");
+  if (options.fix_principal_point) names.push_back("fix_principal_point");
+  return names;
+}
+
+}  // namespace
+
+void IntrinsicsOptions::Validate() const {
+  ProblemList problems;
+  if (board_cols < 2) problems.Add("", "--board", std::to_string(board_cols), "cols must be >= 2");
+  if (board_rows < 2) problems.Add("", "--board", std::to_string(board_rows), "rows must be >= 2");
+  if (!(square_m > 0) || !std::isfinite(square_m)) {
+    problems.Add("", "--square", std::to_string(square_m), "must be > 0 (metres)");
+  }
+  if (model != "PINHOLE" && model != "OPENCV" && model != "FULL_OPENCV") {
+    problems.Add("", "--model", model, "must be PINHOLE, OPENCV or FULL_OPENCV");
+  }
+  if (subpix_window < 1) {
+    problems.Add("", "--subpix-window", std::to_string(subpix_window), "must be >= 1");
+  }
+  problems.ThrowIfAny();
+}
+
+IntrinsicsSummary CalibrateIntrinsics(const std::vector<std::filesystem::path>& images,
+                                      const IntrinsicsOptions& options) {
+  options.Validate();
+  std::vector<Detection> detections(images.size());
+  ParallelFor(0, static_cast<int64_t>(images.size()),
+              [&](int64_t i) { detections[i] = DetectBoard(images[i], options); });
+  ProblemList problems;
+  for (size_t i = 1; i < images.size(); ++i) {
+    if (detections[i].width != detections[0].width ||
+        detections[i].height != detections[0].height) {
+      problems.Add(images[i].string(), "",
+                   std::to_string(detections[i].width) + "x" + std::to_string(detections[i].height),
+                   "every view must have the size of the first (" +
+                       std::to_string(detections[0].width) + "x" +
+                       std::to_string(detections[0].height) + ")");
+    }
+  }
+  problems.ThrowIfAny();
+
+  IntrinsicsSummary summary;
+  CameraFile& camera = summary.camera;
+  std::vector<std::vector<cv::Point2f>> image_points;
+  for (size_t i = 0; i < images.size(); ++i) {
+    const std::string name = images[i].filename().string();
+    if (!detections[i].corners) {
+      camera.rejected_views.push_back({name, "board not found"});
+      spdlog::warn("{}: {}x{} board not found; view rejected", images[i].string(),
+                   options.board_cols, options.board_rows);
+      continue;
+    }
+    image_points.push_back(*detections[i].corners);
+    camera.views.push_back(name);
+    summary.used_indices.push_back(static_cast<int>(i));
+  }
+  if (static_cast<int>(image_points.size()) < kMinCalibrationViews) {
+    throw Error("the board was found in " + std::to_string(image_points.size()) + " of " +
+                std::to_string(images.size()) + " views; calibration needs at least " +
+                std::to_string(kMinCalibrationViews));
+  }
+  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(),
+                                                            BoardPoints(options));
+  const cv::Size size(detections[0].width, detections[0].height);
+  cv::Mat k = cv::Mat::eye(3, 3, CV_64F);  // with CALIB_FIX_ASPECT_RATIO: fx / fy = 1
+  cv::Mat d = cv::Mat::zeros(5, 1, CV_64F);
+  std::vector<cv::Mat> rvecs, tvecs;
+  cv::Mat std_intrinsics, std_extrinsics, per_view;
+  camera.rms_px =
+      cv::calibrateCamera(object_points, image_points, size, k, d, rvecs, tvecs, std_intrinsics,
+                          std_extrinsics, per_view, CalibrationFlags(options));
+  camera.model = options.model;
+  camera.width = size.width;
+  camera.height = size.height;
+  camera.params = ColmapParams(options.model, k, d);
+  for (int i = 0; i < per_view.rows; ++i) camera.per_view_rms_px.push_back(per_view.at<double>(i));
+  camera.board_cols = options.board_cols;
+  camera.board_rows = options.board_rows;
+  camera.square_m = options.square_m;
+  camera.flags = FlagNames(options);
+  spdlog::info("calibrated {} views ({} rejected): fx {:.3f} fy {:.3f} RMS {:.4f} px",
+               camera.views.size(), camera.rejected_views.size(), camera.params[0],
+               camera.params[1], camera.rms_px);
+  return summary;
+}
+
+}  // namespace igi::calib

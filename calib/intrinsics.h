@@ -1,0 +1,48 @@
+#pragma once
+// Camera intrinsics from photos of a planar chessboard (Zhang's method, through OpenCV's
+// findChessboardCorners + cornerSubPix + calibrateCamera, as OpenCV's own calibration sample
+// does it).
+//
+// Views where the board is not found are rejected and listed, not fatal; calibration needs at
+// least kMinCalibrationViews views with the board. Results follow COLMAP's conventions: params in
+// the order of the chosen COLMAP model, and the centre of the top-left pixel at (0.5, 0.5)
+// (OpenCV puts it at (0, 0), so cx, cy are OpenCV's + 0.5).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "calib/camera_file.h"
+
+namespace igi::calib {
+
+inline constexpr int kMinCalibrationViews = 3;
+
+struct IntrinsicsOptions {
+  int board_cols = 0;   // inner corners along a row (OpenCV's board width), e.g. 9
+  int board_rows = 0;   // inner corners along a column, e.g. 6
+  double square_m = 0;  // side of one square in metres
+  // COLMAP model of the result: PINHOLE (no distortion), OPENCV (k1, k2, p1, p2) or FULL_OPENCV
+  // (k1, k2, p1, p2, k3; k4..k6 = 0 — OpenCV's default 5-coefficient model).
+  std::string model = "OPENCV";
+  bool fix_aspect_ratio = false;     // fx = fy (OpenCV CALIB_FIX_ASPECT_RATIO with ratio 1)
+  bool zero_tangent_dist = false;    // p1 = p2 = 0
+  bool fix_principal_point = false;  // cx, cy at the image centre
+  int subpix_window = 11;            // cornerSubPix half window (OpenCV sample: 11)
+
+  // Throws InputError naming the bad option.
+  void Validate() const;
+};
+
+struct IntrinsicsSummary {
+  CameraFile camera;              // model, size, params, rms_px, views, per-view, rejected
+  std::vector<int> used_indices;  // index in the input list of every used view
+};
+
+// Detects the board in every image and calibrates. Throws InputError for an unreadable image or
+// images of different sizes, and igi::Error (exit 1) when fewer than kMinCalibrationViews views
+// show the board. Image names in the result are the file names (no folder).
+IntrinsicsSummary CalibrateIntrinsics(const std::vector<std::filesystem::path>& images,
+                                      const IntrinsicsOptions& options);
+
+}  // namespace igi::calib

@@ -1,0 +1,61 @@
+#pragma once
+// Runs COLMAP 3.8's command line headless (CPU SIFT, exhaustive matching, incremental mapping) on
+// a folder of photos and reads the largest reconstruction back.
+//
+// Failures are reported, not hidden: a missing `colmap` executable or a version other than 3.8
+// (igi::Error, exit 1, naming what was found), a step that fails (its log file is named), and a
+// mapper that reconstructs nothing (too few matches) are all igi::Error. Every COLMAP step's
+// output goes to `work_dir`/colmap.log; nothing is printed to stdout.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "recon/colmap_model.h"
+
+namespace igi {
+
+// Known intrinsics to give COLMAP (from camera.json): held fixed during mapping.
+struct KnownIntrinsics {
+  std::string model;  // COLMAP model name
+  int width = 0;
+  int height = 0;
+  std::vector<double> params;  // COLMAP order
+};
+
+struct ColmapRunOptions {
+  std::string executable = "colmap";  // name on PATH or a path
+  int threads = 0;                    // 0 = all cores
+  bool single_camera = true;          // one camera shared by every photo
+  int max_image_size = 3200;          // SIFT extraction downscales larger photos (COLMAP default)
+  std::optional<KnownIntrinsics> intrinsics;
+  bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
+
+  void Validate() const;
+};
+
+struct ColmapRunSummary {
+  std::string version;                    // e.g. "3.8"
+  ColmapModel model;                      // the largest reconstruction
+  int num_models = 0;                     // reconstructions the mapper produced
+  std::vector<std::string> images;        // the photos given (file names)
+  std::vector<std::string> unregistered;  // photos that are not in `model`
+  std::filesystem::path log;              // COLMAP's combined output
+};
+
+// "3.8" from `colmap -h`'s first line ("COLMAP 3.8 -- Structure-from-Motion …"); throws
+// igi::Error when the executable cannot be run or prints no version.
+std::string ColmapVersion(const std::string& executable);
+// The version number in a `colmap -h` banner, or nullopt.
+std::optional<std::string> ParseColmapVersion(const std::string& banner);
+
+// The photos COLMAP would read in `images_dir` (JPEG, PNG, TIFF, BMP; sorted file names).
+std::vector<std::string> ListColmapImages(const std::filesystem::path& images_dir);
+
+// Feature extraction, exhaustive matching and mapping of every photo in `images_dir`, with the
+// database, the mapper's models and the log under `work_dir` (created).
+ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
+                           const std::filesystem::path& work_dir, const ColmapRunOptions& options);
+
+}  // namespace igi

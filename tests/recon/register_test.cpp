@@ -1,0 +1,97 @@
+// Registration with COLMAP 3.8 on real photos (Sceaux castle, openMVG sample, © 2012 Pierre
+// Moulon; ../shared/data/real/sceaux_castle), downscaled 4x to keep the test fast, and the
+// marker-based alignment on a synthetic model with known truth.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "recon/colmap_runner.h"
+#include "recon/registration.h"
+#include "tests/e2e/run.h"
+#include "tests/temp_dir.h"
+#include "tools/common/error.h"
+#include "tools/common/json.h"
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSceaux = fs::path(IGI_SHARED_DATA_DIR) / "real" / "sceaux_castle";
+constexpr int kDownscale = 4;  // 2832x2128 -> 708x532
+// K.txt: fx = fy = 2905.88 px at full size.
+constexpr double kFocalFullPx = 2905.88;
+
+// The Sceaux photos downscaled kDownscale times (area averaging) into `dir`.
+void WriteDownscaledSceaux(const fs::path& dir) {
+  fs::create_directories(dir);
+  for (const auto& entry : fs::directory_iterator(kSceaux)) {
+    if (entry.path().extension() != ".JPG") continue;
+    const cv::Mat full = cv::imread(entry.path().string());
+    cv::Mat small;
+    cv::resize(full, small, cv::Size(full.cols / kDownscale, full.rows / kDownscale), 0, 0,
+               cv::INTER_AREA);
+    cv::imwrite((dir / entry.path().filename()).string(), small, {cv::IMWRITE_JPEG_QUALITY, 95});
+  }
+}
+
+TEST(ColmapRunnerTest, ParsesVersionBanner) {
+  EXPECT_EQ(ParseColmapVersion("COLMAP 3.8 -- Structure-from-Motion and Multi-View Stereo\n"),
+            "3.8");
+  EXPECT_EQ(ParseColmapVersion("COLMAP 3.9.1 -- Structure-from-Motion"), "3.9.1");
+  EXPECT_FALSE(ParseColmapVersion("bash: colmap: command not found").has_value());
+}
+
+TEST(ColmapRunnerTest, MissingOrWrongColmapIsReported) {
+  const fs::path dir = test::UniqueTempDir("igi_colmap_runner");
+  EXPECT_THROW(ColmapVersion((dir / "no-colmap").string()), Error);
+  const fs::path fake = dir / "fake-colmap";
+  std::ofstream(fake) << "#!/bin/sh\necho 'COLMAP 3.6 -- Structure-from-Motion'\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  EXPECT_EQ(ColmapVersion(fake.string()), "3.6");
+  WriteDownscaledSceaux(dir / "images");
+  ColmapRunOptions options;
+  options.executable = fake.string();
+  try {
+    RunColmap(dir / "images", dir / "work", options);
+    FAIL() << "COLMAP 3.6 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("3.6"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// Every Sceaux photo registers, and the focal length COLMAP estimates (not given the
+// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) is
+// close to K.txt.
+TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
+  const fs::path dir = test::UniqueTempDir("igi_colmap_sceaux");
+  WriteDownscaledSceaux(dir / "images");
+  const ColmapRunSummary run = RunColmap(dir / "images", dir / "work", ColmapRunOptions{});
+  EXPECT_EQ(run.version, "3.8");
+  EXPECT_EQ(run.images.size(), 11u);
+  EXPECT_TRUE(run.unregistered.empty());
+  EXPECT_EQ(run.model.images.size(), 11u);
+  ASSERT_EQ(run.model.cameras.size(), 1u);  // one camera shared by every photo
+  const ColmapCamera& camera = run.model.cameras.begin()->second;
+  const double expected = kFocalFullPx / kDownscale;
+  std::printf("Sceaux: %s focal %.2f px, K.txt %.2f px (%.2f %%)\n", camera.model.c_str(),
+              camera.params[0], expected, 100 * (camera.params[0] / expected - 1));
+  // Issue 6 asks for 2 %; COLMAP 3.8's SIMPLE_RADIAL self-calibration measures +2.06 % here
+  // (+2.21 % at half size), so the requirement is NOT met yet and this checks 3 % to catch
+  // regressions. See the issue for what is left (a fuller camera model or the full-size photos).
+  EXPECT_NEAR(camera.params[0], expected, 0.03 * expected);
+  for (const ImageReprojection& r : ReprojectionErrors(run.model)) {
+    EXPECT_GT(r.observations, 50) << r.name;
+    EXPECT_LT(r.rms_px, 1.5) << r.name;  // COLMAP's default filter keeps errors under 4 px
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace igi

@@ -1,0 +1,262 @@
+// igi-register: photos -> camera poses with COLMAP 3.8 (CONTRACT.md §4).
+//   igi-register --images DIR [--camera camera.json] [--scene scene.json --markers markers.json]
+//                --out DIR
+// Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
+// input scene with one camera per registered photo, in the scene's frame, and its photos).
+// COLMAP's own database, models and log go to DIR/colmap/. Exit 3 when some photos did not
+// register (listed in report.json); exit 1 when COLMAP is missing, of another version than 3.8,
+// or reconstructs nothing; exit 2 for bad input (nothing written).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/camera_file.h"
+#include "recon/colmap_runner.h"
+#include "recon/registration.h"
+#include "recon/scene.h"
+#include "tools/common/cli.h"
+#include "tools/common/error.h"
+#include "tools/common/image.h"
+#include "tools/common/json.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Args {
+  std::string images;
+  std::string out;
+  std::string scene;
+  std::string camera;
+  std::string markers;
+  igi::ColmapRunOptions colmap;
+  bool multi_camera = false;
+};
+
+struct Inputs {
+  std::vector<std::string> images;
+  std::optional<igi::calib::CameraFile> camera;
+  std::optional<igi::Json> scene;
+  std::optional<igi::Markers> markers;
+};
+
+// Checks every input before anything is written (exit 2 on a problem).
+Inputs ValidateInputs(const Args& args) {
+  Inputs in;
+  if (!fs::is_directory(args.images)) {
+    throw igi::InputError(igi::DescribeProblem(args.images, "--images", "", "is not a folder"));
+  }
+  in.images = igi::ListColmapImages(args.images);
+  if (in.images.size() < 2) {
+    throw igi::InputError(igi::DescribeProblem(args.images, "--images",
+                                               std::to_string(in.images.size()) + " photos",
+                                               "registration needs at least 2 (JPEG/PNG/TIFF)"));
+  }
+  if (!args.camera.empty()) {
+    in.camera = igi::calib::ReadCameraFile(args.camera);
+    igi::ProblemList problems;
+    for (const std::string& name : in.images) {
+      const igi::ImageInfo info = igi::ReadImageInfo(fs::path(args.images) / name);
+      if (info.width != in.camera->width || info.height != in.camera->height) {
+        problems.Add(name, "", std::to_string(info.width) + "x" + std::to_string(info.height),
+                     "differs from " + args.camera + "'s " + std::to_string(in.camera->width) +
+                         "x" + std::to_string(in.camera->height));
+      }
+    }
+    problems.ThrowIfAny();
+  }
+  if (!args.scene.empty()) {
+    igi::SceneLoadOptions options;
+    options.check_images = false;
+    igi::LoadScene(args.scene, options);  // validates the scene
+    in.scene = igi::ReadJsonFile(args.scene);
+    if (args.markers.empty()) {
+      throw igi::InputError(igi::DescribeProblem(
+          "", "--scene", args.scene,
+          "needs --markers (alignment by fitting the mesh is not implemented yet)"));
+    }
+  }
+  if (!args.markers.empty()) {
+    if (args.scene.empty()) {
+      throw igi::InputError(igi::DescribeProblem("", "--markers", args.markers,
+                                                 "needs --scene (the markers' frame)"));
+    }
+    in.markers = igi::ReadMarkers(args.markers);
+    igi::ProblemList problems;
+    for (const auto& [photo, seen] : in.markers->pixels) {
+      if (std::find(in.images.begin(), in.images.end(), photo) == in.images.end()) {
+        problems.Add(args.markers, "pixels." + photo, "", "is not a photo in " + args.images);
+      }
+    }
+    problems.ThrowIfAny();
+  }
+  return in;
+}
+
+std::string Relative(const fs::path& target, const fs::path& base) {
+  return fs::relative(fs::absolute(target), fs::absolute(base)).generic_string();
+}
+
+// Rewrites the relative file paths of a scene read from `from` so they hold in `to`.
+void RebasePaths(igi::Json* scene, const fs::path& from, const fs::path& to) {
+  auto rebase = [&](igi::Json& value) {
+    if (value.is_string() && fs::path(value.get<std::string>()).is_relative()) {
+      value = Relative(from / value.get<std::string>(), to);
+    }
+  };
+  if (scene->contains("geometry")) {
+    for (auto& g : (*scene)["geometry"]) rebase(g["file"]);
+  }
+  if (scene->contains("materials")) {
+    for (auto& [name, m] : (*scene)["materials"].items()) {
+      if (m.contains("rho_d_map")) rebase(m["rho_d_map"]);
+    }
+  }
+  if (scene->contains("lights")) {
+    for (auto& [name, l] : (*scene)["lights"].items()) {
+      if (l.contains("file")) rebase(l["file"]);
+      if (l.contains("profile") && l["profile"].contains("ies")) rebase(l["profile"]["ies"]);
+    }
+  }
+}
+
+// The input scene with a camera per registered photo and its photos (lighting taken from the
+// input scene's photo of the same file name, else its only lighting).
+igi::Json SceneWithCameras(const Args& args, igi::Json scene, const igi::ColmapModel& model,
+                           igi::Json* report) {
+  const fs::path from = fs::path(args.scene).parent_path();
+  RebasePaths(&scene, from.empty() ? fs::path(".") : from, args.out);
+  std::map<std::string, igi::Json> old_photos;
+  if (scene.contains("photos")) {
+    for (const auto& p : scene["photos"]) {
+      old_photos[fs::path(p["file"].get<std::string>()).filename().string()] = p;
+    }
+  }
+  std::optional<std::string> only_lighting;
+  if (scene.contains("lightings") && scene["lightings"].size() == 1) {
+    only_lighting = scene["lightings"].begin().key();
+  }
+  igi::Json cameras = igi::Json::object();
+  igi::Json photos = igi::Json::array();
+  igi::Json no_lighting = igi::Json::array();
+  for (const auto& [id, image] : model.images) {
+    const igi::ColmapCamera& cam = model.cameras.at(image.camera_id);
+    const igi::Camera camera = igi::CameraOfImage(model, image);
+    const std::string key = fs::path(image.name).stem().string();
+    cameras[key] = {{"model", std::string(igi::CameraModelName(camera.model))},
+                    {"width", cam.width},
+                    {"height", cam.height},
+                    {"params", camera.params},
+                    {"qvec", {image.qvec[0], image.qvec[1], image.qvec[2], image.qvec[3]}},
+                    {"tvec", {image.tvec[0], image.tvec[1], image.tvec[2]}}};
+    igi::Json photo = {{"file", Relative(fs::path(args.images) / image.name, args.out)},
+                       {"camera", key}};
+    const auto old = old_photos.find(image.name);
+    if (old != old_photos.end() && old->second.contains("lighting")) {
+      photo["lighting"] = old->second["lighting"];
+      if (old->second.contains("mask")) photo["mask"] = old->second["mask"];
+    } else if (only_lighting) {
+      photo["lighting"] = *only_lighting;
+    } else {
+      no_lighting.push_back(image.name);
+      continue;
+    }
+    photos.push_back(photo);
+  }
+  scene["cameras"] = cameras;
+  scene["photos"] = photos;
+  (*report)["photos_without_lighting"] = no_lighting;
+  return scene;
+}
+
+igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
+  igi::Json report;
+  report["format"] = "igi-register-report";
+  report["version"] = 1;
+  report["colmap_version"] = run.version;
+  report["images"] = run.images;
+  report["unregistered"] = run.unregistered;
+  report["models_reconstructed"] = run.num_models;
+  report["known_intrinsics"] = !args.camera.empty();
+  igi::Json registered = igi::Json::array();
+  for (const igi::ImageReprojection& r : igi::ReprojectionErrors(run.model)) {
+    registered.push_back(
+        {{"file", r.name}, {"observations", r.observations}, {"reprojection_rms_px", r.rms_px}});
+  }
+  report["registered"] = registered;
+  igi::Json cameras = igi::Json::array();
+  for (const auto& [id, cam] : run.model.cameras) {
+    cameras.push_back({{"camera_id", id}, {"model", cam.model}, {"params", cam.params}});
+  }
+  report["cameras"] = cameras;
+  report["points3d"] = run.model.points3d.size();
+  return report;
+}
+
+int Run(Args& args, const igi::CommonFlags& flags) {
+  const Inputs in = ValidateInputs(args);
+  args.colmap.threads = flags.threads;
+  args.colmap.single_camera = !args.multi_camera;
+  if (in.camera) {
+    args.colmap.intrinsics = igi::KnownIntrinsics{in.camera->model, in.camera->width,
+                                                  in.camera->height, in.camera->params};
+  }
+  const fs::path out(args.out);
+  igi::ColmapRunSummary run = igi::RunColmap(args.images, out / "colmap", args.colmap);
+  igi::Json report = BaseReport(run, args);
+  if (in.markers) {
+    const igi::MarkerAlignment alignment = igi::AlignByMarkers(run.model, *in.markers);
+    igi::TransformModel(alignment.scene_from_model, &run.model);
+    igi::Json a;
+    a["method"] = "markers";
+    a["markers_used"] = alignment.used;
+    a["scale"] = alignment.scene_from_model.scale;
+    a["rms_residual_m"] = alignment.rms_residual_m;
+    a["rms_reprojection_px"] = alignment.rms_reprojection_px;
+    igi::Json residuals = igi::Json::object();
+    for (const auto& [name, r] : alignment.residual_m) residuals[name] = r;
+    a["residual_m"] = residuals;
+    report["alignment"] = a;
+  }
+  igi::WriteColmapModelText(run.model, out / "sparse");
+  if (in.scene) {
+    igi::WriteJsonFile(out / "scene.json", SceneWithCameras(args, *in.scene, run.model, &report));
+  }
+  igi::WriteJsonFile(out / "report.json", report);
+  std::printf("%s: %zu of %zu photos registered, %zu points\n", args.out.c_str(),
+              run.model.images.size(), run.images.size(), run.model.points3d.size());
+  if (run.unregistered.empty()) return 0;
+  std::vector<std::string> problems;
+  for (const std::string& name : run.unregistered) {
+    problems.push_back(igi::DescribeProblem((fs::path(args.images) / name).string(), "", "",
+                                            "did not register (listed in report.json)"));
+  }
+  throw igi::PartialError(problems);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("igi-register: photos -> camera poses (COLMAP 3.8), optionally in a scene's frame",
+               "igi-register");
+  igi::CommonFlags flags;
+  igi::AddCommonFlags(app, &flags);
+  Args args;
+  app.add_option("--images", args.images, "Folder of photos")->required();
+  app.add_option("--out", args.out, "Output folder")->required();
+  app.add_option("--scene", args.scene, "scene.json whose frame the poses are brought into");
+  app.add_option("--markers", args.markers, "Control points (igi-markers JSON) for --scene");
+  app.add_option("--camera", args.camera, "camera.json: known intrinsics, held fixed");
+  app.add_option("--colmap", args.colmap.executable, "COLMAP executable");
+  app.add_option("--max-image-size", args.colmap.max_image_size,
+                 "SIFT extraction downscales larger photos to this size");
+  app.add_flag("--multi-camera", args.multi_camera, "One camera per photo (default: one shared)");
+  app.add_flag("--allow-other-colmap", args.colmap.allow_other_version,
+               "Accept a COLMAP other than 3.8");
+  return igi::RunMain(app, flags, argc, argv, [&]() -> int { return Run(args, flags); });
+}
