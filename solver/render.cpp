@@ -118,26 +118,25 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     }
     if (hit->geometry > 0) {  // an area light's own mesh: emits on its front, absorbs
       const int light = impl_.area_light_of_geometry[hit->geometry];
-      const Light& l = *impl_.lights[light].light;
-      const Eigen::Vector3i& t = l.mesh.triangles[hit->primitive];
-      const Eigen::Vector3d n = (l.mesh.positions[t[1]] - l.mesh.positions[t[0]])
-                                    .cast<double>()
-                                    .cross((l.mesh.positions[t[2]] - l.mesh.positions[t[0]]).cast<double>())
-                                    .normalized();
-      if (n.dot(dir) < 0) AddEmission(&s, light, l.radiance, dir, p, n);
+      const Eigen::Vector3d& n = impl_.area_normals[hit->geometry][hit->primitive];
+      if (n.dot(dir) < 0) AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
       break;
     }
     const int tri_index = hit->primitive;
-    const Eigen::Vector3i& tri = mesh.triangles[tri_index];
-    const ShadingMaterial& m = impl_.materials[mesh.triangle_region[tri_index]];
-    Eigen::Vector3d n_geo = mesh.FaceNormal(tri_index).cast<double>();
-    if (impl_.emitter_triangle_index[tri_index] >= 0 && n_geo.dot(dir) < 0) {
+    const TriangleShading& ts = impl_.triangles[tri_index];
+    const ShadingMaterial& m = impl_.materials[ts.material];
+    Eigen::Vector3d n_geo = ts.normal;
+    if (ts.emitter >= 0 && n_geo.dot(dir) < 0) {
       AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
     }
     if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
     const double b0 = 1.0 - hit->u - hit->v;
-    Eigen::Vector3d n_s = (b0 * mesh.normals[tri[0]] + hit->u * mesh.normals[tri[1]] +
-                           hit->v * mesh.normals[tri[2]]).cast<double>().normalized();
+    const Eigen::Vector3i& tri = mesh.triangles[tri_index];
+    Eigen::Vector3d n_s = n_geo;
+    if (!ts.flat) {
+      n_s = (b0 * mesh.normals[tri[0]] + hit->u * mesh.normals[tri[1]] +
+             hit->v * mesh.normals[tri[2]]).cast<double>().normalized();
+    }
     const Eigen::Vector3d wo = -dir;
     if (n_geo.dot(wo) < 0) {  // two-sided: shade the side the ray came from
       n_geo = -n_geo;

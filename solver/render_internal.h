@@ -58,6 +58,14 @@ struct Hit {
   int sphere_light = -1;  // >= 0: hit the sphere emitter lights[sphere_light]
 };
 
+// Per scene triangle, precomputed once so that shading a hit reads one record.
+struct TriangleShading {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // geometric, unit, front = CCW
+  int material = 0;        // index into materials
+  int emitter = -1;        // index in the emitter-material light's triangles, or -1
+  bool flat = true;        // vertex normals all equal the face normal: no interpolation
+};
+
 struct Renderer::Impl {
   const Scene* scene = nullptr;
   int lighting = -1;
@@ -66,6 +74,9 @@ struct Renderer::Impl {
   std::vector<int> area_light_of_geometry;  // geometry id -> index into lights (-1 for mesh)
   int emitter_material_light = -1;          // index into lights of the emitter-material set
   std::vector<int> emitter_triangle_index;  // scene triangle -> index in that set (or -1)
+  std::vector<TriangleShading> triangles;   // per scene triangle
+  std::vector<int> sphere_lights;           // indices into lights of the sphere emitters
+  std::vector<std::vector<Eigen::Vector3d>> area_normals;  // geometry id -> triangle normals
   double ray_epsilon = 1e-4;                // self-intersection offset, metres
   struct Embree;
   std::unique_ptr<Embree> embree;

@@ -62,6 +62,15 @@ void AttachSphere(RTCDevice device, RTCScene scene, const Eigen::Vector3d& c, do
   rtcReleaseGeometry(geom);
 }
 
+// Distance along unit d from o to the sphere, or infinity.
+float HitSphere(const Vec3& o, const Vec3& d, const Vec3& c, float r) {
+  const Vec3 oc = o - c;
+  const float b = oc.dot(d), disc = b * b - (oc.squaredNorm() - r * r);
+  if (disc < 0) return kInf;
+  const float s = std::sqrt(disc);
+  return -b - s > 1e-6f ? -b - s : (-b + s > 1e-6f ? -b + s : kInf);
+}
+
 float Uniform(Pcg32& rng) { return float(rng.NextUInt32() >> 8) * 0x1p-24f; }
 
 // Cosine-distributed direction around unit n (Duff et al.'s frame, Malley's method).
@@ -153,11 +162,19 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
   const int n_lights = static_cast<int>(lights.size());
   for (int bounce = 0;; ++bounce) {
     RTCRayHit rh;
-    InitRay(&rh.ray, origin, dir, kInf, kMaskSurfaces | kMaskSpheres);
+    InitRay(&rh.ray, origin, dir, kInf,
+            options.embree_spheres ? kMaskSurfaces | kMaskSpheres : kMaskSurfaces);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &context, &rh);
     ++rays;
+    if (!options.embree_spheres) {
+      for (const RawLight& l : lights) {
+        if (l.type == LightType::kSphere && HitSphere(origin, dir, l.position, l.radius) < rh.ray.tfar) {
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        }
+      }
+    }
     if (rh.hit.geomID != 0) break;  // escaped, or hit an emitter
     const Vec3 p = origin + rh.ray.tfar * dir;
     Vec3 n = normals[rh.hit.primID];

@@ -25,6 +25,9 @@ struct RawTraceOptions {
   int max_bounces = 64;
   int num_threads = 0;
   uint64_t seed = 1;
+  // Sphere lights as Embree point-spheres (true) or intersected analytically in float after
+  // rtcIntersect1, as igi does in double (false).
+  bool embree_spheres = true;
 };
 
 struct RawTraceSummary {
