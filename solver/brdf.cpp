@@ -106,6 +106,12 @@ BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, doubl
   } else {
     sample.lobe = BrdfLobe::kDiffuse;
     sample.wi = SampleCosineHemisphere(u);
+    if (!HasSpecularLobe(params.model)) {  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd
+      sample.f = params.rho_d * kInvPi;
+      sample.pdf = CosineHemispherePdf(sample.wi.z());
+      if (sample.Valid()) sample.weight = params.rho_d;
+      return sample;
+    }
   }
   const BrdfEval eval = EvalBrdfAndPdf(params, wo, sample.wi);
   sample.f = eval.f;

@@ -215,6 +215,16 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   Image image(camera.width, camera.height, 3);
   const PathTracer tracer(*impl_, options);
   const Eigen::Vector3d center = camera.CenterInWorld();
+  // PINHOLE rays straight from the intrinsics and a rotation matrix (what WorldRayFromImg
+  // computes, without its per-call quaternion rotation); OPENCV goes through WorldRayFromImg.
+  const bool pinhole = camera.model == CameraModel::kPinhole;
+  const Eigen::Matrix3d world_from_cam = camera.cam_from_world.rotation.conjugate().toRotationMatrix();
+  auto camera_ray = [&](double px, double py) -> Eigen::Vector3d {
+    if (!pinhole) return camera.WorldRayFromImg(Eigen::Vector2d(px, py));
+    const Eigen::Vector3d d((px - camera.params[2]) / camera.params[0],
+                            (py - camera.params[3]) / camera.params[1], 1.0);
+    return (world_from_cam * d).normalized();
+  };
   std::atomic<uint64_t> total_rays{0};
   Progress progress("igi-render", camera.height, 2.0, options.show_progress && ProgressAllowed());
   ParallelFor(0, camera.height, [&](int64_t y) {
@@ -225,8 +235,7 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
       for (int k = 0; k < options.spp; ++k) {
         Pcg32 rng = PixelSampleRng(options.seed, pixel, k);
         const Eigen::Vector2d jitter = rng.Uniform2D();
-        const Eigen::Vector3d dir =
-            camera.WorldRayFromImg(Eigen::Vector2d(x + jitter.x(), y + jitter.y()));
+        const Eigen::Vector3d dir = camera_ray(x + jitter.x(), y + jitter.y());
         const Eigen::Vector3d l = tracer.Trace(center, dir, rng, &rays);
         if (l.allFinite()) sum += l;
       }

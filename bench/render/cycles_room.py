@@ -1,12 +1,13 @@
 # Blender (Cycles) twin of the radiance_room scene, Lambertian variant, for the time-to-noise
 # benchmark (bench/render/run_cycles_bench.sh). Run headless:
 #   blender -b --factory-startup -P cycles_room.py -- --scene DIR/scene.json --camera cam0 \
-#       --lighting L0 --spp 64 --seed 1 --threads 2 --out out.exr
+#       --lighting L0 --spp 64 --seed 1 --threads 2 --out out.exr [--lamp mesh|light]
 # It builds the scene from scene.json itself (no .blend file): the OBJ geometry as given (z up,
 # metres), every material a Diffuse BSDF (roughness 0 = Lambertian) with rho_d as colour (a
 # material with a specular lobe gets rho_d only: the "Lambertian variant"), each sphere light of
 # the lighting as an emissive ico-sphere (emission strength = radiance: Cycles' emission of
-# strength 1 is radiance 1), the COLMAP pinhole camera (square pixels, principal point at the
+# strength 1 is radiance 1) or, with --lamp light, as Cycles' sphere light (a point light of
+# that radius and the same radiance), the COLMAP pinhole camera (square pixels, principal point at the
 # centre), a box pixel filter of 1 px (the pixel mean, like igi), no denoising, no adaptive
 # sampling, no clamping, bounce limits of 64, CPU. Writes a 32-bit float linear EXR and prints
 # "CYCLES_RENDER_SECONDS <s>" (the render call only: scene sync, BVH build and sampling).
@@ -22,7 +23,8 @@ from mathutils import Matrix, Quaternion, Vector
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    args = {"camera": "cam0", "lighting": "L0", "spp": "16", "seed": "0", "threads": "0"}
+    args = {"camera": "cam0", "lighting": "L0", "spp": "16", "seed": "0", "threads": "0",
+            "lamp": "mesh"}
     for i in range(0, len(argv) - 1, 2):
         args[argv[i].lstrip("-")] = argv[i + 1]
     for key in ("scene", "out"):
@@ -94,17 +96,30 @@ def add_geometry(scene_dir, doc):
         bpy.context.scene.collection.objects.link(bpy.data.objects.new("room", mesh))
 
 
-def add_sphere_lights(doc, lighting):
+def add_sphere_lights(doc, lighting, kind):
     for name in doc["lightings"][lighting]:
         light = doc["lights"][name]
         if light["type"] != "sphere":
             sys.exit(f"cycles_room.py: light {name}: only sphere lights are supported")
+        rad = light["radiance"]
+        rad = [rad] * 3 if isinstance(rad, (int, float)) else rad
+        if kind == "light":
+            # Cycles' own sphere light: a point light of radius r. Its radiance is
+            # P / (4 pi * pi r^2) for power P (Cycles: eval_fac = 1/(4 pi) * 1/(pi r^2)).
+            r = light["radius"]
+            data = bpy.data.lights.new(name, "POINT")
+            peak = max(rad)
+            data.color = (rad[0] / peak, rad[1] / peak, rad[2] / peak)
+            data.energy = peak * 4 * math.pi * math.pi * r * r
+            data.shadow_soft_size = r
+            obj = bpy.data.objects.new(name, data)
+            obj.location = light["center"]
+            bpy.context.scene.collection.objects.link(obj)
+            continue
         bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=6, radius=light["radius"],
                                               location=light["center"])
         obj = bpy.context.active_object
         bpy.ops.object.shade_smooth()
-        rad = light["radiance"]
-        rad = [rad] * 3 if isinstance(rad, (int, float)) else rad
         obj.data.materials.append(emission_material(name, rad))
 
 
@@ -173,7 +188,7 @@ def main():
         bpy.data.objects.remove(obj, do_unlink=True)
     scene = bpy.context.scene
     add_geometry(os.path.dirname(os.path.abspath(args["scene"])), doc)
-    add_sphere_lights(doc, args["lighting"])
+    add_sphere_lights(doc, args["lighting"], args["lamp"])
     w, h = add_camera(doc, args["camera"])
     configure(scene, w, h, args)
     start = time.monotonic()
