@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
   app.add_option("--camera", camera_name, "Camera (default: the first)");
   app.add_option("--lighting", lighting_name, "Lighting (default: the first)");
   app.add_option("--spp", spp, "Paths per pixel")->capture_default_str();
-  app.add_option("--reps", reps, "Runs of each side (medians reported)")->capture_default_str();
+  app.add_option("--reps", reps, "Runs of each side (medians reported)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_flag("--analytic-spheres", analytic_spheres,
                "Raw side: sphere lights intersected analytically (as igi), not by Embree");
   return igi::RunMain(app, flags, argc, argv, [&] {
@@ -104,12 +106,16 @@ int main(int argc, char** argv) {
                 double(raw_rays) / (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp),
                 double(raw_shadow) / (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp));
     std::vector<double> paired;  // each igi run against the raw run right after it
-    for (size_t i = 0; i < igi_rate.size(); ++i) paired.push_back(igi_rate[i] / raw_rate[i]);
+    double lo = 1e300, hi = 0;
+    for (size_t i = 0; i < igi_rate.size(); ++i) {
+      paired.push_back(igi_rate[i] / raw_rate[i]);
+      lo = std::min(lo, paired.back());
+      hi = std::max(hi, paired.back());
+    }
     std::printf("median Mrays/s: igi %.3f, raw Embree %.3f; igi/raw = %.1f %% (median of paired "
                 "runs %.1f %%, min %.1f %%, max %.1f %%)\n",
                 igi_median * 1e-6, raw_median * 1e-6, 100.0 * igi_median / raw_median,
-                100.0 * Median(paired), 100.0 * *std::min_element(paired.begin(), paired.end()),
-                100.0 * *std::max_element(paired.begin(), paired.end()));
+                100.0 * Median(paired), 100.0 * lo, 100.0 * hi);
     return 0;
   });
 }
