@@ -65,10 +65,13 @@ render() {
 
 echo "target noise $TARGET, $THREADS threads, camera $CAMERA, lighting $LIGHTING, Cycles lamp $LAMP, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
 printf "%-7s %7s %10s %9s %12s\n" side spp seconds noise "t@target s"
-declare -A FINAL_T FINAL_EFF
-for side in igi cycles; do
-  spp=$PILOT_SPP
-  for iter in 1 2 3 4 5 6; do
+# The two sides alternate level by level, so that load from other processes hits both alike.
+declare -A FINAL_T FINAL_EFF SPP DONE
+SPP[igi]=$PILOT_SPP; SPP[cycles]=$PILOT_SPP; DONE[igi]=0; DONE[cycles]=0
+for iter in 1 2 3 4 5 6; do
+  for side in igi cycles; do
+    [[ ${DONE[$side]} == 1 ]] && continue
+    spp=${SPP[$side]}
     t1=$(render $side "$spp" 1 "$WORK/${side}_a.exr")
     t2=$(render $side "$spp" 2 "$WORK/${side}_b.exr")
     noise=$("$NOISE" "$WORK/${side}_a.exr" "$WORK/${side}_b.exr" | awk '{print $6}')
@@ -79,8 +82,8 @@ for side in igi cycles; do
     FINAL_T[$side]=$t
     FINAL_EFF[$side]=$eff
     cp "$WORK/${side}_a.exr" "$WORK/${side}_final.exr"
-    if awk -v n="$noise" -v g="$TARGET" 'BEGIN {exit !(n <= g)}'; then break; fi
-    spp=$(awk -v s="$spp" -v n="$noise" -v g="$TARGET" \
+    if awk -v n="$noise" -v g="$TARGET" 'BEGIN {exit !(n <= g)}'; then DONE[$side]=1; fi
+    SPP[$side]=$(awk -v s="$spp" -v n="$noise" -v g="$TARGET" \
       'BEGIN {x = int(s * (n / g)^2 * 1.1) + 1; if (x <= s) x = s + 1; print x}')
   done
 done
