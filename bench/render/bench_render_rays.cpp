@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   std::string scene_path = std::string(IGI_SHARED_DATA_DIR) + "/reference/radiance_room/scene.json";
   std::string camera_name, lighting_name;
   int spp = 16, reps = 3;
-  bool analytic_spheres = false;
+  bool embree_spheres = false;
   app.add_option("--scene", scene_path, "scene.json")->capture_default_str();
   app.add_option("--camera", camera_name, "Camera (default: the first)");
   app.add_option("--lighting", lighting_name, "Lighting (default: the first)");
@@ -51,8 +51,9 @@ int main(int argc, char** argv) {
   app.add_option("--reps", reps, "Runs of each side (medians reported)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_flag("--analytic-spheres", analytic_spheres,
-               "Raw side: sphere lights intersected analytically (as igi), not by Embree");
+  app.add_flag("--embree-spheres", embree_spheres,
+               "Raw side: sphere lights as Embree point-spheres in its scene (default: "
+               "intersected analytically after rtcIntersect1, as igi does)");
   return igi::RunMain(app, flags, argc, argv, [&] {
     igi::SceneLoadOptions load;
     load.check_images = false;
@@ -64,7 +65,7 @@ int main(int argc, char** argv) {
     const int threads = igi::ResolveThreads(flags.threads);
 
     const igi::Renderer renderer(scene, lighting);
-    const igi::bench::RawEmbreeTracer raw(scene, lighting);
+    const igi::bench::RawEmbreeTracer raw(scene, lighting, embree_spheres);
     igi::RenderOptions options;
     options.spp = spp;
     options.num_threads = threads;
@@ -74,7 +75,6 @@ int main(int argc, char** argv) {
     raw_options.num_threads = threads;
     raw_options.rr_start_bounce = options.rr_start_bounce;
     raw_options.max_bounces = options.max_bounces;
-    raw_options.embree_spheres = !analytic_spheres;
 
     std::printf("scene %s, camera %s, lighting %s: %zu triangles, %dx%d, %d spp, %d threads\n",
                 scene_path.c_str(), scene.cameras[camera].name.c_str(),

@@ -109,6 +109,7 @@ struct RawEmbreeTracer::Impl {
   std::vector<Vec3> albedo;   // per scene triangle
   std::vector<RawLight> lights;
   float epsilon = 1e-5f;
+  bool embree_spheres = false;
 
   ~Impl() {
     if (scene != nullptr) rtcReleaseScene(scene);
@@ -162,13 +163,12 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
   const int n_lights = static_cast<int>(lights.size());
   for (int bounce = 0;; ++bounce) {
     RTCRayHit rh;
-    InitRay(&rh.ray, origin, dir, kInf,
-            options.embree_spheres ? kMaskSurfaces | kMaskSpheres : kMaskSurfaces);
+    InitRay(&rh.ray, origin, dir, kInf, kMaskSurfaces | kMaskSpheres);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &context, &rh);
     ++rays;
-    if (!options.embree_spheres) {
+    if (!embree_spheres) {
       for (const RawLight& l : lights) {
         if (l.type == LightType::kSphere && HitSphere(origin, dir, l.position, l.radius) < rh.ray.tfar) {
           rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -204,7 +204,9 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
   return rays;
 }
 
-RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting) : impl_(std::make_unique<Impl>()) {
+RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting, bool embree_spheres)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->embree_spheres = embree_spheres;
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw Error("cannot create the Embree device");
   impl_->scene = rtcNewScene(impl_->device);
@@ -228,7 +230,7 @@ RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting) : impl_(std::
     rl.position = (light.type == LightType::kSphere ? light.center : light.position).cast<float>();
     rl.direction = light.direction.cast<float>();
     rl.radius = float(light.radius);
-    if (light.type == LightType::kSphere) AttachSphere(impl_->device, impl_->scene, light.center, light.radius);
+    if (light.type == LightType::kSphere && embree_spheres) AttachSphere(impl_->device, impl_->scene, light.center, light.radius);
     if (light.type == LightType::kArea) {
       for (const Eigen::Vector3i& t : light.mesh.triangles) {
         for (int k = 0; k < 3; ++k) rl.tri_vertices.push_back(light.mesh.positions[t[k]]);

@@ -25,9 +25,6 @@ struct RawTraceOptions {
   int max_bounces = 64;
   int num_threads = 0;
   uint64_t seed = 1;
-  // Sphere lights as Embree point-spheres (true) or intersected analytically in float after
-  // rtcIntersect1, as igi does in double (false).
-  bool embree_spheres = true;
 };
 
 struct RawTraceSummary {
@@ -39,9 +36,11 @@ struct RawTraceSummary {
 
 class RawEmbreeTracer {
  public:
-  // Builds its own Embree scene (scene mesh, lighting's area-light meshes, sphere lights as
-  // Embree point-spheres) with the same build quality as the Renderer.
-  RawEmbreeTracer(const Scene& scene, int lighting);
+  // Builds its own Embree scene (scene mesh, lighting's area-light meshes and, when
+  // `embree_spheres`, sphere lights as Embree point-spheres; otherwise they are intersected
+  // analytically in float after rtcIntersect1, as igi does in double) with the same build
+  // quality as the Renderer.
+  RawEmbreeTracer(const Scene& scene, int lighting, bool embree_spheres = false);
   ~RawEmbreeTracer();
   RawEmbreeTracer(const RawEmbreeTracer&) = delete;
   RawEmbreeTracer& operator=(const RawEmbreeTracer&) = delete;
