@@ -56,6 +56,11 @@ BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
   BrdfEval out;
   if (!(wo.z() > 0.0)) return out;
   const bool above = wi.z() > 0.0;
+  if (!HasSpecularLobe(params.model)) {  // lambert: no lobe choice, no half vector
+    if (above) out.f = params.rho_d * kInvPi;
+    out.pdf = CosineHemispherePdf(wi.z());
+    return out;
+  }
   const double p_specular = SpecularLobeProbability(params);
   if (above) out.f = params.rho_d * kInvPi;
   out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
