@@ -8,7 +8,6 @@
 namespace igi {
 namespace {
 
-
 void CheckRgb(const Eigen::Vector3d& rho, const std::string& key,
               std::vector<BrdfParamProblem>* problems) {
   for (int c = 0; c < 3; ++c) {

@@ -135,7 +135,8 @@ std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lightin
 
   // Scene extent sets the self-intersection offset.
   double extent = 1.0;
-  for (const Eigen::Vector3f& p : mesh.positions) extent = std::max(extent, double(p.cwiseAbs().maxCoeff()));
+  for (const Eigen::Vector3f& p : mesh.positions)
+    extent = std::max(extent, double(p.cwiseAbs().maxCoeff()));
   impl->ray_epsilon = 1e-5 * extent;
 
   for (int index : scene.lightings[lighting].lights) {

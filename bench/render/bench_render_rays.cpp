@@ -37,7 +37,8 @@ void CompleteMaterials(igi::Scene* scene) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Rays per second: igi's renderer vs raw Embree, same scene and run", "bench_render_rays"};
+  CLI::App app{"Rays per second: igi's renderer vs raw Embree, same scene and run",
+               "bench_render_rays"};
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
   std::string scene_path = std::string(IGI_SHARED_DATA_DIR) + "/reference/radiance_room/scene.json";
@@ -102,9 +103,12 @@ int main(int argc, char** argv) {
     }
     const double igi_median = Median(igi_rate), raw_median = Median(raw_rate);
     std::printf("rays per camera ray: igi %.3f, raw Embree %.3f (%.3f of them shadow rays)\n",
-                double(igi_rays) / (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp),
-                double(raw_rays) / (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp),
-                double(raw_shadow) / (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp));
+                double(igi_rays) /
+                    (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp),
+                double(raw_rays) /
+                    (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp),
+                double(raw_shadow) /
+                    (double(scene.cameras[camera].width) * scene.cameras[camera].height * spp));
     std::vector<double> paired;  // each igi run against the raw run right after it
     double lo = 1e300, hi = 0;
     for (size_t i = 0; i < igi_rate.size(); ++i) {
@@ -112,10 +116,11 @@ int main(int argc, char** argv) {
       lo = std::min(lo, paired.back());
       hi = std::max(hi, paired.back());
     }
-    std::printf("median Mrays/s: igi %.3f, raw Embree %.3f; igi/raw = %.1f %% (median of paired "
-                "runs %.1f %%, min %.1f %%, max %.1f %%)\n",
-                igi_median * 1e-6, raw_median * 1e-6, 100.0 * igi_median / raw_median,
-                100.0 * Median(paired), 100.0 * lo, 100.0 * hi);
+    std::printf(
+        "median Mrays/s: igi %.3f, raw Embree %.3f; igi/raw = %.1f %% (median of paired "
+        "runs %.1f %%, min %.1f %%, max %.1f %%)\n",
+        igi_median * 1e-6, raw_median * 1e-6, 100.0 * igi_median / raw_median,
+        100.0 * Median(paired), 100.0 * lo, 100.0 * hi);
     return 0;
   });
 }

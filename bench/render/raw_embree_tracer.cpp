@@ -31,13 +31,15 @@ struct RawLight {
 
 unsigned AttachMesh(RTCDevice device, RTCScene scene, const TriangleMesh& mesh) {
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                         RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                         mesh.positions.size()));
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     for (int k = 0; k < 3; ++k) vb[3 * i + k] = mesh.positions[i][k];
   }
-  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                                            RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                                            mesh.triangles.size()));
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) ib[3 * t + k] = static_cast<unsigned>(mesh.triangles[t][k]);
   }
@@ -170,7 +172,8 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
     ++rays;
     if (!embree_spheres) {
       for (const RawLight& l : lights) {
-        if (l.type == LightType::kSphere && HitSphere(origin, dir, l.position, l.radius) < rh.ray.tfar) {
+        if (l.type == LightType::kSphere &&
+            HitSphere(origin, dir, l.position, l.radius) < rh.ray.tfar) {
           rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         }
       }
@@ -230,7 +233,8 @@ RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting, bool embree_s
     rl.position = (light.type == LightType::kSphere ? light.center : light.position).cast<float>();
     rl.direction = light.direction.cast<float>();
     rl.radius = float(light.radius);
-    if (light.type == LightType::kSphere && embree_spheres) AttachSphere(impl_->device, impl_->scene, light.center, light.radius);
+    if (light.type == LightType::kSphere && embree_spheres)
+      AttachSphere(impl_->device, impl_->scene, light.center, light.radius);
     if (light.type == LightType::kArea) {
       for (const Eigen::Vector3i& t : light.mesh.triangles) {
         for (int k = 0; k < 3; ++k) rl.tri_vertices.push_back(light.mesh.positions[t[k]]);
@@ -253,20 +257,24 @@ RawTraceSummary RawEmbreeTracer::Trace(const Camera& camera, const RawTraceOptio
   const float fx = float(camera.params[0]), fy = float(camera.params[1]);
   const float cx = float(camera.params[2]), cy = float(camera.params[3]);
   std::atomic<uint64_t> total{0}, total_shadow{0};
-  ParallelFor(0, camera.height, [&](int64_t y) {
-    uint64_t rays = 0, shadow = 0;
-    for (int x = 0; x < camera.width; ++x) {
-      const uint64_t pixel = uint64_t(y) * camera.width + x;
-      for (int k = 0; k < options.spp; ++k) {
-        Pcg32 rng(options.seed, pixel * uint64_t(options.spp) + uint64_t(k));
-        const float px = float(x) + Uniform(rng), py = float(y) + Uniform(rng);
-        const Vec3 d_cam((px - cx) / fx, (py - cy) / fy, 1.0f);
-        rays += impl_->TracePath(center, (world_from_cam * d_cam).normalized(), options, rng, &shadow);
-      }
-    }
-    total += rays;
-    total_shadow += shadow;
-  }, options.num_threads);
+  ParallelFor(
+      0, camera.height,
+      [&](int64_t y) {
+        uint64_t rays = 0, shadow = 0;
+        for (int x = 0; x < camera.width; ++x) {
+          const uint64_t pixel = uint64_t(y) * camera.width + x;
+          for (int k = 0; k < options.spp; ++k) {
+            Pcg32 rng(options.seed, pixel * uint64_t(options.spp) + uint64_t(k));
+            const float px = float(x) + Uniform(rng), py = float(y) + Uniform(rng);
+            const Vec3 d_cam((px - cx) / fx, (py - cy) / fy, 1.0f);
+            rays += impl_->TracePath(center, (world_from_cam * d_cam).normalized(), options, rng,
+                                     &shadow);
+          }
+        }
+        total += rays;
+        total_shadow += shadow;
+      },
+      options.num_threads);
   RawTraceSummary summary;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.rays = total.load();
