@@ -58,6 +58,11 @@ BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
   BrdfEval out;
   if (!(wo.z() > 0.0)) return out;
   const bool above = wi.z() > 0.0;
+  if (!HasSpecularLobe(params.model)) {  // lambert: no lobe choice, no half vector
+    if (above) out.f = params.rho_d * kInvPi;
+    out.pdf = CosineHemispherePdf(wi.z());
+    return out;
+  }
   const double p_specular = SpecularLobeProbability(params);
   if (above) out.f = params.rho_d * kInvPi;
   out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
@@ -108,6 +113,12 @@ BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, doubl
   } else {
     sample.lobe = BrdfLobe::kDiffuse;
     sample.wi = SampleCosineHemisphere(u);
+    if (!HasSpecularLobe(params.model)) {  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd
+      sample.f = params.rho_d * kInvPi;
+      sample.pdf = CosineHemispherePdf(sample.wi.z());
+      if (sample.Valid()) sample.weight = params.rho_d;
+      return sample;
+    }
   }
   const BrdfEval eval = EvalBrdfAndPdf(params, wo, sample.wi);
   sample.f = eval.f;

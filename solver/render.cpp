@@ -46,7 +46,8 @@ struct PathState {
 class PathTracer {
  public:
   PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
-      : impl_(impl), options_(options),
+      : impl_(impl),
+        options_(options),
         light_select_pdf_(impl.lights.empty() ? 0.0 : 1.0 / double(impl.lights.size())) {}
 
   Eigen::Vector3d Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
@@ -97,8 +98,8 @@ void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
   if (impl_.Occluded(p + n_geo * eps, ls.wi, distance, light)) return;
   const double light_pdf = light_select_pdf_ * ls.pdf;
   const double w = ls.delta ? 1.0 : PowerHeuristic(1, light_pdf, 1, fe.pdf);
-  s->radiance += s->throughput.cwiseProduct(fe.f).cwiseProduct(ls.value) *
-                 (wi_local.z() * w / light_pdf);
+  s->radiance +=
+      s->throughput.cwiseProduct(fe.f).cwiseProduct(ls.value) * (wi_local.z() * w / light_pdf);
 }
 
 Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
@@ -118,38 +119,40 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     }
     if (hit->geometry > 0) {  // an area light's own mesh: emits on its front, absorbs
       const int light = impl_.area_light_of_geometry[hit->geometry];
-      const Light& l = *impl_.lights[light].light;
-      const Eigen::Vector3i& t = l.mesh.triangles[hit->primitive];
-      const Eigen::Vector3d n = (l.mesh.positions[t[1]] - l.mesh.positions[t[0]])
-                                    .cast<double>()
-                                    .cross((l.mesh.positions[t[2]] - l.mesh.positions[t[0]]).cast<double>())
-                                    .normalized();
-      if (n.dot(dir) < 0) AddEmission(&s, light, l.radiance, dir, p, n);
+      const Eigen::Vector3d& n = impl_.area_normals[hit->geometry][hit->primitive];
+      if (n.dot(dir) < 0) AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
       break;
     }
     const int tri_index = hit->primitive;
-    const Eigen::Vector3i& tri = mesh.triangles[tri_index];
-    const ShadingMaterial& m = impl_.materials[mesh.triangle_region[tri_index]];
-    Eigen::Vector3d n_geo = mesh.FaceNormal(tri_index).cast<double>();
-    if (impl_.emitter_triangle_index[tri_index] >= 0 && n_geo.dot(dir) < 0) {
+    const TriangleShading& ts = impl_.triangles[tri_index];
+    const ShadingMaterial& m = impl_.materials[ts.material];
+    Eigen::Vector3d n_geo = ts.normal;
+    if (ts.emitter >= 0 && n_geo.dot(dir) < 0) {
       AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
     }
     if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
     const double b0 = 1.0 - hit->u - hit->v;
-    Eigen::Vector3d n_s = (b0 * mesh.normals[tri[0]] + hit->u * mesh.normals[tri[1]] +
-                           hit->v * mesh.normals[tri[2]]).cast<double>().normalized();
+    const Eigen::Vector3i& tri = mesh.triangles[tri_index];
+    Eigen::Vector3d n_s = n_geo;
+    if (!ts.flat) {
+      n_s = (b0 * mesh.normals[tri[0]] + hit->u * mesh.normals[tri[1]] +
+             hit->v * mesh.normals[tri[2]])
+                .cast<double>()
+                .normalized();
+    }
     const Eigen::Vector3d wo = -dir;
     if (n_geo.dot(wo) < 0) {  // two-sided: shade the side the ray came from
       n_geo = -n_geo;
       n_s = -n_s;
     }
     if (!(n_s.dot(wo) > 0)) n_s = n_geo;
-    const Frame frame = m.tangent ? Frame::FromNormalTangent(n_s, *m.tangent)
-                                  : Frame::FromNormal(n_s);
+    const Frame frame =
+        m.tangent ? Frame::FromNormalTangent(n_s, *m.tangent) : Frame::FromNormal(n_s);
     BrdfParams params = m.params;
     if (m.rho_d_map && mesh.has_uvs()) {
-      const Eigen::Vector2d uv = (b0 * mesh.uvs[tri[0]] + hit->u * mesh.uvs[tri[1]] +
-                                  hit->v * mesh.uvs[tri[2]]).cast<double>();
+      const Eigen::Vector2d uv =
+          (b0 * mesh.uvs[tri[0]] + hit->u * mesh.uvs[tri[1]] + hit->v * mesh.uvs[tri[2]])
+              .cast<double>();
       params.rho_d = SampleTexture(*m.rho_d_map, uv);
     }
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
@@ -216,30 +219,44 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   Image image(camera.width, camera.height, 3);
   const PathTracer tracer(*impl_, options);
   const Eigen::Vector3d center = camera.CenterInWorld();
+  // PINHOLE rays straight from the intrinsics and a rotation matrix (what WorldRayFromImg
+  // computes, without its per-call quaternion rotation); OPENCV goes through WorldRayFromImg.
+  const bool pinhole = camera.model == CameraModel::kPinhole;
+  const Eigen::Matrix3d world_from_cam =
+      camera.cam_from_world.rotation.conjugate().toRotationMatrix();
+  auto camera_ray = [&](double px, double py) -> Eigen::Vector3d {
+    if (!pinhole) return camera.WorldRayFromImg(Eigen::Vector2d(px, py));
+    const Eigen::Vector3d d((px - camera.params[2]) / camera.params[0],
+                            (py - camera.params[3]) / camera.params[1], 1.0);
+    return (world_from_cam * d).normalized();
+  };
   std::atomic<uint64_t> total_rays{0};
   Progress progress("igi-render", camera.height, 2.0, options.show_progress && ProgressAllowed());
-  ParallelFor(0, camera.height, [&](int64_t y) {
-    uint64_t rays = 0;
-    for (int x = 0; x < camera.width; ++x) {
-      const uint64_t pixel = uint64_t(y) * camera.width + x;
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (int k = 0; k < options.spp; ++k) {
-        Pcg32 rng = PixelSampleRng(options.seed, pixel, k);
-        const Eigen::Vector2d jitter = rng.Uniform2D();
-        const Eigen::Vector3d dir =
-            camera.WorldRayFromImg(Eigen::Vector2d(x + jitter.x(), y + jitter.y()));
-        const Eigen::Vector3d l = tracer.Trace(center, dir, rng, &rays);
-        if (l.allFinite()) sum += l;
-      }
-      const Eigen::Vector3d mean = sum / options.spp;
-      for (int c = 0; c < 3; ++c) image.at(x, int(y), c) = static_cast<float>(mean[c]);
-    }
-    total_rays += rays;
-    progress.Add(1);
-  }, options.num_threads);
+  ParallelFor(
+      0, camera.height,
+      [&](int64_t y) {
+        uint64_t rays = 0;
+        for (int x = 0; x < camera.width; ++x) {
+          const uint64_t pixel = uint64_t(y) * camera.width + x;
+          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+          for (int k = 0; k < options.spp; ++k) {
+            Pcg32 rng = PixelSampleRng(options.seed, pixel, k);
+            const Eigen::Vector2d jitter = rng.Uniform2D();
+            const Eigen::Vector3d dir = camera_ray(x + jitter.x(), y + jitter.y());
+            const Eigen::Vector3d l = tracer.Trace(center, dir, rng, &rays);
+            if (l.allFinite()) sum += l;
+          }
+          const Eigen::Vector3d mean = sum / options.spp;
+          for (int c = 0; c < 3; ++c) image.at(x, int(y), c) = static_cast<float>(mean[c]);
+        }
+        total_rays += rays;
+        progress.Add(1);
+      },
+      options.num_threads);
   progress.Finish();
   if (summary != nullptr) {
-    summary->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary->seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     summary->camera_rays = uint64_t(camera.width) * camera.height * options.spp;
     summary->rays = total_rays.load();
   }

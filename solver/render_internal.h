@@ -18,9 +18,9 @@ namespace igi {
 // A surface's reflectance, ready to shade.
 struct ShadingMaterial {
   BrdfModel model = BrdfModel::kLambert;
-  BrdfParams params;                         // rho_d replaced per hit when textured
-  std::optional<Eigen::Vector3d> tangent;    // anisotropic models (world)
-  std::shared_ptr<const Image> rho_d_map;    // linear albedo texture
+  BrdfParams params;                                   // rho_d replaced per hit when textured
+  std::optional<Eigen::Vector3d> tangent;              // anisotropic models (world)
+  std::shared_ptr<const Image> rho_d_map;              // linear albedo texture
   Eigen::Vector3d emission = Eigen::Vector3d::Zero();  // "emitter": radiance of the front side
 };
 
@@ -38,35 +38,46 @@ struct RenderLight {
   LightType type = LightType::kPoint;  // kArea also stands for emitter-material triangles
   const Light* light = nullptr;        // nullptr for the emitter-material set
   Eigen::Matrix3d spot_frame = Eigen::Matrix3d::Identity();
-  TriangleEmitter triangles;           // kArea
+  TriangleEmitter triangles;  // kArea
 };
 
 // A sampled direction toward a light, from a shading point.
 struct LightSample {
-  Eigen::Vector3d wi = Eigen::Vector3d::Zero();  // world, unit
-  double distance = 0;                           // to the light (infinity: directional)
+  Eigen::Vector3d wi = Eigen::Vector3d::Zero();     // world, unit
+  double distance = 0;                              // to the light (infinity: directional)
   Eigen::Vector3d value = Eigen::Vector3d::Zero();  // radiance, or I/d² or E for delta lights
-  double pdf = 0;                                // solid angle; 1 for delta lights
+  double pdf = 0;                                   // solid angle; 1 for delta lights
   bool delta = false;
 };
 
 struct Hit {
   double t = 0;
-  int geometry = -1;   // 0 = scene mesh, 1 + k = area light k's mesh
+  int geometry = -1;  // 0 = scene mesh, 1 + k = area light k's mesh
   int primitive = -1;
-  double u = 0, v = 0;  // barycentrics of vertices 1 and 2
+  double u = 0, v = 0;    // barycentrics of vertices 1 and 2
   int sphere_light = -1;  // >= 0: hit the sphere emitter lights[sphere_light]
+};
+
+// Per scene triangle, precomputed once so that shading a hit reads one record.
+struct TriangleShading {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // geometric, unit, front = CCW
+  int material = 0;                                   // index into materials
+  int emitter = -1;  // index in the emitter-material light's triangles, or -1
+  bool flat = true;  // vertex normals all equal the face normal: no interpolation
 };
 
 struct Renderer::Impl {
   const Scene* scene = nullptr;
   int lighting = -1;
-  std::vector<ShadingMaterial> materials;  // per scene material
-  std::vector<RenderLight> lights;         // emitters of the lighting
+  std::vector<ShadingMaterial> materials;   // per scene material
+  std::vector<RenderLight> lights;          // emitters of the lighting
   std::vector<int> area_light_of_geometry;  // geometry id -> index into lights (-1 for mesh)
   int emitter_material_light = -1;          // index into lights of the emitter-material set
   std::vector<int> emitter_triangle_index;  // scene triangle -> index in that set (or -1)
-  double ray_epsilon = 1e-4;                // self-intersection offset, metres
+  std::vector<TriangleShading> triangles;   // per scene triangle
+  std::vector<int> sphere_lights;           // indices into lights of the sphere emitters
+  std::vector<std::vector<Eigen::Vector3d>> area_normals;  // geometry id -> triangle normals
+  double ray_epsilon = 1e-4;                               // self-intersection offset, metres
   struct Embree;
   std::unique_ptr<Embree> embree;
 

@@ -83,6 +83,39 @@ void AddTriangle(TriangleEmitter* e, const Eigen::Vector3d& a, const Eigen::Vect
   e->cdf.push_back(e->total_area);
 }
 
+// Unit geometric normals in double precision (front = counter-clockwise).
+std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3d> normals(mesh.num_triangles());
+  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>();
+    normals[t] = (mesh.positions[tri[1]].cast<double>() - a)
+                     .cross(mesh.positions[tri[2]].cast<double>() - a)
+                     .normalized();
+  }
+  return normals;
+}
+
+// The per-triangle shading records of the scene mesh (after emitter_triangle_index is set).
+std::vector<TriangleShading> TriangleRecords(const Renderer::Impl& impl) {
+  const TriangleMesh& mesh = impl.scene->mesh;
+  const std::vector<Eigen::Vector3d> normals = FaceNormals(mesh);
+  std::vector<TriangleShading> records(mesh.num_triangles());
+  // Vertex normals this close to the face normal shade as the face itself (flat shading).
+  constexpr double kFlatTolerance = 1e-6;
+  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
+    TriangleShading& r = records[t];
+    r.normal = normals[t];
+    r.material = mesh.triangle_region[t];
+    r.emitter = impl.emitter_triangle_index[t];
+    for (int k = 0; k < 3 && mesh.has_normals(); ++k) {
+      const Eigen::Vector3d n = mesh.normals[mesh.triangles[t][k]].cast<double>();
+      if (!((n - r.normal).cwiseAbs().maxCoeff() <= kFlatTolerance)) r.flat = false;
+    }
+  }
+  return records;
+}
+
 }  // namespace
 
 std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lighting) {
@@ -99,6 +132,7 @@ std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lightin
   const TriangleMesh& mesh = scene.mesh;
   AttachTriangles(impl->embree->device, impl->embree->scene, mesh.positions, mesh.triangles);
   impl->area_light_of_geometry.push_back(-1);
+  impl->area_normals.emplace_back();
 
   // Scene extent sets the self-intersection offset.
   double extent = 1.0;
@@ -121,7 +155,9 @@ std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lightin
       }
       AttachTriangles(impl->embree->device, impl->embree->scene, lm.positions, lm.triangles);
       impl->area_light_of_geometry.push_back(static_cast<int>(impl->lights.size()));
+      impl->area_normals.push_back(FaceNormals(lm));
     }
+    if (light.type == LightType::kSphere) impl->sphere_lights.push_back(int(impl->lights.size()));
     impl->lights.push_back(std::move(rl));
   }
   // Triangles of "emitter" materials form one more light, sampled by area.
@@ -142,6 +178,7 @@ std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lightin
     impl->emitter_material_light = static_cast<int>(impl->lights.size());
     impl->lights.push_back(std::move(emitters));
   }
+  impl->triangles = TriangleRecords(*impl);
   if (impl->lights.empty()) {
     throw InputError(DescribeProblem(scene.file.string(),
                                      "lightings." + scene.lightings[lighting].name, "",
@@ -207,13 +244,12 @@ std::optional<Hit> Renderer::Impl::Intersect(const Eigen::Vector3d& origin,
     hit.v = rayhit.hit.v;
     found = true;
   }
-  for (size_t i = 0; i < lights.size(); ++i) {
-    if (lights[i].type != LightType::kSphere) continue;
+  for (int i : sphere_lights) {
     const double t = IntersectSphere(origin, dir, lights[i].light->center, lights[i].light->radius);
     if (t < t_max && (!found || t < hit.t)) {
       hit = Hit();
       hit.t = t;
-      hit.sphere_light = static_cast<int>(i);
+      hit.sphere_light = i;
       found = true;
     }
   }
@@ -223,12 +259,9 @@ std::optional<Hit> Renderer::Impl::Intersect(const Eigen::Vector3d& origin,
 
 bool Renderer::Impl::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                               double distance, int target) const {
-  for (size_t i = 0; i < lights.size(); ++i) {
-    const RenderLight& l = lights[i];
-    if (l.type == LightType::kSphere && int(i) != target &&
-        IntersectSphere(origin, dir, l.light->center, l.light->radius) < distance) {
-      return true;
-    }
+  for (int i : sphere_lights) {
+    const Light& l = *lights[i].light;
+    if (i != target && IntersectSphere(origin, dir, l.center, l.radius) < distance) return true;
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

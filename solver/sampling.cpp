@@ -103,7 +103,7 @@ SphereSample SampleSphereFromPoint(const Eigen::Vector3d& point, const Eigen::Ve
   const double one_minus_cos_max = sin2_max / (1.0 + cos_max);
   const Eigen::Vector3d local = DirectionFromOneMinusCos(u.x() * one_minus_cos_max, u.y());
   const Frame frame = Frame::FromNormal(to_center / std::sqrt(dist2));
-  sample.direction = frame.ToWorld(local).normalized();
+  sample.direction = frame.ToWorld(local);  // unit: an orthonormal frame and a unit local
   const double along = sample.direction.dot(to_center);
   const double perp2 = (to_center - along * sample.direction).squaredNorm();
   sample.distance = std::max(0.0, along - SafeSqrt(radius2 - perp2));
