@@ -2,6 +2,8 @@
 // naming the image and the rule, outputs written only when the input is good).
 #include <gtest/gtest.h>
 
+#include "tests/e2e/run.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -33,14 +35,8 @@ class HdrE2e : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   RunResult Run(const std::string& tool, const std::string& args) {
-    const fs::path log = dir_ / "log.txt";
-    const std::string command =
-        std::string(IGI_BIN_DIR) + "/" + tool + " " + args + " > " + log.string() + " 2>&1";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.output = ReadFileToString(log);
-    return r;
+    const test::RunResult r = test::RunTool(tool, args);
+    return {r.exit_code, r.out + r.err};
   }
 
   // Five Memorial frames (4 s .. 1/4 s) and their times.

@@ -6,6 +6,8 @@
 // - the merged radiance matches the truth radiance within 1 % (per brightness bin),
 // - the noise-aware merge has a lower per-pixel error than the hat-weighted one.
 #include <gtest/gtest.h>
+
+#include "tests/e2e/run.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -31,15 +33,9 @@ struct RunResult {
   std::string output;  // stdout and stderr
 };
 
-RunResult RunTool(const fs::path& dir, const std::string& tool, const std::string& args) {
-  const fs::path log = dir / "log.txt";
-  const std::string command =
-      std::string(IGI_BIN_DIR) + "/" + tool + " " + args + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  RunResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.output = ReadFileToString(log);
-  return r;
+RunResult RunTool(const fs::path& /*dir*/, const std::string& tool, const std::string& args) {
+  const test::RunResult r = test::RunTool(tool, args);
+  return {r.exit_code, r.out + r.err};
 }
 
 double Median(std::vector<double> v) {
