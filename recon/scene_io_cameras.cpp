@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "recon/colmap_model.h"
+#include "recon/registration.h"
 #include "recon/scene_loader.h"
 
 namespace igi {
@@ -68,21 +69,12 @@ void ReadColmapCameras(const SceneLoader& ld, const JsonCursor& c, Scene* scene)
     return;
   }
   for (const auto& [image_id, image] : model.images) {
-    const ColmapCamera& intr = model.cameras.at(image.camera_id);
-    auto converted = ConvertColmapCameraModel(intr.model, intr.params);
-    if (!converted) {
-      c.Problem("image " + image.name + ": COLMAP camera model " + intr.model +
-                " is not supported (use PINHOLE, OPENCV, SIMPLE_PINHOLE, SIMPLE_RADIAL, RADIAL)");
-      continue;
+    try {
+      scene->cameras.push_back(CameraOfImage(model, image));
+    } catch (const Error& e) {
+      c.Problem("image " + image.name + ": " + e.what() +
+                " (use PINHOLE, OPENCV, SIMPLE_PINHOLE, SIMPLE_RADIAL, RADIAL)");
     }
-    Camera cam;
-    cam.name = image.name;
-    cam.model = converted->first;
-    cam.params = converted->second;
-    cam.width = intr.width;
-    cam.height = intr.height;
-    cam.cam_from_world = Rigid3d(QuaternionFromQvec(image.qvec).normalized(), image.tvec);
-    scene->cameras.push_back(std::move(cam));
   }
 }
 
