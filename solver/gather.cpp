@@ -1,1 +1,151 @@
-// placeholder
+#include "solver/gather.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "solver/brdf.h"
+#include "solver/sampling.h"
+#include "solver/surface_hit.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+namespace {
+
+struct PointSamples {
+  GatherPoint point;
+  std::vector<DirectSample> direct;
+  std::vector<IndirectSample> indirect;
+  uint64_t rays = 0;
+};
+
+void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples,
+                  Pcg32& rng, PointSamples* out) {
+  const double eps = scene.ray_epsilon;
+  for (int l = 0; l < static_cast<int>(scene.lights.size()); ++l) {
+    const LightType type = scene.lights[l].type;
+    const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
+                       type == LightType::kDirectional;
+    const int k = delta ? 1 : light_samples;
+    const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
+    for (int s = 0; s < k; ++s) {
+      // Stratified over a side×side grid for the first side² samples, random after.
+      Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
+      if (s < side * side) {
+        u.x() = ((s % side) + u.x()) / side;
+        u.y() = ((s / side) + u.y()) / side;
+      }
+      const LightSample ls = scene.SampleLight(l, q.position, u);
+      if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0)) continue;
+      const double cos_geo = ls.wi.dot(q.n_geo), cos_s = ls.wi.dot(q.n_s);
+      if (!(cos_geo > 0) || !(cos_s > 0)) continue;
+      const double distance = std::isfinite(ls.distance)
+                                  ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
+                                  : ls.distance;
+      ++out->rays;
+      if (scene.Occluded(q.position + q.n_geo * eps, ls.wi, distance, l)) continue;
+      DirectSample d;
+      d.wi = ls.wi.cast<float>();
+      d.value = (ls.value * (cos_s / (ls.pdf * k))).cast<float>();
+      out->point.e_direct += d.value;
+      out->direct.push_back(d);
+    }
+  }
+}
+
+void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const GatherQuery& q,
+                    const GatherOptions& options, Pcg32& rng, PointSamples* out) {
+  const double eps = scene.ray_epsilon;
+  for (const WeightedDirection& d : HemisphereDirections(q, options.indirect_rays, options.lobe_alpha, rng)) {
+    IndirectSample is;
+    is.wi = d.wi.cast<float>();
+    is.weight = static_cast<float>(d.weight);
+    ++out->rays;
+    const std::optional<SurfaceHit> hit = TraceSurface(scene, q.position + q.n_geo * eps, d.wi);
+    if (hit && IsReflective(scene.scene->materials[hit->region].brdf)) {
+      is.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
+    }
+    out->indirect.push_back(is);
+  }
+}
+
+}  // namespace
+
+std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
+                                                    Pcg32& rng) {
+  std::vector<WeightedDirection> out;
+  if (n <= 0) return out;
+  const Frame frame = Frame::FromNormal(q.n_s);
+  const bool lobe = q.lobe && q.view.squaredNorm() > 0;
+  BrdfParams spec;
+  spec.model = BrdfModel::kWard;
+  spec.rho_s = Eigen::Vector3d::Ones();
+  spec.alpha = lobe_alpha;
+  const Eigen::Vector3d wo = lobe ? frame.ToLocal(q.view) : Eigen::Vector3d::UnitZ();
+  const int n_cos = lobe ? (n + 1) / 2 : n;
+  const int side = std::max(1, static_cast<int>(std::sqrt(double(n_cos))));
+  out.reserve(n);
+  for (int s = 0; s < n; ++s) {
+    Eigen::Vector2d u = rng.Uniform2D();
+    Eigen::Vector3d wi_local;
+    if (s < n_cos) {
+      if (s < side * side) {
+        u = Eigen::Vector2d(((s % side) + u.x()) / side, ((s / side) + u.y()) / side);
+      }
+      wi_local = SampleCosineHemisphere(u);
+    } else {
+      const BrdfSample bs = SampleBrdf(spec, wo, 0.5, u);
+      if (!bs.Valid()) continue;
+      wi_local = bs.wi;
+    }
+    if (!(wi_local.z() > 0)) continue;
+    double pdf = CosineHemispherePdf(wi_local.z());
+    if (lobe) pdf = 0.5 * pdf + 0.5 * BrdfPdf(spec, wo, wi_local);
+    const Eigen::Vector3d wi = frame.ToWorld(wi_local);
+    if (!(wi.dot(q.n_geo) > 0) || !(pdf > 0)) continue;
+    out.push_back({wi, wi_local.z() / (pdf * n)});
+  }
+  return out;
+}
+
+GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
+                 const std::vector<GatherQuery>& queries, const GatherOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const int64_t n = static_cast<int64_t>(queries.size());
+  constexpr int64_t kChunk = 256;
+  const int64_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<PointSamples>> results(chunks);
+  ParallelFor(
+      0, chunks,
+      [&](int64_t c) {
+        std::vector<PointSamples>& chunk = results[c];
+        for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+          Pcg32 rng = PixelSampleRng(options.seed, uint64_t(i), 0x5eed);
+          PointSamples ps;
+          GatherDirect(scene, queries[i], options.light_samples, rng, &ps);
+          GatherIndirect(scene, patches, queries[i], options, rng, &ps);
+          chunk.push_back(std::move(ps));
+        }
+      },
+      options.num_threads);
+  GatherSet set;
+  set.points.reserve(n);
+  for (auto& chunk : results) {
+    for (PointSamples& ps : chunk) {
+      GatherPoint p = ps.point;
+      p.direct_begin = static_cast<int>(set.direct.size());
+      set.direct.insert(set.direct.end(), ps.direct.begin(), ps.direct.end());
+      p.direct_end = static_cast<int>(set.direct.size());
+      p.indirect_begin = static_cast<int>(set.indirect.size());
+      set.indirect.insert(set.indirect.end(), ps.indirect.begin(), ps.indirect.end());
+      p.indirect_end = static_cast<int>(set.indirect.size());
+      set.points.push_back(p);
+      set.rays += ps.rays;
+    }
+    std::vector<PointSamples>().swap(chunk);
+  }
+  set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return set;
+}
+
+}  // namespace igi

@@ -1,1 +1,160 @@
-// placeholder
+#include "solver/observations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "solver/patches.h"
+#include "solver/surface_hit.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+
+std::optional<SurfaceHit> TraceSurface(const Renderer::Impl& scene, const Eigen::Vector3d& origin,
+                                       const Eigen::Vector3d& dir) {
+  const std::optional<Hit> hit = scene.Intersect(origin, dir);
+  if (!hit || hit->geometry != 0 || hit->sphere_light >= 0) return std::nullopt;
+  const TriangleMesh& mesh = scene.scene->mesh;
+  SurfaceHit s;
+  s.triangle = hit->primitive;
+  s.b1 = hit->u;
+  s.b2 = hit->v;
+  s.t = hit->t;
+  s.position = origin + hit->t * dir;
+  const TriangleShading& ts = scene.triangles[s.triangle];
+  s.region = ts.material;
+  s.n_geo = ts.normal;
+  s.n_s = s.n_geo;
+  if (!ts.flat) {
+    const Eigen::Vector3i& tri = mesh.triangles[s.triangle];
+    const double b0 = 1.0 - s.b1 - s.b2;
+    s.n_s = (b0 * mesh.normals[tri[0]] + s.b1 * mesh.normals[tri[1]] + s.b2 * mesh.normals[tri[2]])
+                .cast<double>()
+                .normalized();
+  }
+  s.front = s.n_geo.dot(dir) < 0;
+  if (!s.front) {
+    s.n_geo = -s.n_geo;
+    s.n_s = -s.n_s;
+  }
+  if (!(s.n_s.dot(-dir) > 0)) s.n_s = s.n_geo;
+  return s;
+}
+
+double AutoSaturation(const Image& image) {
+  float max_value = 0;
+  for (float v : image.pixels) {
+    if (std::isfinite(v)) max_value = std::max(max_value, v);
+  }
+  if (!(max_value > 0)) return std::numeric_limits<double>::infinity();
+  int at_max = 0;
+  for (int i = 0; i < image.width * image.height; ++i) {
+    for (int c = 0; c < image.channels; ++c) {
+      if (image.pixels[size_t(i) * image.channels + c] == max_value) {
+        ++at_max;
+        break;
+      }
+    }
+  }
+  return at_max >= 3 ? double(max_value) : std::numeric_limits<double>::infinity();
+}
+
+std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
+                                             const Image& radiance, const Image* mask,
+                                             const Renderer::Impl& geometry,
+                                             const PatchSet& patches,
+                                             const ObservationOptions& options,
+                                             PhotoObservationStats* stats) {
+  const Photo& photo = scene.photos[photo_index];
+  const Camera& camera = scene.cameras[photo.camera];
+  const double saturation =
+      options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
+  const Eigen::Vector3d center = camera.CenterInWorld();
+  const int stride = options.pixel_stride;
+  const int rows = (camera.height + stride - 1) / stride;
+  std::vector<std::vector<Observation>> per_row(rows);
+  std::vector<PhotoObservationStats> row_stats(rows);
+  const double cos_edge = std::cos(10.0 * kPi / 180.0);
+  ParallelFor(
+      0, rows,
+      [&](int64_t r) {
+        const int y = int(r) * stride;
+        PhotoObservationStats& st = row_stats[r];
+        for (int x = stride / 2; x < camera.width; x += stride) {
+          const int yy = std::min(y + stride / 2, camera.height - 1);
+          ++st.pixels;
+          if (mask != nullptr && !(mask->at(x, yy, 0) > 0)) {
+            ++st.masked;
+            continue;
+          }
+          Eigen::Vector3f value;
+          bool finite = true, clipped = false;
+          for (int c = 0; c < 3; ++c) {
+            const float v = radiance.at(x, yy, std::min(c, radiance.channels - 1));
+            value[c] = v;
+            if (!std::isfinite(v) || v < 0) finite = false;
+            if (v >= saturation) clipped = true;
+          }
+          if (!finite) {
+            ++st.invalid;
+            continue;
+          }
+          if (clipped) {
+            ++st.clipped;
+            continue;
+          }
+          const Eigen::Vector3d dir = camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, yy + 0.5));
+          const std::optional<SurfaceHit> hit = TraceSurface(geometry, center, dir);
+          if (!hit || !IsReflective(scene.materials[hit->region].brdf)) {
+            ++st.background;
+            continue;
+          }
+          // The pixel's footprint must lie on one smooth piece of one region.
+          bool clean = true;
+          for (int k = 0; k < 4 && clean; ++k) {
+            const double ox = (k & 1) ? 0.75 : 0.25, oy = (k & 2) ? 0.75 : 0.25;
+            const Eigen::Vector3d d = camera.WorldRayFromImg(Eigen::Vector2d(x + ox, yy + oy));
+            const std::optional<SurfaceHit> h = TraceSurface(geometry, center, d);
+            clean = h && h->region == hit->region && h->n_s.dot(hit->n_s) > cos_edge &&
+                    std::abs(hit->n_geo.dot(h->position - hit->position)) < 0.01 * hit->t;
+          }
+          if (!clean) {
+            ++st.edge;
+            continue;
+          }
+          Observation o;
+          o.photo = photo_index;
+          o.x = x;
+          o.y = yy;
+          o.triangle = hit->triangle;
+          o.b1 = float(hit->b1);
+          o.b2 = float(hit->b2);
+          o.region = hit->region;
+          o.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
+          o.position = hit->position.cast<float>();
+          o.normal = hit->n_s.cast<float>();
+          o.view = (-dir).cast<float>();
+          o.radiance = value;
+          per_row[r].push_back(o);
+          ++st.valid;
+        }
+      },
+      options.num_threads);
+  std::vector<Observation> out;
+  PhotoObservationStats total;
+  total.saturation = saturation;
+  for (int r = 0; r < rows; ++r) {
+    out.insert(out.end(), per_row[r].begin(), per_row[r].end());
+    total.pixels += row_stats[r].pixels;
+    total.valid += row_stats[r].valid;
+    total.masked += row_stats[r].masked;
+    total.clipped += row_stats[r].clipped;
+    total.invalid += row_stats[r].invalid;
+    total.background += row_stats[r].background;
+    total.edge += row_stats[r].edge;
+  }
+  if (stats != nullptr) *stats = total;
+  return out;
+}
+
+}  // namespace igi

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "recon/scene.h"
+#include "solver/render.h"
 #include "tools/common/image.h"
 
 namespace igi {
@@ -29,5 +30,37 @@ struct Observation {
   Eigen::Vector3f view = Eigen::Vector3f::UnitZ();     // unit, from the surface toward the camera
   Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // the photo's pixel, linear RGB
 };
+
+struct PatchSet;
+
+struct ObservationOptions {
+  int pixel_stride = 2;   // every stride-th pixel in x and y
+  double saturation = 0;  // values >= this are clipped; 0 = auto (see AutoSaturation)
+  int num_threads = 0;
+};
+
+// What became of a photo's pixels.
+struct PhotoObservationStats {
+  int pixels = 0;      // looked at (after the stride)
+  int valid = 0;       // kept as observations
+  int masked = 0;      // mask = 0
+  int clipped = 0;     // a channel at or above the saturation value
+  int invalid = 0;     // a channel non-finite or negative
+  int background = 0;  // sees no reflective surface (nothing, a light, an emitter or black)
+  int edge = 0;        // footprint straddles regions, creases or depth steps
+  double saturation = 0;  // the clipping value used (infinity: none)
+};
+
+// The clipping value of a photo: its maximum when 3 or more pixels share it exactly (a sensor's
+// clipped highlight), else infinity.
+double AutoSaturation(const Image& image);
+
+// The observations of photo `photo` (its linear radiance image and optional mask, 0 = ignore),
+// traced through `geometry`, the Embree scene of the photo's lighting (solver/render_internal.h).
+std::vector<Observation> CollectObservations(const Scene& scene, int photo, const Image& radiance,
+                                             const Image* mask, const Renderer::Impl& geometry,
+                                             const PatchSet& patches,
+                                             const ObservationOptions& options,
+                                             PhotoObservationStats* stats);
 
 }  // namespace igi

@@ -1,1 +1,480 @@
-// placeholder
+#include "solver/region_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solver/brdf.h"
+
+namespace igi {
+
+double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
+                      const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  double s = SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
+  if (HasFresnel(model) && s > 0) s *= FresnelWeight<double>(ior, wo, wi);
+  return s;
+}
+
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+struct Prepared {
+  std::vector<Eigen::Vector3d> w;  // residual weights per sample and channel
+  std::vector<Eigen::Vector3d> a;  // E/π
+};
+
+Prepared Prepare(const RegionFitInput& in) {
+  Prepared p;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const FitSample& s : in.samples) mean += s.observed.cwiseMax(0.0);
+  mean /= std::max<size_t>(1, in.samples.size());
+  for (const FitSample& s : in.samples) {
+    Eigen::Vector3d w;
+    for (int c = 0; c < 3; ++c) w[c] = 1.0 / (std::max(s.observed[c], 0.0) + 0.1 * mean[c] + 1e-12);
+    p.w.push_back(w);
+    p.a.push_back(s.irradiance / kPi);
+  }
+  return p;
+}
+
+// T_c(α) for every sample.
+std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, double ay) {
+  std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
+  if (!HasSpecularLobe(in.model)) return t;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    const Eigen::Vector3d wo = s.wo.cast<double>();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = s.incident_begin; k < s.incident_end; ++k) {
+      const IncidentLocal& inc = in.incident[k];
+      const double sw = SpecularWeight(in.model, ax, ay, in.ior, wo, inc.wi.cast<double>());
+      if (sw > 0) sum += sw * inc.value.cast<double>();
+    }
+    t[i] = sum;
+  }
+  return t;
+}
+
+// The linear part for given specular terms: ρs and per-slot ρd by least squares.
+struct LinearSolution {
+  double cost = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> slot_rho_d;
+  double sum_v2 = 0;  // Σ v² of the projected specular column (grey), for ρs's variance
+};
+
+LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
+                           const std::vector<Eigen::Vector3d>& t, bool per_patch) {
+  const int slots = per_patch ? in.num_slots : 1;
+  std::vector<Eigen::Vector3d> A(slots, Eigen::Vector3d::Zero()), B = A, C = A;
+  const size_t n = in.samples.size();
+  auto slot_of = [&](size_t i) { return per_patch ? in.samples[i].slot : 0; };
+  if (in.fit_rho_d) {
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+      const int s = slot_of(i);
+      A[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+      B[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed);
+      C[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(t[i]);
+    }
+  }
+  std::vector<Eigen::Vector3d> u(n), v(n);
+  for (size_t i = 0; i < n; ++i) {
+    const FitSample& smp = in.samples[i];
+    for (int c = 0; c < 3; ++c) {
+      const double w = pr.w[i][c], a = pr.a[i][c];
+      if (in.fit_rho_d) {
+        const int s = slot_of(i);
+        const double ratio_b = A[s][c] > 0 ? B[s][c] / A[s][c] : 0.0;
+        const double ratio_c = A[s][c] > 0 ? C[s][c] / A[s][c] : 0.0;
+        u[i][c] = w * (smp.observed[c] - a * ratio_b);
+        v[i][c] = w * (t[i][c] - a * ratio_c);
+      } else {
+        u[i][c] = w * (smp.observed[c] - smp.rho_d_known[c] * a);
+        v[i][c] = w * t[i][c];
+      }
+    }
+  }
+  LinearSolution sol;
+  const bool spec = HasSpecularLobe(in.model);
+  if (spec && (in.rho_s_grey || in.rho_s_rgb)) {
+    sol.rho_s = in.rho_s_rgb ? *in.rho_s_rgb : Eigen::Vector3d::Constant(*in.rho_s_grey);
+  } else if (spec && in.grey_specular) {
+    double uv = 0, vv = 0;
+    for (size_t i = 0; i < n; ++i) {
+      uv += u[i].dot(v[i]);
+      vv += v[i].squaredNorm();
+    }
+    sol.rho_s.setConstant(vv > 0 ? std::max(0.0, uv / vv) : 0.0);
+    sol.sum_v2 = vv;
+  } else if (spec) {
+    for (int c = 0; c < 3; ++c) {
+      double uv = 0, vv = 0;
+      for (size_t i = 0; i < n; ++i) {
+        uv += u[i][c] * v[i][c];
+        vv += v[i][c] * v[i][c];
+      }
+      sol.rho_s[c] = vv > 0 ? std::max(0.0, uv / vv) : 0.0;
+      sol.sum_v2 += vv / 3;
+    }
+  }
+  sol.cost = 0;
+  for (size_t i = 0; i < n; ++i) sol.cost += (u[i] - v[i].cwiseProduct(sol.rho_s)).squaredNorm();
+  sol.slot_rho_d.assign(slots, Eigen::Vector3d::Constant(kNan));
+  if (in.fit_rho_d) {
+    for (int s = 0; s < slots; ++s) {
+      for (int c = 0; c < 3; ++c) {
+        if (A[s][c] > 0) sol.slot_rho_d[s][c] = std::max(0.0, (B[s][c] - sol.rho_s[c] * C[s][c]) / A[s][c]);
+      }
+    }
+  }
+  return sol;
+}
+
+struct AlphaSearch {
+  double ax = 0.1, ay = 0.1;
+  LinearSolution linear;
+  double curvature_log_alpha = kNan;  // d²cost/d(log α)² at the minimum (isotropic)
+};
+
+// Minimises the projected cost over α (or αx, αy).
+AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch) {
+  AlphaSearch best;
+  const bool aniso = IsAnisotropic(in.model);
+  auto eval = [&](double ax, double ay) {
+    return SolveLinear(in, pr, SpecularTerms(in, ax, ay), per_patch);
+  };
+  if (!HasSpecularLobe(in.model)) {
+    best.linear = eval(0.1, 0.1);
+    return best;
+  }
+  const std::optional<double> known_x = aniso ? in.alpha_x : in.alpha;
+  const std::optional<double> known_y = aniso ? in.alpha_y : in.alpha;
+  const double lo = std::log(0.005), hi = std::log(1.0);
+  auto golden = [&](double a, double b, auto&& f) {
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    double fc = f(c), fd = f(d);
+    for (int it = 0; it < 24; ++it) {
+      if (fc < fd) {
+        b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
+      } else {
+        a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
+      }
+    }
+    return fc < fd ? c : d;
+  };
+  if (!aniso) {
+    if (known_x) {
+      best.ax = best.ay = *known_x;
+      best.linear = eval(best.ax, best.ay);
+      return best;
+    }
+    constexpr int kGrid = 28;
+    double best_cost = std::numeric_limits<double>::infinity();
+    int best_i = 0;
+    for (int i = 0; i < kGrid; ++i) {
+      const double la = lo + (hi - lo) * i / (kGrid - 1);
+      const double c = eval(std::exp(la), std::exp(la)).cost;
+      if (c < best_cost) best_cost = c, best_i = i;
+    }
+    const double step = (hi - lo) / (kGrid - 1);
+    const double a = lo + step * std::max(0, best_i - 1), b = lo + step * std::min(kGrid - 1, best_i + 1);
+    const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
+    best.ax = best.ay = std::exp(la);
+    best.linear = eval(best.ax, best.ay);
+    const double h = 0.02;
+    const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
+    const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
+    best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
+    return best;
+  }
+  // Anisotropic: a coarse grid, then alternating golden sections.
+  double bx = known_x.value_or(0.1), by = known_y.value_or(0.1);
+  if (!known_x || !known_y) {
+    constexpr int kGrid = 12;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < kGrid; ++i) {
+      for (int j = 0; j < kGrid; ++j) {
+        const double x = known_x ? *known_x : std::exp(lo + (hi - lo) * i / (kGrid - 1));
+        const double y = known_y ? *known_y : std::exp(lo + (hi - lo) * j / (kGrid - 1));
+        const double c = eval(x, y).cost;
+        if (c < best_cost) best_cost = c, bx = x, by = y;
+      }
+    }
+    for (int round = 0; round < 3; ++round) {
+      const double w = (hi - lo) / 11.0 / (round + 1);
+      if (!known_x) {
+        bx = std::exp(golden(std::log(bx) - w, std::log(bx) + w,
+                             [&](double x) { return eval(std::exp(x), by).cost; }));
+      }
+      if (!known_y) {
+        by = std::exp(golden(std::log(by) - w, std::log(by) + w,
+                             [&](double y) { return eval(bx, std::exp(y)).cost; }));
+      }
+    }
+  }
+  best.ax = bx;
+  best.ay = by;
+  best.linear = eval(bx, by);
+  return best;
+}
+
+// Ceres residual of one sample for the constant-albedo model; parameter blocks in the order
+// ρd (3, if fitted), ρs (1 or 3, if fitted), α (1 or 2, if fitted).
+struct SampleResidual {
+  const RegionFitInput* in = nullptr;
+  const FitSample* s = nullptr;
+  Eigen::Vector3d w, a;
+  int block_d = -1, block_s = -1, block_a = -1;
+  Eigen::Vector3d rho_d_fixed, rho_s_fixed;
+  double ax_fixed = 0.1, ay_fixed = 0.1;
+  std::vector<double> fresnel;  // per incident sample (1 without Fresnel)
+
+  template <typename T>
+  bool operator()(T const* const* p, T* residual) const {
+    using V3 = Eigen::Matrix<T, 3, 1>;
+    V3 rho_d = rho_d_fixed.cast<T>(), rho_s = rho_s_fixed.cast<T>();
+    if (block_d >= 0) rho_d = V3(p[block_d][0], p[block_d][1], p[block_d][2]);
+    if (block_s >= 0) {
+      rho_s = in->grey_specular ? V3(p[block_s][0], p[block_s][0], p[block_s][0])
+                                : V3(p[block_s][0], p[block_s][1], p[block_s][2]);
+    }
+    T ax = T(ax_fixed), ay = T(ay_fixed);
+    if (block_a >= 0) {
+      ax = p[block_a][0];
+      ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
+    }
+    V3 t = V3::Zero();
+    const V3 wo = s->wo.cast<double>().cast<T>();
+    for (int k = s->incident_begin; k < s->incident_end; ++k) {
+      const IncidentLocal& inc = in->incident[k];
+      const V3 wi = inc.wi.cast<double>().cast<T>();
+      const T sf = SpecularFactor<T>(in->model, ax, ay, wo, wi) * fresnel[k - s->incident_begin];
+      t += inc.value.cast<double>().cast<T>() * sf;
+    }
+    for (int c = 0; c < 3; ++c) {
+      residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
+    }
+    return true;
+  }
+};
+
+struct Polish {
+  bool ok = false;
+  std::string message;
+  Eigen::Vector3d rho_d, sigma_rho_d = Eigen::Vector3d::Constant(kNan);
+  Eigen::Vector3d rho_s;
+  double ax = 0, ay = 0, sigma_rho_s = kNan, sigma_ax = kNan, sigma_ay = kNan;
+};
+
+Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaSearch& start,
+                      const RegionFitOptions& options) {
+  Polish out;
+  const bool spec = HasSpecularLobe(in.model);
+  const bool aniso = IsAnisotropic(in.model);
+  const bool fit_s = spec && !in.rho_s_grey && !in.rho_s_rgb;
+  const bool fit_a = spec && !(aniso ? (in.alpha_x && in.alpha_y) : bool(in.alpha));
+  out.rho_d = start.linear.slot_rho_d.empty() ? Eigen::Vector3d::Zero() : start.linear.slot_rho_d[0];
+  out.rho_s = start.linear.rho_s;
+  out.ax = start.ax;
+  out.ay = start.ay;
+  if (!in.fit_rho_d && !fit_s && !fit_a) return out;
+  double d[3] = {out.rho_d[0], out.rho_d[1], out.rho_d[2]};
+  double rs[3] = {out.rho_s[0], out.rho_s[1], out.rho_s[2]};
+  double al[2] = {out.ax, out.ay};
+  std::vector<double*> blocks;
+  int block_d = -1, block_s = -1, block_a = -1;
+  const int ns = in.grey_specular ? 1 : 3, na = aniso ? 2 : 1;
+  ceres::Problem problem;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    auto* r = new SampleResidual;
+    r->in = &in;
+    r->s = &in.samples[i];
+    r->w = pr.w[i];
+    r->a = pr.a[i];
+    r->rho_d_fixed = in.samples[i].rho_d_known;
+    r->rho_s_fixed = out.rho_s;
+    r->ax_fixed = out.ax;
+    r->ay_fixed = out.ay;
+    for (int k = r->s->incident_begin; k < r->s->incident_end; ++k) {
+      r->fresnel.push_back(HasFresnel(in.model)
+                               ? FresnelWeight<double>(in.ior, r->s->wo.cast<double>(),
+                                                       in.incident[k].wi.cast<double>())
+                               : 1.0);
+    }
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<SampleResidual, 8>(r);
+    blocks.clear();
+    int b = 0;
+    if (in.fit_rho_d) cost->AddParameterBlock(3), blocks.push_back(d), r->block_d = b++;
+    if (fit_s) cost->AddParameterBlock(ns), blocks.push_back(rs), r->block_s = b++;
+    if (fit_a) cost->AddParameterBlock(na), blocks.push_back(al), r->block_a = b++;
+    block_d = r->block_d, block_s = r->block_s, block_a = r->block_a;
+    cost->SetNumResiduals(3);
+    problem.AddResidualBlock(cost, nullptr, blocks);
+  }
+  if (in.fit_rho_d) {
+    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(d, c, 0.0);
+  }
+  if (fit_s) {
+    for (int c = 0; c < ns; ++c) problem.SetParameterLowerBound(rs, c, 0.0);
+  }
+  if (fit_a) {
+    for (int c = 0; c < na; ++c) {
+      problem.SetParameterLowerBound(al, c, 0.002);
+      problem.SetParameterUpperBound(al, c, 2.0);
+    }
+  }
+  ceres::Solver::Options so;
+  so.max_num_iterations = options.max_polish_iterations;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.num_threads = std::max(1, options.num_threads);
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  out.ok = summary.IsSolutionUsable();
+  out.message = summary.message;
+  if (!out.ok) return out;
+  if (in.fit_rho_d) out.rho_d = Eigen::Vector3d(d[0], d[1], d[2]);
+  if (fit_s) out.rho_s = in.grey_specular ? Eigen::Vector3d::Constant(rs[0]) : Eigen::Vector3d(rs[0], rs[1], rs[2]);
+  if (fit_a) out.ax = al[0], out.ay = aniso ? al[1] : al[0];
+  // Covariance scaled by the residual variance (the weights are relative, not true sigmas).
+  const int k = (in.fit_rho_d ? 3 : 0) + (fit_s ? ns : 0) + (fit_a ? na : 0);
+  const double dof = std::max(1.0, 3.0 * in.samples.size() - k);
+  const double s2 = 2.0 * summary.final_cost / dof;
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  ceres::Covariance cov(co);
+  std::vector<const double*> params;
+  if (in.fit_rho_d) params.push_back(d);
+  if (fit_s) params.push_back(rs);
+  if (fit_a) params.push_back(al);
+  if (cov.Compute(params, &problem)) {
+    std::vector<double> m(size_t(k) * k);
+    if (cov.GetCovarianceMatrixInTangentSpace(params, m.data())) {
+      int o = 0;
+      auto sd = [&](int i) { return std::sqrt(std::max(0.0, m[size_t(i) * k + i] * s2)); };
+      if (in.fit_rho_d) out.sigma_rho_d = Eigen::Vector3d(sd(0), sd(1), sd(2)), o = 3;
+      if (fit_s) out.sigma_rho_s = sd(o), o += ns;
+      if (fit_a) out.sigma_ax = sd(o), out.sigma_ay = aniso ? sd(o + 1) : sd(o);
+    }
+  }
+  (void)block_d, (void)block_s, (void)block_a;
+  return out;
+}
+
+double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>& t,
+                   const std::vector<Eigen::Vector3d>& slot_rho_d, const Eigen::Vector3d& rho_s,
+                   bool per_patch) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    Eigen::Vector3d rd = in.fit_rho_d ? slot_rho_d[per_patch ? s.slot : 0] : s.rho_d_known;
+    if (!rd.allFinite()) continue;
+    const Eigen::Vector3d pred = rd.cwiseProduct(s.irradiance) / kPi + rho_s.cwiseProduct(t[i]);
+    num += (pred - s.observed).squaredNorm();
+    den += s.observed.squaredNorm();
+  }
+  return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+// Whether the per-patch albedos vary beyond their noise: the area-weighted spread of the
+// slots' mean albedo must exceed 3 % of the mean and three times the spread noise alone gives.
+bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolution& b,
+                  const std::vector<Eigen::Vector3d>& t, std::vector<int>* counts) {
+  const int slots = in.num_slots;
+  counts->assign(slots, 0);
+  std::vector<double> info(slots, 0.0);
+  double rss = 0;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    ++(*counts)[s.slot];
+    for (int c = 0; c < 3; ++c) info[s.slot] += std::pow(pr.w[i][c] * pr.a[i][c], 2) / 3;
+    const Eigen::Vector3d pred = b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
+    if (pred.allFinite()) rss += (pr.w[i].cwiseProduct(pred - s.observed)).squaredNorm();
+  }
+  int used = 0;
+  for (int s = 0; s < slots; ++s) used += (*counts)[s] > 0;
+  const double s2 = rss / std::max(1.0, 3.0 * in.samples.size() - 3.0 * used - 2);
+  double wsum = 0, mean = 0;
+  for (int s = 0; s < slots; ++s) {
+    if ((*counts)[s] < 3) continue;
+    wsum += in.slot_area[s];
+    mean += in.slot_area[s] * b.slot_rho_d[s].mean();
+  }
+  if (!(wsum > 0)) return false;
+  mean /= wsum;
+  double var = 0, noise = 0;
+  for (int s = 0; s < slots; ++s) {
+    if ((*counts)[s] < 3) continue;
+    var += in.slot_area[s] * std::pow(b.slot_rho_d[s].mean() - mean, 2);
+    noise += in.slot_area[s] * (info[s] > 0 ? s2 / info[s] / 3 : 0.0);
+  }
+  var /= wsum;
+  noise /= wsum;
+  return var > std::pow(0.03 * mean, 2) && var > 3 * noise;
+}
+
+}  // namespace
+
+RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
+  RegionFitResult r;
+  r.samples = static_cast<int>(in.samples.size());
+  if (in.samples.empty()) {
+    r.message = "no observation";
+    return r;
+  }
+  r.fitted = true;
+  const Prepared pr = Prepare(in);
+  const AlphaSearch a = SearchAlpha(in, pr, false);
+  const Polish pa = PolishConstant(in, pr, a, options);
+  r.rho_d = pa.rho_d;
+  r.rho_s = pa.rho_s;
+  r.alpha = r.alpha_x = pa.ax;
+  r.alpha_y = pa.ay;
+  r.sigma_rho_d = pa.sigma_rho_d;
+  r.sigma_rho_s = pa.sigma_rho_s;
+  r.sigma_alpha = r.sigma_alpha_x = pa.sigma_ax;
+  r.sigma_alpha_y = pa.sigma_ay;
+  if (!pa.ok && !pa.message.empty()) r.message = "Ceres: " + pa.message;
+  r.slot_rho_d.assign(in.num_slots, in.fit_rho_d ? r.rho_d : Eigen::Vector3d::Constant(kNan));
+  r.slot_count.assign(in.num_slots, 0);
+  for (const FitSample& s : in.samples) ++r.slot_count[s.slot];
+  std::vector<Eigen::Vector3d> t = SpecularTerms(in, r.alpha_x, r.alpha_y);
+  r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
+  if (!in.fit_rho_d || in.num_slots <= 1) return r;
+  const AlphaSearch b = SearchAlpha(in, pr, true);
+  const std::vector<Eigen::Vector3d> tb = SpecularTerms(in, b.ax, b.ay);
+  std::vector<int> counts;
+  r.albedo_varies = AlbedoVaries(in, pr, b.linear, tb, &counts);
+  if (!r.albedo_varies) return r;
+  r.albedo_model = "per_patch";
+  r.rho_s = b.linear.rho_s;
+  r.alpha = r.alpha_x = b.ax;
+  r.alpha_y = b.ay;
+  r.slot_rho_d = b.linear.slot_rho_d;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double wsum = 0;
+  for (int s = 0; s < in.num_slots; ++s) {
+    if (counts[s] == 0 || !r.slot_rho_d[s].allFinite()) continue;
+    mean += in.slot_area[s] * r.slot_rho_d[s];
+    wsum += in.slot_area[s];
+  }
+  if (wsum > 0) r.rho_d = mean / wsum;
+  // Uncertainties from the projected problem: ρs from its normal equation, α from the
+  // curvature of the profile cost in log α.
+  const double dof = std::max(1.0, 3.0 * in.samples.size() - 3.0 * in.num_slots - 2);
+  const double s2 = b.linear.cost / dof;
+  r.sigma_rho_s = b.linear.sum_v2 > 0 ? std::sqrt(s2 / b.linear.sum_v2) : kNan;
+  r.sigma_alpha = r.sigma_alpha_x = r.sigma_alpha_y =
+      b.curvature_log_alpha > 0 ? r.alpha * std::sqrt(2 * s2 / b.curvature_log_alpha) : kNan;
+  r.sigma_rho_d = Eigen::Vector3d::Constant(kNan);
+  r.relative_rms = RelativeRms(in, tb, r.slot_rho_d, r.rho_s, true);
+  return r;
+}
+
+}  // namespace igi

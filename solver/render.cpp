@@ -13,10 +13,7 @@
 #include "tools/common/progress.h"
 
 namespace igi {
-namespace {
 
-// Texture lookup: bilinear, u right and v up (v = 0 is the bottom row); coordinates outside
-// [0, 1] repeat, texels at the borders clamp.
 Eigen::Vector3d SampleTexture(const Image& tex, Eigen::Vector2d uv) {
   for (int k = 0; k < 2; ++k) {
     if (uv[k] < 0.0 || uv[k] > 1.0) uv[k] -= std::floor(uv[k]);
@@ -34,6 +31,8 @@ Eigen::Vector3d SampleTexture(const Image& tex, Eigen::Vector2d uv) {
          fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
 }
 
+namespace {
+
 struct PathState {
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
   Eigen::Vector3d throughput = Eigen::Vector3d::Ones();
@@ -50,8 +49,10 @@ class PathTracer {
         options_(options),
         light_select_pdf_(impl.lights.empty() ? 0.0 : 1.0 / double(impl.lights.size())) {}
 
-  Eigen::Vector3d Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
-                        uint64_t* rays) const;
+  // Radiance arriving along the ray. reflected_only: leave out the emission of what the ray
+  // meets first (lights, emitters), i.e. only light reflected by the first surface.
+  Eigen::Vector3d Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng, uint64_t* rays,
+                        bool reflected_only = false) const;
 
  private:
   // Adds an emitter's radiance seen along the path, MIS-weighted against light sampling.
@@ -103,7 +104,7 @@ void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
 }
 
 Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
-                                  uint64_t* rays) const {
+                                  uint64_t* rays, bool reflected_only) const {
   const Scene& scene = *impl_.scene;
   const TriangleMesh& mesh = scene.mesh;
   PathState s;
@@ -114,20 +115,22 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d p = origin + hit->t * dir;
     if (hit->sphere_light >= 0) {
       const Light& l = *impl_.lights[hit->sphere_light].light;
-      AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
+      if (!(reflected_only && bounce == 0))
+        AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
       break;
     }
     if (hit->geometry > 0) {  // an area light's own mesh: emits on its front, absorbs
       const int light = impl_.area_light_of_geometry[hit->geometry];
       const Eigen::Vector3d& n = impl_.area_normals[hit->geometry][hit->primitive];
-      if (n.dot(dir) < 0) AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
+      if (n.dot(dir) < 0 && !(reflected_only && bounce == 0))
+        AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
       break;
     }
     const int tri_index = hit->primitive;
     const TriangleShading& ts = impl_.triangles[tri_index];
     const ShadingMaterial& m = impl_.materials[ts.material];
     Eigen::Vector3d n_geo = ts.normal;
-    if (ts.emitter >= 0 && n_geo.dot(dir) < 0) {
+    if (ts.emitter >= 0 && n_geo.dot(dir) < 0 && !(reflected_only && bounce == 0)) {
       AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
     }
     if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
@@ -272,6 +275,21 @@ Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::V
   for (int k = 0; k < spp; ++k) {
     Pcg32 rng = PixelSampleRng(seed, 0, k);
     sum += tracer.Trace(origin, direction.normalized(), rng, &rays);
+  }
+  return sum / std::max(1, spp);
+}
+
+Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
+                                            const Eigen::Vector3d& direction, int spp,
+                                            uint64_t seed) const {
+  RenderOptions options;
+  const PathTracer tracer(*impl_, options);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  uint64_t rays = 0;
+  for (int k = 0; k < spp; ++k) {
+    Pcg32 rng = PixelSampleRng(seed, 1, k);
+    const Eigen::Vector3d l = tracer.Trace(origin, direction.normalized(), rng, &rays, true);
+    if (l.allFinite()) sum += l;
   }
   return sum / std::max(1, spp);
 }

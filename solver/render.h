@@ -58,7 +58,15 @@ class Renderer {
   Eigen::Vector3d Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                            int spp, uint64_t seed) const;
 
+  // Radiance reflected toward `origin` by the first surface along the ray, the emission of
+  // whatever the ray meets first (a light, an emitter) left out: the light a surface at
+  // `origin` receives from that direction by reflection (the solver's indirect light).
+  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin,
+                                    const Eigen::Vector3d& direction, int spp,
+                                    uint64_t seed) const;
+
   struct Impl;
+  const Impl& impl() const { return *impl_; }  // for the solver (solver/render_internal.h)
 
  private:
   std::unique_ptr<Impl> impl_;

@@ -100,6 +100,10 @@ struct Renderer::Impl {
   ~Impl();
 };
 
+// Texture lookup: bilinear, u right and v up (v = 0 is the bottom row); coordinates outside
+// [0, 1] repeat, texels at the borders clamp. RGB of a 3-channel linear texture.
+Eigen::Vector3d SampleTexture(const Image& texture, Eigen::Vector2d uv);
+
 // Builds the Embree scene, materials and lights (render_scene.cpp).
 std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lighting);
 

@@ -1,1 +1,417 @@
-// placeholder
+#include "solver/solve.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "solver/albedo_map.h"
+#include "solver/brdf.h"
+#include "solver/gather.h"
+#include "solver/patches.h"
+#include "solver/render.h"
+#include "solver/render_internal.h"
+#include "solver/sampling.h"
+#include "solver/solve_internal.h"
+#include "solver/surface_hit.h"
+#include "tools/common/error.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr int kMaxFitSamples = 6000;  // per region and stage (highlight pixels always kept)
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Set-up: materials, photos, observations, patches, gathering.
+
+void SolverState::InitMaterials() {
+  const size_t n = scene.materials.size();
+  materials.resize(n);
+  for (size_t r = 0; r < n; ++r) {
+    const Material& m = scene.materials[r];
+    MaterialState& s = materials[r];
+    s.params.model = m.brdf;
+    s.reflective = IsReflective(m.brdf);
+    if (!s.reflective) continue;
+    const bool spec = HasSpecularLobe(m.brdf), aniso = IsAnisotropic(m.brdf);
+    s.unknown_rho_d = !m.rho_d && !m.rho_d_map;
+    s.unknown_rho_s = spec && !m.rho_s;
+    s.unknown_alpha = spec && (aniso ? !(m.alpha_x && m.alpha_y) : !m.alpha);
+    s.params.rho_d = m.rho_d.value_or(Eigen::Vector3d::Constant(0.5));
+    s.params.rho_s = m.rho_s.value_or(Eigen::Vector3d::Zero());
+    s.params.alpha = m.alpha.value_or(0.1);
+    s.params.alpha_x = m.alpha_x.value_or(m.alpha.value_or(0.1));
+    s.params.alpha_y = m.alpha_y.value_or(m.alpha.value_or(0.1));
+    s.params.ior = m.ior.value_or(Material::kDefaultIor);
+    s.tangent = m.tangent;
+    if (m.rho_d_map) s.known_map = std::make_shared<const Image>(ReadImage(*m.rho_d_map, 3));
+  }
+  region_patches.assign(n, {});
+  patch_slot.assign(patches.size(), -1);
+  for (int q = 0; q < patches.size(); ++q) {
+    const int r = patches.patch_region[q];
+    patch_slot[q] = static_cast<int>(region_patches[r].size());
+    region_patches[r].push_back(q);
+  }
+  for (size_t r = 0; r < n; ++r) {
+    materials[r].patch_rho_d.assign(region_patches[r].size(), Eigen::Vector3d::Constant(NAN));
+  }
+}
+
+Frame SolverState::LocalFrame(int region, const Eigen::Vector3d& n) const {
+  const MaterialState& m = materials[region];
+  if (IsAnisotropic(m.params.model) && m.tangent) return Frame::FromNormalTangent(n, *m.tangent);
+  return Frame::FromNormal(n);
+}
+
+Eigen::Vector3d SolverState::PatchAlbedo(int q) const {
+  const int r = patches.patch_region[q];
+  const Eigen::Vector3d& v = materials[r].patch_rho_d[patch_slot[q]];
+  return v.allFinite() ? v : materials[r].params.rho_d;
+}
+
+void SolverState::LoadPhotos() {
+  ProblemList problems;
+  photo_images.resize(scene.photos.size());
+  mask_images.resize(scene.photos.size());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const Photo& p = scene.photos[i];
+    const Camera& cam = scene.cameras[p.camera];
+    const std::string key = "photos[" + std::to_string(i) + "]";
+    try {
+      photo_images[i] = ReadImage(p.file, 3);
+      if (photo_images[i].width != cam.width || photo_images[i].height != cam.height) {
+        problems.Add(scene.file.string(), key + ".file",
+                     p.file.string() + " is " + std::to_string(photo_images[i].width) + "x" +
+                         std::to_string(photo_images[i].height),
+                     "must match camera " + cam.name + " (" + std::to_string(cam.width) + "x" +
+                         std::to_string(cam.height) + ")");
+      }
+      if (p.mask) mask_images[i] = ReadImage(*p.mask, 1);
+    } catch (const Error& e) {
+      problems.Append(e);
+    }
+  }
+  problems.ThrowIfAny();
+}
+
+void SolverState::BuildLightingScenes() {
+  ProblemList problems;
+  lighting_scenes.resize(scene.lightings.size());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const int l = scene.photos[i].lighting;
+    if (lighting_scenes[l]) continue;
+    if (scene.lightings[l].lights.empty()) {
+      bool emitter = false;
+      for (const Material& m : scene.materials) emitter |= m.brdf == BrdfModel::kEmitter;
+      if (!emitter) {
+        problems.Add(scene.file.string(), "photos[" + std::to_string(i) + "].lighting",
+                     scene.lightings[l].name,
+                     "the lighting has no light and no material emits: the photo cannot be "
+                     "explained");
+        continue;
+      }
+    }
+    lighting_scenes[l] = BuildRenderScene(scene, l);
+  }
+  problems.ThrowIfAny();
+}
+
+void SolverState::CollectAllObservations() {
+  ProblemList problems;
+  ObservationOptions oo;
+  oo.pixel_stride = options.pixel_stride;
+  oo.saturation = options.saturation;
+  oo.num_threads = options.num_threads;
+  summary.photos.resize(scene.photos.size());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const Image* mask = mask_images[i] ? &*mask_images[i] : nullptr;
+    std::vector<Observation> o =
+        CollectObservations(scene, int(i), photo_images[i], mask,
+                            *lighting_scenes[scene.photos[i].lighting], patches, oo,
+                            &summary.photos[i]);
+    const PhotoObservationStats& st = summary.photos[i];
+    if (o.empty()) {
+      problems.Add(scene.file.string(), "photos[" + std::to_string(i) + "]",
+                   scene.photos[i].file.string(),
+                   "no valid pixel (" + std::to_string(st.pixels) + " looked at: " +
+                       std::to_string(st.masked) + " masked, " + std::to_string(st.clipped) +
+                       " clipped, " + std::to_string(st.invalid) + " non-finite or negative, " +
+                       std::to_string(st.background) + " see no reflective surface, " +
+                       std::to_string(st.edge) + " on edges)");
+    }
+    obs.insert(obs.end(), o.begin(), o.end());
+  }
+  problems.ThrowIfAny();
+  summary.observations = static_cast<int>(obs.size());
+  for (const Observation& o : obs) ++materials[o.region].observations;
+}
+
+void SolverState::SelectFitSamples() {
+  // Per region: every observation near a possible highlight (tanθh < 0.6 toward some light of
+  // its lighting), plus an even subsample of the rest, at most kMaxFitSamples in all.
+  in_fit.assign(obs.size(), 0);
+  std::vector<std::vector<int>> near(materials.size()), rest(materials.size());
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const Observation& o = obs[i];
+    const MaterialState& m = materials[o.region];
+    if (!m.NeedsFit()) continue;
+    bool highlight = false;
+    if (HasSpecularLobe(m.params.model)) {
+      const Renderer::Impl& ls = *lighting_scenes[scene.photos[o.photo].lighting];
+      for (int l = 0; l < int(ls.lights.size()) && !highlight; ++l) {
+        const LightSample s =
+            ls.SampleLight(l, o.position.cast<double>(), Eigen::Vector3d(0.5, 0.5, 0.5));
+        const Eigen::Vector3d h = (s.wi + o.view.cast<double>()).normalized();
+        const double c = h.dot(o.normal.cast<double>());
+        highlight = c > 0 && (1 - c * c) < 0.36 * c * c;
+      }
+    }
+    (highlight ? near : rest)[o.region].push_back(int(i));
+  }
+  for (size_t r = 0; r < materials.size(); ++r) {
+    for (size_t k = 0; k < near[r].size() && k < size_t(kMaxFitSamples) * 2 / 3; ++k) {
+      in_fit[near[r][k * std::max<size_t>(1, near[r].size() / (kMaxFitSamples * 2 / 3))]] = 1;
+    }
+    const size_t budget = kMaxFitSamples - std::min<size_t>(near[r].size(), kMaxFitSamples * 2 / 3);
+    const size_t step = std::max<size_t>(1, (rest[r].size() + budget - 1) / std::max<size_t>(1, budget));
+    for (size_t k = 0; k < rest[r].size(); k += step) in_fit[rest[r][k]] = 1;
+  }
+}
+
+void SolverState::GatherAll() {
+  const auto start = Clock::now();
+  lighting_state.resize(scene.lightings.size());
+  obs_point.assign(obs.size(), -1);
+  GatherOptions go;
+  go.light_samples = options.light_samples;
+  go.indirect_rays = options.indirect_rays;
+  go.seed = options.seed;
+  go.num_threads = options.num_threads;
+  for (size_t l = 0; l < scene.lightings.size(); ++l) {
+    if (!lighting_scenes[l]) continue;
+    LightingState& st = lighting_state[l];
+    st.active = true;
+    std::vector<GatherQuery> queries;
+    for (size_t i = 0; i < obs.size(); ++i) {
+      if (scene.photos[obs[i].photo].lighting != int(l)) continue;
+      const Observation& o = obs[i];
+      GatherQuery q;
+      q.position = o.position.cast<double>();
+      const Eigen::Vector3d fn = scene.mesh.FaceNormal(o.triangle).cast<double>();
+      q.n_geo = fn.dot(o.view.cast<double>()) >= 0 ? fn : -fn;
+      q.n_s = o.normal.cast<double>();
+      q.view = o.view.cast<double>();
+      q.lobe = HasSpecularLobe(materials[o.region].params.model);
+      obs_point[i] = static_cast<int>(queries.size());
+      st.obs.push_back(int(i));
+      queries.push_back(q);
+    }
+    st.first_patch_point = static_cast<int>(queries.size());
+    for (int p = 0; p < patches.size(); ++p) {
+      GatherQuery q;
+      q.position = patches.center[p].cast<double>();
+      q.n_geo = scene.mesh.FaceNormal(patches.patch_triangle[p]).cast<double>();
+      q.n_s = patches.normal[p].cast<double>();
+      queries.push_back(q);
+    }
+    st.gather = Gather(*lighting_scenes[l], patches, queries, go);
+    summary.rays += st.gather.rays;
+    st.patch_d.assign(patches.size(), Eigen::Vector3f::Zero());
+    st.patch_e.assign(patches.size(), Eigen::Vector3f::Zero());
+    for (int p = 0; p < patches.size(); ++p) {
+      st.patch_e[p] = st.gather.points[st.first_patch_point + p].e_direct;
+    }
+    BuildPatchLobes(&st);
+  }
+  summary.seconds_rays += Since(start);
+}
+
+// Each patch's direct samples grouped into at most four representative directions, for the
+// specular part of the radiance it sends toward other points.
+void SolverState::BuildPatchLobes(LightingState* st) const {
+  st->lobe_begin.assign(patches.size() + 1, 0);
+  st->lobes.clear();
+  for (int p = 0; p < patches.size(); ++p) {
+    st->lobe_begin[p] = static_cast<int>(st->lobes.size());
+    const GatherPoint& gp = st->gather.points[st->first_patch_point + p];
+    const int n = gp.direct_end - gp.direct_begin;
+    if (n > 0 && HasSpecularLobe(materials[patches.patch_region[p]].params.model)) {
+      const int groups = std::min(4, n);
+      for (int g = 0; g < groups; ++g) {
+        DirectSample rep;
+        rep.value.setZero();
+        Eigen::Vector3f dir = Eigen::Vector3f::Zero();
+        for (int k = gp.direct_begin + g * n / groups; k < gp.direct_begin + (g + 1) * n / groups; ++k) {
+          const DirectSample& d = st->gather.direct[k];
+          rep.value += d.value;
+          dir += d.wi * d.value.sum();
+        }
+        if (!(dir.squaredNorm() > 0)) continue;
+        rep.wi = dir.normalized();
+        st->lobes.push_back(rep);
+      }
+    }
+  }
+  st->lobe_begin[patches.size()] = static_cast<int>(st->lobes.size());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Radiance leaving patches, and the light arriving at observations.
+
+Eigen::Vector3d SolverState::PatchSpecular(const LightingState& st, int q,
+                                           const Eigen::Vector3d& toward) const {
+  const int r = patches.patch_region[q];
+  const MaterialState& m = materials[r];
+  if (st.lobe_begin[q] == st.lobe_begin[q + 1] || !(m.params.rho_s.maxCoeff() > 0)) {
+    return Eigen::Vector3d::Zero();
+  }
+  const Frame frame = LocalFrame(r, patches.normal[q].cast<double>());
+  const Eigen::Vector3d wo = frame.ToLocal(toward);
+  if (!(wo.z() > 0)) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (int k = st.lobe_begin[q]; k < st.lobe_begin[q + 1]; ++k) {
+    const DirectSample& d = st.lobes[k];
+    const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                    m.params.ior, wo, frame.ToLocal(d.wi.cast<double>()));
+    s += w * d.value.cast<double>();
+  }
+  return s.cwiseProduct(m.params.rho_s);
+}
+
+Eigen::Vector3d SolverState::PatchRadiance(const LightingState& st, int q,
+                                           const Eigen::Vector3d& toward) const {
+  return st.patch_d[q].cast<double>() + PatchSpecular(st, q, toward);
+}
+
+// D_q: the diffuse radiance of each patch: the photos' mean over its observations less their
+// predicted specular part; patches no photo of the lighting sees get ρd·E/π.
+void SolverState::UpdatePatchRadiance(LightingState* st) {
+  std::vector<Eigen::Vector3d> sum(patches.size(), Eigen::Vector3d::Zero());
+  std::vector<int> count(patches.size(), 0);
+  for (int i : st->obs) {
+    const Observation& o = obs[i];
+    const Eigen::Vector3d spec = materials[o.region].params.rho_s.cwiseProduct(obs_t[i]);
+    sum[o.patch] += (o.radiance.cast<double>() - spec).cwiseMax(0.0);
+    ++count[o.patch];
+  }
+  for (int sweep = 0; sweep < 2; ++sweep) {
+    for (int q = 0; q < patches.size(); ++q) {
+      if (count[q] > 0) {
+        st->patch_d[q] = (sum[q] / count[q]).cast<float>();
+      } else if (IsReflective(materials[patches.patch_region[q]].params.model)) {
+        st->patch_d[q] = (PatchAlbedo(q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi).cast<float>();
+      } else {
+        st->patch_d[q].setZero();
+      }
+    }
+    // Irradiance of every patch from the new radiances (for the unseen ones next sweep).
+    ParallelFor(
+        0, patches.size(),
+        [&](int64_t q) {
+          const GatherPoint& gp = st->gather.points[st->first_patch_point + q];
+          Eigen::Vector3d e = gp.e_direct.cast<double>();
+          for (int k = gp.indirect_begin; k < gp.indirect_end; ++k) {
+            const IndirectSample& s = st->gather.indirect[k];
+            if (s.patch < 0) continue;
+            e += s.weight * PatchRadiance(*st, s.patch, -s.wi.cast<double>());
+          }
+          st->patch_e[q] = e.cast<float>();
+        },
+        options.num_threads);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bookkeeping around the stages.
+
+void SolverState::SummariseRegions() {
+  for (size_t r = 0; r < materials.size(); ++r) {
+    const MaterialState& m = materials[r];
+    RegionSolution& rs = summary.regions[r];
+    rs.name = scene.materials[r].name;
+    rs.observations = m.observations;
+    if (m.unknown_rho_d) rs.unknowns.push_back("rho_d");
+    if (m.unknown_rho_s) rs.unknowns.push_back("rho_s");
+    if (m.unknown_alpha) {
+      if (IsAnisotropic(m.params.model)) {
+        rs.unknowns.push_back("alpha_x");
+        rs.unknowns.push_back("alpha_y");
+      } else {
+        rs.unknowns.push_back("alpha");
+      }
+    }
+    rs.status = !m.NeedsFit() ? "known" : (m.observations == 0 ? "unobserved" : "solved");
+    if (rs.status == "unobserved") {
+      spdlog::warn("region {} has unknown values but no photo sees it: its values are placeholders",
+                   rs.name);
+    }
+  }
+}
+
+// The albedo texel: the option, else the median footprint of the observations' pixel grid
+// (distance / focal length, times the pixel stride), so a texel holds about one observation per
+// photo.
+void SolverState::ChooseTexelSize() {
+  if (options.texel_size_m > 0) {
+    summary.texel_size_m = options.texel_size_m;
+    return;
+  }
+  std::vector<double> footprints;
+  for (size_t i = 0; i < obs.size(); i += 7) {
+    const Observation& o = obs[i];
+    const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+    const double d = (cam.CenterInWorld() - o.position.cast<double>()).norm();
+    footprints.push_back(d / cam.params[0] * options.pixel_stride);
+  }
+  if (footprints.empty()) {
+    summary.texel_size_m = 0.01;
+    return;
+  }
+  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
+  summary.texel_size_m = std::max(1e-4, footprints[footprints.size() / 2]);
+}
+
+void SolverState::AnalyseCoverage() {
+  HighlightCoverageOptions ho;
+  summary.coverage = AnalyseHighlightCoverage(scene, obs, lighting_scenes, ho);
+  for (const RegionHighlightCoverage& c : summary.coverage) {
+    if (c.region < 0 || c.region >= int(materials.size()) || c.observed) continue;
+    MaterialState& m = materials[c.region];
+    if (!(m.unknown_rho_s || m.unknown_alpha) || m.observations == 0) continue;
+    m.no_highlight = true;
+    m.params.rho_s.setZero();
+    summary.regions[c.region].status = "no_highlight";
+    spdlog::warn("region {}: no photo shows its highlight; rho_s and alpha cannot be recovered "
+                 "(rho_s held at 0)",
+                 c.name);
+  }
+}
+
+void SolverState::FinishRegions() {
+  for (size_t r = 0; r < materials.size(); ++r) {
+    RegionSolution& rs = summary.regions[r];
+    if (rs.status == "unobserved") {
+      // Placeholders so that the scene renders: the observed regions' mean albedo, no gloss.
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (const MaterialState& m : materials) {
+        if (m.reflective && m.observations > 0) mean += m.params.rho_d, ++n;
+      }
+      materials[r].params.rho_d = n > 0 ? Eigen::Vector3d(mean / n) : Eigen::Vector3d::Constant(0.5);
+      if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
+    }
+    rs.final_params = materials[r].params;
+  }
+}
+
+}  // namespace igi

@@ -1,1 +1,42 @@
-// placeholder
+#include "solver/solve_options.h"
+
+#include <fmt/format.h>
+
+#include "tools/common/error.h"
+
+namespace igi {
+
+void SolveOptions::Validate() const {
+  ProblemList problems;
+  auto check = [&](bool ok, const char* flag, const std::string& value, const char* rule) {
+    if (!ok) problems.Add(DescribeProblem("", flag, value, rule));
+  };
+  check(pixel_stride >= 1 && pixel_stride <= 64, "--pixel-stride", std::to_string(pixel_stride),
+        "must be in [1, 64]");
+  check(saturation >= 0, "--saturation", fmt::format("{}", saturation), "must be >= 0 (0 = auto)");
+  check(patch_size_m >= 0, "--patch-size-m", fmt::format("{}", patch_size_m),
+        "must be >= 0 (0 = auto)");
+  check(light_samples >= 1 && light_samples <= 1024, "--light-samples",
+        std::to_string(light_samples), "must be in [1, 1024]");
+  check(indirect_rays >= 0 && indirect_rays <= 4096, "--indirect-rays",
+        std::to_string(indirect_rays), "must be in [0, 4096]");
+  check(smoothing_radius_m >= 0, "--smoothing-radius-m", fmt::format("{}", smoothing_radius_m),
+        "must be >= 0 (0 = auto)");
+  check(max_iterations >= 1 && max_iterations <= 100, "--max-iterations",
+        std::to_string(max_iterations), "must be in [1, 100]");
+  check(tolerance > 0 && tolerance < 1, "--tolerance", fmt::format("{}", tolerance),
+        "must be in (0, 1)");
+  check(specular_colour == "grey" || specular_colour == "rgb", "--specular-colour",
+        specular_colour, "must be grey or rgb");
+  check(albedo_maps == "auto" || albedo_maps == "all" || albedo_maps == "none", "--albedo-maps",
+        albedo_maps, "must be auto, all or none");
+  check(texel_size_m >= 0, "--texel-size-m", fmt::format("{}", texel_size_m),
+        "must be >= 0 (0 = auto)");
+  check(refine_iterations >= 0 && refine_iterations <= 20, "--refine-iterations",
+        std::to_string(refine_iterations), "must be in [0, 20]");
+  check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),
+        "must be in [1, 4096]");
+  problems.ThrowIfAny();
+}
+
+}  // namespace igi

@@ -1,1 +1,216 @@
-// placeholder
+#include "solver/solve_output.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "solver/uv_charts.h"
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+#include "tools/common/image.h"
+
+namespace igi {
+namespace fs = std::filesystem;
+namespace {
+
+Json Num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json Vec(const Eigen::Vector3d& v) { return Json::array({Num(v[0]), Num(v[1]), Num(v[2])}); }
+
+// A path of the input document (relative to the scene's folder) expressed relative to `out`.
+std::string Rebase(const Scene& scene, const std::string& path, const fs::path& out) {
+  const fs::path p(path);
+  if (p.is_absolute()) return path;
+  std::error_code ec;
+  const fs::path abs = fs::weakly_canonical(fs::absolute(scene.dir / p), ec);
+  const fs::path base = fs::weakly_canonical(fs::absolute(out), ec);
+  fs::path rel = abs.lexically_relative(base);
+  if (rel.empty()) return abs.string();
+  return rel.generic_string();
+}
+
+void RebaseKey(const Scene& scene, Json* j, const char* key, const fs::path& out) {
+  if (j->is_object() && j->contains(key) && (*j)[key].is_string()) {
+    (*j)[key] = Rebase(scene, (*j)[key].get<std::string>(), out);
+  }
+}
+
+Json FitJson(const RegionFitResult& f, BrdfModel model) {
+  Json j;
+  if (!f.fitted) {
+    j["fitted"] = false;
+    if (!f.message.empty()) j["message"] = f.message;
+    return j;
+  }
+  j["rho_d"] = Vec(f.rho_d);
+  j["sigma_rho_d"] = Vec(f.sigma_rho_d);
+  if (HasSpecularLobe(model)) {
+    j["rho_s"] = Vec(f.rho_s);
+    j["sigma_rho_s"] = Num(f.sigma_rho_s);
+    if (IsAnisotropic(model)) {
+      j["alpha_x"] = Num(f.alpha_x);
+      j["alpha_y"] = Num(f.alpha_y);
+      j["sigma_alpha_x"] = Num(f.sigma_alpha_x);
+      j["sigma_alpha_y"] = Num(f.sigma_alpha_y);
+    } else {
+      j["alpha"] = Num(f.alpha);
+      j["sigma_alpha"] = Num(f.sigma_alpha);
+    }
+  }
+  j["albedo_model"] = f.albedo_model;
+  j["albedo_varies"] = f.albedo_varies;
+  j["relative_rms"] = Num(f.relative_rms);
+  j["samples"] = f.samples;
+  if (!f.message.empty()) j["message"] = f.message;
+  return j;
+}
+
+}  // namespace
+
+Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const fs::path& out) {
+  Json doc = scene.document;
+  if (doc.contains("geometry")) {
+    for (Json& g : doc["geometry"]) RebaseKey(scene, &g, "file", out);
+  }
+  if (summary.charted_mesh) doc["geometry"] = Json::array({Json{{"file", "geometry/solved.obj"}}});
+  if (doc.contains("lights")) {
+    for (auto& [name, l] : doc["lights"].items()) {
+      RebaseKey(scene, &l, "file", out);
+      if (l.contains("profile")) RebaseKey(scene, &l["profile"], "ies", out);
+    }
+  }
+  if (doc.contains("photos")) {
+    for (Json& p : doc["photos"]) {
+      RebaseKey(scene, &p, "file", out);
+      RebaseKey(scene, &p, "mask", out);
+    }
+  }
+  if (doc.contains("cameras")) RebaseKey(scene, &doc["cameras"], "colmap", out);
+  for (size_t r = 0; r < scene.materials.size(); ++r) {
+    const std::string& name = scene.materials[r].name;
+    Json& m = doc["materials"][name];
+    RebaseKey(scene, &m, "rho_d_map", out);
+    const RegionSolution& rs = summary.regions[r];
+    const BrdfParams& p = rs.final_params;
+    if (!IsReflective(scene.materials[r].brdf)) continue;
+    m["rho_d"] = Vec(p.rho_d);
+    if (!rs.albedo_map_file.empty()) m["rho_d_map"] = rs.albedo_map_file;
+    if (HasSpecularLobe(p.model)) {
+      const bool grey = p.rho_s[0] == p.rho_s[1] && p.rho_s[1] == p.rho_s[2];
+      m["rho_s"] = grey ? Json(p.rho_s[0]) : Vec(p.rho_s);
+      if (IsAnisotropic(p.model)) {
+        m["alpha_x"] = p.alpha_x;
+        m["alpha_y"] = p.alpha_y;
+      } else {
+        m["alpha"] = p.alpha;
+      }
+    }
+  }
+  return doc;
+}
+
+Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
+  Json j;
+  j["format"] = "igi-solve-report";
+  j["version"] = 1;
+  j["converged"] = s.converged;
+  j["message"] = s.message;
+  j["stages"]["paper"] = {{"iterations", s.stage1_iterations},
+                          {"model_residual", Num(s.stage1_model_residual)},
+                          {"render_residual", Num(s.stage1_render_residual)}};
+  j["stages"]["refined"] = {{"iterations", s.stage2_iterations},
+                            {"render_residual", Num(s.stage2_render_residual)}};
+  j["render_residual_spp"] = s.render_residual_spp;
+  j["residual_metric"] =
+      "relative RMS residual sqrt(sum (render - photo)^2 / sum photo^2) over the observed pixels, "
+      "all channels; renders path traced through each pixel's centre";
+  Json regions = Json::array();
+  for (const RegionSolution& r : s.regions) {
+    Json rj;
+    rj["name"] = r.name;
+    rj["status"] = r.status;
+    rj["unknowns"] = r.unknowns;
+    rj["observations"] = r.observations;
+    rj["paper"] = FitJson(r.stage1, r.final_params.model);
+    rj["refined"] = FitJson(r.stage2, r.final_params.model);
+    if (!r.albedo_map_file.empty()) {
+      rj["albedo_map"] = {{"file", r.albedo_map_file},
+                          {"width", r.albedo_map ? r.albedo_map->width : 0},
+                          {"height", r.albedo_map ? r.albedo_map->height : 0},
+                          {"coverage", Num(r.albedo_map_coverage)},
+                          {"generated_uvs", r.albedo_map_generated_uvs}};
+    }
+    regions.push_back(rj);
+  }
+  j["regions"] = regions;
+  Json photos = Json::array();
+  for (size_t k = 0; k < s.photos.size(); ++k) {
+    const PhotoObservationStats& p = s.photos[k];
+    Json pj = {{"pixels", p.pixels}, {"valid", p.valid},           {"masked", p.masked},
+               {"clipped", p.clipped}, {"invalid", p.invalid},     {"background", p.background},
+               {"edge", p.edge},     {"saturation", Num(p.saturation)}};
+    if (k < s.residuals.size()) {
+      pj["file"] = s.residuals[k].file;
+      pj["residual_paper"] = Num(s.residuals[k].stage1);
+      pj["residual_refined"] = Num(s.residuals[k].stage2);
+    }
+    photos.push_back(pj);
+  }
+  j["photos"] = photos;
+  j["highlight_coverage"] = HighlightCoverageJson(s.coverage);
+  Json history = Json::array();
+  for (const SolveIteration& it : s.history) {
+    history.push_back({{"stage", it.stage == 1 ? "paper" : "refined"},
+                       {"iteration", it.iteration},
+                       {"relative_rms", Num(it.relative_rms)},
+                       {"max_change", Num(it.max_change)},
+                       {"params", it.params}});
+  }
+  j["history"] = history;
+  j["timing"] = {{"total_s", s.seconds_total},
+                 {"ray_casting_s", s.seconds_rays},
+                 {"fitting_s", s.seconds_fit},
+                 {"ray_casting_share", s.seconds_total > 0 ? s.seconds_rays / s.seconds_total : 0.0}};
+  j["rays"] = s.rays;
+  j["patches"] = s.patches;
+  j["patch_size_m"] = s.patch_size_m;
+  j["texel_size_m"] = s.texel_size_m;
+  j["observations"] = s.observations;
+  j["options"] = {{"pixel_stride", o.pixel_stride},     {"light_samples", o.light_samples},
+                  {"indirect_rays", o.indirect_rays},   {"max_iterations", o.max_iterations},
+                  {"tolerance", o.tolerance},           {"specular_colour", o.specular_colour},
+                  {"albedo_maps", o.albedo_maps},       {"refine_iterations", o.refine_iterations},
+                  {"refine_rays", o.refine_rays},       {"seed", o.seed}};
+  return j;
+}
+
+void WriteSolveReportHtml(const SolveSummary& summary, const Json& report, const fs::path& path);
+
+void WriteSolveOutputs(const SolveSummary& s, const SolveOptions& o, const fs::path& out) {
+  fs::create_directories(out);
+  for (const RegionSolution& r : s.regions) {
+    if (r.albedo_map_file.empty() || !r.albedo_map) continue;
+    fs::create_directories((out / r.albedo_map_file).parent_path());
+    WriteImageOptions wo;
+    wo.type = PixelType::kFloat;
+    WriteImage(out / r.albedo_map_file, *r.albedo_map, wo);
+  }
+  if (s.charted_mesh) {
+    fs::create_directories(out / "geometry");
+    WriteObjWithAtlases(*s.charted_mesh, {}, out / "geometry" / "solved.obj");
+  }
+  if (std::getenv("IGI_SOLVE_DEBUG") != nullptr) {
+    fs::create_directories(out / "debug");
+    for (const PhotoResidual& r : s.residuals) {
+      WriteImage(out / "debug" / ("photo_" + r.file), r.photo);
+      WriteImage(out / "debug" / ("render_" + r.file), r.render);
+    }
+  }
+  const Json report = SolveReportJson(s, o);
+  WriteJsonFile(out / "report.json", report);
+  WriteSolveReportHtml(s, report, out / "report.html");
+  WriteJsonFile(out / "scene.json", s.scene_document);
+}
+
+}  // namespace igi

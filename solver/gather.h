@@ -1,0 +1,79 @@
+#pragma once
+// Internal to igi_solver: gathering the light that arrives at surface points (Yu et al. 1999 §4:
+// "gathering over the other patches and the known lights, its irradiance").
+//
+// For each query point the gather keeps the incident samples, not only their sum, so that the
+// solver can re-weight them with any BRDF (the specular term) and re-evaluate the light leaving
+// the patches they hit after each refit (the "specular differences"):
+//  - direct samples toward the lighting's lights (stratified over extended lights, shadow rays
+//    through Embree), each with value = L_light·cosθ/(pdf·K): their sum is the direct irradiance;
+//  - indirect samples over the hemisphere (stratified cosine-weighted, mixed with a Ward lobe
+//    around the mirror direction where a specular fit needs them), each with the patch it hits
+//    and weight = cosθ/(pdf_mix·N): the irradiance is Σ weight·L(patch → point).
+// World frame, unit directions from the point toward where the light comes from.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "solver/patches.h"
+#include "solver/render_internal.h"
+#include "solver/sampling.h"
+
+namespace igi {
+
+struct DirectSample {
+  Eigen::Vector3f wi = Eigen::Vector3f::UnitZ();
+  Eigen::Vector3f value = Eigen::Vector3f::Zero();  // L·cosθ/(pdf·K), W·m⁻² per channel
+};
+
+struct IndirectSample {
+  Eigen::Vector3f wi = Eigen::Vector3f::UnitZ();
+  float weight = 0;  // cosθ/(pdf·N), sr... so that E = Σ weight·L
+  int patch = -1;    // the patch the ray hits; -1: nothing reflective (escaped, light, emitter)
+};
+
+struct GatherQuery {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d n_geo = Eigen::Vector3d::UnitZ();  // face normal on the lit side
+  Eigen::Vector3d n_s = Eigen::Vector3d::UnitZ();    // shading normal on the same side
+  Eigen::Vector3d view = Eigen::Vector3d::Zero();    // toward the viewer; zero = none
+  bool lobe = false;  // mix Ward-lobe directions around the view's mirror into the hemisphere
+};
+
+struct GatherPoint {
+  Eigen::Vector3f e_direct = Eigen::Vector3f::Zero();  // Σ direct values
+  int direct_begin = 0, direct_end = 0;
+  int indirect_begin = 0, indirect_end = 0;
+};
+
+struct GatherSet {
+  std::vector<GatherPoint> points;  // one per query, same order
+  std::vector<DirectSample> direct;
+  std::vector<IndirectSample> indirect;
+  uint64_t rays = 0;
+  double seconds = 0;
+};
+
+struct GatherOptions {
+  int light_samples = 16;  // per extended light (delta lights take one)
+  int indirect_rays = 64;
+  double lobe_alpha = 0.2;  // roughness of the mixed-in Ward lobe
+  uint64_t seed = 1;
+  int num_threads = 0;
+};
+
+// Hemisphere directions for a query: stratified cosine-weighted, half of them from a Ward lobe
+// (roughness lobe_alpha) around the view's mirror direction when q.lobe; each with its weight
+// cosθ/(pdf_mix·n). Directions under the face (q.n_geo) are dropped.
+struct WeightedDirection {
+  Eigen::Vector3d wi;
+  double weight = 0;
+};
+std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
+                                                    Pcg32& rng);
+
+GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
+                 const std::vector<GatherQuery>& queries, const GatherOptions& options);
+
+}  // namespace igi

@@ -1,0 +1,84 @@
+#pragma once
+// Internal to igi_solver: fitting one region's reflectance to its observations (Yu et al. 1999
+// §5: "fit the BRDF parameters of each region by nonlinear optimisation over the observed
+// radiance samples"). Non-diffuse parameters (ρs, α) are constant per region; the diffuse albedo
+// is either constant over the region or free per patch, whichever the data support.
+//
+// The model of one observation o (radiance L toward its camera, channel c):
+//   L_c = ρd_c·E_c/π + ρs_c·T_c(α),   T_c(α) = Σ_k S(wo, wi_k; α)·W(wo, wi_k)·v_k,c
+// with E the gathered irradiance and (wi_k, v_k) the incident samples (v = L_in·cosθ/pdf, so
+// Σ v = E), S the model's colourless specular factor and W its Fresnel weight (solver/brdf.h).
+// For a given α the model is linear in ρd and ρs: they are projected out (variable projection)
+// and α is found by a log-grid search refined by golden sections; Ceres then polishes all
+// parameters jointly (autodiff through EvalBrdf's specular factor) and gives their covariance.
+// Residuals are weighted by 1/(L + 0.1·mean L) per channel, i.e. nearly relative errors.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "recon/brdf_model.h"
+
+namespace igi {
+
+struct IncidentLocal {
+  Eigen::Vector3f wi = Eigen::Vector3f::UnitZ();  // local shading frame, unit
+  Eigen::Vector3f value = Eigen::Vector3f::Zero();
+};
+
+struct FitSample {
+  Eigen::Vector3d observed = Eigen::Vector3d::Zero();    // L
+  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // E
+  Eigen::Vector3d rho_d_known = Eigen::Vector3d::Zero();  // used when the region's ρd is known
+  int slot = 0;                                          // its patch among the region's slots
+  Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();         // local, toward the camera
+  int incident_begin = 0, incident_end = 0;              // into RegionFitInput::incident
+};
+
+struct RegionFitInput {
+  std::string name;
+  BrdfModel model = BrdfModel::kLambert;
+  bool fit_rho_d = true;             // false: FitSample::rho_d_known is used
+  std::optional<double> rho_s_grey;  // known ρs (grey) or unknown
+  std::optional<Eigen::Vector3d> rho_s_rgb;
+  std::optional<double> alpha;            // isotropic models
+  std::optional<double> alpha_x, alpha_y;  // anisotropic models
+  double ior = 1.5;
+  bool grey_specular = true;  // one ρs for the three channels
+  int num_slots = 1;
+  std::vector<double> slot_area;  // m², per slot
+  std::vector<FitSample> samples;
+  std::vector<IncidentLocal> incident;
+};
+
+struct RegionFitResult {
+  bool fitted = false;  // false: nothing to fit (no samples)
+  std::string albedo_model = "constant";  // "constant" or "per_patch"
+  bool albedo_varies = false;             // per-patch albedo significantly non-uniform
+  Eigen::Vector3d rho_d = Eigen::Vector3d::Zero();  // region mean (area-weighted)
+  std::vector<Eigen::Vector3d> slot_rho_d;           // per slot (NaN where no sample)
+  std::vector<int> slot_count;                       // samples per slot
+  Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
+  double alpha = 0, alpha_x = 0, alpha_y = 0;
+  // One-sigma uncertainties (NaN where unknown or not fitted).
+  Eigen::Vector3d sigma_rho_d = Eigen::Vector3d::Constant(NAN);
+  double sigma_rho_s = NAN, sigma_alpha = NAN, sigma_alpha_x = NAN, sigma_alpha_y = NAN;
+  double relative_rms = 0;  // sqrt(Σ(pred−L)²/ΣL²) over the samples, all channels
+  int samples = 0;
+  bool converged = true;
+  std::string message;  // why it stopped, or what went wrong
+};
+
+struct RegionFitOptions {
+  int max_polish_iterations = 30;  // Ceres iterations of the final joint polish
+  int num_threads = 1;             // Ceres threads
+};
+
+RegionFitResult FitRegion(const RegionFitInput& input, const RegionFitOptions& options);
+
+// The colourless specular factor times the Fresnel weight, S·W, for one sample (double).
+double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
+                      const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
+
+}  // namespace igi

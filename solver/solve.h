@@ -1,0 +1,116 @@
+#pragma once
+// igi-solve (CONTRACT.md §4): inverse global illumination after Yu, Debevec, Malik and Hawkins
+// (SIGGRAPH 1999), then a joint refinement against the path tracer.
+//
+// Stage 1, the paper's method: the surfaces are split into patches (region → triangle → patch);
+// each photo pixel that sees a surface cleanly is an observation. At every observation the
+// light arriving from the lights (Embree shadow rays) and from the other patches (hemisphere
+// rays) is gathered; the radiance a patch sends toward another point is what the photos saw of
+// it (its diffuse part, image-based) plus a specular part that depends on the unknown BRDF. The
+// solver alternates: fit each region's ρs and α (constant per region) and albedo (constant, or
+// free per patch where the data say it varies) to the observations, recompute the patches'
+// radiance with the new specular parameters ("specular differences"), refit, until converged.
+//
+// Stage 2, beyond the paper: the light arriving at every observation is re-rendered with the
+// full path tracer using the current model (all bounces, every surface, seen or not), all
+// parameters are refitted against the photos with the same model (gradients through the BRDF
+// by Ceres autodiff; the dependence of the arriving light on the parameters is handled by
+// re-rendering each round), and this is repeated. Both stages are reported.
+//
+// Finally the albedo of every texel of the regions that need a map is π(L − specular)/E
+// averaged over the observations that fall in it.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/brdf.h"
+#include "solver/highlight_coverage.h"
+#include "solver/observations.h"
+#include "solver/region_fit.h"
+#include "solver/solve_options.h"
+#include "tools/common/image.h"
+#include "tools/common/json.h"
+
+namespace igi {
+
+struct RegionSolution {
+  std::string name;
+  // "known" (nothing to estimate), "solved", "unobserved" (unknowns but no observation: values
+  // are placeholders), "no_highlight" (ρs and α cannot be recovered: no photo shows the
+  // highlight; ρs set to 0).
+  std::string status = "known";
+  std::vector<std::string> unknowns;  // scene.json keys estimated
+  RegionFitResult stage1, stage2;     // stage2 == final (stage1 when refinement is off)
+  BrdfParams final_params;            // every value of the solved material
+  int observations = 0;
+  // Albedo map (when estimated): the image, its file name under the output folder, coverage.
+  std::optional<Image> albedo_map;
+  std::string albedo_map_file;
+  double albedo_map_coverage = 0;
+  bool albedo_map_generated_uvs = false;
+};
+
+struct SolveIteration {
+  int stage = 1;
+  int iteration = 0;
+  double relative_rms = 0;  // over all fitted samples
+  double max_change = 0;    // largest relative parameter change from the previous iteration
+  Json params;              // per region: rho_d, rho_s, alpha
+};
+
+// Per photo: the residual of CONTRACT.md §6 at the observed pixels, the photo and the model.
+struct PhotoResidual {
+  std::string file;
+  double stage1 = 0, stage2 = 0;  // path-traced render vs photo, relative RMS
+  Image photo, render, residual;  // at the observation grid (stride), linear, for the report
+};
+
+struct SolveSummary {
+  std::vector<RegionSolution> regions;  // one per material, scene order
+  std::vector<SolveIteration> history;
+  std::vector<PhotoObservationStats> photos;
+  std::vector<PhotoResidual> residuals;
+  std::vector<RegionHighlightCoverage> coverage;
+  bool converged = false;
+  std::string message;  // why stage 1 stopped
+  int stage1_iterations = 0, stage2_iterations = 0;
+  double stage1_model_residual = 0;   // the paper's image-based model vs the photos
+  double stage1_render_residual = 0;  // path-traced render of the stage-1 model vs the photos
+  double stage2_render_residual = 0;  // the same for the final model
+  int render_residual_spp = 0;
+  double patch_size_m = 0, texel_size_m = 0;
+  int patches = 0, observations = 0;
+  uint64_t rays = 0;
+  double seconds_total = 0, seconds_rays = 0, seconds_fit = 0;
+  // The solved scene.json document (paths relative to the output folder) and any mesh with
+  // generated texture charts (written as geometry/solved.obj).
+  Json scene_document;
+  std::optional<TriangleMesh> charted_mesh;
+};
+
+// Solves `scene` (loaded with complete geometry). `out_dir` is only used to express the paths
+// of the returned scene document relative to it; nothing is written. Throws InputError for bad
+// input (a photographed lighting without light, a photo with no valid pixel, a photo whose size
+// differs from its camera's).
+SolveSummary Solve(const Scene& scene, const SolveOptions& options,
+                   const std::filesystem::path& out_dir);
+
+// The input scene.json document with every material value filled in (solver/solve_output.cpp):
+// rho_d (region mean) always, rho_s/alpha where the model has them, rho_d_map where a map was
+// estimated ("albedo/<region>.exr"), geometry replaced by "geometry/solved.obj" when texture
+// charts were generated; every other relative path rewritten relative to `out_dir`.
+Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary,
+                         const std::filesystem::path& out_dir);
+
+// report.json (solver/solve_output.cpp).
+Json SolveReportJson(const SolveSummary& summary, const SolveOptions& options);
+
+// Writes DIR/scene.json, albedo maps, the charted mesh, report.json and report.html, each
+// atomically, the scene last (solver/solve_output.cpp).
+void WriteSolveOutputs(const SolveSummary& summary, const SolveOptions& options,
+                       const std::filesystem::path& out_dir);
+
+}  // namespace igi

@@ -1,0 +1,105 @@
+#pragma once
+// Internal to igi_solver: the state of one solve (solve.cpp: set-up and stage 1's image-based
+// model; solve_stages.cpp: the iterations, stage 2, residuals and albedo maps).
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "solver/brdf.h"
+#include "solver/gather.h"
+#include "solver/observations.h"
+#include "solver/patches.h"
+#include "solver/region_fit.h"
+#include "solver/render_internal.h"
+#include "solver/sampling.h"
+#include "solver/solve.h"
+#include "solver/uv_charts.h"
+
+namespace igi {
+
+struct MaterialState {
+  BrdfParams params;  // complete: known values, or the current estimate
+  bool reflective = false;
+  bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
+  bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
+  std::optional<Eigen::Vector3d> tangent;
+  std::shared_ptr<const Image> known_map;     // a known rho_d_map
+  std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
+  RegionFitResult last_fit;
+  int observations = 0;
+  bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
+};
+
+struct LightingState {
+  bool active = false;
+  std::vector<int> obs;        // observations under this lighting
+  GatherSet gather;            // their points first, then one per patch
+  int first_patch_point = 0;
+  std::vector<Eigen::Vector3f> patch_d;  // diffuse radiance leaving each patch
+  std::vector<Eigen::Vector3f> patch_e;  // irradiance of each patch
+  std::vector<int> lobe_begin;           // per patch (+1): representative direct samples
+  std::vector<DirectSample> lobes;
+};
+
+struct SolverState {
+  const Scene& scene;
+  SolveOptions options;
+  SolveSummary summary;
+  PatchSet patches;
+  std::vector<MaterialState> materials;
+  std::vector<std::vector<int>> region_patches;  // per region: its patches (slot order)
+  std::vector<int> patch_slot;                   // per patch: index within its region
+  std::vector<Image> photo_images;
+  std::vector<std::optional<Image>> mask_images;
+  std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
+  std::vector<Observation> obs;
+  std::vector<char> in_fit;  // per observation: used by the region fits
+  std::vector<int> obs_point;  // per observation: its point in its lighting's gather
+  std::vector<LightingState> lighting_state;
+  // Per observation, refreshed each iteration: direct and indirect irradiance (the indirect
+  // smoothed over neighbours), the incident samples in the local frame (regions with a
+  // specular lobe) and T = Σ S·W·v at the current α.
+  std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
+  std::vector<std::vector<IncidentLocal>> obs_incident;
+  std::vector<Eigen::Vector3d> obs_t;
+
+  SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
+
+  // solve.cpp
+  void InitMaterials();
+  void LoadPhotos();
+  void BuildLightingScenes();
+  void CollectAllObservations();
+  void SelectFitSamples();
+  void GatherAll();
+  void BuildPatchLobes(LightingState* st) const;
+  Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
+  Eigen::Vector3d PatchAlbedo(int patch) const;
+  Eigen::Vector3d PatchSpecular(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
+  Eigen::Vector3d PatchRadiance(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
+  void UpdatePatchRadiance(LightingState* st);
+
+  // solve_stages.cpp
+  void IncidentFromPatches();
+  void IncidentFromRenderer(const Scene& model, uint64_t round);
+  void SmoothIrradiance();
+  void ComputeSpecularTerms();
+  double FitAll(int stage, int iteration);  // returns the largest relative change
+  void RunStage1();
+  void RunStage2();
+  Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
+                      const std::filesystem::path& temp_dir) const;
+  void RenderResiduals(const Scene& model, int stage);
+  void BuildAlbedoMaps();
+  Eigen::Vector3d KnownAlbedo(const Observation& o) const;
+
+  // solve.cpp
+  void SummariseRegions();
+  void ChooseTexelSize();
+  void AnalyseCoverage();
+  void FinishRegions();
+};
+
+}  // namespace igi

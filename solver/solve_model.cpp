@@ -1,0 +1,249 @@
+// Stage 2 (the path tracer against the photos), the residual renders, the albedo maps and the
+// solve's entry point. See solver/solve.h.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "solver/albedo_map.h"
+#include "solver/render.h"
+#include "solver/solve_internal.h"
+#include "tools/common/error.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+namespace {
+
+// The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
+TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases) {
+  std::vector<const RegionAtlas*> of_region(mesh.region_names.size(), nullptr);
+  for (const RegionAtlas& a : atlases) {
+    if (a.generated && a.region >= 0 && a.region < int(of_region.size())) of_region[a.region] = &a;
+  }
+  TriangleMesh out;
+  out.region_names = mesh.region_names;
+  out.triangle_region = mesh.triangle_region;
+  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    const RegionAtlas* a = of_region[mesh.triangle_region[t]];
+    Eigen::Vector3i nt;
+    for (int k = 0; k < 3; ++k) {
+      nt[k] = static_cast<int>(out.positions.size());
+      out.positions.push_back(mesh.positions[tri[k]]);
+      out.normals.push_back(mesh.normals[tri[k]]);
+      if (a != nullptr) {
+        out.uvs.push_back(a->corner_uv[t][k]);
+      } else {
+        out.uvs.push_back(mesh.has_uvs() ? mesh.uvs[tri[k]] : Eigen::Vector2f::Zero());
+      }
+    }
+    out.triangles.push_back(nt);
+  }
+  return out;
+}
+
+}  // namespace
+
+// The albedo map of region r: π(L − ρs·T)/E accumulated per texel over every observation.
+static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage) {
+  AlbedoMapBuilder builder(atlas);
+  const MaterialState& m = s.materials[r];
+  for (size_t i = 0; i < s.obs.size(); ++i) {
+    const Observation& o = s.obs[i];
+    if (o.region != r) continue;
+    const Eigen::Vector3d diffuse = o.radiance.cast<double>() - m.params.rho_s.cwiseProduct(s.obs_t[i]);
+    builder.Add(o.triangle, o.b1, o.b2, kPi * diffuse, s.obs_e[i]);
+  }
+  if (coverage != nullptr) *coverage = builder.Coverage();
+  return builder.Finish(m.params.rho_d);
+}
+
+static RegionAtlas AtlasOf(const SolverState& s, int r) {
+  AtlasOptions ao;
+  ao.texel_size_m = s.summary.texel_size_m;
+  return BuildRegionAtlas(s.scene.mesh, r, ao);
+}
+
+Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
+                                 const std::filesystem::path& temp_dir) const {
+  Scene model = scene;
+  atlases->clear();
+  maps->clear();
+  bool generated = false;
+  for (size_t r = 0; r < materials.size(); ++r) {
+    const MaterialState& m = materials[r];
+    if (!m.reflective) continue;
+    Material& out = model.materials[r];
+    if (!out.rho_d_map) out.rho_d = m.params.rho_d;
+    if (HasSpecularLobe(m.params.model)) {
+      out.rho_s = m.params.rho_s;
+      out.alpha = m.params.alpha;
+      if (IsAnisotropic(m.params.model)) {
+        out.alpha_x = m.params.alpha_x;
+        out.alpha_y = m.params.alpha_y;
+      }
+    }
+    if (m.unknown_rho_d && m.last_fit.albedo_model == "per_patch") {
+      atlases->push_back(AtlasOf(*this, int(r)));
+      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr));
+      const std::filesystem::path file = temp_dir / (out.name + ".exr");
+      WriteImage(file, maps->back());
+      out.rho_d_map = file;
+      generated |= atlases->back().generated;
+    }
+  }
+  if (generated || (!atlases->empty() && !scene.mesh.has_uvs())) {
+    model.mesh = ApplyAtlases(scene.mesh, *atlases);
+  }
+  return model;
+}
+
+void SolverState::RenderResiduals(const Scene& model, int stage) {
+  const auto start = std::chrono::steady_clock::now();
+  constexpr int kSpp = 8;
+  summary.render_residual_spp = kSpp;
+  std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
+  for (size_t l = 0; l < scene.lightings.size(); ++l) {
+    if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+  }
+  std::vector<Eigen::Vector3d> pred(obs.size());
+  ParallelFor(
+      0, int64_t(obs.size()),
+      [&](int64_t i) {
+        const Observation& o = obs[i];
+        const Photo& p = scene.photos[o.photo];
+        const Camera& cam = scene.cameras[p.camera];
+        const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5));
+        pred[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp,
+                                                  options.seed * 7919 + uint64_t(i));
+      },
+      options.num_threads);
+  const int stride = options.pixel_stride;
+  summary.residuals.resize(scene.photos.size());
+  std::vector<double> num(scene.photos.size(), 0), den(scene.photos.size(), 0);
+  double all_num = 0, all_den = 0;
+  for (size_t k = 0; k < scene.photos.size(); ++k) {
+    const Camera& cam = scene.cameras[scene.photos[k].camera];
+    PhotoResidual& pr = summary.residuals[k];
+    pr.file = scene.photos[k].file.filename().string();
+    const int w = (cam.width + stride - 1) / stride, h = (cam.height + stride - 1) / stride;
+    pr.photo = Image(w, h, 3);
+    pr.render = Image(w, h, 3);
+    pr.residual = Image(w, h, 3);
+  }
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const Observation& o = obs[i];
+    PhotoResidual& pr = summary.residuals[o.photo];
+    const int x = std::min(o.x / stride, pr.photo.width - 1), y = std::min(o.y / stride, pr.photo.height - 1);
+    for (int c = 0; c < 3; ++c) {
+      pr.photo.at(x, y, c) = o.radiance[c];
+      pr.render.at(x, y, c) = float(pred[i][c]);
+      pr.residual.at(x, y, c) = float(pred[i][c] - o.radiance[c]);
+    }
+    const double d = (pred[i] - o.radiance.cast<double>()).squaredNorm();
+    const double p2 = o.radiance.cast<double>().squaredNorm();
+    num[o.photo] += d, den[o.photo] += p2, all_num += d, all_den += p2;
+  }
+  for (size_t k = 0; k < scene.photos.size(); ++k) {
+    const double r = den[k] > 0 ? std::sqrt(num[k] / den[k]) : 0.0;
+    (stage == 1 ? summary.residuals[k].stage1 : summary.residuals[k].stage2) = r;
+    if (stage == 1) summary.residuals[k].stage2 = r;
+  }
+  const double total = all_den > 0 ? std::sqrt(all_num / all_den) : 0.0;
+  (stage == 1 ? summary.stage1_render_residual : summary.stage2_render_residual) = total;
+  if (stage == 1) summary.stage2_render_residual = total;
+  summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  spdlog::info("stage {} model rendered at the observed pixels: relative rms {:.4f}", stage, total);
+}
+
+void SolverState::RunStage2() {
+  const std::filesystem::path temp =
+      std::filesystem::temp_directory_path() /
+      fmt::format("igi-solve-{}-{}", ::getpid(), reinterpret_cast<uintptr_t>(this));
+  std::filesystem::create_directories(temp);
+  struct Cleanup {
+    std::filesystem::path p;
+    ~Cleanup() {
+      std::error_code ec;
+      std::filesystem::remove_all(p, ec);
+    }
+  } cleanup{temp};
+  std::vector<RegionAtlas> atlases;
+  std::vector<Image> maps;
+  {
+    const Scene model = CompleteScene(&atlases, &maps, temp / "s1");
+    RenderResiduals(model, 1);
+  }
+  for (int round = 1; round <= options.refine_iterations; ++round) {
+    std::filesystem::create_directories(temp / std::to_string(round));
+    const Scene model = CompleteScene(&atlases, &maps, temp / std::to_string(round));
+    IncidentFromRenderer(model, uint64_t(round));
+    SmoothIrradiance();
+    FitAll(2, round);
+    ComputeSpecularTerms();
+    summary.stage2_iterations = round;
+  }
+  if (options.refine_iterations > 0) {
+    std::filesystem::create_directories(temp / "final");
+    const Scene model = CompleteScene(&atlases, &maps, temp / "final");
+    RenderResiduals(model, 2);
+  }
+  for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
+}
+
+void SolverState::BuildAlbedoMaps() {
+  std::vector<RegionAtlas> generated;
+  for (size_t r = 0; r < materials.size(); ++r) {
+    const MaterialState& m = materials[r];
+    if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
+    const bool want = options.albedo_maps == "all" ||
+                      (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
+    if (!want) continue;
+    const RegionAtlas atlas = AtlasOf(*this, int(r));
+    RegionSolution& rs = summary.regions[r];
+    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage);
+    rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
+    rs.albedo_map_generated_uvs = atlas.generated;
+    if (atlas.generated) generated.push_back(atlas);
+  }
+  if (!generated.empty()) summary.charted_mesh = ApplyAtlases(scene.mesh, generated);
+}
+
+SolveSummary Solve(const Scene& scene, const SolveOptions& options,
+                   const std::filesystem::path& out_dir) {
+  options.Validate();
+  const auto start = std::chrono::steady_clock::now();
+  SolverState s(scene, options);
+  if (scene.photos.empty()) {
+    throw InputError(DescribeProblem(scene.file.string(), "photos", "[]",
+                                     "the solver needs at least one photo"));
+  }
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
+  for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  s.summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 48.0;
+  s.patches = BuildPatches(scene.mesh, s.summary.patch_size_m);
+  s.summary.patches = s.patches.size();
+  s.InitMaterials();
+  s.summary.regions.resize(scene.materials.size());
+  s.BuildLightingScenes();
+  s.LoadPhotos();
+  s.CollectAllObservations();
+  s.SummariseRegions();
+  s.SelectFitSamples();
+  s.ChooseTexelSize();
+  s.AnalyseCoverage();
+  s.GatherAll();
+  s.RunStage1();
+  s.RunStage2();
+  s.BuildAlbedoMaps();
+  s.FinishRegions();
+  s.summary.seconds_total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  s.summary.scene_document = SolvedSceneDocument(scene, s.summary, out_dir);
+  return std::move(s.summary);
+}
+
+}  // namespace igi

@@ -1,0 +1,47 @@
+#pragma once
+// Options of igi-solve (CONTRACT.md §4): the inverse global illumination solver of Yu, Debevec,
+// Malik and Hawkins (SIGGRAPH 1999) followed by a joint refinement against the path tracer.
+// Every field has a default, a unit and a flag of the same name (--pixel-stride, ...).
+
+#include <cstdint>
+#include <string>
+
+namespace igi {
+
+struct SolveOptions {
+  // Observations: every pixel_stride-th pixel of each photo in x and y (>= 1).
+  int pixel_stride = 2;
+  // Pixel values at or above this are clipped and ignored (scene radiance units); 0 = auto: a
+  // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
+  double saturation = 0;
+  // Patch size, metres: 0 = auto (the scene's bounding-box diagonal / 48).
+  double patch_size_m = 0;
+  // Gathering at each observation and patch: samples per extended light (sphere, area) and
+  // stratified hemisphere rays for the light arriving from other surfaces.
+  int light_samples = 16;
+  int indirect_rays = 64;
+  // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
+  // surface is averaged to remove gathering noise; 0 = auto (half the patch size).
+  double smoothing_radius_m = 0;
+  // The paper's alternation: fit, recompute specular differences, refit.
+  int max_iterations = 8;
+  double tolerance = 2e-3;  // largest relative parameter change that counts as converged
+  // "grey": one ρs for all channels (dielectrics, RADIANCE plastic); "rgb": coloured (metals).
+  std::string specular_colour = "grey";
+  // Albedo maps: "auto" for regions whose albedo varies significantly across patches (or that
+  // declare UVs and vary), "all" for every region with an unknown albedo, "none".
+  std::string albedo_maps = "auto";
+  double texel_size_m = 0;  // albedo map texel, metres; 0 = auto (the median pixel footprint)
+  // Beyond the paper: re-render the light arriving at every observation with the full path
+  // tracer and refit all parameters, `refine_iterations` times (0 = off).
+  int refine_iterations = 2;
+  int refine_rays = 16;  // path-traced directions per observation in each refinement round
+  uint64_t seed = 1;
+  int num_threads = 0;  // 0 = the process default
+  bool show_progress = true;
+
+  // Throws InputError naming the flag and the rule.
+  void Validate() const;
+};
+
+}  // namespace igi

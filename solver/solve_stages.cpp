@@ -1,0 +1,352 @@
+// The solver's iterations (stage 1: the paper's image-based model; stage 2: the path tracer),
+// the residual renders and the albedo maps. See solver/solve.h.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <unordered_map>
+
+#include "solver/albedo_map.h"
+#include "solver/render.h"
+#include "solver/solve_internal.h"
+#include "solver/surface_hit.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+namespace {
+
+Eigen::Vector3d FaceNormalToward(const TriangleMesh& mesh, int triangle, const Eigen::Vector3d& v) {
+  const Eigen::Vector3d fn = mesh.FaceNormal(triangle).cast<double>();
+  return fn.dot(v) >= 0 ? fn : -fn;
+}
+
+uint64_t Mix(uint64_t a, uint64_t b) {
+  uint64_t x = a * 0x9e3779b97f4a7c15ULL ^ (b + 0x632be59bd9b4e019ULL + (a << 6) + (a >> 2));
+  x ^= x >> 31;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  return x ^ (x >> 29);
+}
+
+Json ParamsJson(const MaterialState& m) {
+  Json j;
+  j["rho_d"] = {m.params.rho_d[0], m.params.rho_d[1], m.params.rho_d[2]};
+  if (HasSpecularLobe(m.params.model)) {
+    j["rho_s"] = {m.params.rho_s[0], m.params.rho_s[1], m.params.rho_s[2]};
+    if (IsAnisotropic(m.params.model)) {
+      j["alpha_x"] = m.params.alpha_x;
+      j["alpha_y"] = m.params.alpha_y;
+    } else {
+      j["alpha"] = m.params.alpha;
+    }
+  }
+  return j;
+}
+
+double RelChange(double a, double b, double floor) { return std::abs(a - b) / std::max(std::abs(b), floor); }
+
+}  // namespace
+
+Eigen::Vector3d SolverState::KnownAlbedo(const Observation& o) const {
+  const MaterialState& m = materials[o.region];
+  if (m.known_map && scene.mesh.has_uvs()) {
+    const Eigen::Vector3i& t = scene.mesh.triangles[o.triangle];
+    const Eigen::Vector2d uv = ((1.0f - o.b1 - o.b2) * scene.mesh.uvs[t[0]] +
+                                o.b1 * scene.mesh.uvs[t[1]] + o.b2 * scene.mesh.uvs[t[2]])
+                                   .cast<double>();
+    return SampleTexture(*m.known_map, uv);
+  }
+  return m.params.rho_d;
+}
+
+void SolverState::IncidentFromPatches() {
+  const size_t n = obs.size();
+  obs_e_direct.resize(n);
+  obs_e_indirect.resize(n);
+  obs_incident.resize(n);
+  for (LightingState& st : lighting_state) {
+    if (!st.active) continue;
+    ParallelFor(
+        0, int64_t(st.obs.size()),
+        [&](int64_t k) {
+          const int i = st.obs[k];
+          const Observation& o = obs[i];
+          const GatherPoint& gp = st.gather.points[obs_point[i]];
+          const bool glossy = HasSpecularLobe(materials[o.region].params.model);
+          const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
+          std::vector<IncidentLocal> inc;
+          if (glossy) {
+            for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
+              const DirectSample& ds = st.gather.direct[d];
+              inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
+            }
+          }
+          Eigen::Vector3d e = Eigen::Vector3d::Zero();
+          for (int d = gp.indirect_begin; d < gp.indirect_end; ++d) {
+            const IndirectSample& s = st.gather.indirect[d];
+            if (s.patch < 0) continue;
+            const Eigen::Vector3d l = PatchRadiance(st, s.patch, -s.wi.cast<double>());
+            e += s.weight * l;
+            if (glossy) {
+              inc.push_back({frame.ToLocal(s.wi.cast<double>()).cast<float>(),
+                             (s.weight * l).cast<float>()});
+            }
+          }
+          obs_e_direct[i] = gp.e_direct.cast<double>();
+          obs_e_indirect[i] = e;
+          obs_incident[i] = std::move(inc);
+        },
+        options.num_threads);
+  }
+}
+
+void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
+  for (size_t l = 0; l < scene.lightings.size(); ++l) {
+    if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+  }
+  std::atomic<uint64_t> rays{0};
+  ParallelFor(
+      0, int64_t(obs.size()),
+      [&](int64_t i) {
+        const Observation& o = obs[i];
+        const int l = scene.photos[o.photo].lighting;
+        const LightingState& st = lighting_state[l];
+        const GatherPoint& gp = st.gather.points[obs_point[i]];
+        const bool glossy = HasSpecularLobe(materials[o.region].params.model);
+        const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
+        GatherQuery q;
+        q.position = o.position.cast<double>();
+        q.view = o.view.cast<double>();
+        q.n_geo = FaceNormalToward(scene.mesh, o.triangle, q.view);
+        q.n_s = o.normal.cast<double>();
+        q.lobe = glossy;
+        Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
+        std::vector<IncidentLocal> inc;
+        if (glossy) {
+          for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
+            const DirectSample& ds = st.gather.direct[d];
+            inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
+          }
+        }
+        const double eps = lighting_scenes[l]->ray_epsilon;
+        Eigen::Vector3d e = Eigen::Vector3d::Zero();
+        int k = 0;
+        for (const WeightedDirection& d : HemisphereDirections(q, options.refine_rays, 0.2, rng)) {
+          const Eigen::Vector3d li = renderers[l]->ReflectedRadiance(
+              q.position + q.n_geo * eps, d.wi, 1, Mix(Mix(options.seed, round), i * 4096 + k++));
+          e += d.weight * li;
+          if (glossy) inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
+        }
+        rays += k;
+        obs_e_direct[i] = gp.e_direct.cast<double>();
+        obs_e_indirect[i] = e;
+        obs_incident[i] = std::move(inc);
+      },
+      options.num_threads);
+  summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.rays += rays.load();
+}
+
+// The indirect irradiance varies slowly over a surface while its per-point estimate is noisy:
+// average it over the observations (any photo of the same lighting) within the smoothing radius
+// on the same region with normals within 25°.
+void SolverState::SmoothIrradiance() {
+  const double radius =
+      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : 0.5 * summary.patch_size_m;
+  obs_e.resize(obs.size());
+  for (LightingState& st : lighting_state) {
+    if (!st.active) continue;
+    std::unordered_map<int64_t, std::vector<int>> grid;
+    auto key = [&](const Eigen::Vector3f& p, int dx, int dy, int dz) {
+      const int64_t x = int64_t(std::floor(p.x() / radius)) + dx;
+      const int64_t y = int64_t(std::floor(p.y() / radius)) + dy;
+      const int64_t z = int64_t(std::floor(p.z() / radius)) + dz;
+      return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+    };
+    for (int i : st.obs) grid[key(obs[i].position, 0, 0, 0)].push_back(i);
+    ParallelFor(
+        0, int64_t(st.obs.size()),
+        [&](int64_t k) {
+          const int i = st.obs[k];
+          const Observation& o = obs[i];
+          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+          int count = 0;
+          for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dz = -1; dz <= 1; ++dz) {
+                auto it = grid.find(key(o.position, dx, dy, dz));
+                if (it == grid.end()) continue;
+                for (int j : it->second) {
+                  const Observation& p = obs[j];
+                  if (p.region != o.region || (p.position - o.position).norm() > radius ||
+                      p.normal.dot(o.normal) < 0.9f) {
+                    continue;
+                  }
+                  sum += obs_e_indirect[j];
+                  ++count;
+                }
+              }
+          obs_e[i] = obs_e_direct[i] + (count > 0 ? Eigen::Vector3d(sum / count) : obs_e_indirect[i]);
+        },
+        options.num_threads);
+  }
+}
+
+void SolverState::ComputeSpecularTerms() {
+  obs_t.resize(obs.size());
+  ParallelFor(
+      0, int64_t(obs.size()),
+      [&](int64_t i) {
+        const MaterialState& m = materials[obs[i].region];
+        Eigen::Vector3d t = Eigen::Vector3d::Zero();
+        if (HasSpecularLobe(m.params.model)) {
+          const Eigen::Vector3d wo =
+              LocalFrame(obs[i].region, obs[i].normal.cast<double>()).ToLocal(obs[i].view.cast<double>());
+          for (const IncidentLocal& inc : obs_incident[i]) {
+            const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                            m.params.ior, wo, inc.wi.cast<double>());
+            if (w > 0) t += w * inc.value.cast<double>();
+          }
+        }
+        obs_t[i] = t;
+      },
+      options.num_threads);
+}
+
+double SolverState::FitAll(int stage, int iteration) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<int> regions;
+  for (size_t r = 0; r < materials.size(); ++r) {
+    if (materials[r].NeedsFit() && materials[r].observations > 0) regions.push_back(int(r));
+  }
+  std::vector<RegionFitInput> inputs(regions.size());
+  std::vector<RegionFitResult> results(regions.size());
+  for (size_t k = 0; k < regions.size(); ++k) {
+    const int r = regions[k];
+    const MaterialState& m = materials[r];
+    RegionFitInput& in = inputs[k];
+    in.name = scene.materials[r].name;
+    in.model = m.params.model;
+    in.fit_rho_d = m.unknown_rho_d;
+    in.grey_specular = options.specular_colour == "grey";
+    if (m.no_highlight) {
+      in.rho_s_grey = 0.0;
+    } else if (!m.unknown_rho_s) {
+      in.rho_s_rgb = m.params.rho_s;
+    }
+    if (!m.unknown_alpha || m.no_highlight) {
+      in.alpha = m.params.alpha;
+      in.alpha_x = m.params.alpha_x;
+      in.alpha_y = m.params.alpha_y;
+    }
+    in.ior = m.params.ior;
+    in.num_slots = static_cast<int>(region_patches[r].size());
+    for (int q : region_patches[r]) in.slot_area.push_back(patches.area[q]);
+  }
+  std::vector<int> index_of(materials.size(), -1);
+  for (size_t k = 0; k < regions.size(); ++k) index_of[regions[k]] = int(k);
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const Observation& o = obs[i];
+    if (!in_fit[i] || index_of[o.region] < 0) continue;
+    RegionFitInput& in = inputs[index_of[o.region]];
+    FitSample s;
+    s.observed = o.radiance.cast<double>();
+    s.irradiance = obs_e[i];
+    s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : KnownAlbedo(o);
+    s.slot = patch_slot[o.patch];
+    s.wo = LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+    s.incident_begin = static_cast<int>(in.incident.size());
+    in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
+    s.incident_end = static_cast<int>(in.incident.size());
+    in.samples.push_back(s);
+  }
+  for (size_t k = 0; k < regions.size(); ++k) {
+    Eigen::Vector3d e = Eigen::Vector3d::Zero(), l = e;
+    for (const FitSample& fs : inputs[k].samples) e += fs.irradiance, l += fs.observed;
+    const double n = std::max<size_t>(1, inputs[k].samples.size());
+    spdlog::debug("  {}: {} samples, mean irradiance ({:.4g}, {:.4g}, {:.4g}), mean radiance "
+                  "({:.4g}, {:.4g}, {:.4g})",
+                  inputs[k].name, inputs[k].samples.size(), e[0] / n, e[1] / n, e[2] / n,
+                  l[0] / n, l[1] / n, l[2] / n);
+  }
+  ParallelFor(0, int64_t(regions.size()), [&](int64_t k) { results[k] = FitRegion(inputs[k], {}); },
+              options.num_threads, 1);
+  double change = 0, num = 0, den = 0;
+  SolveIteration record;
+  record.stage = stage;
+  record.iteration = iteration;
+  for (size_t k = 0; k < regions.size(); ++k) {
+    MaterialState& m = materials[regions[k]];
+    const RegionFitResult& f = results[k];
+    if (!f.fitted) continue;
+    const BrdfParams old = m.params;
+    if (m.unknown_rho_d) {
+      m.params.rho_d = f.rho_d;
+      for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
+        m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
+                               ? f.slot_rho_d[s]
+                               : Eigen::Vector3d::Constant(NAN);
+      }
+      change = std::max(change, RelChange(m.params.rho_d.mean(), old.rho_d.mean(), 0.01));
+    }
+    if (m.unknown_rho_s) {
+      m.params.rho_s = f.rho_s;
+      change = std::max(change, RelChange(m.params.rho_s.mean(), old.rho_s.mean(), 0.01));
+    }
+    if (m.unknown_alpha) {
+      m.params.alpha = f.alpha;
+      m.params.alpha_x = f.alpha_x;
+      m.params.alpha_y = f.alpha_y;
+      change = std::max(change, RelChange(m.params.AlphaX(), old.AlphaX(), 0.005));
+      change = std::max(change, RelChange(m.params.AlphaY(), old.AlphaY(), 0.005));
+    }
+    m.last_fit = f;
+    record.params[scene.materials[regions[k]].name] = ParamsJson(m);
+    num += f.relative_rms * f.relative_rms * f.samples;
+    den += f.samples;
+  }
+  record.relative_rms = den > 0 ? std::sqrt(num / den) : 0.0;
+  record.max_change = change;
+  summary.history.push_back(record);
+  summary.seconds_fit += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  spdlog::info("stage {} iteration {}: relative rms {:.4f}, largest change {:.2e}", stage,
+               iteration, record.relative_rms, change);
+  return change;
+}
+
+void SolverState::RunStage1() {
+  obs_t.assign(obs.size(), Eigen::Vector3d::Zero());
+  summary.converged = false;
+  for (int it = 1; it <= options.max_iterations; ++it) {
+    for (LightingState& st : lighting_state) {
+      if (st.active) UpdatePatchRadiance(&st);
+    }
+    IncidentFromPatches();
+    SmoothIrradiance();
+    const double change = FitAll(1, it);
+    ComputeSpecularTerms();
+    summary.stage1_iterations = it;
+    if (it > 1 && change < options.tolerance) {
+      summary.converged = true;
+      summary.message = fmt::format("converged: largest relative change {:.2e} < {}", change,
+                                    options.tolerance);
+      break;
+    }
+  }
+  if (!summary.converged) {
+    summary.message = fmt::format("not converged after {} iterations (largest relative change "
+                                  "{:.2e}, tolerance {})",
+                                  options.max_iterations, summary.history.back().max_change,
+                                  options.tolerance);
+  }
+  summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
+  for (size_t r = 0; r < materials.size(); ++r) {
+    summary.regions[r].stage1 = summary.regions[r].stage2 = materials[r].last_fit;
+  }
+}
+
+}  // namespace igi
