@@ -28,7 +28,7 @@ td.bad { background: #f8c8c8; } td.warn { background: #fde9a8; } td.good { backg
 .row { display: flex; flex-wrap: wrap; gap: 10px; align-items: flex-start; }
 figure { margin: 0.5em 0; }
 figcaption { font-size: 90%; color: #444; }
-img { max-width: 100%; height: auto; }
+img, svg { max-width: 100%; height: auto; }
 svg text { font-family: sans-serif; font-size: 11px; }
 )";
 
