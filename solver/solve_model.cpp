@@ -103,13 +103,16 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
 
 void SolverState::RenderResiduals(const Scene& model, int stage) {
   const auto start = std::chrono::steady_clock::now();
-  constexpr int kSpp = 8;
+  // Two independent renders of kSpp/2 paths: Σ(r1 − p)(r2 − p) estimates Σ(r − p)² of the
+  // noise-free render r without the render's own Monte Carlo variance (whose size at a few
+  // paths per pixel would otherwise swamp the model's error).
+  constexpr int kSpp = 16;
   summary.render_residual_spp = kSpp;
   std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
     if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
-  std::vector<Eigen::Vector3d> pred(obs.size());
+  std::vector<Eigen::Vector3d> pred(obs.size()), pred1(obs.size()), pred2(obs.size());
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
@@ -117,8 +120,10 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
         const Photo& p = scene.photos[o.photo];
         const Camera& cam = scene.cameras[p.camera];
         const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5));
-        pred[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp,
-                                                  options.seed * 7919 + uint64_t(i));
+        const uint64_t seed = options.seed * 7919 + uint64_t(i) * 2;
+        pred1[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp / 2, seed);
+        pred2[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp / 2, seed + 1);
+        pred[i] = 0.5 * (pred1[i] + pred2[i]);
       },
       options.num_threads);
   const int stride = options.pixel_stride;
@@ -143,16 +148,16 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
       pr.render.at(x, y, c) = float(pred[i][c]);
       pr.residual.at(x, y, c) = float(pred[i][c] - o.radiance[c]);
     }
-    const double d = (pred[i] - o.radiance.cast<double>()).squaredNorm();
+    const double d = (pred1[i] - o.radiance.cast<double>()).dot(pred2[i] - o.radiance.cast<double>());
     const double p2 = o.radiance.cast<double>().squaredNorm();
     num[o.photo] += d, den[o.photo] += p2, all_num += d, all_den += p2;
   }
   for (size_t k = 0; k < scene.photos.size(); ++k) {
-    const double r = den[k] > 0 ? std::sqrt(num[k] / den[k]) : 0.0;
+    const double r = den[k] > 0 ? std::sqrt(std::max(0.0, num[k]) / den[k]) : 0.0;
     (stage == 1 ? summary.residuals[k].stage1 : summary.residuals[k].stage2) = r;
     if (stage == 1) summary.residuals[k].stage2 = r;
   }
-  const double total = all_den > 0 ? std::sqrt(all_num / all_den) : 0.0;
+  const double total = all_den > 0 ? std::sqrt(std::max(0.0, all_num) / all_den) : 0.0;
   (stage == 1 ? summary.stage1_render_residual : summary.stage2_render_residual) = total;
   if (stage == 1) summary.stage2_render_residual = total;
   summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
