@@ -21,7 +21,7 @@ constexpr double kUsableUvAreaFraction = 0.99;
 // A chart member whose normal is this far from the chart's final mean (cos < kMinProjectedCos,
 // about 84 degrees) is given back and starts a chart of its own: its projection would fold.
 constexpr double kMinProjectedCos = 0.1;
-constexpr int kMaxGrowAttempts = 80;
+constexpr int kMaxGrowAttempts = 40;  // doublings of the texel size
 
 // Shortest text that reads back to the same value.
 template <typename T>
@@ -30,7 +30,6 @@ std::string ShortestText(T value) {
   const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
   return std::string(buffer, result.ptr);
 }
-std::string Num(double value) { return ShortestText(value); }
 std::string Num(float value) { return ShortestText(value); }
 
 // Face normal and area in double precision; a degenerate face has a zero normal.
@@ -223,6 +222,16 @@ std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> points) {
   return hull;
 }
 
+// The length of the points' projections onto `d`.
+double Extent(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& d) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const Eigen::Vector2d& p : points) {
+    lo = std::min(lo, p.dot(d));
+    hi = std::max(hi, p.dot(d));
+  }
+  return hi - lo;
+}
+
 // The direction whose bounding rectangle (along it and its left perpendicular) has the least
 // area: the best is always along an edge of the convex hull.
 Eigen::Vector2d BestDirection(const std::vector<Eigen::Vector2d>& points) {
@@ -274,7 +283,12 @@ ProjectedChart ProjectChart(const TriangleMesh& mesh, const std::vector<int>& tr
     }
     chart.corners_m.push_back(corners);
   }
-  const Eigen::Vector2d d = BestDirection(points), perp(-d.y(), d.x());
+  // Landscape (the wider side along u), so equal inputs give equal layouts.
+  Eigen::Vector2d d = BestDirection(points);
+  if (Extent(points, Eigen::Vector2d(-d.y(), d.x())) > Extent(points, d) * (1 + 1e-9)) {
+    d = Eigen::Vector2d(-d.y(), d.x());
+  }
+  const Eigen::Vector2d perp(-d.y(), d.x());
   Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
   for (auto& corners : chart.corners_m) {
     for (Eigen::Vector2d& c : corners) {
@@ -358,6 +372,35 @@ std::vector<Eigen::Vector2i> ChartSizes(const std::vector<ProjectedChart>& chart
   return sizes;
 }
 
+// The texel size (> options.texel_size_m) at which the charts pack into max_size, within 1% of
+// the smallest such; sets *packing. 0 when none does (too many charts for the gutters).
+double FittingTexelSize(const std::vector<ProjectedChart>& charts, const AtlasOptions& options,
+                        Packing* packing) {
+  auto pack = [&](double texel) { return Pack(ChartSizes(charts, texel, options.gutter_texels)); };
+  auto fits = [&](const Packing& p) { return std::max(p.width, p.height) <= options.max_size; };
+  double too_small = options.texel_size_m, big = too_small;
+  Packing fitting;
+  for (int attempt = 0;; ++attempt) {  // grow until it fits
+    if (attempt >= kMaxGrowAttempts) return 0;
+    big *= 2;
+    fitting = pack(big);
+    if (fits(fitting)) break;
+    too_small = big;
+  }
+  while (big > too_small * 1.01) {  // then bisect
+    const double mid = std::sqrt(big * too_small);
+    Packing p = pack(mid);
+    if (fits(p)) {
+      big = mid;
+      fitting = std::move(p);
+    } else {
+      too_small = mid;
+    }
+  }
+  *packing = std::move(fitting);
+  return big;
+}
+
 void GenerateCharts(const TriangleMesh& mesh, const AtlasOptions& options, RegionAtlas* atlas) {
   const std::vector<int>& tris = atlas->triangles;
   std::vector<Face> faces;
@@ -367,20 +410,14 @@ void GenerateCharts(const TriangleMesh& mesh, const AtlasOptions& options, Regio
     charts.push_back(ProjectChart(mesh, tris, faces, members));
   }
   double texel = options.texel_size_m;
-  Packing packing;
-  std::vector<Eigen::Vector2i> sizes;
-  for (int attempt = 0;; ++attempt) {
-    sizes = ChartSizes(charts, texel, options.gutter_texels);
-    packing = Pack(sizes);
-    const int largest = std::max(packing.width, packing.height);
-    if (largest <= options.max_size) break;
-    if (attempt + 1 >= kMaxGrowAttempts) {
+  Packing packing = Pack(ChartSizes(charts, texel, options.gutter_texels));
+  if (std::max(packing.width, packing.height) > options.max_size) {
+    texel = FittingTexelSize(charts, options, &packing);
+    if (texel <= 0) {
       throw Error("region " + mesh.region_names.at(atlas->region) + ": " +
                   std::to_string(charts.size()) + " charts do not fit into " +
-                  std::to_string(options.max_size) + " texels even at a texel size of " +
-                  Num(texel) + " m");
+                  std::to_string(options.max_size) + " texels at any texel size");
     }
-    texel *= std::max(1.1, double(largest) / options.max_size);
   }
   atlas->texel_size_m = texel;
   atlas->width = packing.width;

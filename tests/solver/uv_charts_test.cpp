@@ -125,6 +125,8 @@ AtlasCheck CheckAtlas(const TriangleMesh& mesh, const RegionAtlas& atlas) {
       const Eigen::Vector2f uv = atlas.corner_uv[t][k];
       EXPECT_TRUE(uv.x() >= 0 && uv.x() <= 1 && uv.y() >= 0 && uv.y() <= 1) << uv.transpose();
       px[k] = Eigen::Vector2d(uv.x() * w, (1 - uv.y()) * h);
+    }
+    for (int k = 0; k < 3; ++k) {
       const Eigen::Vector2d e = px[(k + 1) % 3] - px[k];
       const double world =
           (mesh.positions[mesh.triangles[t][(k + 1) % 3]] - mesh.positions[mesh.triangles[t][k]])
@@ -144,8 +146,10 @@ AtlasCheck CheckAtlas(const TriangleMesh& mesh, const RegionAtlas& atlas) {
       it->second = it->second.min(Eigen::Array4d(p.x() - 0.5, p.y() - 0.5, INFINITY, INFINITY))
                        .max(Eigen::Array4d(-INFINITY, -INFINITY, p.x() - 0.5, p.y() - 0.5));
     }
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
+    const Eigen::Vector2d lo = px[0].cwiseMin(px[1]).cwiseMin(px[2]);
+    const Eigen::Vector2d hi = px[0].cwiseMax(px[1]).cwiseMax(px[2]);
+    for (int y = std::max(0, int(lo.y()) - 1); y < std::min(h, int(hi.y()) + 1); ++y) {
+      for (int x = std::max(0, int(lo.x()) - 1); x < std::min(w, int(hi.x()) + 1); ++x) {
         double sign = 0;
         bool inside = true;
         for (int k = 0; k < 3 && inside; ++k) {
