@@ -1,46 +1,268 @@
-// TEMPORARY stub (the real module comes from the wt-albedo branch).
 #include "solver/albedo_map.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
+
+#include "tools/common/error.h"
 
 namespace igi {
-RegionAtlas BuildRegionAtlas(const TriangleMesh& mesh, int region, const AtlasOptions& options) {
-  RegionAtlas a;
-  a.region = region;
-  a.width = a.height = 64;
-  a.texel_size_m = options.texel_size_m;
-  a.corner_uv.resize(mesh.num_triangles());
-  if (mesh.has_uvs()) {
-    for (size_t t = 0; t < mesh.num_triangles(); ++t) {
-      for (int k = 0; k < 3; ++k) a.corner_uv[t][k] = mesh.uvs[mesh.triangles[t][k]];
+
+namespace {
+
+// Per texel: numerator (3), denominator (3), summed bilinear weight.
+constexpr int kSlots = 7;
+constexpr int kWeightSlot = 6;
+
+// One level of the push-pull pyramid, one channel.
+struct Level {
+  int width = 0, height = 0;
+  std::vector<float> value, weight;
+  Level(int w, int h)
+      : width(w), height(h), value(size_t(w) * h, 0.f), weight(size_t(w) * h, 0.f) {}
+  size_t at(int x, int y) const { return size_t(y) * width + x; }
+};
+
+// Pull: each coarse texel is the weighted mean of its (up to) 2×2 children; weights add up and
+// saturate at 1.
+Level Coarser(const Level& fine) {
+  Level coarse((fine.width + 1) / 2, (fine.height + 1) / 2);
+  for (int y = 0; y < coarse.height; ++y) {
+    for (int x = 0; x < coarse.width; ++x) {
+      double sum_w = 0, sum_v = 0;
+      for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+          const int fx = 2 * x + dx, fy = 2 * y + dy;
+          if (fx >= fine.width || fy >= fine.height) continue;
+          const size_t i = fine.at(fx, fy);
+          sum_w += fine.weight[i];
+          sum_v += double(fine.weight[i]) * fine.value[i];
+        }
+      }
+      if (sum_w > 0) coarse.value[coarse.at(x, y)] = float(sum_v / sum_w);
+      coarse.weight[coarse.at(x, y)] = float(std::min(1.0, sum_w));
     }
   }
-  return a;
+  return coarse;
 }
-void WriteObjWithAtlases(const TriangleMesh&, const std::vector<RegionAtlas>&,
-                         const std::filesystem::path&) {}
-AlbedoMapBuilder::AlbedoMapBuilder(const RegionAtlas& atlas)
-    : atlas_(&atlas), num_(size_t(atlas.width) * atlas.height * 3), den_(num_.size()) {}
-void AlbedoMapBuilder::Add(int triangle, double b1, double b2, const Eigen::Vector3d& n,
-                           const Eigen::Vector3d& d) {
-  const Eigen::Vector2d uv = atlas_->UvAt(triangle, b1, b2);
-  const int x = std::clamp(int(uv.x() * atlas_->width), 0, atlas_->width - 1);
-  const int y = std::clamp(int((1 - uv.y()) * atlas_->height), 0, atlas_->height - 1);
-  for (int c = 0; c < 3; ++c) {
-    num_[(size_t(y) * atlas_->width + x) * 3 + c] += n[c];
-    den_[(size_t(y) * atlas_->width + x) * 3 + c] += d[c];
+
+// Bilinear lookup of a coarse level at the centre of fine texel (x, y), indices clamped.
+float Upsampled(const Level& coarse, int x, int y) {
+  const double cx = (x + 0.5) / 2 - 0.5, cy = (y + 0.5) / 2 - 0.5;
+  const int x0 = static_cast<int>(std::floor(cx)), y0 = static_cast<int>(std::floor(cy));
+  const double fx = cx - x0, fy = cy - y0;
+  auto texel = [&](int xi, int yi) {
+    return double(coarse.value[coarse.at(std::clamp(xi, 0, coarse.width - 1),
+                                         std::clamp(yi, 0, coarse.height - 1))]);
+  };
+  return float((1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
+               fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1)));
+}
+
+// Push-pull fill (Gortler et al. 1996): texels of weight 1 keep their value, the others are
+// blended with the filled coarser level. Needs some weight somewhere.
+void PushPull(Level* level0) {
+  std::vector<Level> pyramid;
+  pyramid.push_back(std::move(*level0));
+  while (pyramid.back().width > 1 || pyramid.back().height > 1) {
+    pyramid.push_back(Coarser(pyramid.back()));
   }
+  for (int l = static_cast<int>(pyramid.size()) - 2; l >= 0; --l) {
+    Level& fine = pyramid[l];
+    const Level& coarse = pyramid[l + 1];
+    for (int y = 0; y < fine.height; ++y) {
+      for (int x = 0; x < fine.width; ++x) {
+        const size_t i = fine.at(x, y);
+        const float a = fine.weight[i];
+        if (a >= 1) continue;
+        fine.value[i] = a * fine.value[i] + (1 - a) * Upsampled(coarse, x, y);
+      }
+    }
+  }
+  *level0 = std::move(pyramid.front());
 }
-void AlbedoMapBuilder::Merge(const AlbedoMapBuilder& o) {
-  for (size_t i = 0; i < num_.size(); ++i) num_[i] += o.num_[i], den_[i] += o.den_[i];
+
+// Whether the centre of texel (x, y) (pixel coordinates x right, y down) is inside the triangle.
+bool Inside(const std::array<Eigen::Vector2d, 3>& p, double x, double y) {
+  double sign = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d& a = p[k];
+    const Eigen::Vector2d& b = p[(k + 1) % 3];
+    const double e = (b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x());
+    if (e == 0) continue;
+    if (sign == 0) sign = e;
+    if ((e > 0) != (sign > 0)) return false;
+  }
+  return true;
 }
+
+}  // namespace
+
+struct AlbedoMapBuilder::Tile {
+  std::array<double, kTile * kTile * kSlots> sums{};
+  double* texel(int x, int y) { return &sums[((y % kTile) * kTile + (x % kTile)) * kSlots]; }
+  const double* texel(int x, int y) const {
+    return &sums[((y % kTile) * kTile + (x % kTile)) * kSlots];
+  }
+};
+
+AlbedoMapBuilder::AlbedoMapBuilder(const RegionAtlas& atlas, double min_texel_weight)
+    : atlas_(&atlas), min_texel_weight_(min_texel_weight) {
+  if (atlas.width <= 0 || atlas.height <= 0) {
+    throw Error("AlbedoMapBuilder: the atlas of region " + std::to_string(atlas.region) +
+                " is empty");
+  }
+  tiles_x_ = (atlas.width + kTile - 1) / kTile;
+  tiles_y_ = (atlas.height + kTile - 1) / kTile;
+  tiles_.resize(size_t(tiles_x_) * tiles_y_);
+}
+
+AlbedoMapBuilder::~AlbedoMapBuilder() = default;
+AlbedoMapBuilder::AlbedoMapBuilder(AlbedoMapBuilder&&) noexcept = default;
+AlbedoMapBuilder& AlbedoMapBuilder::operator=(AlbedoMapBuilder&&) noexcept = default;
+
+AlbedoMapBuilder::Tile* AlbedoMapBuilder::TileAt(int x, int y) {
+  std::unique_ptr<Tile>& tile = tiles_[size_t(y / kTile) * tiles_x_ + x / kTile];
+  if (!tile) tile = std::make_unique<Tile>();
+  return tile.get();
+}
+
+const AlbedoMapBuilder::Tile* AlbedoMapBuilder::TileAt(int x, int y) const {
+  return tiles_[size_t(y / kTile) * tiles_x_ + x / kTile].get();
+}
+
+void AlbedoMapBuilder::Add(int triangle, double b1, double b2, const Eigen::Vector3d& numerator,
+                           const Eigen::Vector3d& denominator) {
+  if (triangle < 0 || triangle >= static_cast<int>(atlas_->corner_uv.size())) {
+    throw Error("AlbedoMapBuilder::Add: triangle " + std::to_string(triangle) +
+                " is not in the mesh");
+  }
+  if (!numerator.allFinite() || !denominator.allFinite() || !std::isfinite(b1) ||
+      !std::isfinite(b2)) {
+    return;
+  }
+  Eigen::Vector2d uv = atlas_->UvAt(triangle, b1, b2);
+  for (int k = 0; k < 2; ++k) {  // wrapped as the renderer does
+    if (uv[k] < 0.0 || uv[k] > 1.0) uv[k] -= std::floor(uv[k]);
+  }
+  const int width = atlas_->width, height = atlas_->height;
+  const double x = uv.x() * width - 0.5, y = (1.0 - uv.y()) * height - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  for (int dy = 0; dy < 2; ++dy) {
+    for (int dx = 0; dx < 2; ++dx) {
+      const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
+      if (w <= 0) continue;
+      const int xi = std::clamp(x0 + dx, 0, width - 1), yi = std::clamp(y0 + dy, 0, height - 1);
+      double* t = TileAt(xi, yi)->texel(xi, yi);
+      for (int c = 0; c < 3; ++c) {
+        t[c] += w * numerator[c];
+        t[3 + c] += w * denominator[c];
+      }
+      t[kWeightSlot] += w;
+    }
+  }
+  ++num_samples_;
+}
+
+void AlbedoMapBuilder::Merge(const AlbedoMapBuilder& other) {
+  if (other.atlas_->width != atlas_->width || other.atlas_->height != atlas_->height) {
+    throw Error("AlbedoMapBuilder::Merge: atlases differ in size");
+  }
+  for (size_t i = 0; i < tiles_.size(); ++i) {
+    if (!other.tiles_[i]) continue;
+    if (!tiles_[i]) {
+      tiles_[i] = std::make_unique<Tile>(*other.tiles_[i]);
+      continue;
+    }
+    for (size_t k = 0; k < tiles_[i]->sums.size(); ++k)
+      tiles_[i]->sums[k] += other.tiles_[i]->sums[k];
+  }
+  num_samples_ += other.num_samples_;
+}
+
+bool AlbedoMapBuilder::Direct(int x, int y, int channel) const {
+  const Tile* tile = TileAt(x, y);
+  if (tile == nullptr) return false;
+  const double* t = tile->texel(x, y);
+  return t[kWeightSlot] >= min_texel_weight_ && t[3 + channel] > 0;
+}
+
 Image AlbedoMapBuilder::Finish(const Eigen::Vector3d& fallback) const {
-  Image img(atlas_->width, atlas_->height, 3);
-  for (size_t i = 0; i < num_.size(); ++i) {
-    img.pixels[i] = den_[i] > 0 ? float(num_[i] / den_[i]) : float(fallback[i % 3]);
+  const int width = atlas_->width, height = atlas_->height;
+  Image out(width, height, 3);
+  for (int c = 0; c < 3; ++c) {
+    Level level(width, height);
+    bool any = false;
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (!Direct(x, y, c)) continue;
+        const double* t = TileAt(x, y)->texel(x, y);
+        level.value[level.at(x, y)] = float(t[c] / t[3 + c]);
+        level.weight[level.at(x, y)] = 1.f;
+        any = true;
+      }
+    }
+    if (any) PushPull(&level);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        out.at(x, y, c) = any ? level.value[level.at(x, y)] : float(fallback[c]);
+      }
+    }
   }
-  return img;
+  return out;
 }
-double AlbedoMapBuilder::Coverage() const { return 0; }
-double AlbedoPsnr(const Image&, const Image&, double) { return 0; }
+
+double AlbedoMapBuilder::Coverage() const {
+  const int width = atlas_->width, height = atlas_->height;
+  std::vector<char> inside(size_t(width) * height, 0);
+  for (int t : atlas_->triangles) {
+    std::array<Eigen::Vector2d, 3> p;  // pixel coordinates: x right, y down, texel i = [i, i+1)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2f& uv = atlas_->corner_uv[t][k];
+      p[k] = Eigen::Vector2d(uv.x() * width, (1.0 - uv.y()) * height);
+    }
+    const Eigen::Vector2d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
+    const Eigen::Vector2d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
+    const int x_begin = std::max(0, static_cast<int>(std::floor(lo.x() - 0.5)));
+    const int x_end = std::min(width - 1, static_cast<int>(std::ceil(hi.x() - 0.5)));
+    const int y_begin = std::max(0, static_cast<int>(std::floor(lo.y() - 0.5)));
+    const int y_end = std::min(height - 1, static_cast<int>(std::ceil(hi.y() - 0.5)));
+    for (int y = y_begin; y <= y_end; ++y) {
+      for (int x = x_begin; x <= x_end; ++x) {
+        if (Inside(p, x + 0.5, y + 0.5)) inside[size_t(y) * width + x] = 1;
+      }
+    }
+  }
+  int64_t total = 0, direct = 0;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (!inside[size_t(y) * width + x]) continue;
+      ++total;
+      if (Direct(x, y, 0) && Direct(x, y, 1) && Direct(x, y, 2)) ++direct;
+    }
+  }
+  return total == 0 ? 0.0 : double(direct) / double(total);
+}
+
+double AlbedoPsnr(const Image& estimate, const Image& truth, double peak) {
+  if (estimate.width != truth.width || estimate.height != truth.height ||
+      estimate.channels != truth.channels || estimate.pixels.size() != truth.pixels.size()) {
+    throw Error("AlbedoPsnr: image sizes differ (" + std::to_string(estimate.width) + "x" +
+                std::to_string(estimate.height) + "x" + std::to_string(estimate.channels) + " vs " +
+                std::to_string(truth.width) + "x" + std::to_string(truth.height) + "x" +
+                std::to_string(truth.channels) + ")");
+  }
+  if (estimate.pixels.empty()) throw Error("AlbedoPsnr: empty images");
+  if (!(peak > 0)) throw Error("AlbedoPsnr: peak must be > 0");
+  double sum = 0;
+  for (size_t i = 0; i < estimate.pixels.size(); ++i) {
+    const double d = double(estimate.pixels[i]) - truth.pixels[i];
+    sum += d * d;
+  }
+  const double mse = sum / double(estimate.pixels.size());
+  return mse == 0 ? INFINITY : 10.0 * std::log10(peak * peak / mse);
+}
+
 }  // namespace igi

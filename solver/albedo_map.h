@@ -1,23 +1,75 @@
 #pragma once
-// TEMPORARY stub (the real module comes from the wt-albedo branch).
+// Per-texel diffuse albedo maps (issue 7): the solver's per-point albedo estimates, accumulated
+// into the texels of a region's atlas (solver/uv_charts.h) and turned into a linear RGB image.
+//
+// Texel convention = the renderer's lookup (solver/render.cpp SampleTexture): a UV (u right, v
+// up) sits at x = u·W − 0.5, y = (1 − v)·H − 0.5 in texel units (row 0 = top), and reads the four
+// nearest texels bilinearly, indices clamped to the image. Add() splats with exactly those
+// weights (the adjoint of the lookup), so a texel's value is the weighted ratio of the samples
+// whose lookups would read it.
+
 #include <Eigen/Core>
+#include <memory>
+#include <vector>
 
 #include "solver/uv_charts.h"
 #include "tools/common/image.h"
 
 namespace igi {
+
 class AlbedoMapBuilder {
  public:
-  explicit AlbedoMapBuilder(const RegionAtlas& atlas);
+  // A texel is estimated directly when its summed bilinear weight (≈ samples that read it) is at
+  // least this and its denominator is positive; the others are filled from their neighbours.
+  static constexpr double kDefaultMinTexelWeight = 0.5;
+
+  // Keeps a reference to `atlas`, which must outlive the builder. Storage is allocated in tiles
+  // of 16×16 texels on first touch, so sparse builders (one per thread) stay small.
+  explicit AlbedoMapBuilder(const RegionAtlas& atlas,
+                            double min_texel_weight = kDefaultMinTexelWeight);
+  ~AlbedoMapBuilder();
+  AlbedoMapBuilder(AlbedoMapBuilder&&) noexcept;
+  AlbedoMapBuilder& operator=(AlbedoMapBuilder&&) noexcept;
+
+  // One sample at a surface point (barycentrics b1, b2 of corners 1, 2 of `triangle`, which must
+  // be the atlas region's): albedo = numerator / denominator per channel (the solver adds
+  // numerator = w·π·(L_observed − specular), denominator = w·E, E the irradiance). Splat
+  // bilinearly into the 4 nearest texels. Samples with a non-finite value are ignored. Not
+  // thread-safe: use one builder per thread and Merge().
   void Add(int triangle, double b1, double b2, const Eigen::Vector3d& numerator,
            const Eigen::Vector3d& denominator);
+  // Adds another builder's sums (same atlas size; throws igi::Error otherwise).
   void Merge(const AlbedoMapBuilder& other);
+
+  // The map: linear RGB Image (width×height of the atlas, row 0 = top = v 1), each texel
+  // numerator/denominator where the weight is enough; the other texels (holes, gutters, the
+  // space between charts) are filled by push-pull over the whole atlas (per channel: texels keep
+  // their direct value, holes get the weighted average of ever coarser neighbourhoods,
+  // interpolated back bilinearly). A channel that nothing was added to is `fallback` everywhere.
   Image Finish(const Eigen::Vector3d& fallback) const;
+
+  // Fraction of the region's texels (centres inside one of its triangles) that are estimated
+  // directly (see kDefaultMinTexelWeight); 0 when the region covers no texel centre.
   double Coverage() const;
 
+  int64_t num_samples() const { return num_samples_; }  // samples added (incl. merged)
+
  private:
+  struct Tile;
+  static constexpr int kTile = 16;
+  Tile* TileAt(int x, int y);  // allocates
+  const Tile* TileAt(int x, int y) const;
+  bool Direct(int x, int y, int channel) const;
+
   const RegionAtlas* atlas_;
-  std::vector<double> num_, den_;
+  double min_texel_weight_;
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<std::unique_ptr<Tile>> tiles_;
+  int64_t num_samples_ = 0;
 };
+
+// PSNR in dB, 10·log10(peak² / MSE), over all texels and channels (+infinity when equal). Throws
+// igi::Error when the sizes or channel counts differ, the images are empty, or peak <= 0.
 double AlbedoPsnr(const Image& estimate, const Image& truth, double peak);
+
 }  // namespace igi

@@ -1,0 +1,306 @@
+// Albedo maps (solver/albedo_map.h): splatting ratio samples into an atlas, push-pull filling,
+// and PSNR.
+#include "solver/albedo_map.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace igi {
+namespace {
+
+constexpr float kQuadW = 1.0f, kQuadH = 0.5f;
+
+// A 1 × 0.5 m rectangle in z = 0 with UVs [0,1]² (u = x / 1 m, v = y / 0.5 m), region "floor".
+TriangleMesh Quad() {
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {kQuadW, 0, 0}, {kQuadW, kQuadH, 0}, {0, kQuadH, 0}};
+  mesh.normals.assign(4, Eigen::Vector3f::UnitZ());
+  mesh.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  mesh.triangle_region = {0, 0};
+  mesh.region_names = {"floor"};
+  return mesh;
+}
+
+// A 1 × 0.6 × 0.4 m box without UVs (generated charts), 12 triangles, one region.
+TriangleMesh Box() {
+  TriangleMesh mesh;
+  for (int i = 0; i < 8; ++i) {
+    mesh.positions.emplace_back((i & 1) ? 1.0f : 0, (i & 2) ? 0.6f : 0, (i & 4) ? 0.4f : 0);
+  }
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    mesh.triangles.emplace_back(q[0], q[1], q[2]);
+    mesh.triangles.emplace_back(q[0], q[2], q[3]);
+  }
+  mesh.triangle_region.assign(12, 0);
+  mesh.region_names = {"box"};
+  return mesh;
+}
+
+// The renderer's lookup (solver/render.cpp SampleTexture): bilinear, x = u·W − 0.5,
+// y = (1 − v)·H − 0.5, texel indices clamped.
+Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) {
+  const double x = uv.x() * tex.width - 0.5, y = (1.0 - uv.y()) * tex.height - 0.5;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  auto texel = [&tex](int xi, int yi) {
+    xi = std::clamp(xi, 0, tex.width - 1);
+    yi = std::clamp(yi, 0, tex.height - 1);
+    return Eigen::Vector3d(tex.at(xi, yi, 0), tex.at(xi, yi, 1), tex.at(xi, yi, 2));
+  };
+  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
+         fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
+}
+
+// A smooth albedo over the quad, different in every channel and asymmetric in x and y (so a
+// flipped or transposed map cannot pass).
+Eigen::Vector3d Albedo(double x, double y) {
+  return Eigen::Vector3d(0.5 + 0.3 * std::sin(2 * M_PI * x) * std::cos(M_PI * y),
+                         0.2 + 0.6 * y / kQuadH, 0.2 + 0.5 * x / kQuadW + 0.1 * y / kQuadH);
+}
+
+struct Sample {
+  int triangle;
+  double b1, b2;
+  Eigen::Vector3d position;
+};
+
+Sample RandomPoint(const TriangleMesh& mesh, const std::vector<int>& tris, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u01(0, 1);
+  Sample s;
+  s.triangle = tris[std::uniform_int_distribution<size_t>(0, tris.size() - 1)(rng)];
+  const double r1 = std::sqrt(u01(rng)), r2 = u01(rng);  // uniform over the triangle
+  s.b1 = r1 * (1 - r2);
+  s.b2 = r1 * r2;
+  const Eigen::Vector3i& t = mesh.triangles[s.triangle];
+  s.position = (1 - s.b1 - s.b2) * mesh.positions[t[0]].cast<double>() +
+               s.b1 * mesh.positions[t[1]].cast<double>() +
+               s.b2 * mesh.positions[t[2]].cast<double>();
+  return s;
+}
+
+// Adds `n` samples of albedo `f` with random irradiance E in [0.2, 2] and weights in [0.5, 1.5]
+// at random points of `tris` for which `keep(position)` holds.
+template <typename F, typename Keep>
+void AddSamples(const TriangleMesh& mesh, const std::vector<int>& tris, int n, F f, Keep keep,
+                AlbedoMapBuilder* builder, std::mt19937& rng) {
+  std::uniform_real_distribution<double> e_dist(0.2, 2.0), w_dist(0.5, 1.5);
+  for (int i = 0; i < n;) {
+    const Sample s = RandomPoint(mesh, tris, rng);
+    if (!keep(s.position)) continue;
+    const Eigen::Vector3d e(e_dist(rng), e_dist(rng), e_dist(rng));
+    const double w = w_dist(rng);
+    builder->Add(s.triangle, s.b1, s.b2, w * f(s.position).cwiseProduct(e), w * e);
+    ++i;
+  }
+}
+
+TEST(AlbedoMap, SmoothAlbedoOnQuadIsRecoveredWhereTheRendererLooksItUp) {
+  const TriangleMesh mesh = Quad();
+  AtlasOptions options;
+  options.texel_size_m = 0.01;
+  const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
+  ASSERT_EQ(atlas.width, 100);
+  ASSERT_EQ(atlas.height, 50);
+  std::mt19937 rng(7);
+  AlbedoMapBuilder builder(atlas);
+  const auto f = [](const Eigen::Vector3d& p) { return Albedo(p.x(), p.y()); };
+  AddSamples(
+      mesh, atlas.triangles, 100000, f, [](auto&) { return true; }, &builder, rng);
+  EXPECT_GT(builder.Coverage(), 0.999);
+  const Image map = builder.Finish(Eigen::Vector3d::Zero());
+  ASSERT_EQ(map.width, 100);
+  ASSERT_EQ(map.height, 50);
+
+  // Looked up at random points as the renderer does. Each texel is a weighted average of f over
+  // the random samples within ±1 texel, and the lookup interpolates between texel centres:
+  // - inside, the bias is second order, about h²·|f''|/4 ≈ 1e-4 · 12 / 4 = 3e-4 (h = 1 cm,
+  //   |f''| <= 0.3·(2π)² ≈ 12 per m²), and the random sample positions add noise of about
+  //   h·|f'|/sqrt(12·n) ≈ 0.01 · 1.9 / sqrt(12 · 20) ≈ 1.2e-3 (|f'| <= 1.9 per m, n ≈ 20 samples
+  //   per texel): RMS < 1e-3, max over 5000 lookups (≈ 4σ) < 5e-3;
+  // - within 1.5 texels of the border the clamped footprint is one-sided: a first-order bias of
+  //   about h·|f'|/3 ≈ 6e-3 plus that noise: max < 2.5e-2.
+  double max_inner = 0, max_border = 0, sum_sq_inner = 0;
+  int n_inner = 0;
+  std::uniform_real_distribution<double> u01(0, 1);
+  for (int i = 0; i < 5000; ++i) {
+    const double u = u01(rng), v = u01(rng);
+    const double error =
+        (Lookup(map, {u, v}) - Albedo(u * kQuadW, v * kQuadH)).cwiseAbs().maxCoeff();
+    if (std::min(u, 1 - u) * atlas.width < 1.5 || std::min(v, 1 - v) * atlas.height < 1.5) {
+      max_border = std::max(max_border, error);
+    } else {
+      max_inner = std::max(max_inner, error);
+      sum_sq_inner += error * error;
+      ++n_inner;
+    }
+  }
+  const double rms_inner = std::sqrt(sum_sq_inner / n_inner);
+  std::printf("error inside: RMS %.2e, max %.2e; near the border: max %.2e\n", rms_inner, max_inner,
+              max_border);
+  EXPECT_LT(rms_inner, 1e-3);
+  EXPECT_LT(max_inner, 5e-3);
+  EXPECT_LT(max_border, 2.5e-2);
+
+  // PSNR against f at the texel centres (peak 1): the same errors; > 60 dB means RMS < 1e-3.
+  Image truth(map.width, map.height, 3);
+  for (int y = 0; y < truth.height; ++y) {
+    for (int x = 0; x < truth.width; ++x) {
+      const Eigen::Vector3d a =
+          Albedo((x + 0.5) / truth.width * kQuadW, (1 - (y + 0.5) / truth.height) * kQuadH);
+      for (int c = 0; c < 3; ++c) truth.at(x, y, c) = float(a[c]);
+    }
+  }
+  const double psnr = AlbedoPsnr(map, truth, 1.0);
+  std::printf("PSNR %.1f dB\n", psnr);
+  EXPECT_GT(psnr, 60.0);
+}
+
+TEST(AlbedoMap, TexelConventionMatchesTheRenderer) {
+  const RegionAtlas atlas = BuildRegionAtlas(Quad(), 0, {});  // 100 × 50
+  AlbedoMapBuilder builder(atlas);
+  // Triangle 0 has corner UVs (0,0), (1,0), (1,1): UV = (b1 + b2, b2). A sample exactly at the
+  // centre of texel (column 80, row 10) — u = 80.5/100, v = 1 − 10.5/50 — lands on it alone.
+  const double u = 80.5 / 100, v = 1 - 10.5 / 50;
+  builder.Add(0, u - v, v, Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d::Ones());
+  builder.Add(1, 0.0, 0.0, Eigen::Vector3d(0.9, 0.9, 0.9),
+              Eigen::Vector3d::Ones());  // texel (0, 49)
+  const Image map = builder.Finish(Eigen::Vector3d::Zero());
+  EXPECT_FLOAT_EQ(map.at(80, 10, 0), 0.1f);
+  EXPECT_FLOAT_EQ(map.at(80, 10, 2), 0.3f);
+  EXPECT_FLOAT_EQ(map.at(0, 49, 1), 0.9f);  // UV (0, 0): bottom-left texel, last row
+  EXPECT_NEAR(Lookup(map, {u, v}).y(), 0.2, 1e-6);
+}
+
+TEST(AlbedoMap, ConstantAlbedoFillsEveryTexelIncludingGutters) {
+  const TriangleMesh mesh = Box();
+  const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
+  ASSERT_TRUE(atlas.generated);
+  AlbedoMapBuilder builder(atlas);
+  std::mt19937 rng(3);
+  const Eigen::Vector3d albedo(0.3, 0.5, 0.7);
+  // 200 samples over ~ 3 m² of 1-cm texels: almost every texel is a hole.
+  AddSamples(
+      mesh, atlas.triangles, 200, [&](auto&) { return albedo; }, [](auto&) { return true; },
+      &builder, rng);
+  EXPECT_GT(builder.Coverage(), 0.0);
+  EXPECT_LT(builder.Coverage(), 0.02);
+  const Image map = builder.Finish(Eigen::Vector3d(9, 9, 9));
+  double max_error = 0;
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      for (int c = 0; c < 3; ++c)
+        max_error = std::max(max_error, std::abs(map.at(x, y, c) - albedo[c]));
+    }
+  }
+  // Push-pull only forms convex combinations of the (float) texel values: float rounding.
+  EXPECT_LT(max_error, 1e-6);
+}
+
+TEST(AlbedoMap, HolesGetValuesFromTheirNeighbourhood) {
+  const TriangleMesh mesh = Quad();
+  const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
+  AlbedoMapBuilder builder(atlas);
+  std::mt19937 rng(5);
+  // Albedo 0.2 + 0.5·x observed only on x < 0.4 m (texel columns < 40).
+  const auto f = [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d::Constant(0.2 + 0.5 * p.x());
+  };
+  AddSamples(
+      mesh, atlas.triangles, 50000, f, [](const auto& p) { return p.x() < 0.4; }, &builder, rng);
+  EXPECT_NEAR(builder.Coverage(), 0.4, 0.02);
+  const Image map = builder.Finish(Eigen::Vector3d::Zero());
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      // Every value is a convex combination of observed ones: within [0.2, 0.4] (± float).
+      EXPECT_GE(map.at(x, y, 0), 0.2f - 1e-5f);
+      EXPECT_LE(map.at(x, y, 0), 0.4f + 1e-5f);
+    }
+    // Next to the hole's edge the fill continues the observed value (0.4 − 0.005 at column 39):
+    // the nearest coarse levels average a few texels back, so within 0.02.
+    EXPECT_NEAR(map.at(41, y, 0), 0.395, 0.02) << "row " << y;
+  }
+}
+
+TEST(AlbedoMap, EmptyBuilderGivesFallback) {
+  const RegionAtlas atlas = BuildRegionAtlas(Box(), 0, {});
+  AlbedoMapBuilder builder(atlas);
+  EXPECT_EQ(builder.Coverage(), 0.0);
+  // Non-finite samples are ignored.
+  builder.Add(0, 0.2, 0.2, Eigen::Vector3d::Constant(NAN), Eigen::Vector3d::Ones());
+  EXPECT_EQ(builder.num_samples(), 0);
+  const Image map = builder.Finish(Eigen::Vector3d(0.25, 0.5, 0.75));
+  ASSERT_EQ(map.width, atlas.width);
+  ASSERT_EQ(map.height, atlas.height);
+  ASSERT_EQ(map.channels, 3);
+  for (size_t i = 0; i < map.pixels.size(); ++i) EXPECT_EQ(map.pixels[i], 0.25f * (1 + i % 3));
+  EXPECT_THROW(builder.Add(99, 0, 0, Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones()), Error);
+}
+
+TEST(AlbedoMap, ChannelWithoutIrradianceFallsBack) {
+  const RegionAtlas atlas = BuildRegionAtlas(Quad(), 0, {});
+  AlbedoMapBuilder builder(atlas);
+  for (int i = 0; i < 100; ++i) {  // red light only: blue cannot be estimated
+    builder.Add(i % 2, 0.3, 0.3, Eigen::Vector3d(0.5, 0.25, 0), Eigen::Vector3d(1, 0.5, 0));
+  }
+  const Image map = builder.Finish(Eigen::Vector3d(0.1, 0.1, 0.1));
+  EXPECT_FLOAT_EQ(map.at(50, 25, 0), 0.5f);
+  EXPECT_FLOAT_EQ(map.at(50, 25, 1), 0.5f);
+  EXPECT_FLOAT_EQ(map.at(50, 25, 2), 0.1f);
+}
+
+TEST(AlbedoMap, MergeEqualsOneBuilder) {
+  const TriangleMesh mesh = Box();
+  const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
+  AlbedoMapBuilder all(atlas), even(atlas), odd(atlas);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u01(0.1, 0.9);
+  for (int i = 0; i < 20000; ++i) {
+    const Sample s = RandomPoint(mesh, atlas.triangles, rng);
+    const Eigen::Vector3d num(u01(rng), u01(rng), u01(rng)), den(1, 1, 1);
+    all.Add(s.triangle, s.b1, s.b2, num, den);
+    (i % 2 ? odd : even).Add(s.triangle, s.b1, s.b2, num, den);
+  }
+  even.Merge(odd);
+  EXPECT_EQ(even.num_samples(), 20000);
+  EXPECT_DOUBLE_EQ(even.Coverage(), all.Coverage());
+  const Image a = all.Finish(Eigen::Vector3d::Zero()), b = even.Finish(Eigen::Vector3d::Zero());
+  // Same sums in a different order: double rounding, then float output.
+  EXPECT_GT(AlbedoPsnr(a, b, 1.0), 120.0);
+
+  const RegionAtlas other = BuildRegionAtlas(Quad(), 0, {});
+  AlbedoMapBuilder different(other);
+  EXPECT_THROW(all.Merge(different), Error);
+}
+
+TEST(AlbedoMap, MinTexelWeightDecidesWhatIsDirect) {
+  const RegionAtlas atlas = BuildRegionAtlas(Quad(), 0, {});
+  // One sample at a texel corner gives each of 4 texels weight 1/4.
+  const double u = 0.5, v = 0.5;
+  for (double min_weight : {0.2, 0.5}) {
+    AlbedoMapBuilder builder(atlas, min_weight);
+    builder.Add(0, u - v, v, Eigen::Vector3d::Constant(0.4), Eigen::Vector3d::Ones());
+    EXPECT_EQ(builder.Coverage() > 0, min_weight < 0.25) << min_weight;
+  }
+}
+
+TEST(AlbedoPsnr, KnownImages) {
+  Image truth(4, 3, 3, 0.0f), estimate(4, 3, 3, 0.1f);
+  EXPECT_NEAR(AlbedoPsnr(estimate, truth, 1.0), 20.0, 1e-5);  // MSE 0.01
+  EXPECT_NEAR(AlbedoPsnr(estimate, truth, 2.0), 20.0 + 20 * std::log10(2.0), 1e-5);
+  Image one_off = truth;
+  one_off.at(2, 1, 1) = 1.0f;  // MSE 1/36
+  EXPECT_NEAR(AlbedoPsnr(one_off, truth, 1.0), 10 * std::log10(36.0), 1e-9);
+  EXPECT_TRUE(std::isinf(AlbedoPsnr(truth, truth, 1.0)));
+  EXPECT_THROW(AlbedoPsnr(Image(4, 4, 3), truth, 1.0), Error);
+  EXPECT_THROW(AlbedoPsnr(Image(4, 3, 1), truth, 1.0), Error);
+  EXPECT_THROW(AlbedoPsnr(truth, truth, 0.0), Error);
+}
+
+}  // namespace
+}  // namespace igi
