@@ -73,16 +73,24 @@ void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const 
 
 std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
                                                     Pcg32& rng) {
+  // A mixture of three strategies with fixed shares (cosine, a broad Ward lobe of roughness
+  // lobe_alpha and a narrow one of a quarter of it, both about the view's mirror direction);
+  // each direction is weighted with the mixture's density (the balance heuristic), so the
+  // estimate is unbiased for any BRDF while sharp lobes still get samples.
   std::vector<WeightedDirection> out;
   if (n <= 0) return out;
   const Frame frame = Frame::FromNormal(q.n_s);
   const bool lobe = q.lobe && q.view.squaredNorm() > 0;
-  BrdfParams spec;
-  spec.model = BrdfModel::kWard;
-  spec.rho_s = Eigen::Vector3d::Ones();
-  spec.alpha = lobe_alpha;
+  BrdfParams broad, narrow;
+  broad.model = narrow.model = BrdfModel::kWard;
+  broad.rho_s = narrow.rho_s = Eigen::Vector3d::Ones();
+  broad.alpha = lobe_alpha;
+  narrow.alpha = 0.25 * lobe_alpha;
   const Eigen::Vector3d wo = lobe ? frame.ToLocal(q.view) : Eigen::Vector3d::UnitZ();
-  const int n_cos = lobe ? (n + 1) / 2 : n;
+  const int n_cos = lobe ? std::max(1, n / 3) : n;
+  const int n_broad = lobe ? (n - n_cos + 1) / 2 : 0;
+  const double p_cos = double(n_cos) / n, p_broad = double(n_broad) / n;
+  const double p_narrow = 1.0 - p_cos - p_broad;
   const int side = std::max(1, static_cast<int>(std::sqrt(double(n_cos))));
   out.reserve(n);
   for (int s = 0; s < n; ++s) {
@@ -94,13 +102,13 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
       }
       wi_local = SampleCosineHemisphere(u);
     } else {
-      const BrdfSample bs = SampleBrdf(spec, wo, 0.5, u);
+      const BrdfSample bs = SampleBrdf(s < n_cos + n_broad ? broad : narrow, wo, 0.5, u);
       if (!bs.Valid()) continue;
       wi_local = bs.wi;
     }
     if (!(wi_local.z() > 0)) continue;
-    double pdf = CosineHemispherePdf(wi_local.z());
-    if (lobe) pdf = 0.5 * pdf + 0.5 * BrdfPdf(spec, wo, wi_local);
+    double pdf = p_cos * CosineHemispherePdf(wi_local.z());
+    if (lobe) pdf += p_broad * BrdfPdf(broad, wo, wi_local) + p_narrow * BrdfPdf(narrow, wo, wi_local);
     const Eigen::Vector3d wi = frame.ToWorld(wi_local);
     if (!(wi.dot(q.n_geo) > 0) || !(pdf > 0)) continue;
     out.push_back({wi, wi_local.z() / (pdf * n)});

@@ -27,13 +27,23 @@ struct Prepared {
 };
 
 Prepared Prepare(const RegionFitInput& in) {
+  // Weights from a noise-free proxy of each sample's level (the region's mean reflectance ratio
+  // times its irradiance), not from the observed value: weights that follow the noise would
+  // bias the fit low.
   Prepared p;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const FitSample& s : in.samples) mean += s.observed.cwiseMax(0.0);
-  mean /= std::max<size_t>(1, in.samples.size());
+  Eigen::Vector3d sum_l = Eigen::Vector3d::Zero(), sum_e = sum_l;
+  for (const FitSample& s : in.samples) {
+    sum_l += s.observed.cwiseMax(0.0);
+    sum_e += s.irradiance / kPi;
+  }
+  const size_t n = std::max<size_t>(1, in.samples.size());
+  const Eigen::Vector3d mean = sum_l / n;
   for (const FitSample& s : in.samples) {
     Eigen::Vector3d w;
-    for (int c = 0; c < 3; ++c) w[c] = 1.0 / (std::max(s.observed[c], 0.0) + 0.1 * mean[c] + 1e-12);
+    for (int c = 0; c < 3; ++c) {
+      const double ratio = sum_e[c] > 0 ? sum_l[c] / sum_e[c] : 0.0;
+      w[c] = 1.0 / (ratio * s.irradiance[c] / kPi + 0.1 * mean[c] + 1e-12);
+    }
     p.w.push_back(w);
     p.a.push_back(s.irradiance / kPi);
   }
@@ -382,6 +392,29 @@ double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>&
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
+// Each slot's albedo from its samples whose specular part is under 10 % of the radiance (least
+// squares per channel); NaN for a slot without such a sample.
+std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const Prepared& pr,
+                                                const std::vector<Eigen::Vector3d>& t,
+                                                const Eigen::Vector3d& rho_s) {
+  std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    const Eigen::Vector3d spec = rho_s.cwiseProduct(t[i]);
+    if ((spec.array() > 0.1 * s.observed.array().max(0.0)).any()) continue;
+    const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+    num[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(s.observed - spec);
+    den[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+  }
+  std::vector<Eigen::Vector3d> out(in.num_slots, Eigen::Vector3d::Constant(kNan));
+  for (int k = 0; k < in.num_slots; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      if (den[k][c] > 0) out[k][c] = std::max(0.0, num[k][c] / den[k][c]);
+    }
+  }
+  return out;
+}
+
 // Whether the per-patch albedos vary beyond their noise: the area-weighted spread of the
 // slots' mean albedo must exceed 3 % of the mean and three times the spread noise alone gives.
 bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolution& b,
@@ -394,6 +427,7 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
     const FitSample& s = in.samples[i];
     ++(*counts)[s.slot];
     for (int c = 0; c < 3; ++c) info[s.slot] += std::pow(pr.w[i][c] * pr.a[i][c], 2) / 3;
+    if (!b.slot_rho_d[s.slot].allFinite()) continue;
     const Eigen::Vector3d pred = b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
     if (pred.allFinite()) rss += (pr.w[i].cwiseProduct(pred - s.observed)).squaredNorm();
   }
@@ -402,7 +436,7 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
   const double s2 = rss / std::max(1.0, 3.0 * in.samples.size() - 3.0 * used - 2);
   double wsum = 0, mean = 0;
   for (int s = 0; s < slots; ++s) {
-    if ((*counts)[s] < 3) continue;
+    if ((*counts)[s] < 3 || !b.slot_rho_d[s].allFinite()) continue;
     wsum += in.slot_area[s];
     mean += in.slot_area[s] * b.slot_rho_d[s].mean();
   }
@@ -410,7 +444,7 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
   mean /= wsum;
   double var = 0, noise = 0;
   for (int s = 0; s < slots; ++s) {
-    if ((*counts)[s] < 3) continue;
+    if ((*counts)[s] < 3 || !b.slot_rho_d[s].allFinite()) continue;
     var += in.slot_area[s] * std::pow(b.slot_rho_d[s].mean() - mean, 2);
     noise += in.slot_area[s] * (info[s] > 0 ? s2 / info[s] / 3 : 0.0);
   }
@@ -447,33 +481,63 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   std::vector<Eigen::Vector3d> t = SpecularTerms(in, r.alpha_x, r.alpha_y);
   r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
   if (!in.fit_rho_d || in.num_slots <= 1) return r;
-  const AlphaSearch b = SearchAlpha(in, pr, true);
-  const std::vector<Eigen::Vector3d> tb = SpecularTerms(in, b.ax, b.ay);
+  // Per-patch albedo from the observations off the highlights (specular part < 10 % of the
+  // radiance): fitted freely per patch, a highlight that only one photo shows would be absorbed
+  // into that patch's albedo instead of constraining ρs and α.
+  LinearSolution patch;
+  patch.rho_s = r.rho_s;
+  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s);
   std::vector<int> counts;
-  r.albedo_varies = AlbedoVaries(in, pr, b.linear, tb, &counts);
+  r.albedo_varies = AlbedoVaries(in, pr, patch, t, &counts);
+  if (r.albedo_varies) {
+    // More parameters must earn their place: the per-patch albedo has to cut the residual of
+    // the constant albedo by 10 % or more.
+    std::vector<Eigen::Vector3d> filled = patch.slot_rho_d;
+    for (Eigen::Vector3d& v : filled) {
+      if (!v.allFinite()) v = r.rho_d;
+    }
+    r.albedo_varies = RelativeRms(in, t, filled, r.rho_s, true) < 0.9 * r.relative_rms;
+  }
   if (!r.albedo_varies) return r;
+  // The albedo varies: ρs and α again with each patch's albedo held (NaN: the region's), twice.
+  RegionFitInput held = in;
+  held.fit_rho_d = false;
+  AlphaSearch b;
+  for (int round = 0; round < 2; ++round) {
+    for (FitSample& smp : held.samples) {
+      const Eigen::Vector3d& v = patch.slot_rho_d[smp.slot];
+      smp.rho_d_known = v.allFinite() ? v : r.rho_d;
+    }
+    b = SearchAlpha(held, pr, false);
+    t = SpecularTerms(in, b.ax, b.ay);
+    patch.rho_s = b.linear.rho_s;
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s);
+  }
   r.albedo_model = "per_patch";
   r.rho_s = b.linear.rho_s;
   r.alpha = r.alpha_x = b.ax;
   r.alpha_y = b.ay;
-  r.slot_rho_d = b.linear.slot_rho_d;
+  r.slot_rho_d = patch.slot_rho_d;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   double wsum = 0;
-  for (int s = 0; s < in.num_slots; ++s) {
-    if (counts[s] == 0 || !r.slot_rho_d[s].allFinite()) continue;
-    mean += in.slot_area[s] * r.slot_rho_d[s];
-    wsum += in.slot_area[s];
+  for (int k = 0; k < in.num_slots; ++k) {
+    if (!r.slot_rho_d[k].allFinite()) continue;
+    mean += in.slot_area[k] * r.slot_rho_d[k];
+    wsum += in.slot_area[k];
   }
   if (wsum > 0) r.rho_d = mean / wsum;
+  for (Eigen::Vector3d& v : r.slot_rho_d) {
+    if (!v.allFinite()) v = r.rho_d;
+  }
   // Uncertainties from the projected problem: ρs from its normal equation, α from the
-  // curvature of the profile cost in log α.
-  const double dof = std::max(1.0, 3.0 * in.samples.size() - 3.0 * in.num_slots - 2);
+  // curvature of the profile cost in log α (the patches' albedos held).
+  const double dof = std::max(1.0, 3.0 * in.samples.size() - 2);
   const double s2 = b.linear.cost / dof;
   r.sigma_rho_s = b.linear.sum_v2 > 0 ? std::sqrt(s2 / b.linear.sum_v2) : kNan;
   r.sigma_alpha = r.sigma_alpha_x = r.sigma_alpha_y =
       b.curvature_log_alpha > 0 ? r.alpha * std::sqrt(2 * s2 / b.curvature_log_alpha) : kNan;
   r.sigma_rho_d = Eigen::Vector3d::Constant(kNan);
-  r.relative_rms = RelativeRms(in, tb, r.slot_rho_d, r.rho_s, true);
+  r.relative_rms = RelativeRms(in, t, r.slot_rho_d, r.rho_s, true);
   return r;
 }
 

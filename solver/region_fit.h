@@ -11,7 +11,8 @@
 // For a given α the model is linear in ρd and ρs: they are projected out (variable projection)
 // and α is found by a log-grid search refined by golden sections; Ceres then polishes all
 // parameters jointly (autodiff through EvalBrdf's specular factor) and gives their covariance.
-// Residuals are weighted by 1/(L + 0.1·mean L) per channel, i.e. nearly relative errors.
+// Residuals are weighted by 1/(ρ̄E/π + 0.1·mean L) per channel, ρ̄ the region's mean ratio of L
+// to E/π: nearly relative errors, with weights that do not follow the photos' noise.
 
 #include <Eigen/Core>
 #include <optional>
