@@ -27,9 +27,11 @@ struct Prepared {
 };
 
 Prepared Prepare(const RegionFitInput& in) {
-  // Weights from a noise-free proxy of each sample's level (the region's mean reflectance ratio
-  // times its irradiance), not from the observed value: weights that follow the noise would
-  // bias the fit low.
+  // Shot-noise weights (variance ∝ level) from a proxy of each sample's level (the region's mean
+  // reflectance ratio times its irradiance), not from the observed value: weights that follow
+  // the photos' noise would bias the fit low. With variance ∝ E the albedo estimate is a ratio
+  // of sums, Σ L / Σ E/π, which noise in the gathered E does not bias the way a mean of ratios
+  // would.
   Prepared p;
   Eigen::Vector3d sum_l = Eigen::Vector3d::Zero(), sum_e = sum_l;
   for (const FitSample& s : in.samples) {
@@ -42,7 +44,7 @@ Prepared Prepare(const RegionFitInput& in) {
     Eigen::Vector3d w;
     for (int c = 0; c < 3; ++c) {
       const double ratio = sum_e[c] > 0 ? sum_l[c] / sum_e[c] : 0.0;
-      w[c] = 1.0 / (ratio * s.irradiance[c] / kPi + 0.1 * mean[c] + 1e-12);
+      w[c] = 1.0 / std::sqrt((ratio * s.irradiance[c] / kPi + 0.1 * mean[c]) * mean[c] + 1e-24);
     }
     p.w.push_back(w);
     p.a.push_back(s.irradiance / kPi);

@@ -11,8 +11,9 @@
 // For a given α the model is linear in ρd and ρs: they are projected out (variable projection)
 // and α is found by a log-grid search refined by golden sections; Ceres then polishes all
 // parameters jointly (autodiff through EvalBrdf's specular factor) and gives their covariance.
-// Residuals are weighted by 1/(ρ̄E/π + 0.1·mean L) per channel, ρ̄ the region's mean ratio of L
-// to E/π: nearly relative errors, with weights that do not follow the photos' noise.
+// Residuals are weighted as for shot noise, 1/√((ρ̄E/π + 0.1·mean L)·mean L) per channel, ρ̄
+// the region's mean ratio of L to E/π: weights that follow neither the photos' noise nor that of
+// the gathered irradiance (either would bias the fit).
 
 #include <Eigen/Core>
 #include <optional>

@@ -135,7 +135,10 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         const double eps = lighting_scenes[l]->ray_epsilon;
         Eigen::Vector3d e = Eigen::Vector3d::Zero();
         int k = 0;
-        for (const WeightedDirection& d : HemisphereDirections(q, options.refine_rays, 0.2, rng)) {
+        // Glossy observations that the fits use get four times the rays: noise in the specular
+        // term T would bias ρs low (regression dilution).
+        const int n = options.refine_rays * (glossy && in_fit[i] ? 4 : 1);
+        for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
           const Eigen::Vector3d li = renderers[l]->ReflectedRadiance(
               q.position + q.n_geo * eps, d.wi, 1, Mix(Mix(options.seed, round), i * 4096 + k++));
           e += d.weight * li;
