@@ -170,7 +170,7 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     double c = b - g * (b - a), d = a + g * (b - a);
     double fc = f(c), fd = f(d);
-    for (int it = 0; it < 24; ++it) {
+    for (int it = 0; it < 20; ++it) {
       if (fc < fd) {
         b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
       } else {
@@ -184,6 +184,20 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
       best.ax = best.ay = *known_x;
       best.linear = eval(best.ax, best.ay);
       return best;
+    }
+    if (in.alpha_hint && *in.alpha_hint > 0) {
+      // A window of ±0.4 in log α around the hint; accepted unless the minimum sits at its edge.
+      const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4), b = std::min(hi, c + 0.4);
+      const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
+      if (la > a + 0.02 && la < b - 0.02) {
+        best.ax = best.ay = std::exp(la);
+        best.linear = eval(best.ax, best.ay);
+        const double h = 0.02;
+        const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
+        const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
+        best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
+        return best;
+      }
     }
     constexpr int kGrid = 28;
     double best_cost = std::numeric_limits<double>::infinity();

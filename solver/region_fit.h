@@ -48,6 +48,9 @@ struct RegionFitInput {
   std::optional<double> alpha_x, alpha_y;  // anisotropic models
   double ior = 1.5;
   bool grey_specular = true;  // one ρs for the three channels
+  // The previous iteration's α (isotropic models): the search then starts near it instead of
+  // scanning the whole range (it still scans when the minimum leaves the window).
+  std::optional<double> alpha_hint;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot
   std::vector<FitSample> samples;

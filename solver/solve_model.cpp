@@ -54,8 +54,14 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
   for (size_t i = 0; i < s.obs.size(); ++i) {
     const Observation& o = s.obs[i];
     if (o.region != r) continue;
-    const Eigen::Vector3d diffuse = o.radiance.cast<double>() - m.params.rho_s.cwiseProduct(s.obs_t[i]);
-    builder.Add(o.triangle, o.b1, o.b2, kPi * diffuse, s.obs_e[i]);
+    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(s.obs_t[i]);
+    const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
+    // Highlights tell little about the albedo and much about any error in the fitted lobe:
+    // weight each observation by its diffuse share, and leave out those under half diffuse.
+    const double share = 1.0 - spec.sum() / std::max(1e-12, double(o.radiance.sum()));
+    const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
+    if (!(w > 0)) continue;
+    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * s.obs_e[i]);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
   return builder.Finish(m.params.rho_d);

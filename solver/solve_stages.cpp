@@ -247,6 +247,7 @@ double SolverState::FitAll(int stage, int iteration) {
       in.alpha_y = m.params.alpha_y;
     }
     in.ior = m.params.ior;
+    if (m.last_fit.fitted && HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     in.num_slots = static_cast<int>(region_patches[r].size());
     for (int q : region_patches[r]) in.slot_area.push_back(patches.area[q]);
   }
