@@ -504,8 +504,8 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   patch.rho_s = r.rho_s;
   patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s);
   std::vector<int> counts;
-  r.albedo_varies = AlbedoVaries(in, pr, patch, t, &counts);
-  if (r.albedo_varies) {
+  r.albedo_varies = in.albedo_varies ? *in.albedo_varies : AlbedoVaries(in, pr, patch, t, &counts);
+  if (r.albedo_varies && !in.albedo_varies) {
     // More parameters must earn their place: the per-patch albedo has to cut the residual of
     // the constant albedo by 10 % or more.
     std::vector<Eigen::Vector3d> filled = patch.slot_rho_d;

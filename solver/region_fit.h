@@ -51,6 +51,9 @@ struct RegionFitInput {
   // The previous iteration's α (isotropic models): the search then starts near it instead of
   // scanning the whole range (it still scans when the minimum leaves the window).
   std::optional<double> alpha_hint;
+  // Whether the albedo varies over the region, when an earlier fit decided it (the refinement's
+  // noisier irradiance would otherwise tip the test); unset: decided from these samples.
+  std::optional<bool> albedo_varies;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot
   std::vector<FitSample> samples;

@@ -28,6 +28,7 @@ struct MaterialState {
   std::shared_ptr<const Image> known_map;     // a known rho_d_map
   std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
   RegionFitResult last_fit;
+  bool stage1_albedo_varies = false;  // stage 1's decision, kept by the refinement
   int observations = 0;
   bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
 };

@@ -248,6 +248,7 @@ double SolverState::FitAll(int stage, int iteration) {
     }
     in.ior = m.params.ior;
     if (m.last_fit.fitted && HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
+    if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
     in.num_slots = static_cast<int>(region_patches[r].size());
     for (int q : region_patches[r]) in.slot_area.push_back(patches.area[q]);
   }
@@ -350,6 +351,7 @@ void SolverState::RunStage1() {
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
   for (size_t r = 0; r < materials.size(); ++r) {
     summary.regions[r].stage1 = summary.regions[r].stage2 = materials[r].last_fit;
+    materials[r].stage1_albedo_varies = materials[r].last_fit.albedo_varies;
   }
 }
 
