@@ -92,9 +92,10 @@ LobeFit FitAndReport(const Material& material, const LobeFitOptions& options,
   const BrdfParams params = ParamsOf(material);
   const LobeFit fit = FitSpecularLobe(params, options);
   std::string how = fmt::format(
-      "{} specular lobe fitted by {} (least squares over the hemisphere, cos-weighted): "
-      "alpha {:.6g}, scale {:.6g}",
-      BrdfModelName(material.brdf), target_label, fit.alpha, fit.scale);
+      "{} specular lobe fitted by {} (least squares of f cos(i) cos(o), view angles up to {} "
+      "deg): alpha {:.6g}, scale {:.6g}; relative error {:.3g} (up to 88 deg: {:.3g})",
+      BrdfModelName(material.brdf), target_label, options.max_theta_o_deg, fit.alpha, fit.scale,
+      fit.relative_error, fit.relative_error_to_88deg);
   if (IsAnisotropic(material.brdf)) how += "; anisotropy dropped (isotropic fit)";
   if (HasFresnel(material.brdf)) how += "; igi's Schlick weight folded into the fit";
   report->Add("materials." + material.name, how, fit.relative_error);

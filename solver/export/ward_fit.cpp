@@ -8,7 +8,7 @@
 namespace igi {
 namespace {
 
-// One (wo, wi) pair of the fitting grid with its weight cosθi·cosθo·dωi·dωo.
+// One (wo, wi) pair of the fitting grid with its weight cos²θi·cos²θo·dωi·dωo.
 struct DirectionPair {
   Eigen::Vector3d wo, wi;
   double weight = 0;
@@ -22,14 +22,14 @@ std::vector<DirectionPair> BuildPairs(double alpha_grid, bool anisotropic,
   std::vector<DirectionPair> pairs;
   const int n_o = options.theta_o_steps, n_h = options.half_steps;
   const int n_phi_o = anisotropic ? 8 : 1;
-  const double theta_o_max = 88.0 * kPi / 180.0, t_max = 8.0;
+  const double theta_o_max = options.max_theta_o_deg * kPi / 180.0, t_max = 8.0;
   for (int io = 0; io < n_o; ++io) {
     const double theta_o = (io + 0.5) * theta_o_max / n_o;
     for (int jo = 0; jo < n_phi_o; ++jo) {
       const double phi_o = (jo + 0.5) * kPi / n_phi_o;  // lobes are symmetric under φ -> φ + π
       const Eigen::Vector3d wo(std::sin(theta_o) * std::cos(phi_o),
                                std::sin(theta_o) * std::sin(phi_o), std::cos(theta_o));
-      const double w_o = std::cos(theta_o) * std::sin(theta_o);
+      const double w_o = std::cos(theta_o) * std::cos(theta_o) * std::sin(theta_o);
       for (int ih = 0; ih < n_h; ++ih) {
         const double t = (ih + 0.5) * t_max / n_h;
         const double theta_h = std::atan(alpha_grid * t);
@@ -43,7 +43,7 @@ std::vector<DirectionPair> BuildPairs(double alpha_grid, bool anisotropic,
           const Eigen::Vector3d wi = 2.0 * c * h - wo;
           if (wi.z() <= 1e-6) continue;
           const double d_omega_h = std::sin(theta_h) * dtheta_dt;
-          pairs.push_back({wo, wi, w_o * wi.z() * 4.0 * c * d_omega_h});
+          pairs.push_back({wo, wi, w_o * wi.z() * wi.z() * 4.0 * c * d_omega_h});
         }
       }
     }
@@ -57,6 +57,33 @@ double SmithG1Beckmann(const Eigen::Vector3d& v, double alpha) {
   const double a = 1.0 / (alpha * std::sqrt(tan2));
   if (a >= 1.6) return 1.0;
   return (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
+}
+
+// The fit of `source` (grey ρs) at roughness `alpha` over `pairs`: k solved in closed form (the
+// target is affine in k) unless `fixed_scale` is given; the relative RMS error.
+LobeFit FitAt(const BrdfParams& source, const std::vector<DirectionPair>& pairs,
+              const LobeFitOptions& options, double alpha, const double* fixed_scale) {
+  double aa = 0, ab = 0, norm = 0;
+  std::vector<double> a(pairs.size()), b(pairs.size()), f(pairs.size());
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const auto& q = pairs[p];
+    f[p] = EvalBrdf(source, q.wo, q.wi).x();
+    b[p] = TargetLobeValue(options.target, alpha, 0.0, options.target_ior, q.wo, q.wi);
+    a[p] = TargetLobeValue(options.target, alpha, 1.0, options.target_ior, q.wo, q.wi) - b[p];
+    aa += q.weight * a[p] * a[p];
+    ab += q.weight * a[p] * (f[p] - b[p]);
+    norm += q.weight * f[p] * f[p];
+  }
+  LobeFit fit;
+  fit.alpha = alpha;
+  fit.scale = fixed_scale ? *fixed_scale : (aa > 0 ? ab / aa : 0.0);
+  double err = 0;
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const double r = fit.scale * a[p] + b[p] - f[p];
+    err += pairs[p].weight * r * r;
+  }
+  fit.relative_error = norm > 0 ? std::sqrt(err / norm) : 0.0;
+  return fit;
 }
 
 }  // namespace
@@ -119,32 +146,8 @@ LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options)
   const double alpha_grid = std::max(src.AlphaX(), src.AlphaY());
   const std::vector<DirectionPair> pairs =
       BuildPairs(alpha_grid, IsAnisotropic(src.model), options);
-  std::vector<double> f_src(pairs.size());
-  double norm = 0;
-  for (size_t p = 0; p < pairs.size(); ++p) {
-    f_src[p] = EvalBrdf(src, pairs[p].wo, pairs[p].wi).x();
-    norm += pairs[p].weight * f_src[p] * f_src[p];
-  }
   // For a roughness, the best k (closed form: the target is affine in k) and the error.
-  auto fit_at = [&](double alpha) {
-    double aa = 0, ab = 0;
-    std::vector<double> a(pairs.size()), b(pairs.size());
-    for (size_t p = 0; p < pairs.size(); ++p) {
-      const auto& q = pairs[p];
-      b[p] = TargetLobeValue(options.target, alpha, 0.0, options.target_ior, q.wo, q.wi);
-      a[p] = TargetLobeValue(options.target, alpha, 1.0, options.target_ior, q.wo, q.wi) - b[p];
-      aa += q.weight * a[p] * a[p];
-      ab += q.weight * a[p] * (f_src[p] - b[p]);
-    }
-    LobeFit fit{alpha, aa > 0 ? ab / aa : 0.0, 0.0};
-    double err = 0;
-    for (size_t p = 0; p < pairs.size(); ++p) {
-      const double r = fit.scale * a[p] + b[p] - f_src[p];
-      err += pairs[p].weight * r * r;
-    }
-    fit.relative_error = norm > 0 ? std::sqrt(err / norm) : 0.0;
-    return fit;
-  };
+  auto fit_at = [&](double alpha) { return FitAt(src, pairs, options, alpha, nullptr); };
   // Golden section on log α over [α/4, 4α] (the lobes' widths are within a factor 2).
   const double geo = std::sqrt(src.AlphaX() * src.AlphaY());
   double lo = std::log(geo / 4.0), hi = std::log(std::min(4.0 * geo, 2.0));
@@ -160,7 +163,12 @@ LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options)
       x2 = lo + g * (hi - lo), f2 = fit_at(std::exp(x2));
     }
   }
-  return f1.relative_error < f2.relative_error ? f1 : f2;
+  LobeFit best = f1.relative_error < f2.relative_error ? f1 : f2;
+  LobeFitOptions wide = options;
+  wide.max_theta_o_deg = 88;
+  const auto wide_pairs = BuildPairs(alpha_grid, IsAnisotropic(src.model), wide);
+  best.relative_error_to_88deg = FitAt(src, wide_pairs, options, best.alpha, &best.scale).relative_error;
+  return best;
 }
 
 }  // namespace igi

@@ -2,9 +2,11 @@
 // Fits of a Ward specular lobe (solver/brdf.h) by the lobes other renderers implement, for the
 // exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
 // values (ρd left out: the diffuse terms map exactly) over a grid of direction pairs covering the
-// lobe: view directions θo in [0°, 88°] (and several azimuths for an anisotropic source), light
-// directions parameterised by the half vector around the source's lobe (tanθh up to 8 α). Each
-// pair is weighted by cosθi·cosθo·dωi·dωo, so the fit matches what a renderer integrates.
+// lobe: view directions θo in [0°, max_theta_o_deg] (and several azimuths for an anisotropic source), light
+// directions parameterised by the half vector around the source's lobe (tanθh up to 8 α). The
+// residuals are those of f·cosθi·cosθo (the BRDF in projected solid angle on both sides, which
+// stays bounded at grazing angles where f itself grows like 1/cos²), i.e. each pair is weighted
+// by cos²θi·cos²θo·dωi·dωo.
 //
 // The scale k of the target is solved in closed form for each roughness; the roughness is
 // searched by golden section on log α. The error reported is the relative RMS error
@@ -32,14 +34,19 @@ struct LobeFitOptions {
   LobeTarget target = LobeTarget::kWardGmd;
   // kBeckmannDielectric only: relative index of refraction of the target's Fresnel term.
   double target_ior = 1.5;
-  int theta_o_steps = 24;  // view elevations
-  int half_steps = 64;     // half-vector elevations and azimuths (each)
+  // View elevations fitted: [0, max]. Past ~60° the models part ways for reasons no (α, k)
+  // can fix (Fresnel and shadowing terms), and fitting them would spoil the lobe where most
+  // highlights are seen; the error up to 88° is reported separately.
+  double max_theta_o_deg = 60;
+  int theta_o_steps = 16;  // view elevations
+  int half_steps = 48;     // half-vector elevations and azimuths (each)
 };
 
 struct LobeFit {
   double alpha = 0;           // fitted roughness (Beckmann/GMD α, or GGX α = roughness²)
   double scale = 0;           // fitted k (see LobeTarget)
-  double relative_error = 0;  // relative RMS error of the fitted specular BRDF values
+  double relative_error = 0;  // relative RMS error over the fitted domain (θo <= max)
+  double relative_error_to_88deg = 0;  // the same fitted lobe compared over θo in [0, 88°]
 };
 
 // Fits the specular lobe of `source` (its ρs taken as grey: the mean of rho_s; rho_d ignored;
