@@ -22,8 +22,12 @@ std::string Primitive(const std::string& modifier, const std::string& type,
                       const std::vector<double>& reals) {
   std::string text = fmt::format("{} {} {}\n{}\n0\n{}", modifier, type, name,
                                  strings.empty() ? "0" : strings, reals.size());
-  for (double r : reals) text += " " + Num(r);
-  return text + "\n\n";
+  for (double r : reals) {
+    text += ' ';
+    text += Num(r);
+  }
+  text += "\n\n";
+  return text;
 }
 
 // ρs proportional to ρd (within 1e-3 relative): the ratio t, else nullopt.
@@ -97,7 +101,7 @@ std::string MaterialText(const Material& m, ExportReport* report) {
     LobeFitOptions fit_options;
     fit_options.target = LobeTarget::kWardGmd;
     const LobeFit fit = export_internal::FitAndReport(m, fit_options, "RADIANCE plastic", report);
-    rho_s *= fit.scale;
+    rho_s *= fit.scale / rho_s.mean();  // the fit's k is the grey ρs of the fitted lobe
     const double ratio = fit.alpha / std::sqrt(rough.size() == 2 ? rough[0] * rough[1]
                                                                  : rough[0] * rough[0]);
     for (double& r : rough) r *= ratio;

@@ -19,7 +19,7 @@
 namespace igi {
 
 enum class LobeTarget {
-  // RADIANCE plastic/metal = contract ward_gmd: k·S_gmd(α); k multiplies ρs.
+  // RADIANCE plastic/metal = contract ward_gmd: k·S_gmd(α); k is the fitted (grey) ρs.
   kWardGmd,
   // Mitsuba 3 roughplastic, distribution "beckmann": k·F(c, η)·D_beckmann(α)·G_smith / (4 cosθi
   // cosθo), F the unpolarised dielectric Fresnel of relative index η; k = specular_reflectance.
