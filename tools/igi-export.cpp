@@ -29,8 +29,8 @@ int main(int argc, char** argv) {
   return igi::RunMain(app, flags, argc, argv, [&] {
     const auto format = igi::ExportFormatFromName(format_name);
     if (!format) {
-      throw igi::InputError(igi::DescribeProblem("", "--format", format_name,
-                                                 "must be radiance, mitsuba or gltf"));
+      throw igi::InputError(
+          igi::DescribeProblem("", "--format", format_name, "must be radiance, mitsuba or gltf"));
     }
     options.format = *format;
     options.Validate();
@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
     const igi::Scene scene = igi::LoadScene(scene_path, load);
     const igi::ExportReport report = igi::ExportScene(scene, out_path, options);
     spdlog::info("{} export: {} files, {} approximations (see {}/export_report.json)",
-                 igi::ExportFormatName(*format), report.files.size(),
-                 report.approximations.size(), out_path);
+                 igi::ExportFormatName(*format), report.files.size(), report.approximations.size(),
+                 out_path);
     return 0;
   });
 }

@@ -39,8 +39,7 @@ void ExportOptions::Validate() const {
                  "must be a finite number > 0");
   }
   if (!(source_angle_deg > 0 && source_angle_deg < 180)) {
-    problems.Add("", "--source-angle-deg", std::to_string(source_angle_deg),
-                 "must be in (0, 180)");
+    problems.Add("", "--source-angle-deg", std::to_string(source_angle_deg), "must be in (0, 180)");
   }
   if (mitsuba_spp < 1) {
     problems.Add("", "--mitsuba-spp", std::to_string(mitsuba_spp), "must be >= 1");

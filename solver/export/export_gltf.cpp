@@ -93,22 +93,26 @@ int GltfBuilder::AddMesh(const std::string& name, const RegionMesh& mesh, int ma
   Eigen::Vector3f lo = mesh.positions[0], hi = mesh.positions[0];
   for (const auto& p : mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   Json attributes;
-  attributes["POSITION"] = AddAccessor(
-      mesh.positions.data(), n * 12, kArrayBuffer,
-      {{"componentType", kFloat}, {"count", n}, {"type", "VEC3"},
-       {"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}});
+  attributes["POSITION"] = AddAccessor(mesh.positions.data(), n * 12, kArrayBuffer,
+                                       {{"componentType", kFloat},
+                                        {"count", n},
+                                        {"type", "VEC3"},
+                                        {"min", {lo.x(), lo.y(), lo.z()}},
+                                        {"max", {hi.x(), hi.y(), hi.z()}}});
   attributes["NORMAL"] = AddAccessor(mesh.normals.data(), n * 12, kArrayBuffer,
                                      {{"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
   if (!mesh.uvs.empty()) {
     std::vector<float> st;
     for (const auto& uv : mesh.uvs) st.insert(st.end(), {uv.x(), 1.0f - uv.y()});
-    attributes["TEXCOORD_0"] = AddAccessor(st.data(), st.size() * 4, kArrayBuffer,
-                                           {{"componentType", kFloat}, {"count", n}, {"type", "VEC2"}});
+    attributes["TEXCOORD_0"] =
+        AddAccessor(st.data(), st.size() * 4, kArrayBuffer,
+                    {{"componentType", kFloat}, {"count", n}, {"type", "VEC2"}});
   }
-  const int indices =
-      AddAccessor(mesh.triangles.data(), mesh.triangles.size() * 12, kElementArrayBuffer,
-                  {{"componentType", kUInt32}, {"count", mesh.triangles.size() * 3}, {"type", "SCALAR"}});
-  Json primitive = {{"attributes", attributes}, {"indices", indices}, {"material", material}, {"mode", 4}};
+  const int indices = AddAccessor(
+      mesh.triangles.data(), mesh.triangles.size() * 12, kElementArrayBuffer,
+      {{"componentType", kUInt32}, {"count", mesh.triangles.size() * 3}, {"type", "SCALAR"}});
+  Json primitive = {
+      {"attributes", attributes}, {"indices", indices}, {"material", material}, {"mode", 4}};
   doc_["meshes"].push_back({{"name", name}, {"primitives", Json::array({primitive})}});
   return int(doc_["meshes"].size()) - 1;
 }
@@ -124,7 +128,8 @@ int GltfBuilder::AddTexture(const Material& m) {
   WriteImage(dir_ / relative, image, write);
   report_->files.push_back(relative);
   report_->Add("materials." + m.name, "rho_d_map written as an 8-bit sRGB PNG (quantised)");
-  if (doc_["samplers"].empty()) doc_["samplers"].push_back({{"magFilter", 9729}, {"minFilter", 9987}});
+  if (doc_["samplers"].empty())
+    doc_["samplers"].push_back({{"magFilter", 9729}, {"minFilter", 9987}});
   doc_["images"].push_back({{"uri", relative}, {"name", m.name}});
   doc_["textures"].push_back({{"source", int(doc_["images"].size()) - 1}, {"sampler", 0}});
   return int(doc_["textures"].size()) - 1;
@@ -137,12 +142,12 @@ int GltfBuilder::AddMaterial(const Material& m) {
   if (m.brdf == BrdfModel::kEmitter) {
     pbr["baseColorFactor"] = {0.0, 0.0, 0.0, 1.0};
     const double peak = m.radiance->maxCoeff();
-    material["emissiveFactor"] = Array3(peak > 0 ? Eigen::Vector3d(*m.radiance / peak)
-                                                 : Eigen::Vector3d::Zero());
+    material["emissiveFactor"] =
+        Array3(peak > 0 ? Eigen::Vector3d(*m.radiance / peak) : Eigen::Vector3d::Zero());
     ext["KHR_materials_emissive_strength"] = {{"emissiveStrength", peak}};
   } else {
-    Eigen::Vector3d base = m.brdf == BrdfModel::kBlack ? Eigen::Vector3d::Zero()
-                                                      : export_internal::RegionRhoD(m);
+    Eigen::Vector3d base =
+        m.brdf == BrdfModel::kBlack ? Eigen::Vector3d::Zero() : export_internal::RegionRhoD(m);
     if (m.rho_d_map) {
       pbr["baseColorTexture"] = {{"index", AddTexture(m)}};
       base.setOnes();
@@ -206,11 +211,13 @@ Json GltfBuilder::LightFor(const Light& light) {
       double inner = SpotAngle(p, 0.9), outer = SpotAngle(p, 0.1);
       if (p.kind == SpotProfile::Kind::kCone) {
         inner = p.inner_deg * kPi / 180, outer = std::min(p.outer_deg, 90.0) * kPi / 180;
-        report_->Add(item, "cone falloff: glTF's smooth falloff between inner and outer angles "
-                           "replaces the smoothstep");
+        report_->Add(item,
+                     "cone falloff: glTF's smooth falloff between inner and outer angles "
+                     "replaces the smoothstep");
       } else {
-        report_->Add(item, "spot profile as a glTF cone: inner/outer angles where it falls to "
-                           "90%/10% of its axis value");
+        report_->Add(item,
+                     "spot profile as a glTF cone: inner/outer angles where it falls to "
+                     "90%/10% of its axis value");
       }
       out["spot"] = {{"innerConeAngle", std::min(inner, outer - 1e-4)}, {"outerConeAngle", outer}};
       break;
@@ -222,8 +229,9 @@ Json GltfBuilder::LightFor(const Light& light) {
     case LightType::kSphere:
       out["type"] = "point";
       ColorIntensity(light.radiance * kPi * light.radius * light.radius, &out);
-      report_->Add(item, "sphere light as a point light of intensity radiance*pi*r^2 (exact at "
-                         "distances >> r; no visible sphere)");
+      report_->Add(item,
+                   "sphere light as a point light of intensity radiance*pi*r^2 (exact at "
+                   "distances >> r; no visible sphere)");
       break;
     case LightType::kArea:
       break;
@@ -256,18 +264,20 @@ void GltfBuilder::AddLights() {
     AddNode(std::move(node));
   }
   if (!lights_.empty()) extensions_.insert("KHR_lights_punctual");
-  report_->Add("lights", "radiometric values passed through 1:1 as glTF candela/lux (no luminous "
-                         "efficacy applied)");
+  report_->Add("lights",
+               "radiometric values passed through 1:1 as glTF candela/lux (no luminous "
+               "efficacy applied)");
 }
 
 void GltfBuilder::AddCameras() {
   for (const Camera& camera : scene_.cameras) {
     const double yfov = 2 * std::atan(camera.height / (2 * camera.focal_y_px()));
-    doc_["cameras"].push_back(
-        {{"name", camera.name},
-         {"type", "perspective"},
-         {"perspective",
-          {{"aspectRatio", double(camera.width) / camera.height}, {"yfov", yfov}, {"znear", 0.01}}}});
+    doc_["cameras"].push_back({{"name", camera.name},
+                               {"type", "perspective"},
+                               {"perspective",
+                                {{"aspectRatio", double(camera.width) / camera.height},
+                                 {"yfov", yfov},
+                                 {"znear", 0.01}}}});
     const Eigen::Matrix3d world_from_cam =
         camera.cam_from_world.rotation.toRotationMatrix().transpose();
     // glTF cameras look along −z with +y up: COLMAP's axes with y and z negated.
@@ -279,8 +289,8 @@ void GltfBuilder::AddCameras() {
              {"rotation", Rotation(world_from_gltf)}});
     const bool centred = std::abs(camera.principal_x_px() - 0.5 * camera.width) < 1e-6 &&
                          std::abs(camera.principal_y_px() - 0.5 * camera.height) < 1e-6;
-    const bool square = std::abs(camera.focal_x_px() - camera.focal_y_px()) <
-                        1e-6 * camera.focal_x_px();
+    const bool square =
+        std::abs(camera.focal_x_px() - camera.focal_y_px()) < 1e-6 * camera.focal_x_px();
     if (!centred || !square || camera.model == CameraModel::kOpenCv) {
       report_->Add("cameras." + camera.name,
                    "glTF perspective keeps yfov and aspect only: principal point offset, fx != fy "

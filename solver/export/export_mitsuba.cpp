@@ -75,15 +75,16 @@ std::string BsdfText(const Material& m, const std::filesystem::path& dir, Export
     inner = "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"beckmann\"/>" +
             Float("alpha", fit.alpha) + Float("int_ior", eta) + Float("ext_ior", 1.0) +
             "<boolean name=\"nonlinear\" value=\"false\"/>" +
-            DiffuseValue(m, "diffuse_reflectance", dir, report) + Rgb("specular_reflectance", spec) +
-            "</bsdf>";
+            DiffuseValue(m, "diffuse_reflectance", dir, report) +
+            Rgb("specular_reflectance", spec) + "</bsdf>";
   }
   return fmt::format("  <!-- {} ({}) -->\n  <bsdf type=\"twosided\" id=\"bsdf.{}\">{}</bsdf>\n",
                      m.name, BrdfModelName(m.brdf), id, inner);
 }
 
 std::string SensorText(const Camera& camera, int spp, ExportReport* report) {
-  const Eigen::Matrix3d world_from_cam = camera.cam_from_world.rotation.toRotationMatrix().transpose();
+  const Eigen::Matrix3d world_from_cam =
+      camera.cam_from_world.rotation.toRotationMatrix().transpose();
   const Eigen::Vector3d c = camera.CenterInWorld();
   const double fov = 2 * std::atan(camera.width / (2 * camera.focal_x_px())) * 180 / kPi;
   if (camera.model == CameraModel::kOpenCv ||
@@ -99,7 +100,8 @@ std::string SensorText(const Camera& camera, int spp, ExportReport* report) {
       "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" "
       "value=\"{}\"/><rfilter type=\"box\"/></film>\n  </sensor>\n",
       camera.name, SafeName(camera.name), Float("fov", fov), Float("near_clip", 0.01),
-      Float("principal_point_offset_x", (camera.principal_x_px() - 0.5 * camera.width) / camera.width),
+      Float("principal_point_offset_x",
+            (camera.principal_x_px() - 0.5 * camera.width) / camera.width),
       Float("principal_point_offset_y",
             (camera.principal_y_px() - 0.5 * camera.height) / camera.height),
       LookAt(c, c + world_from_cam.col(2), -world_from_cam.col(1)), spp, camera.width,

@@ -17,9 +17,8 @@ std::string Triple(const Eigen::Vector3d& v) {
 }
 
 // "void TYPE NAME\n0\n<strings>\n<n> <reals>\n".
-std::string Primitive(const std::string& modifier, const std::string& type,
-                      const std::string& name, const std::string& strings,
-                      const std::vector<double>& reals) {
+std::string Primitive(const std::string& modifier, const std::string& type, const std::string& name,
+                      const std::string& strings, const std::vector<double>& reals) {
   std::string text = fmt::format("{} {} {}\n{}\n0\n{}", modifier, type, name,
                                  strings.empty() ? "0" : strings, reals.size());
   for (double r : reals) {
@@ -31,7 +30,8 @@ std::string Primitive(const std::string& modifier, const std::string& type,
 }
 
 // ρs proportional to ρd (within 1e-3 relative): the ratio t, else nullopt.
-std::optional<double> ProportionalRatio(const Eigen::Vector3d& rho_d, const Eigen::Vector3d& rho_s) {
+std::optional<double> ProportionalRatio(const Eigen::Vector3d& rho_d,
+                                        const Eigen::Vector3d& rho_s) {
   if (!(rho_d.minCoeff() > 0)) return std::nullopt;
   const Eigen::Vector3d t = rho_s.cwiseQuotient(rho_d);
   if (t.maxCoeff() - t.minCoeff() > 1e-3 * t.maxCoeff()) return std::nullopt;
@@ -80,8 +80,8 @@ std::string MaterialText(const Material& m, ExportReport* report) {
                 "rho_d_map replaced by the region mean rho_d (RADIANCE polygons carry no UVs)");
   }
   if (m.brdf == BrdfModel::kEmitter) {
-    return text + Primitive("void", "light", name, "", {(*m.radiance)[0], (*m.radiance)[1],
-                                                        (*m.radiance)[2]});
+    return text + Primitive("void", "light", name, "",
+                            {(*m.radiance)[0], (*m.radiance)[1], (*m.radiance)[2]});
   }
   const Eigen::Vector3d rho_d =
       m.brdf == BrdfModel::kBlack ? Eigen::Vector3d::Zero() : export_internal::RegionRhoD(m);
@@ -102,8 +102,8 @@ std::string MaterialText(const Material& m, ExportReport* report) {
     fit_options.target = LobeTarget::kWardGmd;
     const LobeFit fit = export_internal::FitAndReport(m, fit_options, "RADIANCE plastic", report);
     rho_s *= fit.scale / rho_s.mean();  // the fit's k is the grey ρs of the fitted lobe
-    const double ratio = fit.alpha / std::sqrt(rough.size() == 2 ? rough[0] * rough[1]
-                                                                 : rough[0] * rough[0]);
+    const double ratio =
+        fit.alpha / std::sqrt(rough.size() == 2 ? rough[0] * rough[1] : rough[0] * rough[0]);
     for (double& r : rough) r *= ratio;
     text += fmt::format("# {}: {} converted to the GMD Ward of RADIANCE (fitted error {:.3g})\n",
                         m.name, BrdfModelName(m.brdf), fit.relative_error);
@@ -133,7 +133,8 @@ std::string SceneText(const Scene& scene, ExportReport* report) {
   for (size_t t = 0; t < mesh.num_triangles(); ++t) by_region[mesh.triangle_region[t]].push_back(t);
   for (size_t r = 0; r < by_region.size(); ++r) {
     const std::string mod = SafeName(scene.materials[r].name);
-    text += fmt::format("# region {}: {} triangles\n", scene.materials[r].name, by_region[r].size());
+    text +=
+        fmt::format("# region {}: {} triangles\n", scene.materials[r].name, by_region[r].size());
     for (size_t i = 0; i < by_region[r].size(); ++i) {
       text += PolygonText(mod, fmt::format("{}.t{}", mod, i), mesh, by_region[r][i]);
     }
@@ -157,8 +158,8 @@ std::string LightText(const Light& light, const ExportOptions& options, ExportRe
   const double r = options.point_light_radius_m;
   switch (light.type) {
     case LightType::kSphere:
-      return Primitive("void", "light", mat, "", {light.radiance.x(), light.radiance.y(),
-                                                  light.radiance.z()}) +
+      return Primitive("void", "light", mat, "",
+                       {light.radiance.x(), light.radiance.y(), light.radiance.z()}) +
              Primitive(mat, "sphere", name, "",
                        {light.center.x(), light.center.y(), light.center.z(), light.radius});
     case LightType::kPoint:
@@ -207,7 +208,8 @@ std::string LightText(const Light& light, const ExportOptions& options, ExportRe
 }
 
 std::string ViewText(const Camera& camera, ExportReport* report) {
-  const Eigen::Matrix3d world_from_cam = camera.cam_from_world.rotation.toRotationMatrix().transpose();
+  const Eigen::Matrix3d world_from_cam =
+      camera.cam_from_world.rotation.toRotationMatrix().transpose();
   const Eigen::Vector3d vp = camera.CenterInWorld();
   const Eigen::Vector3d vd = world_from_cam.col(2), vu = -world_from_cam.col(1);
   const double vh = 2 * std::atan(camera.width / (2 * camera.focal_x_px())) * 180 / kPi;

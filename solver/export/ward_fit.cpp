@@ -130,8 +130,8 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
   const double denom = cos_h2 * (a2 - 1.0) + 1.0;
   const double d = a2 / (kPi * denom * denom);
   const double nl = wi.z(), nv = wo.z();
-  const double v = 0.5 / (nl * std::sqrt(nv * nv * (1.0 - a2) + a2) +
-                          nv * std::sqrt(nl * nl * (1.0 - a2) + a2));
+  const double v =
+      0.5 / (nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2));
   const double m = std::pow(1.0 - c, 5.0);
   return (scale + (1.0 - scale) * m) * d * v;
 }
@@ -167,7 +167,8 @@ LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options)
   LobeFitOptions wide = options;
   wide.max_theta_o_deg = 88;
   const auto wide_pairs = BuildPairs(alpha_grid, IsAnisotropic(src.model), wide);
-  best.relative_error_to_88deg = FitAt(src, wide_pairs, options, best.alpha, &best.scale).relative_error;
+  best.relative_error_to_88deg =
+      FitAt(src, wide_pairs, options, best.alpha, &best.scale).relative_error;
   return best;
 }
 

@@ -2,14 +2,13 @@
 // materials, cameras and lights, vertex positions, and the camera and light placement.
 #include "solver/export/export_gltf.h"
 
-#include <gtest/gtest.h>
-
-#include <map>
-
-#include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include <assimp/Importer.hpp>
+#include <map>
 
 #include "solver/export/export.h"
 #include "solver/sampling.h"
@@ -118,7 +117,8 @@ TEST(ExportGltf, EveryLightTypeAndTexture) {
   const Image png = ReadImage(dir / "out" / "textures" / "matte.png", 3);
   EXPECT_NEAR(png.pixels[0], 188.0 / 255.0, 1e-6);
   aiString path;
-  ASSERT_EQ(Materials(ai).at("matte")->GetTexture(aiTextureType_DIFFUSE, 0, &path), aiReturn_SUCCESS);
+  ASSERT_EQ(Materials(ai).at("matte")->GetTexture(aiTextureType_DIFFUSE, 0, &path),
+            aiReturn_SUCCESS);
   EXPECT_STREQ(path.C_Str(), "textures/matte.png");
 }
 

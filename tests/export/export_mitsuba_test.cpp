@@ -16,10 +16,10 @@ namespace {
 
 struct XmlSummary {
   bool well_formed = false;
-  std::map<std::string, int> open_tags;       // tag -> count (elements, self-closing included)
-  std::map<std::string, int> types;           // "tag:type" -> count
-  std::vector<std::string> filenames;         // <string name="filename" value="...">
-  std::vector<std::string> top_level;         // tags of the <scene>'s children
+  std::map<std::string, int> open_tags;  // tag -> count (elements, self-closing included)
+  std::map<std::string, int> types;      // "tag:type" -> count
+  std::vector<std::string> filenames;    // <string name="filename" value="...">
+  std::vector<std::string> top_level;    // tags of the <scene>'s children
 };
 
 // Checks that tags nest and close, the root is <scene>, and counts elements. Enough for the
@@ -89,7 +89,7 @@ TEST(ExportMitsuba, EveryLightType) {
   EXPECT_EQ(x.types["emitter:point"], 1);
   EXPECT_EQ(x.types["emitter:spot"], 1);
   EXPECT_EQ(x.types["emitter:directional"], 1);
-  EXPECT_EQ(x.types["emitter:area"], 3);  // sphere lamp, area panel, emitter region "glow"
+  EXPECT_EQ(x.types["emitter:area"], 3);   // sphere lamp, area panel, emitter region "glow"
   EXPECT_EQ(x.types["shape:obj"], 5 + 1);  // regions + the panel
   for (const auto& f : x.filenames) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
 }

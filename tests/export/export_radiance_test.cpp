@@ -89,8 +89,8 @@ TEST(ExportRadiance, ReproducesTheReferenceRoom) {
 
   // The reference prints 6 significant digits: 1e-5 covers its rounding.
   const std::map<std::string, std::string> ref_name = {
-      {"floor", "floor_mat"},     {"ceiling", "ceil_mat"},    {"wall_x0", "red_wall"},
-      {"wall_x4", "green_wall"},  {"wall_y4", "back_wall"},   {"wall_y0", "front_wall"},
+      {"floor", "floor_mat"},        {"ceiling", "ceil_mat"},  {"wall_x0", "red_wall"},
+      {"wall_x4", "green_wall"},     {"wall_y4", "back_wall"}, {"wall_y0", "front_wall"},
       {"glossy_box", "glossy_blue"}, {"tall_box", "white_box"}};
   for (const auto& [region, ref_mat] : ref_name) {
     const Primitive& a = Find(mine, region);
@@ -104,9 +104,9 @@ TEST(ExportRadiance, ReproducesTheReferenceRoom) {
 
   // One polygon per triangle (18 RADIANCE quads = 36 triangles), 12 on the glossy box.
   EXPECT_EQ(Count(mine, "polygon"), 36);
-  EXPECT_EQ(std::count_if(mine.begin(), mine.end(),
-                          [](auto& p) { return p.modifier == "glossy_box"; }),
-            12);
+  EXPECT_EQ(
+      std::count_if(mine.begin(), mine.end(), [](auto& p) { return p.modifier == "glossy_box"; }),
+      12);
 
   // Lighting L0: the lamp exactly as in room_L0.rad.
   const auto lights = ParseRad(dir / "lighting_L0.rad");

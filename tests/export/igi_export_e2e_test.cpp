@@ -37,8 +37,8 @@ TEST(IgiExport, EveryFormatWritesItsFilesAndReport) {
   }
   // An existing empty folder is fine.
   std::filesystem::create_directories(dir / "empty");
-  EXPECT_EQ(RunTool("igi-export", RoomScene() + " --format gltf --quiet --out " +
-                                      Quote((dir / "empty").string()))
+  EXPECT_EQ(RunTool("igi-export",
+                    RoomScene() + " --format gltf --quiet --out " + Quote((dir / "empty").string()))
                 .exit_code,
             0);
 }
@@ -53,8 +53,8 @@ TEST(IgiExport, BadInputExitsTwoAndWritesNothing) {
   EXPECT_NE(r.err.find("--format"), std::string::npos);
   // Non-empty output folder: left as it was.
   WriteFileAtomic(dir / "busy" / "keep.txt", "x");
-  r = RunTool("igi-export", RoomScene() + " --format radiance --out " +
-                                Quote((dir / "busy").string()));
+  r = RunTool("igi-export",
+              RoomScene() + " --format radiance --out " + Quote((dir / "busy").string()));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir / "busy"),

@@ -38,8 +38,8 @@ TEST(InstalledPackage, ConsumerFindsIgiAndLoadsAScene) {
   EXPECT_TRUE(std::filesystem::exists(prefix / "bin/igi-export"));
 
   const std::string source = std::string(IGI_SOURCE_DIR) + "/tests/export/consumer";
-  ASSERT_EQ(Shell(Quote(cmake) + " -S " + Quote(source) + " -B " + Quote(build.string()) +
-                      " -G " + Quote(IGI_CMAKE_GENERATOR) +
+  ASSERT_EQ(Shell(Quote(cmake) + " -S " + Quote(source) + " -B " + Quote(build.string()) + " -G " +
+                      Quote(IGI_CMAKE_GENERATOR) +
                       " -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + Quote(prefix.string()),
                   log),
             0)

@@ -36,8 +36,8 @@ TEST(WardFit, GmdByGmdIsExact) {
 TEST(WardFit, Ward1992ByGmdIsClose) {
   for (double alpha : {0.05, 0.1, 0.2}) {
     const LobeFit fit = FitSpecularLobe(Source(BrdfModel::kWard, alpha, 1.0));
-    std::printf("ward alpha %.2f -> ward_gmd: alpha %.4f scale %.4f error %.4f\n", alpha,
-                fit.alpha, fit.scale, fit.relative_error);
+    std::printf("ward alpha %.2f -> ward_gmd: alpha %.4f scale %.4f error %.4f\n", alpha, fit.alpha,
+                fit.scale, fit.relative_error);
     EXPECT_NEAR(fit.alpha, alpha, 0.05 * alpha);
     EXPECT_NEAR(fit.scale, 0.76, 0.06);
     EXPECT_LT(fit.relative_error, 0.22);
@@ -59,9 +59,10 @@ TEST(WardFit, GmdByMicrofacetTargets) {
     LobeFitOptions ggx;
     ggx.target = LobeTarget::kGgxSchlick;
     const LobeFit g = FitSpecularLobe(src, ggx);
-    std::printf("ward_gmd alpha %.2f -> beckmann: alpha %.4f k %.4f error %.4f; ggx: alpha %.4f "
-                "F0 %.4f error %.4f\n",
-                alpha, b.alpha, b.scale, b.relative_error, g.alpha, g.scale, g.relative_error);
+    std::printf(
+        "ward_gmd alpha %.2f -> beckmann: alpha %.4f k %.4f error %.4f; ggx: alpha %.4f "
+        "F0 %.4f error %.4f\n",
+        alpha, b.alpha, b.scale, b.relative_error, g.alpha, g.scale, g.relative_error);
     EXPECT_NEAR(b.alpha, alpha, 0.1 * alpha);
     EXPECT_NEAR(b.scale, 0.73, 0.1);
     EXPECT_LT(b.relative_error, 0.34);
