@@ -47,6 +47,14 @@ void ExportOptions::Validate() const {
   problems.ThrowIfAny();
 }
 
+void ExportReport::Add(std::string item, std::string description,
+                       std::optional<double> relative_error) {
+  for (const Approximation& a : approximations) {
+    if (a.item == item && a.description == description) return;
+  }
+  approximations.push_back({std::move(item), std::move(description), relative_error});
+}
+
 Json ExportReport::ToJson() const {
   Json j;
   j["format"] = "igi-export-report";

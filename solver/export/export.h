@@ -56,10 +56,9 @@ struct ExportReport {
   std::vector<std::string> files;  // relative to the output folder, in writing order
   std::vector<Approximation> approximations;
 
+  // Records an approximation (an identical item + description is recorded once).
   void Add(std::string item, std::string description,
-           std::optional<double> relative_error = std::nullopt) {
-    approximations.push_back({std::move(item), std::move(description), relative_error});
-  }
+           std::optional<double> relative_error = std::nullopt);
   // {"format": "igi-export-report", "version": 1, "target", "files", "approximations"}.
   Json ToJson() const;
 };

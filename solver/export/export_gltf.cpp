@@ -263,7 +263,8 @@ void GltfBuilder::AddLights() {
     }
     AddNode(std::move(node));
   }
-  if (!lights_.empty()) extensions_.insert("KHR_lights_punctual");
+  if (lights_.empty()) return;
+  extensions_.insert("KHR_lights_punctual");
   report_->Add("lights",
                "radiometric values passed through 1:1 as glTF candela/lux (no luminous "
                "efficacy applied)");

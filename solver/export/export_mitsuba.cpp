@@ -93,6 +93,13 @@ std::string SensorText(const Camera& camera, int spp, ExportReport* report) {
                 "Mitsuba perspective has one focal length and no distortion: fy and lens "
                 "distortion dropped");
   }
+  if (std::abs(camera.principal_x_px() - 0.5 * camera.width) > 1e-6 ||
+      std::abs(camera.principal_y_px() - 0.5 * camera.height) > 1e-6) {
+    report->Add("cameras." + camera.name,
+                "principal point written as principal_point_offset_x/y = (cx - W/2)/W, "
+                "(cy - H/2)/H (film fractions; sign convention not checked against a Mitsuba "
+                "render)");
+  }
   return fmt::format(
       "  <!-- camera {} -->\n  <sensor type=\"perspective\" id=\"{}\">\n"
       "    <string name=\"fov_axis\" value=\"x\"/>{}{}{}{}\n    {}\n"
