@@ -10,6 +10,7 @@
 #include "tests/export/export_test_scene.h"
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
+#include "tools/common/image.h"
 
 namespace igi {
 namespace {
@@ -81,10 +82,19 @@ TEST(ExportMitsuba, RadianceRoom) {
 }
 
 TEST(ExportMitsuba, EveryLightType) {
-  const Scene scene = test::SyntheticScene();
-  const auto dir = test::UniqueTempDir("igi_export_mi") / "out";
+  Scene scene = test::SyntheticScene();
+  const auto tmp = test::UniqueTempDir("igi_export_mi");
+  const auto dir = tmp / "out";
+  // A 4x2 linear albedo map on "matte": written as textures/matte.exr, values unchanged.
+  Image texture;
+  texture.width = 4, texture.height = 2, texture.channels = 3;
+  texture.pixels.assign(4 * 2 * 3, 0.25f);
+  WriteImage(tmp / "matte.exr", texture);
+  scene.materials[0].rho_d_map = tmp / "matte.exr";
   ExportScene(scene, dir, {.format = ExportFormat::kMitsuba});
   XmlSummary x = ReadXml(ReadFileToString(dir / "scene_all.xml"));
+  EXPECT_EQ(x.types["texture:bitmap"], 1);
+  EXPECT_EQ(ReadImage(dir / "textures" / "matte.exr").pixels, texture.pixels);
   ASSERT_TRUE(x.well_formed);
   EXPECT_EQ(x.types["emitter:point"], 1);
   EXPECT_EQ(x.types["emitter:spot"], 1);
