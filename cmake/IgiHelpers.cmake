@@ -7,15 +7,38 @@ function(igi_set_warnings target)
   endif()
 endfunction()
 
-# igi_add_library(NAME SOURCES ... PUBLIC_DEPS ... PRIVATE_DEPS ...)
+include(GNUInstallDirs)
+
+# Installs the headers (*.h) of the calling folder, recursively, under include/igi/<folder>/ so
+# that "recon/scene.h" style includes work against include/igi; once per folder tree.
+function(igi_install_headers)
+  file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
+  get_property(done GLOBAL PROPERTY IGI_HEADER_DIRS)
+  foreach(dir IN LISTS done)
+    if(rel STREQUAL dir OR rel MATCHES "^${dir}/")
+      return()
+    endif()
+  endforeach()
+  set_property(GLOBAL APPEND PROPERTY IGI_HEADER_DIRS ${rel})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/igi/${rel}
+          FILES_MATCHING PATTERN "*.h")
+endfunction()
+
+# igi_add_library(NAME SOURCES ... PUBLIC_DEPS ... PRIVATE_DEPS ...): also installed, with its
+# headers, into the igiTargets export set (find_package(igi) gives igi::NAME).
 function(igi_add_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${name} ${ARG_SOURCES})
   target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
-                                            $<INSTALL_INTERFACE:include>)
+                                            $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/igi>)
   target_link_libraries(${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   target_compile_features(${name} PUBLIC cxx_std_20)
   igi_set_warnings(${name})
+  install(TARGETS ${name} EXPORT igiTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  igi_install_headers()
 endfunction()
 
 # igi_add_executable(NAME SOURCE DEPS ...): one thin main per executable, into build/bin/.
@@ -23,7 +46,7 @@ function(igi_add_executable name source)
   add_executable(${name} ${source})
   target_link_libraries(${name} PRIVATE ${ARGN})
   igi_set_warnings(${name})
-  install(TARGETS ${name} RUNTIME DESTINATION bin)
+  install(TARGETS ${name} EXPORT igiTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endfunction()
 
 # igi_add_test(NAME SOURCES ... DEPS ... [LABELS ...]): a GoogleTest binary registered with ctest.
