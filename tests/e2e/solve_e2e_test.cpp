@@ -6,12 +6,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include "tests/e2e/run.h"
 #include "tests/temp_dir.h"
+#include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
@@ -152,7 +154,9 @@ void ExpectBadInput(const test::RunResult& r, const fs::path& out, const std::st
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find(key), std::string::npos) << "expected " << key << " in: " << r.err;
   EXPECT_NE(r.err.find(file), std::string::npos) << "expected " << file << " in: " << r.err;
-  if (fs::exists(out)) EXPECT_TRUE(fs::is_empty(out)) << "something was written into --out";
+  if (fs::exists(out)) {
+    EXPECT_TRUE(fs::is_empty(out)) << "something was written into --out";
+  }
 }
 
 // The simplest valid capture: cam0 under L0, a constant photo (bad-input checks come before
@@ -245,11 +249,14 @@ TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {
   EXPECT_EQ(render.exit_code, 0) << render.err;
 }
 
-// The happy path: photos rendered by igi-render from known Lambertian albedos, every albedo
-// stripped, solved back. Tolerance 3 %: the photos are the same renderer's output (64 spp: the
-// per-pixel noise of a few % averages out over the ~700 observations of each region), so what
-// remains is the solver's gathering noise at 32 indirect rays and its bias at the room's
-// corners; both measured well below 3 % on each channel of the region means.
+// The happy path: photos rendered by igi-render from known Lambertian albedos (two views, one
+// lamp), every albedo stripped, solved back. Tolerance 3 %: the photos are the same renderer's
+// output, so there is no model error; what remains is the photos' Monte Carlo noise (64 spp,
+// averaged over hundreds of observations per region), the solver's gathering noise at 32
+// indirect rays and one refinement round. Measured: every channel of the three regions within
+// 1.3 % (floor +1.0 %, ceiling -0.9 %, walls +1.2 % at worst). Indirect light matters here: with
+// --indirect-rays 0 --refine-iterations 0 the same test gives +55 % .. +207 %, so the tolerance
+// catches a solver that loses the inter-reflections.
 TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
   RenderPhotos(false);
   Json m = TrueMaterials(false);
@@ -267,6 +274,8 @@ TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
     for (int c = 0; c < 3; ++c) {
       const double want = material.at("rho_d")[c].get<double>();
       const double got = rho[c].get<double>();
+      std::printf("%s[%d]: %.4f (truth %.2f, %+.2f %%)\n", name.c_str(), c, got, want,
+                  100 * (got / want - 1));
       EXPECT_NEAR(got / want, 1.0, 0.03)
           << name << " channel " << c << ": " << got << " vs " << want;
     }
@@ -274,9 +283,7 @@ TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
   const Json report = ReadJsonFile(Out() / "report.json");
   EXPECT_EQ(report.at("format"), "igi-solve-report");
   for (const Json& region : report.at("regions")) EXPECT_EQ(region.at("status"), "solved");
-  std::ifstream html(Out() / "report.html");
-  const std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("<img"), std::string::npos);
+  EXPECT_NE(ReadFileToString(Out() / "report.html").find("<img"), std::string::npos);
   const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
                                                 " --camera cam1 --lighting L0 --spp 2 --quiet "
                                                 "--out " +

@@ -121,8 +121,11 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   return fit;
 }
 
-// Measured (Release, 2 threads on the shared 2-core machine): see the numbers printed; the
-// comments below record one run.
+// Measured (Release, 2 threads, shared 2-core machine under load ~5; the whole test 12 s):
+//   ward:    rho_d (0.487 0.411 0.268), rho_s 0.0081, alpha 0.032; fit render residual 0.067,
+//            region rms 0.072, held-out residual 0.098
+//   lambert: rho_d (0.476 0.400 0.264);               fit render residual 0.126,
+//            region rms 0.115, held-out residual 0.155
 TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   const fs::path out = test::UniqueTempDir("igi_diligent_solve");
   const BallFit ward = FitBall(BrdfModel::kWard, "ward", out);
@@ -136,10 +139,11 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   EXPECT_GT(ward.region.final_params.rho_s.minCoeff(), 0.0);
   EXPECT_GT(ward.region.final_params.alpha, 0.01);
   EXPECT_LT(ward.region.final_params.alpha, 0.5);
-  // Clearly below: at least 20 % lower residual on the fitted photos, by both measures.
+  // Clearly below: at least 20 % lower residual on the fitted photos, by both measures
+  // (measured: 0.53 and 0.62 of Lambert's).
   EXPECT_LT(ward.fit_residual, 0.8 * lambert.fit_residual);
   EXPECT_LT(ward.region_rms, 0.8 * lambert.region_rms);
-  // Photos under lights neither fit saw.
+  // Photos under lights neither fit saw (measured 0.63 of Lambert's).
   EXPECT_LE(ward.held_out, lambert.held_out);
 }
 
