@@ -71,42 +71,61 @@ for n in $PHOTOS; do
 done
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 
-python3 - "$WORK" <<'EOF'
+python3 - "$WORK" "$DATA" <<'EOF'
 import json, os, sys
-work = sys.argv[1]
+work, data = sys.argv[1], sys.argv[2]
+truth = json.load(open(os.path.join(data, "scene.json")))["materials"]
 rows = []
 for line in open(os.path.join(work, "runs.txt")):
     n, s, rc, wall, load = line.split()
     rep_path = os.path.join(work, f"out_p{n}_s{s}", "report.json")
-    if not os.path.exists(rep_path):
-        rows.append((int(n), int(s), rc, float(wall), load, None))
-        continue
-    rows.append((int(n), int(s), rc, float(wall), load, json.load(open(rep_path))))
+    rep = json.load(open(rep_path)) if os.path.exists(rep_path) else None
+    rows.append((int(n), int(s), rc, float(wall), load, rep))
 ok = [r for r in rows if r[5]]
 if not ok:
     sys.exit("no run wrote report.json")
 base = min(ok, key=lambda r: (r[0], -r[1]))
 base_t = base[5]["timing"]["total_s"]
+
+
+def f(v, digits=3):
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def albedo_error(rep, stage):
+    # Mean over the solved regions and channels of |rho_d - truth| / truth (region means).
+    errs = []
+    for r in rep["regions"]:
+        fit = r[stage]
+        if r["status"] == "unobserved" or not fit.get("rho_d"):
+            continue
+        want = truth[r["name"]]["rho_d"]
+        errs += [abs(g - w) / w for g, w in zip(fit["rho_d"], want)]
+    return 100 * sum(errs) / len(errs) if errs else None
+
+
+def glossy(rep, stage):
+    g = next(r for r in rep["regions"] if r["name"] == "glossy_box")[stage]
+    if not g.get("rho_d"):
+        return "-"
+    return f"{f(g.get('rho_s', [None])[0])} / {f(g.get('alpha'))}"
+
+
 print()
 print("| photos | stride | observations | wall s | solve s | x smallest | s per 1k obs | ray share "
-      "| paper residual | refined residual | glossy_box rho_s (0.05) | alpha (0.1) | rho_d (0.2 0.3 0.6) "
-      "| exit | load |")
-print("|" + "---|" * 15)
+      "| render residual paper / refined | mean ρd error % paper / refined "
+      "| glossy_box ρs / α paper (truth 0.05 / 0.1) | refined | exit | load |")
+print("|" + "---|" * 14)
 for n, s, rc, wall, load, rep in rows:
     if rep is None:
-        print(f"| {n} | {s} | - | {wall:.1f} | - | - | - | - | - | - | - | - | - | {rc} | {load} |")
+        print(f"| {n} | {s} | - | {wall:.1f} | - | - | - | - | - | - | - | - | {rc} | {load} |")
         continue
     t = rep["timing"]
     obs = rep["observations"]
-    g = next(r for r in rep["regions"] if r["name"] == "glossy_box")
-    fit = g["refined"] if g["refined"].get("rho_d") else g["paper"]
-    def f(v):
-        return "-" if v is None else f"{v:.3f}"
-    rho_s = fit.get("rho_s", [None])[0]
-    rho_d = " ".join(f(v) for v in fit.get("rho_d", [None] * 3))
+    st = rep["stages"]
     print(f"| {n} | {s} | {obs} | {wall:.1f} | {t['total_s']:.1f} | {t['total_s'] / base_t:.2f} "
           f"| {1000 * t['total_s'] / max(obs, 1):.3f} | {t['ray_casting_share']:.2f} "
-          f"| {f(rep['stages']['paper']['render_residual'])} "
-          f"| {f(rep['stages']['refined']['render_residual'])} | {f(rho_s)} | {f(fit.get('alpha'))} "
-          f"| {rho_d} | {rc} | {load} |")
+          f"| {f(st['paper']['render_residual'])} / {f(st['refined']['render_residual'])} "
+          f"| {f(albedo_error(rep, 'paper'), 1)} / {f(albedo_error(rep, 'refined'), 1)} "
+          f"| {glossy(rep, 'paper')} | {glossy(rep, 'refined')} | {rc} | {load} |")
 EOF
