@@ -1,0 +1,151 @@
+// igi::Solve on real photographs: the DiLiGenT "ball" (shared data, real/diligent_ball: a
+// radius-1 sphere under 48 directional lights, one photo each, a mask, clipped highlight
+// pixels). The ball is glossy, so a Ward fit must explain the photos clearly better than a
+// Lambertian fit of the same photos, with a plausible lobe, and must predict photos it never saw
+// at least as well.
+//
+// Photos: every 4th of the 48 (12); the fits use the odd half of those (6 photos) and the
+// even half (6 photos under lights the fits never saw) is predicted with the path tracer.
+// A single convex ball has no inter-reflection, so the indirect gathering can be minimal; the
+// paper's stage alone (refine_iterations 0) is enough to compare models.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/render.h"
+#include "solver/solve.h"
+#include "tests/temp_dir.h"
+#include "tools/common/image.h"
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kBall = fs::path(IGI_SHARED_DATA_DIR) / "real" / "diligent_ball";
+
+struct BallFit {
+  double fit_residual = 0;  // path-traced render of the fitted model vs the fitted photos
+  double region_rms = 0;    // the region fit's own relative RMS over its samples
+  double held_out = 0;      // relative RMS on the held-out photos
+  RegionSolution region;
+  double seconds = 0;
+};
+
+std::vector<Photo> Select(const std::vector<Photo>& all, int first, int step) {
+  std::vector<Photo> out;
+  for (size_t i = first; i < all.size(); i += step) out.push_back(all[i]);
+  return out;
+}
+
+// Relative RMS sqrt(Σ(pred − photo)² / Σ photo²) of `solved` rendered at the pixels of `photos`
+// that are inside the mask eroded by one pixel (the silhouette of the mesh and the mask differ
+// by a few boundary pixels) and not clipped, every `stride`-th pixel, all channels.
+double HeldOutResidual(const Scene& solved, const std::vector<Photo>& photos, int stride) {
+  double num = 0, den = 0;
+  for (const Photo& p : photos) {
+    const Image photo = ReadImage(p.file, 3);
+    const Image mask = ReadImage(*p.mask, 1);
+    const Camera& cam = solved.cameras[p.camera];
+    const Renderer renderer(solved, p.lighting);
+    const Eigen::Vector3d origin = cam.CenterInWorld();
+    auto inside = [&](int x, int y) { return mask.at(x, y) > 0.5f; };
+    for (int y = 1; y + 1 < photo.height; y += stride) {
+      for (int x = 1; x + 1 < photo.width; x += stride) {
+        if (!inside(x, y) || !inside(x - 1, y) || !inside(x + 1, y) || !inside(x, y - 1) ||
+            !inside(x, y + 1)) {
+          continue;
+        }
+        const Eigen::Vector3d l(photo.at(x, y, 0), photo.at(x, y, 1), photo.at(x, y, 2));
+        if (l.maxCoeff() >= 1.0) continue;  // clipped: 65535 / 65535
+        const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+        // Directional light on a convex object: next-event estimation is exact and every
+        // bounce escapes, so a couple of paths give the noise-free radiance.
+        const Eigen::Vector3d pred = renderer.Radiance(origin, dir, 2, uint64_t(y) * 7919 + x);
+        num += (pred - l).squaredNorm();
+        den += l.squaredNorm();
+      }
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) {
+  Scene scene = LoadScene(kBall / "scene.json", SceneLoadOptions{});
+  EXPECT_EQ(scene.photos.size(), 48u);
+  const std::vector<Photo> used = Select(scene.photos, 0, 4);  // 12 photos
+  const std::vector<Photo> held_out = Select(used, 0, 2);      // 6
+  scene.photos = Select(used, 1, 2);                           // 6 fitted
+  scene.materials[0].brdf = brdf;
+  scene.document["materials"]["ball"]["brdf"] = brdf_name;
+
+  SolveOptions options;
+  options.pixel_stride = 2;
+  options.saturation = 1.0;   // 16-bit PNG / 65535: clipped pixels are exactly 1.0
+  options.indirect_rays = 4;  // nothing to inter-reflect on a convex ball
+  options.refine_iterations = 0;
+  options.albedo_maps = "none";  // compare region-constant models
+  options.num_threads = 2;
+  options.show_progress = false;
+  const auto start = std::chrono::steady_clock::now();
+  const SolveSummary summary = Solve(scene, options, out_dir);
+  BallFit fit;
+  fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(summary.regions.size(), 1u);
+  fit.region = summary.regions.at(0);
+  fit.fit_residual = summary.stage2_render_residual;
+  fit.region_rms = fit.region.stage2.relative_rms;
+
+  Scene solved = scene;
+  Material& m = solved.materials[0];
+  m.rho_d = fit.region.final_params.rho_d;
+  if (brdf != BrdfModel::kLambert) {
+    m.rho_s = fit.region.final_params.rho_s;
+    m.alpha = fit.region.final_params.alpha;
+  }
+  EXPECT_TRUE(m.MissingForRendering().empty());
+  fit.held_out = HeldOutResidual(solved, held_out, 2);
+  std::printf(
+      "%s: %.1f s, %d observations, rho_d (%.4f %.4f %.4f), rho_s %.4f, alpha %.4f; "
+      "fit render residual %.4f, region rms %.4f, held-out residual %.4f\n",
+      brdf_name, fit.seconds, fit.region.observations, m.rho_d->x(), m.rho_d->y(), m.rho_d->z(),
+      fit.region.final_params.rho_s.x(), fit.region.final_params.alpha, fit.fit_residual,
+      fit.region_rms, fit.held_out);
+  return fit;
+}
+
+// Measured (Release, 2 threads, shared 2-core machine under load ~5; the whole test 12 s):
+//   ward:    rho_d (0.487 0.411 0.268), rho_s 0.0081, alpha 0.032; fit render residual 0.067,
+//            region rms 0.072, held-out residual 0.098
+//   lambert: rho_d (0.476 0.400 0.264);               fit render residual 0.126,
+//            region rms 0.115, held-out residual 0.155
+TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
+  const fs::path out = test::UniqueTempDir("igi_diligent_solve");
+  const BallFit ward = FitBall(BrdfModel::kWard, "ward", out);
+  const BallFit lambert = FitBall(BrdfModel::kLambert, "lambert", out);
+  fs::remove_all(out);
+
+  EXPECT_EQ(ward.region.status, "solved");
+  EXPECT_EQ(lambert.region.status, "solved");
+  // The glossy lobe is real: a clearly positive ρs and a roughness in the range of real glossy
+  // paints and plastics.
+  EXPECT_GT(ward.region.final_params.rho_s.minCoeff(), 0.0);
+  EXPECT_GT(ward.region.final_params.alpha, 0.01);
+  EXPECT_LT(ward.region.final_params.alpha, 0.5);
+  // Clearly below: at least 20 % lower residual on the fitted photos, by both measures
+  // (measured: 0.53 and 0.62 of Lambert's).
+  EXPECT_LT(ward.fit_residual, 0.8 * lambert.fit_residual);
+  EXPECT_LT(ward.region_rms, 0.8 * lambert.region_rms);
+  // Photos under lights neither fit saw (measured 0.63 of Lambert's).
+  EXPECT_LE(ward.held_out, lambert.held_out);
+}
+
+}  // namespace
+}  // namespace igi
