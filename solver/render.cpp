@@ -274,7 +274,8 @@ Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::V
   uint64_t rays = 0;
   for (int k = 0; k < spp; ++k) {
     Pcg32 rng = PixelSampleRng(seed, 0, k);
-    sum += tracer.Trace(origin, direction.normalized(), rng, &rays);
+    const Eigen::Vector3d l = tracer.Trace(origin, direction.normalized(), rng, &rays);
+    if (l.allFinite()) sum += l;
   }
   return sum / std::max(1, spp);
 }

@@ -81,6 +81,11 @@ struct SolveSummary {
   double stage1_render_residual = 0;  // path-traced render of the stage-1 model vs the photos
   double stage2_render_residual = 0;  // the same for the final model
   int render_residual_spp = 0;
+  // Standard errors of the squared render residuals (the estimate is noisy at a few paths).
+  double stage1_render_residual_sq_se = 0, stage2_render_residual_sq_se = 0;
+  // Whether the refinement's parameters were kept (false: they explained the photos worse, and
+  // the paper stage's are the result; both are reported).
+  bool refinement_accepted = true;
   double patch_size_m = 0, texel_size_m = 0;
   int patches = 0, observations = 0;
   uint64_t rays = 0;

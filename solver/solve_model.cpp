@@ -164,8 +164,19 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
     if (stage == 1) summary.residuals[k].stage2 = r;
   }
   const double total = all_den > 0 ? std::sqrt(std::max(0.0, all_num) / all_den) : 0.0;
+  // Standard error of the squared residual, from the spread of the per-pixel terms.
+  double mean = all_num / std::max<size_t>(1, obs.size()), var = 0;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const double d = (pred1[i] - obs[i].radiance.cast<double>()).dot(pred2[i] - obs[i].radiance.cast<double>());
+    var += (d - mean) * (d - mean);
+  }
+  const double se_sq = all_den > 0 ? std::sqrt(var) / all_den : 0.0;  // of residual²
   (stage == 1 ? summary.stage1_render_residual : summary.stage2_render_residual) = total;
-  if (stage == 1) summary.stage2_render_residual = total;
+  (stage == 1 ? summary.stage1_render_residual_sq_se : summary.stage2_render_residual_sq_se) = se_sq;
+  if (stage == 1) {
+    summary.stage2_render_residual = total;
+    summary.stage2_render_residual_sq_se = se_sq;
+  }
   summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("stage {} model rendered at the observed pixels: relative rms {:.4f}", stage, total);
 }
@@ -184,6 +195,7 @@ void SolverState::RunStage2() {
   } cleanup{temp};
   std::vector<RegionAtlas> atlases;
   std::vector<Image> maps;
+  const std::vector<MaterialState> stage1 = materials;
   {
     const Scene model = CompleteScene(&atlases, &maps, temp / "s1");
     RenderResiduals(model, 1);
@@ -197,12 +209,28 @@ void SolverState::RunStage2() {
     ComputeSpecularTerms();
     summary.stage2_iterations = round;
   }
+  for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
   if (options.refine_iterations > 0) {
     std::filesystem::create_directories(temp / "final");
     const Scene model = CompleteScene(&atlases, &maps, temp / "final");
     RenderResiduals(model, 2);
+    // The refinement's parameters are kept only if the photos are not explained worse than by
+    // the paper's (beyond twice the standard error of the comparison).
+    const double r1 = summary.stage1_render_residual, r2 = summary.stage2_render_residual;
+    const double se = std::hypot(summary.stage1_render_residual_sq_se, summary.stage2_render_residual_sq_se);
+    summary.refinement_accepted = r2 * r2 <= r1 * r1 + 2 * se;
+    if (!summary.refinement_accepted) {
+      for (size_t r = 0; r < materials.size(); ++r) {
+        materials[r].params = stage1[r].params;
+        materials[r].patch_rho_d = stage1[r].patch_rho_d;
+        materials[r].last_fit = stage1[r].last_fit;
+      }
+      ComputeSpecularTerms();
+      spdlog::warn("the refinement explains the photos worse ({:.4f} vs {:.4f}): the paper stage's "
+                   "parameters are kept",
+                   r2, r1);
+    }
   }
-  for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
 }
 
 void SolverState::BuildAlbedoMaps() {

@@ -35,7 +35,7 @@ struct SolveOptions {
   // Beyond the paper: re-render the light arriving at every observation with the full path
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
-  int refine_rays = 16;  // path-traced directions per observation in each refinement round
+  int refine_rays = 32;  // path-traced directions per observation in each refinement round
   uint64_t seed = 1;
   int num_threads = 0;  // 0 = the process default
   bool show_progress = true;

@@ -119,8 +119,11 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["stages"]["paper"] = {{"iterations", s.stage1_iterations},
                           {"model_residual", Num(s.stage1_model_residual)},
                           {"render_residual", Num(s.stage1_render_residual)}};
+  j["stages"]["paper"]["render_residual_squared_stderr"] = Num(s.stage1_render_residual_sq_se);
   j["stages"]["refined"] = {{"iterations", s.stage2_iterations},
-                            {"render_residual", Num(s.stage2_render_residual)}};
+                            {"render_residual", Num(s.stage2_render_residual)},
+                            {"render_residual_squared_stderr", Num(s.stage2_render_residual_sq_se)},
+                            {"accepted", s.refinement_accepted}};
   j["render_residual_spp"] = s.render_residual_spp;
   j["residual_metric"] =
       "relative RMS residual sqrt(sum (render - photo)^2 / sum photo^2) over the observed pixels, "

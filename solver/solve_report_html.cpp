@@ -14,10 +14,10 @@ std::string Fmt(double v, int digits = 4) {
   return std::isfinite(v) ? fmt::format("{:.{}g}", v, digits) : "–";
 }
 std::string FmtPm(double v, double sigma) {
-  return std::isfinite(sigma) ? Fmt(v) + " ± " + Fmt(sigma, 2) : Fmt(v);
+  return std::isfinite(sigma) ? fmt::format("{} ± {}", Fmt(v), Fmt(sigma, 2)) : Fmt(v);
 }
 std::string Rgb(const Eigen::Vector3d& v) {
-  return "(" + Fmt(v[0], 3) + ", " + Fmt(v[1], 3) + ", " + Fmt(v[2], 3) + ")";
+  return fmt::format("({}, {}, {})", Fmt(v[0], 3), Fmt(v[1], 3), Fmt(v[2], 3));
 }
 
 void ParameterTable(HtmlReport* page, const SolveSummary& s) {
@@ -29,8 +29,9 @@ void ParameterTable(HtmlReport* page, const SolveSummary& s) {
     const bool spec = HasSpecularLobe(p.model);
     std::string alpha1 = "", alpha2 = "";
     if (spec && IsAnisotropic(p.model)) {
-      alpha1 = Fmt(f1.alpha_x) + " / " + Fmt(f1.alpha_y);
-      alpha2 = FmtPm(f2.alpha_x, f2.sigma_alpha_x) + " / " + FmtPm(f2.alpha_y, f2.sigma_alpha_y);
+      alpha1 = fmt::format("{} / {}", Fmt(f1.alpha_x), Fmt(f1.alpha_y));
+      alpha2 = fmt::format("{} / {}", FmtPm(f2.alpha_x, f2.sigma_alpha_x),
+                           FmtPm(f2.alpha_y, f2.sigma_alpha_y));
     } else if (spec) {
       alpha1 = Fmt(f1.alpha);
       alpha2 = FmtPm(p.alpha, f2.sigma_alpha);
@@ -75,13 +76,13 @@ void Coverage(HtmlReport* page, const SolveSummary& s) {
   std::vector<std::vector<std::string>> rows, classes;
   for (const RegionHighlightCoverage& c : s.coverage) {
     std::string where;
-    for (const HighlightSuggestion& h : c.suggestions) where += h.text + " ";
+    for (const HighlightSuggestion& h : c.suggestions) where += fmt::format("{} ", h.text);
     rows.push_back({c.name, c.observed ? "yes" : "NO", std::to_string(c.highlight_pixels),
                     std::to_string(c.photos.size()), where});
     classes.push_back({"", c.observed ? "good" : "bad"});
     if (!c.observed) {
-      page->Note(c.name + ": no photo shows the highlight, so ρs and α cannot be recovered. " +
-                     where,
+      page->Note(fmt::format("{}: no photo shows the highlight, so ρs and α cannot be recovered. {}",
+                             c.name, where),
                  "warning");
     }
   }
@@ -105,10 +106,16 @@ void WriteSolveReportHtml(const SolveSummary& s, const Json& /*report*/,
       "Render vs photo at the observed pixels (relative RMS, path traced with {} samples per "
       "pixel, render noise removed): paper stage {}, refined {}.",
       s.render_residual_spp, Fmt(s.stage1_render_residual), Fmt(s.stage2_render_residual)));
-  if (!s.converged) page.Note("Stage 1 did not converge: " + s.message, "warning");
+  if (!s.refinement_accepted) {
+    page.Note("The refinement explained the photos worse than the paper stage; the paper stage's "
+              "parameters are the result (both are in the table).",
+              "warning");
+  }
+  if (!s.converged) page.Note(fmt::format("Stage 1 did not converge: {}", s.message), "warning");
   for (const RegionSolution& r : s.regions) {
     if (r.status == "unobserved") {
-      page.Note(r.name + ": no photo sees this region; its values are placeholders.", "error");
+      page.Note(fmt::format("{}: no photo sees this region; its values are placeholders.", r.name),
+                "error");
     }
   }
   page.Heading("Parameters");
@@ -130,7 +137,7 @@ void WriteSolveReportHtml(const SolveSummary& s, const Json& /*report*/,
     if (!r.albedo_map) continue;
     if (!maps) page.Heading("Albedo maps");
     maps = true;
-    page.Image(*r.albedo_map, r.name + " (" + r.albedo_map_file + ")", 1.0, 256);
+    page.Image(*r.albedo_map, fmt::format("{} ({})", r.name, r.albedo_map_file), 1.0, 256);
   }
   page.Write(path);
 }

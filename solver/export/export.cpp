@@ -1,5 +1,7 @@
 #include "solver/export/export.h"
 
+#include <fmt/format.h>
+
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -105,7 +107,7 @@ ExportReport ExportScene(const Scene& scene, const std::filesystem::path& out_di
   const std::filesystem::path final_dir = std::filesystem::absolute(out_dir).lexically_normal();
   const std::filesystem::path tmp_dir =
       final_dir.parent_path() /
-      ("." + final_dir.filename().string() + ".tmp" + std::to_string(::getpid()));
+      fmt::format(".{}.tmp{}", final_dir.filename().string(), ::getpid());
   std::filesystem::remove_all(tmp_dir);
   std::filesystem::create_directories(tmp_dir);
   ExportReport report;

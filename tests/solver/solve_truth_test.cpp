@@ -171,7 +171,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
                          ::testing::Values(SynthCase{"clean", false}, SynthCase{"noisy", true}),
-                         [](const auto& info) { return info.param.name; });
+                         [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace
 }  // namespace igi
