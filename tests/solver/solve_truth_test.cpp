@@ -81,6 +81,8 @@ struct SynthCase {
   bool noise;
 };
 
+void PrintTo(const SynthCase& c, std::ostream* os) { *os << c.name; }
+
 class SolveSynth : public ::testing::TestWithParam<SynthCase> {};
 
 TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
