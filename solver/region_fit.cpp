@@ -412,11 +412,13 @@ double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>&
 // squares per channel); NaN for a slot without such a sample.
 std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const Prepared& pr,
                                                 const std::vector<Eigen::Vector3d>& t,
-                                                const Eigen::Vector3d& rho_s) {
+                                                const Eigen::Vector3d& rho_s,
+                                                const Eigen::Vector3d& rho_d_mean) {
   std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
   for (size_t i = 0; i < in.samples.size(); ++i) {
     const FitSample& s = in.samples[i];
     const Eigen::Vector3d spec = rho_s.cwiseProduct(t[i]);
+    (void)rho_d_mean;
     if ((spec.array() > 0.1 * s.observed.array().max(0.0)).any()) continue;
     const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
     num[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(s.observed - spec);
@@ -502,7 +504,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   // into that patch's albedo instead of constraining ρs and α.
   LinearSolution patch;
   patch.rho_s = r.rho_s;
-  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s);
+  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s, r.rho_d);
   std::vector<int> counts;
   r.albedo_varies = in.albedo_varies ? *in.albedo_varies : AlbedoVaries(in, pr, patch, t, &counts);
   if (r.albedo_varies && !in.albedo_varies) {
@@ -527,21 +529,27 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
     b = SearchAlpha(held, pr, false);
     t = SpecularTerms(in, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
-    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s);
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }
   r.albedo_model = "per_patch";
   r.rho_s = b.linear.rho_s;
   r.alpha = r.alpha_x = b.ax;
   r.alpha_y = b.ay;
   r.slot_rho_d = patch.slot_rho_d;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  double wsum = 0;
-  for (int k = 0; k < in.num_slots; ++k) {
-    if (!r.slot_rho_d[k].allFinite()) continue;
-    mean += in.slot_area[k] * r.slot_rho_d[k];
-    wsum += in.slot_area[k];
+  // The region's mean albedo with the lobe fitted: Σ(L − specular)/Σ E/π over every sample (a
+  // ratio of sums, as the constant model computes it). The patches' own albedos come from the
+  // samples off the highlights, which favour bright texels there; their mean would be biased.
+  {
+    Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = num;
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+      num += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed - r.rho_s.cwiseProduct(t[i]));
+      den += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (den[c] > 0) r.rho_d[c] = std::max(0.0, num[c] / den[c]);
+    }
   }
-  if (wsum > 0) r.rho_d = mean / wsum;
   for (Eigen::Vector3d& v : r.slot_rho_d) {
     if (!v.allFinite()) v = r.rho_d;
   }

@@ -58,7 +58,10 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
     // Highlights tell little about the albedo and much about any error in the fitted lobe:
     // weight each observation by its diffuse share, and leave out those under half diffuse.
-    const double share = 1.0 - spec.sum() / std::max(1e-12, double(o.radiance.sum()));
+    // (from the model, not the observation: a test on the observed radiance would favour the
+    // bright texels near highlights)
+    const double diffuse_pred = (s.PatchAlbedo(o.patch).cwiseProduct(s.obs_e[i]) / kPi).sum();
+    const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
     const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
     if (!(w > 0)) continue;
     builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * s.obs_e[i]);
@@ -262,7 +265,7 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
   }
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
   for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  s.summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 48.0;
+  s.summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
   s.patches = BuildPatches(scene.mesh, s.summary.patch_size_m);
   s.summary.patches = s.patches.size();
   s.InitMaterials();

@@ -14,7 +14,7 @@ struct SolveOptions {
   // Pixel values at or above this are clipped and ignored (scene radiance units); 0 = auto: a
   // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
   double saturation = 0;
-  // Patch size, metres: 0 = auto (the scene's bounding-box diagonal / 48).
+  // Patch size, metres: 0 = auto (the scene's bounding-box diagonal / 96).
   double patch_size_m = 0;
   // Gathering at each observation and patch: samples per extended light (sphere, area) and
   // stratified hemisphere rays for the light arriving from other surfaces.
