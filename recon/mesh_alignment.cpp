@@ -297,8 +297,8 @@ void RefinePose(const std::vector<Eigen::Vector2d>& pixels, const std::vector<Ve
 }  // namespace
 
 void MeshAlignmentOptions::Validate() const {
-  if (max_iterations < 1 || coarse_iterations < 1 || coarse_sample < 10 || !(trim_fraction > 0) ||
-      trim_fraction > 1 || !(tolerance > 0) || !(inlier_sigmas > 0)) {
+  if (max_iterations < 1 || coarse_iterations < 1 || coarse_sample < 10 || random_hypotheses < 0 ||
+      !(trim_fraction > 0) || trim_fraction > 1 || !(tolerance > 0) || !(inlier_sigmas > 0)) {
     throw Error("MeshAlignmentOptions: invalid values");
   }
 }
@@ -336,24 +336,32 @@ MeshAlignmentSummary AlignPointsToMeshCoarse(const std::vector<Vector3d>& points
   const Frame from = PrincipalFrame(kept);
   const Frame to = PrincipalFrame(SampleMesh(mesh, 20000));
   const std::vector<Vector3d> sample = Subsample(kept, options.coarse_sample);
+  // Rotation hypotheses: the 24 that map principal axes onto principal axes, then random ones
+  // (the principal axes of a partial reconstruction can be far from the mesh's).
+  std::vector<Matrix3d> rotations;
+  for (const Matrix3d& flip : AxisRotations()) {
+    rotations.push_back(to.axes * flip * from.axes.transpose());
+  }
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  for (int i = 0; i < options.random_hypotheses; ++i) {
+    rotations.push_back(Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().matrix());
+  }
   double best_score = -1;
   Similarity3d best;
-  const std::vector<Matrix3d> rotations = AxisRotations();
-  for (const Matrix3d& flip : rotations) {
+  for (const Matrix3d& r : rotations) {
     Similarity3d sim;
     sim.scale = to.spread / from.spread;
-    const Matrix3d r = to.axes * flip * from.axes.transpose();
     sim.rotation = Eigen::Quaterniond(r);
     sim.translation = to.centroid - sim.scale * (r * from.centroid);
     const double start_scale = sim.scale;
     sim = RunIcp(sample, closest, sim, options.coarse_iterations, extent, options).sim;
     // A hypothesis whose scale ran away collapsed onto a few surfaces: not a fit.
     if (sim.scale < 0.5 * start_scale || sim.scale > 2 * start_scale) continue;
-    // Score: share of points within 1 % of the mesh's size, then fit quality.
+    // Score: number of points within 1 % of the mesh's size.
     int near = 0;
     for (const Match& m : MatchPoints(sample, sim, closest)) near += m.distance < 0.01 * extent;
-    const double score = near;
-    if (score > best_score) best_score = score, best = sim;
+    if (near > best_score) best_score = near, best = sim;
   }
   MeshAlignmentSummary s = AlignPointsToMesh(points_model, mesh, best, options);
   s.start = "pca";

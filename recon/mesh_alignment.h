@@ -24,14 +24,15 @@
 namespace igi {
 
 struct MeshAlignmentOptions {
-  int max_iterations = 60;     // of the final ICP
-  double trim_fraction = 0.8;  // share of the points kept in each iteration, (0, 1]
-  double tolerance = 1e-8;     // stop when the update (rotation rad, relative scale, and
-                               // translation / mesh size) is below this
-  int coarse_iterations = 15;  // ICP iterations per rotation hypothesis (PCA start)
-  int coarse_sample = 1500;    // points used per hypothesis (PCA start)
-  double inlier_sigmas = 3;    // final inliers: distance <= this x robust sigma
-  void Validate() const;       // throws igi::Error (a programming error, not user input)
+  int max_iterations = 60;      // of the final ICP
+  double trim_fraction = 0.8;   // share of the points kept in each iteration, (0, 1]
+  double tolerance = 1e-8;      // stop when the update (rotation rad, relative scale, and
+                                // translation / mesh size) is below this
+  int coarse_iterations = 15;   // ICP iterations per rotation hypothesis (PCA start)
+  int coarse_sample = 500;      // points used per hypothesis (PCA start)
+  int random_hypotheses = 200;  // random rotations tried after the 24 principal-axes ones
+  double inlier_sigmas = 3;     // final inliers: distance <= this x robust sigma
+  void Validate() const;        // throws igi::Error (a programming error, not user input)
 };
 
 struct MeshAlignmentSummary {
@@ -53,7 +54,9 @@ MeshAlignmentSummary AlignPointsToMesh(const std::vector<Eigen::Vector3d>& point
 
 // As above from a coarse start of its own: the points' and the mesh's (area-sampled) centroids,
 // scale from their spreads, and each of the 24 rotations that map the points' principal axes to
-// the mesh's up to order and sign; the hypothesis with the most inliers after a short ICP wins.
+// the mesh's up to order and sign plus `random_hypotheses` random rotations; the hypothesis with
+// the most points within 1 % of the mesh size after a short ICP wins. A mesh with symmetries
+// (an empty box room) can still be fitted upside down: prefer control points for the start.
 // Throws igi::Error with fewer than 10 points.
 MeshAlignmentSummary AlignPointsToMeshCoarse(const std::vector<Eigen::Vector3d>& points_model,
                                              const TriangleMesh& mesh,

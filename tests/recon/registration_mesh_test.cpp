@@ -153,7 +153,7 @@ TEST(MeshAlignmentTest, CoarseStartFromPrincipalAxes) {
   const auto points = ToModel(PointsOnMesh(mesh, 4000, 0.005, 200, 2), truth);
   const MeshAlignmentSummary s = AlignPointsToMeshCoarse(points, mesh);
   EXPECT_EQ(s.start, "pca");
-  EXPECT_EQ(s.hypotheses, 24);
+  EXPECT_EQ(s.hypotheses, 224);
   EXPECT_LT(AngleDeg(s.scene_from_model.rotation, truth.rotation), 0.05);
   EXPECT_NEAR(s.scene_from_model.scale / truth.scale, 1.0, 1e-3);
   EXPECT_LT((s.scene_from_model.translation - truth.translation).norm(), 0.005);
