@@ -357,7 +357,7 @@ MeshAlignmentSummary AlignPointsToMeshCoarse(const std::vector<Vector3d>& points
     const double start_scale = sim.scale;
     sim = RunIcp(sample, closest, sim, options.coarse_iterations, extent, options).sim;
     // A hypothesis whose scale ran away collapsed onto a few surfaces: not a fit.
-    if (sim.scale < 0.5 * start_scale || sim.scale > 2 * start_scale) continue;
+    if (sim.scale < 0.25 * start_scale || sim.scale > 4 * start_scale) continue;
     // Score: number of points within 1 % of the mesh's size.
     int near = 0;
     for (const Match& m : MatchPoints(sample, sim, closest)) near += m.distance < 0.01 * extent;

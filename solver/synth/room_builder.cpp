@@ -47,7 +47,7 @@ Image MakeFloorTexture(uint64_t seed) {
 }
 
 // Value noise in [0, 1]: octaves of bilinearly interpolated random grids (4 to 256 cells across),
-// equal amplitudes, contrast-stretched, for features at every scale.
+// equal amplitudes, contrast-stretched and posterised, for features at every scale.
 std::vector<float> ValueNoise(int size, uint64_t seed) {
   std::vector<double> sum(size_t(size) * size, 0.0);
   for (int cells = 4, octave = 0; cells <= 256; cells *= 2, ++octave) {
@@ -74,7 +74,9 @@ std::vector<float> ValueNoise(int size, uint64_t seed) {
   const double sd = std::sqrt(std::max(sq / double(sum.size()) - mean * mean, 1e-12));
   std::vector<float> out(sum.size());
   for (size_t i = 0; i < sum.size(); ++i) {
-    out[i] = float(std::clamp(0.5 + 0.25 * (sum[i] - mean) / sd, 0.0, 1.0));
+    // Posterised to 4 levels: blobs of every size with sharp edges, which SIFT localises well.
+    const double v = std::clamp(0.5 + 0.25 * (sum[i] - mean) / sd, 0.0, 0.999);
+    out[i] = float(std::floor(4 * v) / 3);
   }
   return out;
 }
