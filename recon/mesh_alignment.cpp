@@ -294,6 +294,83 @@ void RefinePose(const std::vector<Eigen::Vector2d>& pixels, const std::vector<Ve
   }
 }
 
+// The image's observations of snapped points: pixels and world points.
+void SnappedObservations(const ColmapImage& image, const std::map<uint64_t, Vector3d>& snapped,
+                         std::vector<Eigen::Vector2d>* pixels, std::vector<Vector3d>* world) {
+  for (const ColmapPoint2D& p : image.points2d) {
+    if (p.point3d_id < 0) continue;
+    const auto it = snapped.find(static_cast<uint64_t>(p.point3d_id));
+    if (it == snapped.end()) continue;
+    pixels->push_back(p.xy);
+    world->push_back(it->second);
+  }
+}
+
+double SnappedReprojectionRms(const ColmapModel& model,
+                              const std::map<uint64_t, Vector3d>& snapped) {
+  double sum_sq = 0;
+  size_t count = 0;
+  for (const auto& [id, image] : model.images) {
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<Vector3d> world;
+    SnappedObservations(image, snapped, &pixels, &world);
+    sum_sq += ReprojectionSumSq(CameraOfImage(model, image), pixels, world);
+    count += pixels.size();
+  }
+  return count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : 0;
+}
+
+// Each pose alone against the snapped points; returns how many were refined.
+int RefineEveryPose(const std::map<uint64_t, Vector3d>& snapped, ColmapModel* model) {
+  int refined = 0;
+  for (auto& [id, image] : model->images) {
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<Vector3d> world;
+    SnappedObservations(image, snapped, &pixels, &world);
+    if (pixels.size() < 6) continue;
+    Camera camera = CameraOfImage(*model, image);
+    const double before = ReprojectionSumSq(camera, pixels, world);
+    RefinePose(pixels, world, &camera);
+    ++refined;
+    if (!(ReprojectionSumSq(camera, pixels, world) <= before)) continue;  // keep the better pose
+    image.qvec = QvecFromQuaternion(camera.cam_from_world.rotation.normalized());
+    image.tvec = camera.cam_from_world.translation;
+  }
+  return refined;
+}
+
+// Every snapped point triangulated again from the current poses (least squares over its rays)
+// and snapped to the mesh; points that leave the mesh's neighbourhood are dropped.
+void Resnap(const ColmapModel& model, const MeshClosestPoint& closest, double threshold_m,
+            std::map<uint64_t, Vector3d>* snapped) {
+  std::map<uint32_t, Camera> cameras;
+  for (const auto& [id, image] : model.images) cameras.emplace(id, CameraOfImage(model, image));
+  for (auto it = snapped->begin(); it != snapped->end();) {
+    if (model.points3d.at(it->first).track.size() < 2) {  // nothing to triangulate from
+      ++it;
+      continue;
+    }
+    Matrix3d a = Matrix3d::Zero();
+    Vector3d b = Vector3d::Zero();
+    for (const ColmapTrackElement& t : model.points3d.at(it->first).track) {
+      const Camera& camera = cameras.at(t.image_id);
+      const Vector3d d =
+          camera.WorldRayFromImg(model.images.at(t.image_id).points2d[t.point2d_idx].xy);
+      const Matrix3d p = Matrix3d::Identity() - d * d.transpose();
+      a += p;
+      b += p * camera.CenterInWorld();
+    }
+    const Vector3d x = a.ldlt().solve(b);
+    const auto c = x.allFinite() ? closest.Query(x, threshold_m) : std::nullopt;
+    if (c) {
+      it->second = c->point;
+      ++it;
+    } else {
+      it = snapped->erase(it);
+    }
+  }
+}
+
 }  // namespace
 
 void MeshAlignmentOptions::Validate() const {
@@ -370,41 +447,22 @@ MeshAlignmentSummary AlignPointsToMeshCoarse(const std::vector<Vector3d>& points
 }
 
 PoseRefinementSummary RefinePosesAgainstMesh(const TriangleMesh& mesh, double inlier_threshold_m,
-                                             ColmapModel* model) {
+                                             ColmapModel* model, int rounds) {
   const MeshClosestPoint closest(mesh);
   std::map<uint64_t, Vector3d> snapped;
   for (const auto& [id, p] : model->points3d) {
     if (const auto c = closest.Query(p.xyz, inlier_threshold_m)) snapped[id] = c->point;
   }
   PoseRefinementSummary summary;
+  summary.rms_before_px = SnappedReprojectionRms(*model, snapped);
+  for (int round = 0; round < rounds; ++round) {
+    summary.images = RefineEveryPose(snapped, model);
+    if (round + 1 < rounds) Resnap(*model, closest, inlier_threshold_m, &snapped);
+  }
   summary.points = static_cast<int>(snapped.size());
-  double before_sq = 0, after_sq = 0;
-  size_t count = 0;
-  for (auto& [id, image] : model->images) {
-    std::vector<Eigen::Vector2d> pixels;
-    std::vector<Vector3d> world;
-    for (const ColmapPoint2D& p : image.points2d) {
-      if (p.point3d_id < 0) continue;
-      const auto it = snapped.find(static_cast<uint64_t>(p.point3d_id));
-      if (it == snapped.end()) continue;
-      pixels.push_back(p.xy);
-      world.push_back(it->second);
-    }
-    Camera camera = CameraOfImage(*model, image);
-    before_sq += ReprojectionSumSq(camera, pixels, world);
-    if (pixels.size() >= 6) {
-      RefinePose(pixels, world, &camera);
-      image.qvec = QvecFromQuaternion(camera.cam_from_world.rotation.normalized());
-      image.tvec = camera.cam_from_world.translation;
-      ++summary.images;
-    }
-    after_sq += ReprojectionSumSq(camera, pixels, world);
-    count += pixels.size();
-  }
-  if (count > 0) {
-    summary.rms_before_px = std::sqrt(before_sq / static_cast<double>(count));
-    summary.rms_after_px = std::sqrt(after_sq / static_cast<double>(count));
-  }
+  summary.rounds = rounds;
+  summary.rms_after_px = SnappedReprojectionRms(*model, snapped);
+  for (const auto& [id, x] : snapped) model->points3d.at(id).xyz = x;
   return summary;
 }
 

@@ -64,17 +64,20 @@ MeshAlignmentSummary AlignPointsToMeshCoarse(const std::vector<Eigen::Vector3d>&
 
 struct PoseRefinementSummary {
   int images = 0;            // poses refined
-  int points = 0;            // sparse points snapped to the mesh (inliers)
+  int points = 0;            // sparse points snapped to the mesh (inliers) at the end
+  int rounds = 0;            // pose / point alternations
   double rms_before_px = 0;  // reprojection of the snapped points, before
   double rms_after_px = 0;   // and after
 };
 
 // Refines every image pose of `model` (already in the scene frame) against the mesh: the
 // model's 3D points within `inlier_threshold_m` of the mesh are replaced by their closest mesh
-// points, and each pose is moved (Gauss-Newton, Huber on 2 px) to minimise their reprojection.
-// Images with fewer than 6 such points keep their pose.
+// points, then `rounds` times: each pose is moved alone (Gauss-Newton, Huber on 2 px) to
+// minimise their reprojection, and each point is triangulated again from the new poses and
+// snapped to the mesh (so the structure cannot bend away from the mesh). Images with fewer than
+// 6 such points keep their pose. The snapped points replace the model's.
 PoseRefinementSummary RefinePosesAgainstMesh(const TriangleMesh& mesh, double inlier_threshold_m,
-                                             ColmapModel* model);
+                                             ColmapModel* model, int rounds = 5);
 
 // The model's 3D points (any order).
 std::vector<Eigen::Vector3d> ModelPoints(const ColmapModel& model);

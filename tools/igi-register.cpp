@@ -284,6 +284,7 @@ igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapModel* mod
         igi::RefinePosesAgainstMesh(mesh, fit->inlier_threshold_m, model);
     a["pose_refinement"] = {{"images", p.images},
                             {"points", p.points},
+                            {"rounds", p.rounds},
                             {"rms_before_px", p.rms_before_px},
                             {"rms_after_px", p.rms_after_px}};
     steps.push_back("pose_refinement");

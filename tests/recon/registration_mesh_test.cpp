@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "recon/mesh_alignment.h"
 #include "recon/mesh_closest_point.h"
@@ -188,10 +189,12 @@ TEST(MeshAlignmentTest, RefinePosesAgainstMesh) {
     truth.push_back(Rigid3d(Eigen::Quaterniond(r), image.tvec));
     model.images[i + 1] = image;
     const Camera camera = CameraOfImage(model, image);
-    for (const auto& [id, p] : model.points3d) {
+    for (const auto& [id, p] : std::as_const(model.points3d)) {
       const auto px = camera.ImgFromWorld(p.xyz);
       if (!px || px->x() < 0 || px->y() < 0 || px->x() > 640 || px->y() > 480) continue;
+      const auto index = static_cast<uint32_t>(model.images[i + 1].points2d.size());
       model.images[i + 1].points2d.push_back({*px, static_cast<int64_t>(id)});
+      model.points3d[id].track.push_back({i + 1, index});
     }
     // Perturb.
     const Eigen::Quaterniond off(Eigen::AngleAxisd(M_PI / 180, Vector3d(0, 1, 1).normalized()));
