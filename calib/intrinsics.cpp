@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,22 +36,60 @@ struct Detection {
   int width = 0;
   int height = 0;
   std::optional<std::vector<cv::Point2f>> corners;  // nullopt: board not found
+  std::vector<cv::Point3f> object_points;           // board frame, metres, per corner
+  std::string reason = "board not found";
 };
 
-Detection DetectBoard(const std::filesystem::path& path, const IntrinsicsOptions& options) {
-  const Image image = ReadImage(path);
-  Detection detection{image.width, image.height, std::nullopt};
-  const cv::Mat grey = GreyImage(image);
-  const cv::Size board(options.board_cols, options.board_rows);
+const std::map<std::string, cv::aruco::PREDEFINED_DICTIONARY_NAME>& Dictionaries() {
+  using namespace cv::aruco;  // NOLINT: the enum's names
+  static const std::map<std::string, PREDEFINED_DICTIONARY_NAME> kNames = {
+      {"DICT_4X4_50", DICT_4X4_50},
+      {"DICT_4X4_100", DICT_4X4_100},
+      {"DICT_4X4_250", DICT_4X4_250},
+      {"DICT_4X4_1000", DICT_4X4_1000},
+      {"DICT_5X5_50", DICT_5X5_50},
+      {"DICT_5X5_100", DICT_5X5_100},
+      {"DICT_5X5_250", DICT_5X5_250},
+      {"DICT_5X5_1000", DICT_5X5_1000},
+      {"DICT_6X6_50", DICT_6X6_50},
+      {"DICT_6X6_100", DICT_6X6_100},
+      {"DICT_6X6_250", DICT_6X6_250},
+      {"DICT_6X6_1000", DICT_6X6_1000},
+      {"DICT_7X7_50", DICT_7X7_50},
+      {"DICT_7X7_100", DICT_7X7_100},
+      {"DICT_7X7_250", DICT_7X7_250},
+      {"DICT_7X7_1000", DICT_7X7_1000},
+      {"DICT_ARUCO_ORIGINAL", DICT_ARUCO_ORIGINAL}};
+  return kNames;
+}
+
+cv::Ptr<cv::aruco::CharucoBoard> MakeCharucoBoard(const IntrinsicsOptions& options) {
+  return cv::aruco::CharucoBoard::create(
+      options.board_cols, options.board_rows, static_cast<float>(options.square_m),
+      static_cast<float>(options.marker_m),
+      cv::aruco::getPredefinedDictionary(Dictionaries().at(options.dictionary)));
+}
+
+// ArUco markers, then the chessboard corners between them (by id, so partial views count).
+void DetectCharuco(const cv::Mat& grey, const IntrinsicsOptions& options, Detection* detection) {
+  const cv::Ptr<cv::aruco::CharucoBoard> board = MakeCharucoBoard(options);
+  std::vector<std::vector<cv::Point2f>> marker_corners;
+  std::vector<int> marker_ids;
+  cv::aruco::detectMarkers(grey, board->dictionary, marker_corners, marker_ids);
+  if (marker_ids.empty()) {
+    detection->reason = "no ArUco marker of " + options.dictionary + " found";
+    return;
+  }
   std::vector<cv::Point2f> corners;
-  const int flags =
-      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE;
-  if (!cv::findChessboardCorners(grey, board, corners, flags)) return detection;
-  const int w = options.subpix_window;
-  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-4));
-  detection.corners = std::move(corners);
-  return detection;
+  std::vector<int> ids;
+  cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, grey, board, corners, ids);
+  if (static_cast<int>(ids.size()) < kMinCharucoCorners) {
+    detection->reason = "only " + std::to_string(ids.size()) + " ChArUco corners found (needs " +
+                        std::to_string(kMinCharucoCorners) + ")";
+    return;
+  }
+  for (int id : ids) detection->object_points.push_back(board->chessboardCorners[id]);
+  detection->corners = std::move(corners);
 }
 
 std::vector<cv::Point3f> BoardPoints(const IntrinsicsOptions& options) {
@@ -61,6 +101,29 @@ std::vector<cv::Point3f> BoardPoints(const IntrinsicsOptions& options) {
     }
   }
   return points;
+}
+
+Detection DetectBoard(const std::filesystem::path& path, const IntrinsicsOptions& options) {
+  const Image image = ReadImage(path);
+  Detection detection;
+  detection.width = image.width;
+  detection.height = image.height;
+  const cv::Mat grey = GreyImage(image);
+  if (options.board_type == "charuco") {
+    DetectCharuco(grey, options, &detection);
+    return detection;
+  }
+  detection.object_points = BoardPoints(options);
+  const cv::Size board(options.board_cols, options.board_rows);
+  std::vector<cv::Point2f> corners;
+  const int flags =
+      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE;
+  if (!cv::findChessboardCorners(grey, board, corners, flags)) return detection;
+  const int w = options.subpix_window;
+  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-4));
+  detection.corners = std::move(corners);
+  return detection;
 }
 
 int CalibrationFlags(const IntrinsicsOptions& options) {
@@ -109,6 +172,19 @@ void IntrinsicsOptions::Validate() const {
   if (model != "PINHOLE" && model != "OPENCV" && model != "FULL_OPENCV") {
     problems.Add("", "--model", model, "must be PINHOLE, OPENCV or FULL_OPENCV");
   }
+  if (board_type != "chessboard" && board_type != "charuco") {
+    problems.Add("", "--board-type", board_type, "must be chessboard or charuco");
+  }
+  if (board_type == "charuco") {
+    if (Dictionaries().count(dictionary) == 0) {
+      problems.Add("", "--dictionary", dictionary,
+                   "is not an OpenCV predefined ArUco dictionary (e.g. DICT_4X4_50)");
+    }
+    if (!(marker_m > 0) || !(marker_m < square_m)) {
+      problems.Add("", "--marker", std::to_string(marker_m),
+                   "must be > 0 and smaller than --square (metres)");
+    }
+  }
   if (subpix_window < 1) {
     problems.Add("", "--subpix-window", std::to_string(subpix_window), "must be >= 1");
   }
@@ -137,15 +213,17 @@ IntrinsicsSummary CalibrateIntrinsics(const std::vector<std::filesystem::path>& 
   IntrinsicsSummary summary;
   CameraFile& camera = summary.camera;
   std::vector<std::vector<cv::Point2f>> image_points;
+  std::vector<std::vector<cv::Point3f>> object_points;
   for (size_t i = 0; i < images.size(); ++i) {
     const std::string name = images[i].filename().string();
     if (!detections[i].corners) {
-      camera.rejected_views.push_back({name, "board not found"});
-      spdlog::warn("{}: {}x{} board not found; view rejected", images[i].string(),
-                   options.board_cols, options.board_rows);
+      camera.rejected_views.push_back({name, detections[i].reason});
+      spdlog::warn("{}: {}x{} {}: {}; view rejected", images[i].string(), options.board_cols,
+                   options.board_rows, options.board_type, detections[i].reason);
       continue;
     }
     image_points.push_back(*detections[i].corners);
+    object_points.push_back(detections[i].object_points);
     camera.views.push_back(name);
     summary.used_indices.push_back(static_cast<int>(i));
   }
@@ -154,8 +232,6 @@ IntrinsicsSummary CalibrateIntrinsics(const std::vector<std::filesystem::path>& 
                 std::to_string(images.size()) + " views; calibration needs at least " +
                 std::to_string(kMinCalibrationViews));
   }
-  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(),
-                                                            BoardPoints(options));
   const cv::Size size(detections[0].width, detections[0].height);
   cv::Mat k = cv::Mat::eye(3, 3, CV_64F);  // with CALIB_FIX_ASPECT_RATIO: fx / fy = 1
   cv::Mat d = cv::Mat::zeros(5, 1, CV_64F);

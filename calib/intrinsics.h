@@ -1,7 +1,8 @@
 #pragma once
 // Camera intrinsics from photos of a planar chessboard (Zhang's method, through OpenCV's
 // findChessboardCorners + cornerSubPix + calibrateCamera, as OpenCV's own calibration sample
-// does it).
+// does it), or of a ChArUco board (OpenCV's aruco module: detectMarkers +
+// interpolateCornersCharuco; the corners found, by id, go to the same calibrateCamera).
 //
 // Views where the board is not found are rejected and listed, not fatal; calibration needs at
 // least kMinCalibrationViews views with the board. Results follow COLMAP's conventions: params in
@@ -18,10 +19,18 @@ namespace igi::calib {
 
 inline constexpr int kMinCalibrationViews = 3;
 
+// A ChArUco view needs this many interpolated chessboard corners to be used.
+inline constexpr int kMinCharucoCorners = 6;
+
 struct IntrinsicsOptions {
-  int board_cols = 0;   // inner corners along a row (OpenCV's board width), e.g. 9
-  int board_rows = 0;   // inner corners along a column, e.g. 6
-  double square_m = 0;  // side of one square in metres
+  std::string board_type = "chessboard";  // chessboard or charuco
+  // chessboard: inner corners along a row / a column (OpenCV's board size), e.g. 9 x 6.
+  // charuco: squares along X / Y (OpenCV's CharucoBoard squaresX, squaresY), e.g. 5 x 7.
+  int board_cols = 0;
+  int board_rows = 0;
+  double square_m = 0;                     // side of one square in metres
+  std::string dictionary = "DICT_4X4_50";  // charuco: OpenCV predefined ArUco dictionary name
+  double marker_m = 0;                     // charuco: side of a marker in metres (< square_m)
   // COLMAP model of the result: PINHOLE (no distortion), OPENCV (k1, k2, p1, p2) or FULL_OPENCV
   // (k1, k2, p1, p2, k3; k4..k6 = 0 — OpenCV's default 5-coefficient model).
   std::string model = "OPENCV";

@@ -11,7 +11,8 @@ find_package(TBB REQUIRED)                                  # TBB::tbb
 find_package(OpenImageIO REQUIRED)                          # OpenImageIO::OpenImageIO
 find_package(OpenEXR 3 REQUIRED)                            # OpenEXR::OpenEXR
 find_package(assimp REQUIRED)                               # assimp::assimp
-find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs calib3d photo features2d)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs calib3d photo features2d
+  aruco)                                                    # aruco: libopencv-contrib-dev
 find_package(Ceres 2 REQUIRED)                              # Ceres::ceres
 find_package(embree 3 REQUIRED)                             # embree
 pkg_check_modules(LIBRAW REQUIRED IMPORTED_TARGET libraw_r)  # PkgConfig::LIBRAW

@@ -8,7 +8,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libfmt-dev libspdlog-dev libcli11-dev libtbb-dev
   libopenimageio-dev openimageio-tools libopenexr-dev libassimp-dev
-  libopencv-dev libceres-dev libembree-dev libraw-dev
+  libopencv-dev libopencv-contrib-dev libceres-dev libembree-dev libraw-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev
   colmap libgtest-dev libgmock-dev
 )

@@ -3,6 +3,7 @@
 //             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N]
 //             [--plot FILE]
 //   igi-calib intrinsics IMAGES… --board COLSxROWS --square METRES --out camera.json
+//             [--board-type charuco --dictionary DICT_4X4_50 --marker METRES]
 //             [--model PINHOLE|OPENCV|FULL_OPENCV] [--fix-aspect-ratio] [--zero-tangent-dist]
 //             [--fix-principal-point]
 //     Exit 3 (camera.json written) when the board was not found in some views; they are listed
@@ -109,7 +110,14 @@ CLI::App* AddIntrinsicsCommand(CLI::App& app, IntrinsicsCommand* cmd) {
   CLI::App* sub = app.add_subcommand(
       "intrinsics", "Calibrate focal length, principal point and distortion from chessboard views");
   sub->add_option("images", cmd->images, "Views of a planar chessboard")->required();
-  sub->add_option("--board", cmd->board, "Inner corners COLSxROWS, e.g. 9x6")->required();
+  sub->add_option("--board", cmd->board,
+                  "chessboard: inner corners COLSxROWS, e.g. 9x6; charuco: squares X x Y, e.g. 5x7")
+      ->required();
+  sub->add_option("--board-type", cmd->options.board_type, "chessboard (default) or charuco")
+      ->check(CLI::IsMember({"chessboard", "charuco"}));
+  sub->add_option("--dictionary", cmd->options.dictionary,
+                  "charuco: OpenCV ArUco dictionary (default DICT_4X4_50)");
+  sub->add_option("--marker", cmd->options.marker_m, "charuco: side of a marker in metres");
   sub->add_option("--square", cmd->options.square_m, "Side of one square in metres")->required();
   sub->add_option("--out", cmd->out, "Output camera.json")->required();
   sub->add_option("--model", cmd->options.model, "PINHOLE, OPENCV (default) or FULL_OPENCV")
@@ -136,8 +144,7 @@ void ParseBoard(const std::string& text, igi::calib::IntrinsicsOptions* options)
     rows = std::stoi(text.substr(x + 1), &used_rows);
     if (used_cols != x || used_rows != text.size() - x - 1) throw std::invalid_argument(text);
   } catch (const std::exception&) {
-    throw igi::InputError(
-        igi::DescribeProblem("", "--board", text, "must be COLSxROWS inner corners, e.g. 9x6"));
+    throw igi::InputError(igi::DescribeProblem("", "--board", text, "must be COLSxROWS, e.g. 9x6"));
   }
   options->board_cols = cols;
   options->board_rows = rows;

@@ -1,12 +1,19 @@
 // igi-register: photos -> camera poses with COLMAP 3.8 (CONTRACT.md §4).
-//   igi-register --images DIR [--camera camera.json] [--scene scene.json --markers markers.json]
+//   igi-register --images DIR [--camera camera.json] [--scene scene.json [--markers markers.json]]
 //                --out DIR
+// With --scene the model is brought into the scene's frame: by the markers' control points when
+// given, then by fitting the sparse points to the scene mesh (robust point-to-plane ICP with
+// scale; without markers from a principal-axes start), then each pose is refined against the
+// mesh (report.json "alignment" says what was done and how well).
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
 // COLMAP's own database, models and log go to DIR/colmap/. Exit 3 when some photos did not
 // register (listed in report.json); exit 1 when COLMAP is missing, of another version than 3.8,
 // or reconstructs nothing; exit 2 for bad input (nothing written).
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -17,12 +24,14 @@
 
 #include "calib/camera_file.h"
 #include "recon/colmap_runner.h"
+#include "recon/mesh_alignment.h"
 #include "recon/registration.h"
 #include "recon/scene.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
+#include "tools/common/strings.h"
 
 namespace fs = std::filesystem;
 
@@ -36,14 +45,36 @@ struct Args {
   std::string markers;
   igi::ColmapRunOptions colmap;
   bool multi_camera = false;
+  bool no_mesh_fit = false;
+  bool no_pose_refinement = false;
 };
 
 struct Inputs {
   std::vector<std::string> images;
   std::optional<igi::calib::CameraFile> camera;
   std::optional<igi::Json> scene;
+  std::optional<igi::Scene> loaded_scene;  // with its mesh
   std::optional<igi::Markers> markers;
 };
+
+// A marker point outside the scene's bounding box grown by 10 % of its diagonal is not a point
+// of the scene (wrong units or a typo): exit 2.
+void CheckMarkersInScene(const igi::Markers& markers, const igi::TriangleMesh& mesh,
+                         const std::string& file) {
+  Eigen::AlignedBox3d box;
+  for (const auto& p : mesh.positions) box.extend(p.cast<double>());
+  const double margin = 0.1 * box.diagonal().norm();
+  box.extend(box.min() - Eigen::Vector3d::Constant(margin));
+  box.extend(box.max() + Eigen::Vector3d::Constant(margin));
+  igi::ProblemList problems;
+  for (const auto& [name, p] : markers.points) {
+    if (!box.contains(p)) {
+      problems.Add(file, "points." + name, fmt::format("[{}, {}, {}]", p.x(), p.y(), p.z()),
+                   "is not in the scene (outside its geometry's bounding box)");
+    }
+  }
+  problems.ThrowIfAny();
+}
 
 // Checks every input before anything is written (exit 2 on a problem).
 Inputs ValidateInputs(const Args& args) {
@@ -73,12 +104,12 @@ Inputs ValidateInputs(const Args& args) {
   if (!args.scene.empty()) {
     igi::SceneLoadOptions options;
     options.check_images = false;
-    igi::LoadScene(args.scene, options);  // validates the scene
+    in.loaded_scene = igi::LoadScene(args.scene, options);  // validates the scene
     in.scene = igi::ReadJsonFile(args.scene);
-    if (args.markers.empty()) {
+    if (in.loaded_scene->mesh.num_triangles() == 0 || (args.markers.empty() && args.no_mesh_fit)) {
       throw igi::InputError(igi::DescribeProblem(
           "", "--scene", args.scene,
-          "needs --markers (alignment by fitting the mesh is not implemented yet)"));
+          "needs geometry, and --markers when the mesh is not fitted (--no-mesh-fit)"));
     }
   }
   if (!args.markers.empty()) {
@@ -94,6 +125,7 @@ Inputs ValidateInputs(const Args& args) {
       }
     }
     problems.ThrowIfAny();
+    CheckMarkersInScene(*in.markers, in.loaded_scene->mesh, args.markers);
   }
   return in;
 }
@@ -198,6 +230,69 @@ igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
   return report;
 }
 
+igi::Json MarkersJson(const igi::MarkerAlignment& alignment) {
+  igi::Json a;
+  a["markers_used"] = alignment.used;
+  a["scale"] = alignment.scene_from_model.scale;
+  a["rms_residual_m"] = alignment.rms_residual_m;
+  a["rms_reprojection_px"] = alignment.rms_reprojection_px;
+  igi::Json residuals = igi::Json::object();
+  for (const auto& [name, r] : alignment.residual_m) residuals[name] = r;
+  a["residual_m"] = residuals;
+  return a;
+}
+
+igi::Json MeshJson(const igi::MeshAlignmentSummary& m) {
+  return {{"start", m.start},
+          {"hypotheses", m.hypotheses},
+          {"iterations", m.iterations},
+          {"points", m.points},
+          {"scale", m.scene_from_model.scale},
+          {"inlier_threshold_m", m.inlier_threshold_m},
+          {"inlier_fraction", m.inlier_fraction},
+          {"rms_m", m.rms_m},
+          {"median_m", m.median_m}};
+}
+
+// Brings `model` into the scene's frame: markers (when given) for a start, then the sparse
+// points fitted to the mesh (from the markers' similarity, else from principal axes), then each
+// pose refined against the mesh. Returns report.json's "alignment".
+igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapModel* model) {
+  igi::Json a;
+  igi::Similarity3d sim;
+  std::vector<std::string> steps;
+  if (in.markers) {
+    const igi::MarkerAlignment alignment = igi::AlignByMarkers(*model, *in.markers);
+    sim = alignment.scene_from_model;
+    a["markers"] = MarkersJson(alignment);
+    steps.push_back("markers");
+  }
+  const igi::TriangleMesh& mesh = in.loaded_scene->mesh;
+  std::optional<igi::MeshAlignmentSummary> fit;
+  if (!args.no_mesh_fit) {
+    const std::vector<Eigen::Vector3d> points = igi::ModelPoints(*model);
+    fit = in.markers ? igi::AlignPointsToMesh(points, mesh, sim)
+                     : igi::AlignPointsToMeshCoarse(points, mesh);
+    sim = fit->scene_from_model;
+    a["mesh"] = MeshJson(*fit);
+    steps.push_back("mesh");
+  }
+  igi::TransformModel(sim, model);
+  a["scale"] = sim.scale;
+  if (fit && !args.no_pose_refinement) {
+    const igi::PoseRefinementSummary p =
+        igi::RefinePosesAgainstMesh(mesh, fit->inlier_threshold_m, model);
+    a["pose_refinement"] = {{"images", p.images},
+                            {"points", p.points},
+                            {"rounds", p.rounds},
+                            {"rms_before_px", p.rms_before_px},
+                            {"rms_after_px", p.rms_after_px}};
+    steps.push_back("pose_refinement");
+  }
+  a["method"] = igi::Join(steps, "+");
+  return a;
+}
+
 int Run(Args& args, const igi::CommonFlags& flags) {
   const Inputs in = ValidateInputs(args);
   args.colmap.threads = flags.threads;
@@ -209,20 +304,7 @@ int Run(Args& args, const igi::CommonFlags& flags) {
   const fs::path out(args.out);
   igi::ColmapRunSummary run = igi::RunColmap(args.images, out / "colmap", args.colmap);
   igi::Json report = BaseReport(run, args);
-  if (in.markers) {
-    const igi::MarkerAlignment alignment = igi::AlignByMarkers(run.model, *in.markers);
-    igi::TransformModel(alignment.scene_from_model, &run.model);
-    igi::Json a;
-    a["method"] = "markers";
-    a["markers_used"] = alignment.used;
-    a["scale"] = alignment.scene_from_model.scale;
-    a["rms_residual_m"] = alignment.rms_residual_m;
-    a["rms_reprojection_px"] = alignment.rms_reprojection_px;
-    igi::Json residuals = igi::Json::object();
-    for (const auto& [name, r] : alignment.residual_m) residuals[name] = r;
-    a["residual_m"] = residuals;
-    report["alignment"] = a;
-  }
+  if (in.scene) report["alignment"] = AlignToScene(args, in, &run.model);
   igi::WriteColmapModelText(run.model, out / "sparse");
   if (in.scene) {
     igi::WriteJsonFile(out / "scene.json", SceneWithCameras(args, *in.scene, run.model, &report));
@@ -255,6 +337,11 @@ int main(int argc, char** argv) {
   app.add_option("--colmap", args.colmap.executable, "COLMAP executable");
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
+  app.add_flag(
+      "--no-mesh-fit", args.no_mesh_fit,
+      "With --scene: align by --markers only, without fitting the sparse points to the mesh");
+  app.add_flag("--no-pose-refinement", args.no_pose_refinement,
+               "With --scene: keep the aligned poses (no per-photo refinement against the mesh)");
   app.add_flag("--multi-camera", args.multi_camera, "One camera per photo (default: one shared)");
   app.add_flag("--allow-other-colmap", args.colmap.allow_other_version,
                "Accept a COLMAP other than 3.8");

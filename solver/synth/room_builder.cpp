@@ -46,6 +46,78 @@ Image MakeFloorTexture(uint64_t seed) {
   return img;
 }
 
+// Value noise in [0, 1]: octaves of bilinearly interpolated random grids (4 to 256 cells across),
+// equal amplitudes, contrast-stretched and posterised, for features at every scale.
+std::vector<float> ValueNoise(int size, uint64_t seed) {
+  std::vector<double> sum(size_t(size) * size, 0.0);
+  for (int cells = 4, octave = 0; cells <= 256; cells *= 2, ++octave) {
+    Pcg32 rng(seed, 0x5eed + octave);
+    std::vector<double> grid(size_t(cells + 1) * (cells + 1));
+    for (double& g : grid) g = rng.UniformDouble();
+    for (int y = 0; y < size; ++y) {
+      const double gy = (y + 0.5) * cells / size;
+      const int iy = std::min(int(gy), cells - 1);
+      const double fy = gy - iy;
+      for (int x = 0; x < size; ++x) {
+        const double gx = (x + 0.5) * cells / size;
+        const int ix = std::min(int(gx), cells - 1);
+        const double fx = gx - ix;
+        auto g = [&](int i, int j) { return grid[size_t(j) * (cells + 1) + i]; };
+        sum[size_t(y) * size + x] += (1 - fy) * ((1 - fx) * g(ix, iy) + fx * g(ix + 1, iy)) +
+                                     fy * ((1 - fx) * g(ix, iy + 1) + fx * g(ix + 1, iy + 1));
+      }
+    }
+  }
+  double mean = 0, sq = 0;
+  for (double v : sum) mean += v, sq += v * v;
+  mean /= double(sum.size());
+  const double sd = std::sqrt(std::max(sq / double(sum.size()) - mean * mean, 1e-12));
+  std::vector<float> out(sum.size());
+  for (size_t i = 0; i < sum.size(); ++i) {
+    // Posterised to 4 levels: blobs of every size with sharp edges, which SIFT localises well.
+    const double v = std::clamp(0.5 + 0.25 * (sum[i] - mean) / sd, 0.0, 0.999);
+    out[i] = float(std::floor(4 * v) / 3);
+  }
+  return out;
+}
+
+// `base` colour modulated by value noise between 0.25x and 1.25x (capped at 0.95).
+Image NoiseTexture(const Vector3d& base, uint64_t seed) {
+  constexpr int kSize = 512;
+  const std::vector<float> noise = ValueNoise(kSize, seed);
+  Image img(kSize, kSize, 3);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const double m = 0.25 + noise[size_t(y) * kSize + x];
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(std::min(0.95, base[c] * m));
+    }
+  }
+  return img;
+}
+
+// --textured-walls: every region but the floor gets a noise texture of its colour; the floor's
+// tiles are modulated by noise too.
+void TextureEveryRegion(const SynthOptions& options, bool rho_d_known, SynthRoom* room) {
+  uint64_t index = 0;
+  for (auto& [name, m] : room->materials.items()) {
+    ++index;
+    if (name == "floor") {
+      const std::vector<float> noise = ValueNoise(room->floor_albedo.width, options.seed ^ 0xf1);
+      for (size_t i = 0; i < noise.size(); ++i) {
+        for (int c = 0; c < 3; ++c) room->floor_albedo.pixels[3 * i + c] *= 0.4f + 1.2f * noise[i];
+      }
+      m["rho_d"] = Rgb(ImageMean(room->floor_albedo));
+      continue;
+    }
+    const std::vector<double> rgb = m["rho_d"].get<std::vector<double>>();
+    Image texture = NoiseTexture({rgb[0], rgb[1], rgb[2]}, options.seed * 1000 + index);
+    const std::string file = (rho_d_known ? "textures/" : "truth/textures/") + name + "_albedo.exr";
+    m["rho_d"] = Rgb(ImageMean(texture));
+    m["rho_d_map"] = file;
+    room->region_textures.emplace_back(file, std::move(texture));
+  }
+}
+
 void AddRoomShell(const Vector3d& s, SynthMesh* mesh) {
   auto uv = [](double u0, double v0, double u1, double v1) {
     return std::array<Vector2d, 4>{Vector2d(u0, v0), Vector2d(u1, v0), Vector2d(u1, v1),
@@ -132,6 +204,7 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   m["glossy_box"] = Glossy(g, {0.1, 0.2, 0.5}, 0.08, 0.05);
   m["glossy_sphere"] = Glossy(g, {0.5, 0.15, 0.1}, 0.1, 0.1);
   m["matte_box"] = Lambert({0.7, 0.7, 0.7});
+  if (options.textured_walls) TextureEveryRegion(options, rho_d_known, &room);
   room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
 
   const double radius = options.lamp == "point" ? 0.0 : 0.04;

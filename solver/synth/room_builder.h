@@ -34,6 +34,9 @@ struct SynthRoom {
   std::vector<SynthLamp> lamps;             // lamps[0] in L0, lamps[1] in L1
   Image floor_albedo;                       // linear RGB texture of the floor (rho_d_map)
   std::string floor_albedo_file;            // where it is written, relative to the scene folder
+  // --textured-walls: the other regions' albedo textures, (file relative to the scene folder,
+  // linear RGB image); empty otherwise.
+  std::vector<std::pair<std::string, Image>> region_textures;
 
   // igi-scene "lights" and "lightings" for the lamps as they are.
   Json LightsJson() const;

@@ -80,6 +80,11 @@ struct SynthOptions {
   BracketOptions brackets;
   std::vector<EffectSpec> effects;
   int num_threads = 0;  // 0 = process default
+  // Every region (walls, ceiling, floor, boxes, sphere) gets a high-frequency albedo texture
+  // (rho_d_map; value noise over several octaves times the region's colour), so that
+  // structure-from-motion finds features everywhere (registration tests). Off: only the floor
+  // is textured.
+  bool textured_walls = false;
 
   // Every problem as one InputError (flag name, value, rule).
   void Validate() const;

@@ -330,6 +330,7 @@ SynthSummary Synthesize(const SynthOptions& options) {
   WriteText(out / "geometry/room.obj", room.mesh.ToObj("igi-synth room: regions by usemtl"));
   for (const auto& [file, text] : scenes.extra_files) WriteText(out / file, text);
   WriteExr(out / room.floor_albedo_file, room.floor_albedo);
+  for (const auto& [file, image] : room.region_textures) WriteExr(out / file, image);
   WriteJsonFile(out / "truth/scene.json", RelocateToTruthFolder(scenes.true_scene));
   SceneLoadOptions load;
   load.require_complete_materials = true;

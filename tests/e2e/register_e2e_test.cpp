@@ -1,5 +1,7 @@
 // igi-register end to end: failures are reported with the contract's exit codes and nothing is
-// written on bad input. (The COLMAP runs on real photos are in tests/recon/register_test.cpp.)
+// written on bad input. (The COLMAP runs on real photos are in tests/recon/register_test.cpp;
+// photos that do not register (exit 3, listed in report.json) and known intrinsics from
+// --camera are checked on synthetic photos in tests/recon/registration_synth_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -51,6 +53,42 @@ TEST(RegisterE2eTest, BadInputExits2AndWritesNothing) {
                                   Quote(out.string()));
   EXPECT_EQ(r.exit_code, 2) << r.err;  // 320x240 photos, 640x480 camera
   EXPECT_NE(r.err.find("320x240"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+// Lines of stderr that are igi-register's error message (spdlog lines left out).
+int ErrorLines(const std::string& err) {
+  int n = 0;
+  size_t pos = 0;
+  while ((pos = err.find("igi-register: error:", pos)) != std::string::npos) ++n, ++pos;
+  return n;
+}
+
+// A markers file naming a point the scene lacks: a pixel entry for an undeclared point, or a
+// point far outside the scene's geometry. Exit 2 with one line naming it; nothing written.
+TEST(RegisterE2eTest, MarkersNamingPointsTheSceneLacksExit2) {
+  const fs::path dir = test::UniqueTempDir("igi_register_e2e");
+  const fs::path out = dir / "out";
+  const fs::path images = FlatImages(dir);
+  auto run = [&](const std::string& markers) {
+    std::ofstream(dir / "markers.json") << markers;
+    return RunTool("igi-register", "--images " + Quote(images.string()) + " --scene " +
+                                       Quote(kScene.string()) + " --markers " +
+                                       Quote((dir / "markers.json").string()) + " --out " +
+                                       Quote(out.string()));
+  };
+  auto r = run(R"({"format": "igi-markers", "version": 1,
+    "points": {"a": [0, 0, 0]}, "pixels": {"flat0.png": {"ghost": [3, 4]}}})");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(ErrorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("pixels.flat0.png.ghost"), std::string::npos) << r.err;
+  r = run(R"({"format": "igi-markers", "version": 1,
+    "points": {"far": [1000, 0, 0]}, "pixels": {"flat0.png": {"far": [3, 4]}}})");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(ErrorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("points.far"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is not in the scene"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(dir);
 }
