@@ -52,14 +52,13 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
     ASSERT_EQ(r.status, "solved") << r.name;
     for (int c = 0; c < 3; ++c) {
       const double want = t["rho_d"][c].get<double>();
-      // Issue 7: within 2 %. Measured (paper stage): at most 0.5 %.
+      // Issue 7: within 2 %. Measured (paper stage): at most 0.45 %.
       EXPECT_LT(RelErr(r.stage1.rho_d[c], want), 0.02) << r.name << " paper rho_d[" << c << "]";
-      // The path-traced refinement moves the albedos by up to +2.2 % here (see the issue note:
-      // RADIANCE's images and igi's forward model differ by that much region by region).
+      // The path-traced refinement: measured within 1 % (its noisier gathering moves them).
       EXPECT_LT(RelErr(r.stage2.rho_d[c], want), 0.03) << r.name << " refined rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Issue 7: within 10 %. Measured: rho_s -0.2 %, alpha +0.1 % (paper); -1 %, -0.2 %.
+      // Issue 7: within 10 %. Measured: rho_s 0.0 %, alpha +0.2 % (paper); -0.4 %, -0.4 %.
       for (const RegionFitResult* f : {&r.stage1, &r.stage2}) {
         EXPECT_LT(RelErr(f->rho_s.mean(), t["rho_s"].get<double>()), 0.10) << r.name;
         EXPECT_LT(RelErr(f->alpha, t["alpha"].get<double>()), 0.10) << r.name;
@@ -69,7 +68,7 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
   }
   EXPECT_TRUE(s.converged) << s.message;
   // Rendered at the observed pixels, the model reproduces the photos to within RADIANCE's own
-  // noise (2.4-5 % per pixel): measured 6.0 % (paper) and 5.4 % (refined).
+  // noise (2.4-5 % per pixel): measured 4.9 % (paper) and 5.6 % (refined).
   EXPECT_LT(s.stage1_render_residual, 0.09);
   EXPECT_LT(s.stage2_render_residual, 0.09);
   ASSERT_EQ(s.coverage.size(), 1u);
@@ -102,21 +101,22 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     const Json& t = truth[r.name];
     const RegionFitResult& f = r.stage1;
     if (r.name == "floor") {
-      // The textured glossy floor is the weak case (see the issue note): measured rho_d +4.5 %,
-      // rho_s -25 %, alpha +26 %. Guard against it getting worse.
-      for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.08);
-      EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.5);
+      // The textured glossy floor is the weak case (see the issue note): measured rho_d
+      // +2.3..2.9 %, rho_s +2.5 %, alpha -6 % (clean). Guarded at 5 %, 15 %, 15 %.
+      for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.05);
+      EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.15);
+      EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.15);
       EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
       continue;
     }
     for (int c = 0; c < 3; ++c) {
-      // Issue 7 asks 1 %; measured at most 1.5 % (wall_y4, whose sides few photos see) and
-      // 2.4 % (glossy_sphere's blue); 3 % guards those.
+      // Issue 7 asks 1 %; measured at most 1.2 % (wall_y0) and 2.4 % (glossy_sphere's blue,
+      // a small region seen by few pixels); 3 % guards those.
       EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.03)
           << r.name << " rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Issue 7: within 5 %; measured glossy_box -0.5 %/-0.2 %, wall_y4 -5 %/-3.4 %,
+      // Issue 7: within 5 %; measured glossy_box -0.6 %/-0.2 %, wall_y4 -4 %/-3.1 %,
       // glossy_sphere -7 %/-0.4 % (rho_s/alpha). 10 % guards them.
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.10) << r.name;
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.10) << r.name;
