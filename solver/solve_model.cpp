@@ -64,7 +64,11 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
     const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
     if (!(w > 0)) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * s.obs_e[i]);
+    // An albedo above 1.2 is physically impossible: its irradiance estimate is wrong (a contact
+    // shadow the gathering smoothed over); such observations are left out of the map.
+    const Eigen::Vector3d e = s.obs_e[i];
+    if (!(e.minCoeff() > 0) || (kPi * diffuse).cwiseQuotient(e).maxCoeff() > 1.2) continue;
+    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * e);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
   return builder.Finish(m.params.rho_d);
