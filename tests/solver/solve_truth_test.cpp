@@ -196,9 +196,9 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   };
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
-  // Issue 7: within 2 % relative RMS plus the noise floor (in quadrature here); the floor's
-  // lobe error adds more, so 6 % is what this guards.
-  EXPECT_LT(err, std::sqrt(floor * floor + 0.06 * 0.06));
+  // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here). Measured
+  // 2.0 % beyond the floor (clean photos) and 3.4 % (with sensor noise); 4 % guards both.
+  EXPECT_LT(err, std::sqrt(floor * floor + 0.04 * 0.04));
 }
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
