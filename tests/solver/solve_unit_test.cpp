@@ -54,7 +54,9 @@ TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
 // Samples of one region: each sees a small light near the mirror direction of some views, plus
 // a few random incident directions, with L generated from the model.
 RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& slot_rho_d,
-                           double rho_s, double alpha, double noise, uint64_t seed) {
+                           double rho_s, double alpha, double noise, uint64_t seed,
+                           double alpha_y = 0) {
+  if (alpha_y <= 0) alpha_y = alpha;
   RegionFitInput in;
   in.name = "test";
   in.model = model;
@@ -80,7 +82,7 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
     auto add = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& value) {
       in.incident.push_back({wi.cast<float>(), value.cast<float>()});
       e += value;
-      spec += SpecularWeight(model, alpha, alpha, 1.5, wo, wi) * value;
+      spec += SpecularWeight(model, alpha, alpha_y, 1.5, wo, wi) * value;
     };
     for (int k = 0; k < 4; ++k) {  // an extended light: four directions close together
       const Eigen::Vector3d wi =
@@ -116,6 +118,16 @@ TEST(RegionFit, RecoversWardParametersExactlyFromNoiseFreeSamples) {
     EXPECT_NEAR(r.alpha, 0.08, 1e-4 * 0.08);
     EXPECT_LT(r.relative_rms, 1e-5);
   }
+}
+
+TEST(RegionFit, RecoversAnisotropicRoughnessAlongTheTangentAndAcrossIt) {
+  // ward_aniso with its tangent known (the local frame's x): αx and αy both recovered.
+  const Eigen::Vector3d rho_d(0.3, 0.3, 0.3);
+  const RegionFitInput in = MakeSamples(BrdfModel::kWardAniso, {rho_d}, 0.08, 0.05, 0.0, 6, 0.2);
+  const RegionFitResult r = FitRegion(in, {});
+  EXPECT_NEAR(r.alpha_x, 0.05, 0.01 * 0.05);
+  EXPECT_NEAR(r.alpha_y, 0.2, 0.01 * 0.2);
+  EXPECT_NEAR(r.rho_s.mean(), 0.08, 0.01 * 0.08);
 }
 
 TEST(RegionFit, NoisySamplesStayWithinTheirStatedUncertainty) {
