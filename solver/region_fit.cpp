@@ -185,19 +185,21 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
       best.linear = eval(best.ax, best.ay);
       return best;
     }
+    // The solution at log α = la, with the cost's curvature there (for σ_α).
+    auto finish = [&](double la) {
+      best.ax = best.ay = std::exp(la);
+      best.linear = eval(best.ax, best.ay);
+      const double h = 0.02;
+      const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
+      const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
+      best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
+      return best;
+    };
     if (in.alpha_hint && *in.alpha_hint > 0) {
       // A window of ±0.4 in log α around the hint; accepted unless the minimum sits at its edge.
       const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4), b = std::min(hi, c + 0.4);
       const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
-      if (la > a + 0.02 && la < b - 0.02) {
-        best.ax = best.ay = std::exp(la);
-        best.linear = eval(best.ax, best.ay);
-        const double h = 0.02;
-        const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
-        const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
-        best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
-        return best;
-      }
+      if (la > a + 0.02 && la < b - 0.02) return finish(la);
     }
     constexpr int kGrid = 28;
     double best_cost = std::numeric_limits<double>::infinity();
@@ -209,14 +211,7 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     }
     const double step = (hi - lo) / (kGrid - 1);
     const double a = lo + step * std::max(0, best_i - 1), b = lo + step * std::min(kGrid - 1, best_i + 1);
-    const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
-    best.ax = best.ay = std::exp(la);
-    best.linear = eval(best.ax, best.ay);
-    const double h = 0.02;
-    const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
-    const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
-    best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
-    return best;
+    return finish(golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; }));
   }
   // Anisotropic: a coarse grid, then alternating golden sections.
   double bx = known_x.value_or(0.1), by = known_y.value_or(0.1);

@@ -266,33 +266,36 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   return image;
 }
 
-Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                                   int spp, uint64_t seed) const {
+namespace {
+
+// The mean of `spp` paths along one ray (non-finite paths dropped).
+Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& origin,
+                             const Eigen::Vector3d& direction, int spp, uint64_t seed,
+                             bool reflected_only) {
   RenderOptions options;
-  const PathTracer tracer(*impl_, options);
+  const PathTracer tracer(impl, options);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   uint64_t rays = 0;
   for (int k = 0; k < spp; ++k) {
-    Pcg32 rng = PixelSampleRng(seed, 0, k);
-    const Eigen::Vector3d l = tracer.Trace(origin, direction.normalized(), rng, &rays);
+    Pcg32 rng = PixelSampleRng(seed, reflected_only ? 1 : 0, k);
+    const Eigen::Vector3d l =
+        tracer.Trace(origin, direction.normalized(), rng, &rays, reflected_only);
     if (l.allFinite()) sum += l;
   }
   return sum / std::max(1, spp);
 }
 
+}  // namespace
+
+Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                   int spp, uint64_t seed) const {
+  return MeanRadiance(*impl_, origin, direction, spp, seed, false);
+}
+
 Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction, int spp,
                                             uint64_t seed) const {
-  RenderOptions options;
-  const PathTracer tracer(*impl_, options);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  uint64_t rays = 0;
-  for (int k = 0; k < spp; ++k) {
-    Pcg32 rng = PixelSampleRng(seed, 1, k);
-    const Eigen::Vector3d l = tracer.Trace(origin, direction.normalized(), rng, &rays, true);
-    if (l.allFinite()) sum += l;
-  }
-  return sum / std::max(1, spp);
+  return MeanRadiance(*impl_, origin, direction, spp, seed, true);
 }
 
 }  // namespace igi

@@ -1,6 +1,7 @@
 // Albedo maps (solver/albedo_map.h): splatting ratio samples into an atlas, push-pull filling,
 // and PSNR.
 #include "solver/albedo_map.h"
+#include "solver/render_internal.h"
 
 #include <gtest/gtest.h>
 
@@ -42,20 +43,8 @@ TriangleMesh Box() {
   return mesh;
 }
 
-// The renderer's lookup (solver/render.cpp SampleTexture): bilinear, x = u·W − 0.5,
-// y = (1 − v)·H − 0.5, texel indices clamped.
-Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) {
-  const double x = uv.x() * tex.width - 0.5, y = (1.0 - uv.y()) * tex.height - 0.5;
-  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
-  const double fx = x - x0, fy = y - y0;
-  auto texel = [&tex](int xi, int yi) {
-    xi = std::clamp(xi, 0, tex.width - 1);
-    yi = std::clamp(yi, 0, tex.height - 1);
-    return Eigen::Vector3d(tex.at(xi, yi, 0), tex.at(xi, yi, 1), tex.at(xi, yi, 2));
-  };
-  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
-         fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
-}
+// The renderer's own lookup (solver/render_internal.h): the map must match what it reads.
+Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) { return SampleTexture(tex, uv); }
 
 // A smooth albedo over the quad, different in every channel and asymmetric in x and y (so a
 // flipped or transposed map cannot pass).
