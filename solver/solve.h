@@ -87,6 +87,7 @@ struct SolveSummary {
   // the paper stage's are the result; both are reported).
   bool refinement_accepted = true;
   double patch_size_m = 0, texel_size_m = 0;
+  double scene_diagonal_m = 0;  // of the geometry's bounding box
   int patches = 0, observations = 0;
   uint64_t rays = 0;
   double seconds_total = 0, seconds_rays = 0, seconds_fit = 0;

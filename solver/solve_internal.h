@@ -86,6 +86,8 @@ struct SolverState {
   void IncidentFromPatches();
   void IncidentFromRenderer(const Scene& model, uint64_t round);
   void SmoothIrradiance();
+  std::vector<Eigen::Vector3d> NeighbourMean(const std::vector<Eigen::Vector3d>& values,
+                                             double radius, bool same_photo) const;
   void ComputeSpecularTerms();
   double FitAll(int stage, int iteration);  // returns the largest relative change
   void RunStage1();

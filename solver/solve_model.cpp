@@ -48,13 +48,16 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 }  // namespace
 
 // The albedo map of region r: π(L − ρs·T)/E accumulated per texel over every observation.
-static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage) {
+// The specular term T of each observation is noisy (few incident samples carry the reflected
+// room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
+static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
+                         const std::vector<Eigen::Vector3d>& obs_t) {
   AlbedoMapBuilder builder(atlas);
   const MaterialState& m = s.materials[r];
   for (size_t i = 0; i < s.obs.size(); ++i) {
     const Observation& o = s.obs[i];
     if (o.region != r) continue;
-    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(s.obs_t[i]);
+    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
     const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
     // Highlights tell little about the albedo and much about any error in the fitted lobe:
     // weight each observation by its diffuse share, and leave out those under half diffuse.
@@ -83,6 +86,8 @@ static RegionAtlas AtlasOf(const SolverState& s, int r) {
 Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                                  const std::filesystem::path& temp_dir) const {
   Scene model = scene;
+  const std::vector<Eigen::Vector3d> smooth_t =
+      NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
   atlases->clear();
   maps->clear();
   bool generated = false;
@@ -101,7 +106,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
     }
     if (m.unknown_rho_d && m.last_fit.albedo_model == "per_patch") {
       atlases->push_back(AtlasOf(*this, int(r)));
-      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr));
+      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr, smooth_t));
       const std::filesystem::path file = temp_dir / (out.name + ".exr");
       WriteImage(file, maps->back());
       out.rho_d_map = file;
@@ -242,6 +247,8 @@ void SolverState::RunStage2() {
 
 void SolverState::BuildAlbedoMaps() {
   std::vector<RegionAtlas> generated;
+  const std::vector<Eigen::Vector3d> smooth_t =
+      NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
@@ -250,7 +257,7 @@ void SolverState::BuildAlbedoMaps() {
     if (!want) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
-    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage);
+    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t);
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     rs.albedo_map_generated_uvs = atlas.generated;
     if (atlas.generated) generated.push_back(atlas);
@@ -269,6 +276,7 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
   }
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
   for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  s.summary.scene_diagonal_m = (hi - lo).norm();
   s.summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
   s.patches = BuildPatches(scene.mesh, s.summary.patch_size_m);
   s.summary.patches = s.patches.size();

@@ -21,7 +21,7 @@ struct SolveOptions {
   int light_samples = 16;
   int indirect_rays = 64;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
-  // surface is averaged to remove gathering noise; 0 = auto (half the patch size).
+  // surface is averaged to remove gathering noise; 0 = auto (the scene diagonal / 96).
   double smoothing_radius_m = 0;
   // The paper's alternation: fit, recompute specular differences, refit.
   int max_iterations = 8;

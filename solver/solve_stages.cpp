@@ -154,14 +154,12 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   summary.rays += rays.load();
 }
 
-// The indirect irradiance varies slowly over a surface while its per-point estimate is noisy:
-// average it over the observations (any photo of the same lighting) within the smoothing radius
-// on the same region with normals within 25°.
-void SolverState::SmoothIrradiance() {
-  const double radius =
-      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : 0.5 * summary.patch_size_m;
-  obs_e.resize(obs.size());
-  for (LightingState& st : lighting_state) {
+// The mean of `values` over each observation's neighbours: same region, normals within 25°,
+// within `radius`, and (same_photo) in the same photo, else any photo of the same lighting.
+std::vector<Eigen::Vector3d> SolverState::NeighbourMean(const std::vector<Eigen::Vector3d>& values,
+                                                        double radius, bool same_photo) const {
+  std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
+  for (const LightingState& st : lighting_state) {
     if (!st.active) continue;
     std::unordered_map<int64_t, std::vector<int>> grid;
     auto key = [&](const Eigen::Vector3f& p, int dx, int dy, int dz) {
@@ -186,17 +184,29 @@ void SolverState::SmoothIrradiance() {
                 for (int j : it->second) {
                   const Observation& p = obs[j];
                   if (p.region != o.region || (p.position - o.position).norm() > radius ||
-                      p.normal.dot(o.normal) < 0.9f) {
+                      p.normal.dot(o.normal) < 0.9f || (same_photo && p.photo != o.photo)) {
                     continue;
                   }
-                  sum += obs_e_indirect[j];
+                  sum += values[j];
                   ++count;
                 }
               }
-          obs_e[i] = obs_e_direct[i] + (count > 0 ? Eigen::Vector3d(sum / count) : obs_e_indirect[i]);
+          out[i] = count > 0 ? Eigen::Vector3d(sum / count) : values[i];
         },
         options.num_threads);
   }
+  return out;
+}
+
+// The indirect irradiance varies slowly over a surface while its per-point estimate is noisy:
+// it is averaged over the observations (any photo of the same lighting) within the smoothing
+// radius on the same region.
+void SolverState::SmoothIrradiance() {
+  const double radius =
+      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
+  const std::vector<Eigen::Vector3d> smooth = NeighbourMean(obs_e_indirect, radius, false);
+  obs_e.resize(obs.size());
+  for (size_t i = 0; i < obs.size(); ++i) obs_e[i] = obs_e_direct[i] + smooth[i];
 }
 
 void SolverState::ComputeSpecularTerms() {
