@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 
 #include "solver/uv_charts.h"
@@ -202,13 +201,6 @@ void WriteSolveOutputs(const SolveSummary& s, const SolveOptions& o, const fs::p
   if (s.charted_mesh) {
     fs::create_directories(out / "geometry");
     WriteObjWithAtlases(*s.charted_mesh, {}, out / "geometry" / "solved.obj");
-  }
-  if (std::getenv("IGI_SOLVE_DEBUG") != nullptr) {
-    fs::create_directories(out / "debug");
-    for (const PhotoResidual& r : s.residuals) {
-      WriteImage(out / "debug" / ("photo_" + r.file), r.photo);
-      WriteImage(out / "debug" / ("render_" + r.file), r.render);
-    }
   }
   const Json report = SolveReportJson(s, o);
   WriteJsonFile(out / "report.json", report);

@@ -45,6 +45,17 @@ Json ParamsJson(const MaterialState& m) {
   return j;
 }
 
+// A gather point's direct samples in the local shading frame (for the specular term).
+std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
+                                          const Frame& frame) {
+  std::vector<IncidentLocal> inc;
+  for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
+    const DirectSample& ds = st.gather.direct[d];
+    inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
+  }
+  return inc;
+}
+
 double RelChange(double a, double b, double floor) { return std::abs(a - b) / std::max(std::abs(b), floor); }
 
 }  // namespace
@@ -77,12 +88,7 @@ void SolverState::IncidentFromPatches() {
           const bool glossy = HasSpecularLobe(materials[o.region].params.model);
           const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
-          if (glossy) {
-            for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
-              const DirectSample& ds = st.gather.direct[d];
-              inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
-            }
-          }
+          if (glossy) inc = DirectIncident(st, gp, frame);
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
           for (int d = gp.indirect_begin; d < gp.indirect_end; ++d) {
             const IndirectSample& s = st.gather.indirect[d];
@@ -126,12 +132,7 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         q.lobe = glossy;
         Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
         std::vector<IncidentLocal> inc;
-        if (glossy) {
-          for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
-            const DirectSample& ds = st.gather.direct[d];
-            inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
-          }
-        }
+        if (glossy) inc = DirectIncident(st, gp, frame);
         const double eps = lighting_scenes[l]->ray_epsilon;
         Eigen::Vector3d e = Eigen::Vector3d::Zero();
         int k = 0;
