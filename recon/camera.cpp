@@ -12,6 +12,14 @@ size_t CameraModelNumParams(CameraModel model) { return model == CameraModel::kP
 
 Eigen::Vector3d Camera::CenterInWorld() const { return cam_from_world.Inverse().translation; }
 
+double Camera::VignettingFactor(const Eigen::Vector2d& pixel) const {
+  if (!HasVignetting()) return 1.0;
+  const double dx = pixel.x() - principal_x_px(), dy = pixel.y() - principal_y_px();
+  const double half_diag2 = 0.25 * (double(width) * width + double(height) * height);
+  const double r2 = (dx * dx + dy * dy) / half_diag2;
+  return 1.0 + vignetting_k1 * r2 + vignetting_k2 * r2 * r2;
+}
+
 namespace {
 
 // OpenCV's radial-tangential distortion of normalised coordinates (COLMAP's OPENCV model).

@@ -27,6 +27,13 @@ struct Camera {
   // PINHOLE: fx, fy, cx, cy. OPENCV: fx, fy, cx, cy, k1, k2, p1, p2 (pixels, COLMAP order).
   std::vector<double> params;
   Rigid3d cam_from_world;
+  // Vignetting (igi extension of scene.json, "vignetting": {"k1", "k2"}): the photo records
+  // radiance × (1 + k1 r² + k2 r⁴), r = distance to the principal point over half the image
+  // diagonal. Zero = none.
+  double vignetting_k1 = 0, vignetting_k2 = 0;
+  bool HasVignetting() const { return vignetting_k1 != 0 || vignetting_k2 != 0; }
+  // The vignetting factor at continuous pixel coordinates (1 without vignetting).
+  double VignettingFactor(const Eigen::Vector2d& pixel) const;
 
   double focal_x_px() const { return params[0]; }
   double focal_y_px() const { return params[1]; }

@@ -80,8 +80,24 @@ std::string_view LightTypeName(LightType type) {
       return "sphere";
     case LightType::kArea:
       return "area";
+    case LightType::kAmbient:
+      return "ambient";
   }
   return "unknown";
+}
+
+double Photo::LinearFromRecorded(double v) const {
+  if (!HasResponse()) return v;
+  const double mag = response_reference * std::pow(std::abs(v) / response_reference,
+                                                   1.0 / response_exponent);
+  return v < 0 ? -mag : mag;
+}
+
+double Photo::RecordedFromLinear(double u) const {
+  if (!HasResponse()) return u;
+  const double mag =
+      response_reference * std::pow(std::abs(u) / response_reference, response_exponent);
+  return u < 0 ? -mag : mag;
 }
 
 double SpotProfile::Relative(double theta, double phi) const {

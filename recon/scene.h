@@ -45,7 +45,10 @@ struct Material {
   std::vector<std::string> MissingForRendering() const;
 };
 
-enum class LightType { kPoint, kSpot, kDirectional, kSphere, kArea };
+// kAmbient (igi extension): radiance `radiance` arriving at every surface point from every
+// direction of its hemisphere, unoccluded (like RADIANCE's ambient value) — a model of light from
+// sources the scene does not describe.
+enum class LightType { kPoint, kSpot, kDirectional, kSphere, kArea, kAmbient };
 std::string_view LightTypeName(LightType type);
 
 // A spot light's emission profile. The relative intensity in a direction at angle θ from the
@@ -74,7 +77,7 @@ struct Light {
   Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // directional: W·m⁻² ⟂ to direction
   Eigen::Vector3d center = Eigen::Vector3d::Zero();      // sphere
   double radius = 0;                                     // sphere, metres
-  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();    // sphere, area: W·sr⁻¹·m⁻²
+  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();    // sphere, area, ambient: W·sr⁻¹·m⁻²
   std::filesystem::path file;                            // area: mesh (front = CCW)
   TriangleMesh mesh;                                     // area: loaded mesh
   SpotProfile profile;                                   // spot
@@ -90,6 +93,16 @@ struct Photo {
   std::optional<std::filesystem::path> mask;
   int camera = -1;    // index into Scene::cameras
   int lighting = -1;  // index into Scene::lightings
+  // igi extensions (both describe how the photo's values relate to radiance):
+  // "exposure_scale": the photo records exposure_scale × radiance (default 1);
+  // "response": {"exponent": e, "reference": r}: a recorded value v relates to the linear one u
+  // (after scale and vignetting) by v = r·(u/r)^e (default linear).
+  double exposure_scale = 1.0;
+  double response_exponent = 1.0, response_reference = 1.0;
+  bool HasResponse() const { return response_exponent != 1.0; }
+  // Linear value u from a recorded value v (the inverse of the response), and the reverse.
+  double LinearFromRecorded(double v) const;
+  double RecordedFromLinear(double u) const;
 };
 
 struct Scene {

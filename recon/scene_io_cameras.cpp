@@ -28,7 +28,9 @@ std::optional<Eigen::Quaterniond> ReadQvec(const JsonCursor& c) {
 Camera ReadInlineCamera(const JsonCursor& c, const std::string& name) {
   Camera cam;
   cam.name = name;
-  if (!c.ExpectObject({"model", "width", "height", "params", "qvec", "tvec"})) return cam;
+  if (!c.ExpectObject({"model", "width", "height", "params", "qvec", "tvec", "vignetting"})) {
+    return cam;
+  }
   const NumberRule size_rule = NumberRule::Between(1, 1 << 16);
   cam.width = static_cast<int>(c["width"].Integer(size_rule).value_or(0));
   cam.height = static_cast<int>(c["height"].Integer(size_rule).value_or(0));
@@ -49,6 +51,17 @@ Camera ReadInlineCamera(const JsonCursor& c, const std::string& name) {
   }
   if (auto q = ReadQvec(c["qvec"])) cam.cam_from_world.rotation = *q;
   if (auto t = c["tvec"].Vec3()) cam.cam_from_world.translation = *t;
+  if (c["vignetting"].present()) {
+    const JsonCursor v = c["vignetting"];
+    if (v.ExpectObject({"k1", "k2"})) {
+      const NumberRule rule = NumberRule::Between(-1, 1);
+      cam.vignetting_k1 = v["k1"].present() ? v["k1"].Number(rule).value_or(0) : 0;
+      cam.vignetting_k2 = v["k2"].present() ? v["k2"].Number(rule).value_or(0) : 0;
+      if (1 + cam.vignetting_k1 + cam.vignetting_k2 < 0.05) {
+        v.Problem("1 + k1 + k2 must be at least 0.05 (the factor in the corners)");
+      }
+    }
+  }
   return cam;
 }
 
@@ -115,7 +128,9 @@ void ReadPhotos(const SceneLoader& ld, const JsonCursor& root, Scene* scene) {
   const size_t n = photos.ArraySize();
   for (size_t i = 0; i < n; ++i) {
     const JsonCursor c = photos[i];
-    if (!c.ExpectObject({"file", "camera", "lighting", "mask"})) continue;
+    if (!c.ExpectObject({"file", "camera", "lighting", "mask", "exposure_scale", "response"})) {
+      continue;
+    }
     Photo photo;
     auto file = ld.File(c["file"]);
     // With a COLMAP model the camera may be left out: the image named like the photo is used.
@@ -140,6 +155,16 @@ void ReadPhotos(const SceneLoader& ld, const JsonCursor& root, Scene* scene) {
     if (c["mask"].present()) {
       photo.mask = ld.File(c["mask"]);
       if (photo.mask) CheckImageSize(ld, c["mask"], *photo.mask, camera);
+    }
+    if (c["exposure_scale"].present()) {
+      photo.exposure_scale = c["exposure_scale"].Number(NumberRule::Positive()).value_or(1.0);
+    }
+    if (c["response"].present()) {
+      const JsonCursor r = c["response"];
+      if (r.ExpectObject({"exponent", "reference"})) {
+        photo.response_exponent = r["exponent"].Number(NumberRule::Between(0.1, 10)).value_or(1);
+        photo.response_reference = r["reference"].Number(NumberRule::Positive()).value_or(1);
+      }
     }
     scene->photos.push_back(std::move(photo));
   }

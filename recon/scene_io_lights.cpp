@@ -50,13 +50,14 @@ std::vector<std::string_view> LightKeys(LightType type) {
     case LightType::kDirectional: return {"type", "direction", "irradiance"};
     case LightType::kSphere: return {"type", "center", "radius", "radiance"};
     case LightType::kArea: return {"type", "file", "radiance"};
+    case LightType::kAmbient: return {"type", "radiance"};
   }
   return {"type"};
 }
 
 std::optional<LightType> LightTypeFromName(const std::string& name) {
   for (LightType t : {LightType::kPoint, LightType::kSpot, LightType::kDirectional,
-                      LightType::kSphere, LightType::kArea}) {
+                      LightType::kSphere, LightType::kArea, LightType::kAmbient}) {
     if (LightTypeName(t) == name) return t;
   }
   return std::nullopt;
@@ -69,7 +70,7 @@ Light ReadLight(const SceneLoader& ld, const JsonCursor& c, const std::string& n
     c.Problem("must be an object");
     return light;
   }
-  auto type_name = c["type"].Enum({"point", "spot", "directional", "sphere", "area"});
+  auto type_name = c["type"].Enum({"point", "spot", "directional", "sphere", "area", "ambient"});
   if (!type_name) return light;
   light.type = *LightTypeFromName(*type_name);
   c.ExpectObject(LightKeys(light.type));
@@ -92,6 +93,9 @@ Light ReadLight(const SceneLoader& ld, const JsonCursor& c, const std::string& n
     case LightType::kSphere:
       light.center = c["center"].Vec3().value_or(zero);
       light.radius = c["radius"].Number(NumberRule::Positive()).value_or(0);
+      light.radiance = c["radiance"].Rgb(non_negative).value_or(zero);
+      break;
+    case LightType::kAmbient:
       light.radiance = c["radiance"].Rgb(non_negative).value_or(zero);
       break;
     case LightType::kArea:

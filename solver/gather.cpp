@@ -26,7 +26,8 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
     const LightType type = scene.lights[l].type;
     const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
                        type == LightType::kDirectional;
-    const int k = delta ? 1 : light_samples;
+    // Ambient light: uniform directions, so more samples than an extended light.
+    const int k = delta ? 1 : type == LightType::kAmbient ? 4 * light_samples : light_samples;
     const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
     for (int s = 0; s < k; ++s) {
       // Stratified over a side×side grid for the first side² samples, random after.

@@ -53,6 +53,7 @@ struct LightDir {
 void SampleLightDirs(const Renderer::Impl& impl, int light, const Vector3d& p,
                      const Vector3d& n_geo, int samples, Pcg32* rng, std::vector<LightDir>* out) {
   const LightType type = impl.lights[light].type;
+  if (type == LightType::kAmbient) return;  // light from everywhere: no highlight to place
   const bool delta =
       type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
   const int count = delta ? 1 : samples;

@@ -249,7 +249,8 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
             const Eigen::Vector3d l = tracer.Trace(center, dir, rng, &rays);
             if (l.allFinite()) sum += l;
           }
-          const Eigen::Vector3d mean = sum / options.spp;
+          const Eigen::Vector3d mean =
+              sum * (camera.VignettingFactor(Eigen::Vector2d(x + 0.5, y + 0.5)) / options.spp);
           for (int c = 0; c < 3; ++c) image.at(x, int(y), c) = static_cast<float>(mean[c]);
         }
         total_rays += rays;

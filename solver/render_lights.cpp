@@ -77,6 +77,16 @@ LightSample Renderer::Impl::SampleLight(int index, const Eigen::Vector3d& point,
       s.pdf = d2 / (cos_light * rl.triangles.total_area);
       return s;
     }
+    case LightType::kAmbient: {
+      // Uniform directions; no distance: the ambient light is never occluded. Treated as a
+      // delta light for MIS (no BRDF-sampled ray ever reaches it).
+      s.wi = SampleUniformSphere(Eigen::Vector2d(u[0], u[1]));
+      s.distance = 0;
+      s.value = light->radiance;
+      s.pdf = UniformSpherePdf();
+      s.delta = true;
+      return s;
+    }
   }
   return s;
 }

@@ -259,6 +259,7 @@ std::optional<Hit> Renderer::Impl::Intersect(const Eigen::Vector3d& origin,
 
 bool Renderer::Impl::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                               double distance, int target) const {
+  if (!(distance > 0)) return false;  // ambient light: nothing occludes it
   for (int i : sphere_lights) {
     const Light& l = *lights[i].light;
     if (i != target && IntersectSphere(origin, dir, l.center, l.radius) < distance) return true;

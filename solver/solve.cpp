@@ -12,10 +12,12 @@
 #include "solver/brdf.h"
 #include "solver/gather.h"
 #include "solver/patches.h"
+#include "solver/photo_model.h"
 #include "solver/render.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
 #include "solver/solve_internal.h"
+#include "solver/photo_model.h"
 #include "solver/surface_hit.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
@@ -79,6 +81,32 @@ Eigen::Vector3d SolverState::PatchAlbedo(int q) const {
   return v.allFinite() ? v : materials[r].params.rho_d;
 }
 
+// Photos whose values are not plain radiance are linearised (their clipped pixels masked out
+// first, as the clip level is a recorded value); held-out pixels are masked out.
+void SolverState::ApplyPhotoModelAndHoldout(int i) {
+  const Photo& p = scene.photos[i];
+  const Camera& cam = scene.cameras[p.camera];
+  Image& photo = photo_images[i];
+  const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
+                             options.holdout_seed};
+  const bool model = HasPhotoModel(p, cam);
+  if (!model && !(holdout.fraction > 0)) return;
+  const double clip = options.saturation > 0 ? options.saturation : AutoSaturation(photo);
+  std::optional<Image>& mask = mask_images[i];
+  if (!mask) {
+    mask = Image(photo.width, photo.height, 1);
+    std::fill(mask->pixels.begin(), mask->pixels.end(), 1.0f);
+  }
+  for (int y = 0; y < photo.height; ++y) {
+    for (int x = 0; x < photo.width; ++x) {
+      bool out = holdout.HeldOut(i, x, y);
+      for (int c = 0; c < photo.channels && model; ++c) out |= photo.at(x, y, c) >= clip;
+      if (out) mask->at(x, y, 0) = 0;
+    }
+  }
+  if (model) photo = LinearRadianceOfPhoto(p, cam, photo);
+}
+
 void SolverState::LoadPhotos() {
   ProblemList problems;
   photo_images.resize(scene.photos.size());
@@ -97,6 +125,7 @@ void SolverState::LoadPhotos() {
                          std::to_string(cam.height) + ")");
       }
       if (p.mask) mask_images[i] = ReadImage(*p.mask, 1);
+      ApplyPhotoModelAndHoldout(int(i));
     } catch (const Error& e) {
       problems.Append(e);
     }
@@ -169,6 +198,7 @@ void SolverState::SelectFitSamples() {
     if (HasSpecularLobe(m.params.model)) {
       const Renderer::Impl& ls = *lighting_scenes[scene.photos[o.photo].lighting];
       for (int l = 0; l < int(ls.lights.size()) && !highlight; ++l) {
+        if (ls.lights[l].type == LightType::kAmbient) continue;
         const LightSample s =
             ls.SampleLight(l, o.position.cast<double>(), Eigen::Vector3d(0.5, 0.5, 0.5));
         const Eigen::Vector3d h = (s.wi + o.view.cast<double>()).normalized();

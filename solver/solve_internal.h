@@ -71,6 +71,7 @@ struct SolverState {
   // solve.cpp
   void InitMaterials();
   void LoadPhotos();
+  void ApplyPhotoModelAndHoldout(int photo);
   void BuildLightingScenes();
   void CollectAllObservations();
   void SelectFitSamples();

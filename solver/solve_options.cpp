@@ -36,6 +36,10 @@ void SolveOptions::Validate() const {
         std::to_string(refine_iterations), "must be in [0, 20]");
   check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),
         "must be in [1, 4096]");
+  check(holdout_fraction >= 0 && holdout_fraction < 1, "--holdout-fraction",
+        fmt::format("{}", holdout_fraction), "must be in [0, 1)");
+  check(holdout_block_px >= 1, "--holdout-block-px", std::to_string(holdout_block_px),
+        "must be >= 1");
   problems.ThrowIfAny();
 }
 

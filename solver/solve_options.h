@@ -37,6 +37,11 @@ struct SolveOptions {
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
   uint64_t seed = 1;
+  // Pixels left out of every fit (igi-diagnose measures its held-out residual on them): square
+  // blocks of holdout_block_px, a `holdout_fraction` share of them (0 = none).
+  double holdout_fraction = 0;
+  int holdout_block_px = 16;
+  uint64_t holdout_seed = 7;
   int num_threads = 0;  // 0 = the process default
   bool show_progress = true;
 

@@ -234,6 +234,7 @@ Json GltfBuilder::LightFor(const Light& light) {
                    "distances >> r; no visible sphere)");
       break;
     case LightType::kArea:
+    case LightType::kAmbient:
       break;
   }
   return out;
@@ -249,6 +250,10 @@ void GltfBuilder::AddLights() {
       const int material = AddMaterial(emitter);
       const int mesh = AddMesh(emitter.name, export_internal::WholeMesh(light.mesh), material);
       AddNode({{"name", emitter.name}, {"mesh", mesh}});
+      continue;
+    }
+    if (light.type == LightType::kAmbient) {
+      report_->Add("lights." + light.name, "ambient light left out: glTF has no such light");
       continue;
     }
     lights_.push_back(LightFor(light));

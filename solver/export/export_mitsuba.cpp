@@ -158,6 +158,9 @@ std::string EmitterText(const Light& light, ExportReport* report) {
              "<bsdf type=\"diffuse\">" + Rgb("reflectance", Eigen::Vector3d::Zero()) +
              "</bsdf><emitter type=\"area\">" + Rgb("radiance", light.radiance) +
              "</emitter></shape>\n";
+    case LightType::kAmbient:
+      return "  <emitter type=\"constant\" id=\"" + SafeName(light.name) + "\">" +
+             Rgb("radiance", light.radiance) + "</emitter>\n";
     case LightType::kArea:
       return "  <shape type=\"obj\" id=\"" + SafeName(light.name) +
              "\"><string name=\"filename\" value=\"meshes/light." + SafeName(light.name) +

@@ -195,6 +195,13 @@ std::string LightText(const Light& light, const ExportOptions& options, ExportRe
              Primitive(mat, "source", name, "",
                        {to_source.x(), to_source.y(), to_source.z(), options.source_angle_deg});
     }
+    case LightType::kAmbient:
+      report->Add(item, "ambient light has no RADIANCE primitive: render with -av " +
+                            Num(light.radiance.x()) + " " + Num(light.radiance.y()) + " " +
+                            Num(light.radiance.z()) +
+                            " -aw 0 (RADIANCE applies it where ambient bounces end)");
+      return "# " + light.name + ": ambient radiance " + Num(light.radiance.x()) + " " +
+             Num(light.radiance.y()) + " " + Num(light.radiance.z()) + " (use rpict -av)\n";
     case LightType::kArea: {
       std::string text = Primitive("void", "light", mat, "",
                                    {light.radiance.x(), light.radiance.y(), light.radiance.z()});

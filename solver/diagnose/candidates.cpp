@@ -1,0 +1,475 @@
+#include "solver/diagnose/candidates.h"
+
+#include "solver/diagnose/residual_fit.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+#include <unordered_map>
+
+namespace igi {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+std::string Pct(double v) { return fmt::format("{:.1f}%", 100 * v); }
+
+void Fill(const ResidualFit& fit, CandidateResult* out) {
+  out->train_before = fit.train_before;
+  out->train_after = fit.train_after;
+  out->held_before = fit.held_before;
+  out->held_after = fit.held_after;
+  out->z = fit.z;
+}
+
+std::vector<std::string> PhotoFiles(const Scene& model) {
+  std::vector<std::string> out;
+  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
+  return out;
+}
+
+// ---------------------------------------------------------------- exposure_scale
+CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& f) {
+  CandidateResult out;
+  out.effect = "exposure_scale";
+  const int n = int(cx.model.photos.size());
+  if (n < 2) {
+    out.note = "one photo: a scale of its own cannot be told from the model's";
+    return out;
+  }
+  const ResidualFit fit =
+      f.Fit(n, [&](const PixelRecord& r, int c, double* b) { b[r.photo] = r.sim[c]; });
+  if (fit.coef.size() == 0) return out;
+  Fill(fit, &out);
+  std::vector<double> scale(n);
+  for (int j = 0; j < n; ++j) scale[j] = 1 + fit.coef[j];
+  std::vector<double> sorted = scale;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double ref = cx.materials_solved ? sorted[n / 2] : 1.0;
+  const std::vector<std::string> files = PhotoFiles(cx.model);
+  Json scales = Json::object();
+  Json photos = Json::array();
+  std::string worst = files[0];
+  double worst_dev = -1;
+  for (int j = 0; j < n; ++j) {
+    const double v = scale[j] / ref;
+    scales[files[j]] = v;
+    if (std::abs(v - 1) > 0.02) photos.push_back(files[j]);
+    if (std::abs(v - 1) > worst_dev) worst_dev = std::abs(v - 1), worst = files[j];
+  }
+  out.params = {{"scale", scales}};
+  out.where = {{"photos", photos}, {"frame", "photo"}};
+  out.num_params = n;
+  out.evidence = fmt::format(
+      "per-photo level: {} is {:.3f}x the model where the other photos agree with it, on every "
+      "surface alike: a scale of the whole photo",
+      worst, double(scales[worst]));
+  out.valid = true;
+  out.apply = [scales, files](Json* doc) {
+    Json& ph = (*doc)["photos"];
+    for (size_t j = 0; j < ph.size() && j < files.size(); ++j) {
+      const double old = ph[j].value("exposure_scale", 1.0);
+      ph[j]["exposure_scale"] = old * scales[files[j]].get<double>();
+    }
+  };
+  return out;
+}
+
+// ---------------------------------------------------------------- vignetting
+CandidateResult Vignetting(const CandidateContext& cx, const ResidualFitter& f) {
+  CandidateResult out;
+  out.effect = "vignetting";
+  if (!cx.declared.contains("cameras") || cx.declared["cameras"].contains("colmap")) {
+    out.note = "cameras come from a COLMAP model: no place for a vignetting model";
+    return out;
+  }
+  const ResidualFit fit = f.Fit(2, [&](const PixelRecord& r, int c, double* b) {
+    b[0] = r.sim[c] * r.r2;
+    b[1] = r.sim[c] * r.r2 * r.r2;
+  });
+  if (fit.coef.size() == 0) return out;
+  Fill(fit, &out);
+  const double k1 = fit.coef[0], k2 = fit.coef[1];
+  out.params = {{"k1", k1}, {"k2", k2}};
+  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "image"}};
+  out.num_params = 2;
+  out.evidence = fmt::format(
+      "image-fixed radial fall-off, the same in all {} photos: photo/model is {} lower in the "
+      "corners than at the principal point, whichever surface is seen there (fit 1 + k1 r^2 + "
+      "k2 r^4)",
+      cx.model.photos.size(), Pct(-(k1 + k2)));
+  out.valid = true;
+  out.apply = [k1, k2](Json* doc) {
+    for (auto& [name, cam] : (*doc)["cameras"].items()) {
+      double o1 = 0, o2 = 0;
+      if (cam.contains("vignetting")) {
+        o1 = cam["vignetting"].value("k1", 0.0);
+        o2 = cam["vignetting"].value("k2", 0.0);
+      }
+      cam["vignetting"] = {{"k1", o1 + k1}, {"k2", o2 + k2 + o1 * k1}};
+    }
+  };
+  return out;
+}
+
+// ---------------------------------------------------------------- camera_response
+CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
+  CandidateResult out;
+  out.effect = "camera_response";
+  std::vector<float> values;
+  for (const PixelRecord& r : f.records()) {
+    if (!r.held_out && !r.outlier) values.push_back(r.sim.mean());
+  }
+  if (values.size() < 100) return out;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double ref = std::max(1e-12, double(values[values.size() / 2]));
+  auto model = [ref](double s, double e) {
+    const double mag = ref * std::pow(std::abs(s) / ref, e);
+    return s < 0 ? -mag : mag;
+  };
+  ResidualFit best;
+  double best_e = 1;
+  for (double e : {0.5, 0.6, 0.7, 0.8, 0.9, 1.1, 1.25, 1.4, 1.6, 1.8, 2.0}) {
+    const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+      b[0] = model(r.sim[c], e) - r.sim[c];
+    });
+    if (fit.coef.size() && (best.coef.size() == 0 || fit.train_after < best.train_after)) {
+      best = fit, best_e = e;
+    }
+  }
+  if (best.coef.size() == 0) return out;
+  // Refine e around the best grid value by golden section on the train error.
+  double lo = best_e * 0.85, hi = best_e * 1.15;
+  for (int it = 0; it < 14; ++it) {
+    const double m1 = lo + (hi - lo) * 0.382, m2 = lo + (hi - lo) * 0.618;
+    auto err = [&](double e) {
+      return f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+                b[0] = model(r.sim[c], e) - r.sim[c];
+              }).train_after;
+    };
+    (err(m1) < err(m2) ? hi : lo) = (err(m1) < err(m2) ? m2 : m1);
+  }
+  const double e_grid = 0.5 * (lo + hi);
+  best = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    b[0] = model(r.sim[c], e_grid) - r.sim[c];
+  });
+  if (best.coef.size() == 0) return out;
+  Fill(best, &out);
+  // photo ≈ sim + c·(model_e − sim): for c near 1 the exponent is e; in general 1 + c(e − 1).
+  const double e = 1 + best.coef[0] * (e_grid - 1);
+  out.params = {{"exponent", e}, {"reference", ref}};
+  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "pixel value"}};
+  out.num_params = 1;
+  out.evidence = fmt::format(
+      "photo/model depends on the pixel's level, not on its place or surface: the photos follow "
+      "the model's value to the power {:.3f} (slope {:.3f} in log-log)",
+      e, e);
+  out.valid = true;
+  out.apply = [e, ref](Json* doc) {
+    for (Json& p : (*doc)["photos"]) {
+      double old = 1;
+      if (p.contains("response")) old = p["response"].value("exponent", 1.0);
+      p["response"] = {{"exponent", old * e}, {"reference", ref}};
+    }
+  };
+  return out;
+}
+
+// ---------------------------------------------------------------- ambient_light
+CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
+  CandidateResult out;
+  out.effect = "ambient_light";
+  const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
+    b[c] = r.albedo[c] * cx.model.photos[r.photo].exposure_scale;
+  });
+  if (fit.coef.size() == 0) return out;
+  const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
+  if (!(radiance.minCoeff() > 0)) {
+    out.note = "the offset that fits is negative in some channel: not an ambient light";
+    return out;
+  }
+  Fill(fit, &out);
+  out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
+  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
+  out.num_params = 3;
+  double mean_sim = 0;
+  int n = 0;
+  for (const PixelRecord& r : f.records()) mean_sim += r.sim.mean(), ++n;
+  out.evidence = fmt::format(
+      "a smooth offset proportional to the albedo everywhere, in shadow too, that no change of "
+      "the albedos explains: the photos are brighter than the model by albedo x {:.4g} (mean "
+      "model radiance {:.4g}), light from no declared source",
+      radiance.mean(), n ? mean_sim / n : 0.0);
+  out.valid = true;
+  out.apply = [radiance](Json* doc) {
+    std::string name = "ambient";
+    while ((*doc)["lights"].contains(name)) name += "_";
+    (*doc)["lights"][name] = {{"type", "ambient"},
+                              {"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
+    for (auto& [lname, list] : (*doc)["lightings"].items()) list.push_back(name);
+  };
+  return out;
+}
+
+// Diffuse direct light of one light at a record (ρd/π · Σ irradiance), and the mean direction
+// from the light to the point.
+struct LightTerm {
+  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();
+  Eigen::Vector3f from_light = Eigen::Vector3f::Zero();
+  bool lit = false;
+};
+
+LightTerm TermOf(const PixelRecord& r, int light) {
+  LightTerm t;
+  for (const RecordLightSample& s : r.lights) {
+    if (s.light != light) continue;
+    t.diffuse += r.albedo.cwiseProduct(s.irradiance) / float(kPi);
+    t.from_light -= s.wi;
+    t.lit = true;
+  }
+  if (t.lit) t.from_light.normalize();
+  return t;
+}
+
+std::vector<Eigen::Vector3d> SphereDirections(int n) {
+  std::vector<Eigen::Vector3d> d;
+  const double golden = kPi * (3 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - 2 * (i + 0.5) / n, rr = std::sqrt(1 - z * z);
+    d.emplace_back(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
+  }
+  return d;
+}
+
+// ---------------------------------------------------------------- light_emission_profile
+CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light) {
+  CandidateResult out;
+  out.effect = "light_emission_profile";
+  const Light& l = cx.model.lights[light];
+  const std::vector<PixelRecord>& recs = f.records();
+  std::vector<LightTerm> terms(recs.size());
+  int lit = 0;
+  for (size_t i = 0; i < terms.size(); ++i) {
+    terms[i] = TermOf(recs[i], light);
+    lit += terms[i].lit;
+  }
+  if (lit < 100) return out;
+  // The direct light of `light` becomes D·cos^n(angle from the axis).
+  auto fit_at = [&](const Eigen::Vector3d& axis, double n) {
+    const Eigen::Vector3f ax = axis.cast<float>();
+    return f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+      const LightTerm& t = terms[size_t(&r - recs.data())];
+      if (!t.lit) return;
+      const double cs = std::max(0.0f, t.from_light.dot(ax));
+      b[0] = double(t.diffuse[c]) * (std::pow(cs, n) - 1);
+    });
+  };
+  ResidualFit best;
+  double best_n = 1;
+  Eigen::Vector3d best_axis = -Eigen::Vector3d::UnitZ();
+  auto consider = [&](const Eigen::Vector3d& axis, double n) {
+    const ResidualFit fit = fit_at(axis, n);
+    if (fit.coef.size() == 0 || !(fit.coef[0] > 0)) return false;
+    if (best.coef.size() && fit.train_after >= best.train_after) return false;
+    best = fit, best_axis = axis, best_n = n;
+    return true;
+  };
+  for (const Eigen::Vector3d& axis : SphereDirections(64)) {
+    for (double n : {1.0, 3.0}) consider(axis, n);
+  }
+  if (best.coef.size() == 0) {
+    out.note = "no axis makes the light's own direct term explain the residual";
+    return out;
+  }
+  for (double step : {0.2, 0.08, 0.03}) {
+    for (int k = 0; k < 10; ++k) {
+      bool moved = false;
+      for (int d = 0; d < 6; ++d) {
+        Eigen::Vector3d axis = best_axis;
+        axis[d / 2] += (d % 2 ? -step : step);
+        moved |= consider(axis.normalized(), best_n);
+      }
+      for (double factor : {0.8, 1.25}) moved |= consider(best_axis, best_n * factor);
+      if (!moved) break;
+    }
+  }
+  Fill(best, &out);
+  const double n = best_n * best.coef[0];  // cos^(n·c) ≈ first order in the amplitude
+  const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
+  const Eigen::Vector3d intensity =
+      l.type == LightType::kSphere ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))
+                                   : l.intensity;
+  out.params = {{"light", l.name},
+                {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
+                {"cos_power", n}};
+  out.where = {{"light", l.name}, {"frame", "angle from the light"}};
+  out.num_params = 3;
+  out.evidence = fmt::format(
+      "the residual follows the direction from light '{}': surfaces it reaches at larger angles "
+      "from ({:.2f}, {:.2f}, {:.2f}) are darker in the photos than the model, as cos^{:.2f} of "
+      "that angle, whatever their distance, region or image position",
+      l.name, best_axis.x(), best_axis.y(), best_axis.z(), n);
+  out.valid = true;
+  const std::string name = l.name;
+  const Eigen::Vector3d axis = best_axis;
+  out.apply = [name, position, axis, intensity, n](Json* doc) {
+    (*doc)["lights"][name] = {{"type", "spot"},
+                              {"position", {position.x(), position.y(), position.z()}},
+                              {"direction", {axis.x(), axis.y(), axis.z()}},
+                              {"intensity", {intensity.x(), intensity.y(), intensity.z()}},
+                              {"profile", {{"cos_power", n}}}};
+  };
+  return out;
+}
+
+// ---------------------------------------------------------------- light_intensity
+CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter& f, int light) {
+  CandidateResult out;
+  out.effect = "light_intensity";
+  const Light& l = cx.model.lights[light];
+  const std::vector<PixelRecord>& recs = f.records();
+  std::vector<float> share(recs.size(), 0.0f);
+  bool any = false;
+  for (size_t i = 0; i < share.size(); ++i) {
+    float mine = 0, all = 0;
+    for (const RecordLightSample& s : recs[i].lights) {
+      all += s.irradiance.sum();
+      if (s.light == light) mine += s.irradiance.sum();
+    }
+    share[i] = all > 0 ? mine / all : 0;
+    any |= mine > 0;
+  }
+  if (!any) return out;
+  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    b[0] = r.sim[c] * share[size_t(&r - recs.data())];
+  });
+  if (fit.coef.size() == 0) return out;
+  // With the albedos free, a light that is the only one of every photographed lighting scales
+  // like the albedos: nothing is left of its basis after the nuisance.
+  if (f.nuisance() && !(fit.train_before - fit.train_after > 1e-6 * fit.train_before)) {
+    out.note = "light '" + l.name +
+               "' is alone in every photographed lighting: its intensity cannot be told from "
+               "the albedos";
+    return out;
+  }
+  Fill(fit, &out);
+  const double factor = 1 + fit.coef[0];
+  if (!(factor > 0)) return out;
+  out.params = {{"light", l.name}, {"factor", factor}};
+  out.where = {{"light", l.name}, {"frame", "light"}};
+  out.num_params = 1;
+  out.evidence = fmt::format(
+      "where light '{}' dominates, the photos are {:.3f}x the model; elsewhere they agree",
+      l.name, factor);
+  out.valid = true;
+  const std::string name = l.name;
+  out.apply = [name, factor](Json* doc) {
+    Json& j = (*doc)["lights"][name];
+    for (const char* key : {"intensity", "radiance", "irradiance"}) {
+      if (!j.contains(key)) continue;
+      for (Json& v : j[key]) v = v.get<double>() * factor;
+    }
+  };
+  return out;
+}
+
+// ---------------------------------------------------------------- specular_reflection
+double WardLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,
+                double alpha) {
+  const double ci = n.dot(wi), co = n.dot(wo);
+  if (!(ci > 0) || !(co > 0)) return 0;
+  const Eigen::Vector3f h = (wi + wo).normalized();
+  const double ch = n.dot(h);
+  if (!(ch > 0)) return 0;
+  const double tan2 = (1 - ch * ch) / (ch * ch);
+  return std::exp(-tan2 / (alpha * alpha)) / (4 * kPi * alpha * alpha * std::sqrt(ci * co));
+}
+
+CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFitter& f,
+                                   int region) {
+  CandidateResult out;
+  out.effect = "specular_reflection";
+  const std::string& name = cx.model.materials[region].name;
+  int count = 0;
+  for (const PixelRecord& r : f.records()) count += r.region == region;
+  if (count < 50) return out;
+  ResidualFit best;
+  double best_alpha = 0.1;
+  for (double alpha : {0.03, 0.05, 0.08, 0.12, 0.18, 0.25, 0.35}) {
+    const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+      if (r.region != region) return;
+      double s = 0;
+      for (const RecordLightSample& ls : r.lights) {
+        s += WardLobe(r.normal, ls.wi, r.view, alpha) * ls.irradiance[c];
+      }
+      b[0] = s;
+    });
+    if (fit.coef.size() == 0 || !(fit.coef[0] > 0)) continue;
+    if (best.coef.size() == 0 || fit.train_after < best.train_after) best = fit, best_alpha = alpha;
+  }
+  if (best.coef.size() == 0) {
+    out.note = "no positive lobe fits region " + name;
+    return out;
+  }
+  Fill(best, &out);
+  const double rho_s = best.coef[0];
+  out.params = {{"region", name}, {"rho_s", rho_s}, {"alpha", best_alpha}};
+  out.where = {{"regions", {name}}, {"frame", "half-vector angle"}};
+  out.num_params = 2;
+  out.evidence = fmt::format(
+      "region '{}' (declared diffuse) is brighter than the model where the half vector nears "
+      "its normal, a highlight: a Ward lobe with rho_s ~ {:.3f}, alpha ~ {:.2f} explains it",
+      name, rho_s, best_alpha);
+  out.valid = true;
+  out.apply = [name](Json* doc) {
+    Json& m = (*doc)["materials"][name];
+    Json fresh = {{"brdf", "ward"}};
+    if (m.contains("rho_d")) fresh["rho_d"] = m["rho_d"];
+    if (m.contains("rho_d_map")) fresh["rho_d_map"] = m["rho_d_map"];
+    m = fresh;
+  };
+  return out;
+}
+
+}  // namespace
+
+std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
+                                                const std::vector<PixelRecord>& records,
+                                                const std::vector<std::string>& excluded) {
+  int num_cells = 0;
+  std::vector<int> cells = RecordCells(cx.model, records, cx.cell_m, &num_cells);
+  const ResidualFitter f(records, std::move(cells), num_cells, cx.materials_solved, cx.block_px);
+  std::vector<CandidateResult> out;
+  auto allowed = [&](const std::string& e) {
+    return std::find(excluded.begin(), excluded.end(), e) == excluded.end();
+  };
+  if (allowed("exposure_scale")) out.push_back(ExposureScale(cx, f));
+  if (allowed("vignetting")) out.push_back(Vignetting(cx, f));
+  if (allowed("camera_response")) out.push_back(Response(cx, f));
+  if (allowed("ambient_light")) out.push_back(Ambient(cx, f));
+  for (int l = 0; l < int(cx.model.lights.size()); ++l) {
+    const Light& light = cx.model.lights[l];
+    const bool point_like = light.type == LightType::kPoint || light.type == LightType::kSphere ||
+                            (light.type == LightType::kSpot &&
+                             light.profile.kind == SpotProfile::Kind::kNone);
+    if (point_like && allowed("light_emission_profile")) out.push_back(EmissionProfile(cx, f, l));
+    if (light.type != LightType::kAmbient && allowed("light_intensity")) {
+      out.push_back(LightIntensity(cx, f, l));
+    }
+  }
+  if (allowed("specular_reflection")) {
+    for (int g = 0; g < int(cx.model.materials.size()); ++g) {
+      if (cx.model.materials[g].brdf == BrdfModel::kLambert) {
+        out.push_back(SpecularReflection(cx, f, g));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace igi

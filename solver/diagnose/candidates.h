@@ -1,0 +1,52 @@
+#pragma once
+// Candidate effects (CONTRACT.md §6 names): each studies the residual of the current model in
+// the frame where its physics shows itself, fits a model of it on the fitted (not held-out)
+// samples, and predicts the residual it would leave on the held-out samples. The best candidate
+// is then applied to the scene and the whole scene refitted (solver/diagnose/diagnose.cpp).
+//
+// Each candidate's fit is linear in its amplitudes (nonlinear parameters — a response exponent,
+// an emission axis, a lobe width — are searched on a grid), with the global scale free as a
+// nuisance where the materials are solved (it is absorbed by the albedos when refitted).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/diagnose/pixel_records.h"
+#include "tools/common/json.h"
+
+namespace igi {
+
+struct CandidateContext {
+  const Scene& model;          // the current (complete) model
+  const Json& declared;        // the declared scene document (absolute paths)
+  bool materials_solved;       // unknown materials are re-solved after each step
+  double cell_m = 0.05;        // surface cell of regions with albedo maps (their free albedo)
+  int block_px = 16;           // held-out block: the unit of the gain's standard error
+};
+
+struct CandidateResult {
+  std::string effect;
+  std::string evidence;
+  Json where = Json::object();
+  Json params = Json::object();
+  int num_params = 0;
+  // Predicted squared-error sums on the records (before: the current model).
+  double train_before = 0, train_after = 0, held_before = 0, held_after = 0;
+  double held_photo = 0;  // Σ photo² of the held-out records
+  double z = 0;           // held-out gain over its standard error (across blocks)
+  bool valid = false;
+  std::string note;       // why a candidate could not be fitted (e.g. degenerate)
+  // Writes the fitted model into the declared scene document.
+  std::function<void(Json* declared)> apply;
+
+  double Gain() const { return held_before > 0 ? 1 - held_after / held_before : 0; }
+};
+
+// Every candidate that applies to this scene, fitted on `records`.
+std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
+                                                const std::vector<PixelRecord>& records,
+                                                const std::vector<std::string>& excluded);
+
+}  // namespace igi

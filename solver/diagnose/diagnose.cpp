@@ -1,0 +1,367 @@
+#include "solver/diagnose/diagnose.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+
+#include "solver/solve.h"
+#include "tools/common/atomic_file.h"
+#include "tools/common/error.h"
+
+namespace igi {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Applies `fn` to every path-valued key of an igi-scene document.
+template <class F>
+void ForEachPath(Json* doc, F fn) {
+  auto key = [&](Json& j, const char* k) {
+    if (j.is_object() && j.contains(k) && j[k].is_string()) j[k] = fn(j[k].get<std::string>());
+  };
+  if (doc->contains("geometry")) {
+    for (Json& g : (*doc)["geometry"]) key(g, "file");
+  }
+  if (doc->contains("lights")) {
+    for (auto& [n, l] : (*doc)["lights"].items()) {
+      key(l, "file");
+      if (l.contains("profile")) key(l["profile"], "ies");
+    }
+  }
+  if (doc->contains("materials")) {
+    for (auto& [n, m] : (*doc)["materials"].items()) key(m, "rho_d_map");
+  }
+  if (doc->contains("cameras")) key((*doc)["cameras"], "colmap");
+  if (doc->contains("photos")) {
+    for (Json& p : (*doc)["photos"]) {
+      key(p, "file");
+      key(p, "mask");
+    }
+  }
+}
+
+Json AbsolutePaths(Json doc, const fs::path& dir) {
+  ForEachPath(&doc, [&](const std::string& p) {
+    const fs::path path(p);
+    return (path.is_absolute() ? path : fs::absolute(dir / path)).lexically_normal().string();
+  });
+  return doc;
+}
+
+Json RelativePaths(Json doc, const fs::path& base) {
+  const fs::path b = fs::weakly_canonical(fs::absolute(base));
+  ForEachPath(&doc, [&](const std::string& p) {
+    const fs::path rel = fs::weakly_canonical(fs::path(p)).lexically_relative(b);
+    return rel.empty() ? p : rel.generic_string();
+  });
+  return doc;
+}
+
+bool HasUnknowns(const Scene& scene) {
+  for (const Material& m : scene.materials) {
+    if (!m.MissingForRendering().empty()) return true;
+  }
+  return false;
+}
+
+struct ModelState {
+  fs::path dir;
+  Scene model;
+  std::vector<Image> sims;
+  std::vector<PixelRecord> records;
+  ResidualSums train, held;
+};
+
+// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it.
+ModelState FitModel(const Json& declared, bool solve, const std::string& maps,
+                    const fs::path& dir, const DiagnoseOptions& o, const PhotoSet& photos) {
+  ModelState st;
+  st.dir = dir;
+  fs::create_directories(dir);
+  WriteJsonFile(dir / "declared.json", declared, 1);
+  fs::path model_path = dir / "declared.json";
+  if (solve) {
+    const Scene declared_scene = LoadScene(dir / "declared.json");
+    SolveOptions so = o.solve;
+    so.holdout_fraction = o.holdout_fraction;
+    so.holdout_block_px = o.holdout_block_px;
+    so.num_threads = o.num_threads;
+    so.show_progress = false;
+    so.albedo_maps = maps;
+    const SolveSummary summary = Solve(declared_scene, so, dir);
+    WriteSolveOutputs(summary, so, dir);
+    model_path = dir / "scene.json";
+  }
+  SceneLoadOptions lo;
+  lo.require_complete_materials = true;
+  st.model = LoadScene(model_path, lo);
+  st.sims = SimulatePhotos(st.model, o, o.seed);
+  st.records = BuildRecords(st.model, photos, st.sims, o);
+  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  st.train = ResidualOverPhotos(photos, st.sims, holdout, false);
+  st.held = ResidualOverPhotos(photos, st.sims, holdout, true);
+  return st;
+}
+
+// The held-out gain of `after` over `before` (share of the squared error) and its significance
+// with the held-out blocks as independent units.
+std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
+                                      const std::vector<Image>& after, const PixelHoldout& h) {
+  std::unordered_map<int64_t, double> gain;
+  double total_before = 0, total_gain = 0;
+  for (size_t i = 0; i < before.size(); ++i) {
+    const Image& rec = photos.recorded[i];
+    for (int y = 0; y < rec.height; ++y) {
+      for (int x = 0; x < rec.width; ++x) {
+        if (photos.valid[i].at(x, y, 0) < 0.5f || !h.HeldOut(int(i), x, y)) continue;
+        double g = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
+          if (!std::isfinite(a) || !std::isfinite(b)) continue;
+          total_before += (b - p) * (b - p);
+          g += (b - p) * (b - p) - (a - p) * (a - p);
+        }
+        gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px] += g;
+        total_gain += g;
+      }
+    }
+  }
+  const double n = double(gain.size());
+  if (n < 2 || !(total_before > 0)) return {0, 0};
+  const double mean = total_gain / n;
+  double sq = 0;
+  for (const auto& [k, g] : gain) sq += (g - mean) * (g - mean);
+  const double se = std::sqrt(sq / (n - 1) / n);
+  return {total_gain / total_before, se > 0 ? mean / se : 0};
+}
+
+// The white part of the residual, from differences of horizontally adjacent valid pixels on the
+// same photo: what no smooth model can explain (photo noise plus render noise).
+double NoiseFloor(const PhotoSet& photos, const std::vector<Image>& sims) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < sims.size(); ++i) {
+    const Image& rec = photos.recorded[i];
+    for (int y = 0; y < rec.height; ++y) {
+      for (int x = 0; x + 1 < rec.width; ++x) {
+        if (photos.valid[i].at(x, y, 0) < 0.5f || photos.valid[i].at(x + 1, y, 0) < 0.5f) continue;
+        for (int c = 0; c < 3; ++c) {
+          const double e1 = sims[i].at(x, y, c) - rec.at(x, y, c);
+          const double e2 = sims[i].at(x + 1, y, c) - rec.at(x + 1, y, c);
+          if (!std::isfinite(e1) || !std::isfinite(e2)) continue;
+          num += 0.5 * (e1 - e2) * (e1 - e2);
+          den += 0.5 * (rec.at(x, y, c) * rec.at(x, y, c) + rec.at(x + 1, y, c) * rec.at(x + 1, y, c));
+        }
+      }
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : 0;
+}
+
+Image ResidualImage(const PhotoSet& photos, const std::vector<Image>& sims, size_t i) {
+  const Image& rec = photos.recorded[i];
+  Image out(rec.width, rec.height, 3);
+  for (int y = 0; y < rec.height; ++y) {
+    for (int x = 0; x < rec.width; ++x) {
+      const bool ok = photos.valid[i].at(x, y, 0) > 0.5f;
+      for (int c = 0; c < 3; ++c) {
+        out.at(x, y, c) = ok ? sims[i].at(x, y, c) - rec.at(x, y, c) : 0.0f;
+      }
+    }
+  }
+  return out;
+}
+
+// Residual per (photo, region) on the held-out records, against the noise floor.
+Json Unexplained(const ModelState& st, double floor) {
+  struct Acc {
+    double err = 0, photo = 0;
+    int n = 0;
+  };
+  std::map<std::pair<int, int>, Acc> acc;
+  for (const PixelRecord& r : st.records) {
+    Acc& a = acc[{r.photo, r.region}];
+    a.err += double((r.sim - r.recorded).squaredNorm());
+    a.photo += double(r.recorded.squaredNorm());
+    ++a.n;
+  }
+  Json out = Json::array();
+  for (const auto& [key, a] : acc) {
+    if (a.n < 20 || !(a.photo > 0)) continue;
+    const double rel = std::sqrt(a.err / a.photo);
+    if (rel < 1.5 * floor) continue;
+    out.push_back({{"where", fmt::format("photo {}, region {}",
+                                         st.model.photos[key.first].file.filename().string(),
+                                         st.model.materials[key.second].name)},
+                   {"residual", rel},
+                   {"samples", a.n}});
+  }
+  std::sort(out.begin(), out.end(), [](const Json& a, const Json& b) {
+    return a["residual"].get<double>() > b["residual"].get<double>();
+  });
+  if (out.size() > 12) out.erase(out.begin() + 12, out.end());
+  return out;
+}
+
+// Surface cell for the albedo nuisance of regions with maps: the scene diagonal / 96 (igi-solve's
+// patch size).
+double CellSize(const Scene& model) {
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : model.mesh.positions) box.extend(p);
+  return box.isEmpty() ? 0.05 : std::max(1e-3, double(box.diagonal().norm()) / 96);
+}
+
+// The photo whose held-out residual the step reduced most (for the report's images).
+size_t MostImprovedPhoto(const PhotoSet& photos, const std::vector<Image>& before,
+                         const std::vector<Image>& after) {
+  size_t best = 0;
+  double best_gain = -1e300;
+  for (size_t i = 0; i < before.size(); ++i) {
+    double g = 0;
+    const Image& rec = photos.recorded[i];
+    for (size_t k = 0; k < rec.pixels.size(); ++k) {
+      const double p = rec.pixels[k], b = before[i].pixels[k], a = after[i].pixels[k];
+      if (std::isfinite(a) && std::isfinite(b) && photos.valid[i].pixels[k / 3] > 0.5f) {
+        g += (b - p) * (b - p) - (a - p) * (a - p);
+      }
+    }
+    if (g > best_gain) best_gain = g, best = i;
+  }
+  return best;
+}
+
+}  // namespace
+
+DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs::path& out_dir) {
+  o.Validate();
+  const auto start = std::chrono::steady_clock::now();
+  DiagnosisSummary sum;
+  const PhotoSet photos = LoadPhotoSet(scene);
+  const bool solve = HasUnknowns(scene);
+  sum.solved = solve;
+  Json declared = AbsolutePaths(scene.document, scene.dir);
+  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+
+  // Albedo maps are themselves a model to earn: the baseline (when solving) has constant
+  // albedos per region, so that a map cannot absorb an effect of the image or the lights before
+  // it is found; "albedo_texture" is the step that adds them.
+  std::string maps = solve ? "none" : "auto";
+  spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
+  ModelState st = FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos);
+  sum.baseline_residual = st.train.Relative();
+  sum.baseline_held_out = st.held.Relative();
+  spdlog::info("igi-diagnose: baseline residual {:.4f} (held out {:.4f})", sum.baseline_residual,
+               sum.baseline_held_out);
+  std::vector<std::string> kept_effects, rejected;
+  int attempt = 0;
+  // Refits with candidate `c` (its document change, and the albedo-map mode) and keeps it when
+  // the held-out residual improves significantly.
+  auto try_step = [&](CandidateResult c, const std::string& next_maps) {
+    spdlog::info("igi-diagnose: trying {} (predicted held-out gain {:.1f}%, z {:.1f})", c.effect,
+                 100 * c.Gain(), c.z);
+    Json next = declared;
+    if (c.apply) c.apply(&next);
+    DiagnosisStep ds;
+    ds.residual_before = st.train.Relative();
+    ds.held_out_before = st.held.Relative();
+    ds.model_dir = out_dir / "steps" / fmt::format("{:02d}-{}", ++attempt, c.effect);
+    ModelState next_st;
+    try {
+      next_st = FitModel(next, solve, next_maps, ds.model_dir, o, photos);
+    } catch (const Error& e) {
+      ds.verdict = std::string("the refit failed: ") + e.what();
+      ds.candidate = std::move(c);
+      sum.steps.push_back(std::move(ds));
+      return false;
+    }
+    ds.residual_after = next_st.train.Relative();
+    ds.held_out_after = next_st.held.Relative();
+    const auto [gain, z] = HeldOutGain(photos, st.sims, next_st.sims, holdout);
+    ds.z = z;
+    ds.kept = gain >= o.min_gain && z >= o.min_z;
+    ds.verdict = ds.kept ? fmt::format("kept: held-out residual² down {:.1f}% ({:.1f} standard "
+                                       "errors over the held-out blocks)", 100 * gain, z)
+                         : fmt::format("rejected: held-out residual² changed by {:.1f}% ({:.1f} "
+                                       "standard errors): the model does not earn its {} "
+                                       "parameter(s)", -100 * gain, z, c.num_params);
+    const size_t img = MostImprovedPhoto(photos, st.sims, next_st.sims);
+    ds.image_photo = scene.photos[img].file.filename().string();
+    ds.residual_before_image = ResidualImage(photos, st.sims, img);
+    ds.residual_after_image = ResidualImage(photos, next_st.sims, img);
+    spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
+    if (c.effect == "albedo_texture" && ds.kept) {
+      Json regions = Json::array();
+      for (const Material& m : next_st.model.materials) {
+        if (m.rho_d_map) regions.push_back(m.name);
+      }
+      c.params = {{"regions", regions}};
+      c.where = {{"regions", regions}, {"frame", "position on the surfaces"}};
+      c.evidence = "the residual follows position on the surfaces of " + regions.dump() +
+                   " (the same texture in every photo that sees them): their albedo varies";
+    }
+    const bool kept = ds.kept;
+    (kept ? kept_effects : rejected).push_back(c.effect);
+    ds.candidate = std::move(c);
+    if (kept) {
+      declared = std::move(next);
+      st = std::move(next_st);
+      maps = next_maps;
+    }
+    sum.steps.push_back(std::move(ds));
+    return kept;
+  };
+  for (int step = 0; step < o.max_steps; ++step) {
+    std::vector<std::string> excluded = kept_effects;
+    excluded.insert(excluded.end(), rejected.begin(), rejected.end());
+    const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
+    std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
+    sum.last_candidates = cands;
+    std::vector<CandidateResult*> ranked;
+    for (CandidateResult& c : cands) {
+      if (c.valid && c.Gain() >= o.candidate_min_gain && c.z >= o.candidate_min_z) {
+        ranked.push_back(&c);
+      }
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const CandidateResult* a, const CandidateResult* b) {
+      return a->held_before - a->held_after > b->held_before - b->held_after;
+    });
+    bool kept = false;
+    for (size_t k = 0; k < ranked.size() && int(k) < o.max_tries && !kept; ++k) {
+      kept = try_step(*ranked[k], maps);
+    }
+    if (!kept && maps == "none") {
+      CandidateResult texture;
+      texture.effect = "albedo_texture";
+      texture.valid = true;
+      texture.num_params = -1;  // one albedo per texel of the regions that get a map
+      texture.evidence = "albedo maps where the solver finds the albedo varies";
+      kept = try_step(texture, "auto");
+      if (kept) rejected.clear();  // with free albedos the earlier verdicts may change
+    }
+    if (!kept) break;
+  }
+  sum.final_residual = st.train.Relative();
+  sum.final_held_out = st.held.Relative();
+  sum.noise_floor = NoiseFloor(photos, st.sims);
+  sum.unexplained = Unexplained(st, sum.noise_floor);
+  sum.final_model_dir = st.dir;
+  const fs::path model_file = st.dir / (solve ? "scene.json" : "declared.json");
+  sum.final_scene = RelativePaths(AbsolutePaths(ReadJsonFile(model_file), st.dir), out_dir);
+  if (!scene.photos.empty()) {
+    Image render = st.sims[0];
+    sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},
+                        {render, "re-render of the improved model"},
+                        {ResidualImage(photos, st.sims, 0), "residual (render − photo)"}};
+  }
+  sum.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return sum;
+}
+
+}  // namespace igi

@@ -1,0 +1,32 @@
+#include "solver/diagnose/diagnose_options.h"
+
+#include <fmt/format.h>
+
+#include "tools/common/error.h"
+
+namespace igi {
+
+void DiagnoseOptions::Validate() const {
+  ProblemList problems;
+  auto check = [&](bool ok, const char* flag, const std::string& value, const char* rule) {
+    if (!ok) problems.Add(DescribeProblem("", flag, value, rule));
+  };
+  check(spp >= 1 && spp <= 65536, "--spp", std::to_string(spp), "must be in [1, 65536]");
+  check(pixel_stride >= 1 && pixel_stride <= 64, "--pixel-stride", std::to_string(pixel_stride),
+        "must be in [1, 64]");
+  check(max_steps >= 0 && max_steps <= 20, "--max-steps", std::to_string(max_steps),
+        "must be in [0, 20]");
+  check(holdout_fraction > 0 && holdout_fraction < 0.9, "--holdout-fraction",
+        fmt::format("{}", holdout_fraction), "must be in (0, 0.9)");
+  check(holdout_block_px >= 2 && holdout_block_px <= 1024, "--holdout-block-px",
+        std::to_string(holdout_block_px), "must be in [2, 1024]");
+  check(min_gain >= 0 && min_gain < 1, "--min-gain", fmt::format("{}", min_gain),
+        "must be in [0, 1)");
+  check(min_z >= 0, "--min-z", fmt::format("{}", min_z), "must be >= 0");
+  check(light_samples >= 1 && light_samples <= 256, "--light-samples",
+        std::to_string(light_samples), "must be in [1, 256]");
+  problems.ThrowIfAny();
+  solve.Validate();
+}
+
+}  // namespace igi

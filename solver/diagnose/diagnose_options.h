@@ -1,0 +1,35 @@
+#pragma once
+// Options of igi-diagnose (CONTRACT.md §4, §6).
+
+#include <cstdint>
+
+#include "solver/solve_options.h"
+
+namespace igi {
+
+struct DiagnoseOptions {
+  int spp = 32;            // paths per pixel of the re-renders
+  int pixel_stride = 2;    // every Nth pixel of each photo is a residual sample
+  int max_steps = 4;       // effects modelled at most
+  // Held-out pixels: square blocks, left out of every fit (the solver's and the effects').
+  double holdout_fraction = 0.25;
+  int holdout_block_px = 16;
+  // A step is kept when its held-out residual² falls by at least this share AND by at least
+  // `min_z` standard errors (estimated over the held-out blocks).
+  double min_gain = 0.02;
+  double min_z = 3.0;
+  // A candidate is refitted (the real test above) when its predicted held-out gain reaches
+  // these; at most `max_tries` candidates per step, best predicted first.
+  double candidate_min_gain = 0.01;
+  double candidate_min_z = 2.0;
+  int max_tries = 3;
+  int light_samples = 8;   // per extended light, for the direct-light features
+  uint64_t seed = 1;
+  int num_threads = 0;
+  bool show_progress = true;
+  SolveOptions solve;      // used when materials are unknown (refits re-solve them)
+
+  void Validate() const;
+};
+
+}  // namespace igi

@@ -1,0 +1,242 @@
+#include "solver/diagnose/pixel_records.h"
+
+#include <cmath>
+#include <memory>
+
+#include "solver/observations.h"
+#include "solver/render.h"
+#include "solver/render_internal.h"
+#include "solver/sampling.h"
+#include "solver/surface_hit.h"
+#include "tools/common/parallel.h"
+
+namespace igi {
+namespace {
+
+std::vector<std::unique_ptr<Renderer::Impl>> LightingScenes(const Scene& scene) {
+  std::vector<std::unique_ptr<Renderer::Impl>> out(scene.lightings.size());
+  for (const Photo& p : scene.photos) {
+    if (!out[p.lighting]) out[p.lighting] = BuildRenderScene(scene, p.lighting);
+  }
+  return out;
+}
+
+// The region the ray through continuous pixel (x, y) hits first, or -1 (nothing, a light, or a
+// surface that does not reflect).
+int RegionAt(const Renderer::Impl& impl, const Camera& cam, double x, double y) {
+  const std::optional<SurfaceHit> hit =
+      TraceSurface(impl, cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(x, y)));
+  if (!hit) return -1;
+  const BrdfModel m = impl.materials[hit->region].model;
+  return IsReflective(m) ? hit->region : -1;
+}
+
+}  // namespace
+
+PhotoSet LoadPhotoSet(const Scene& scene) {
+  PhotoSet set;
+  const auto scenes = LightingScenes(scene);
+  set.recorded.resize(scene.photos.size());
+  set.valid.resize(scene.photos.size());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const Photo& p = scene.photos[i];
+    const Camera& cam = scene.cameras[p.camera];
+    const Image& img = set.recorded[i] = ReadImage(p.file, 3);
+    std::optional<Image> mask;
+    if (p.mask) mask = ReadImage(*p.mask, 1);
+    const double clip = AutoSaturation(img);
+    Image& valid = set.valid[i] = Image(img.width, img.height, 1);
+    const Renderer::Impl& impl = *scenes[p.lighting];
+    ParallelFor(0, img.height, [&](int64_t yy) {
+      const int y = int(yy);
+      for (int x = 0; x < img.width; ++x) {
+        bool ok = !mask || mask->at(x, y, 0) > 0.5f;
+        for (int c = 0; c < 3 && ok; ++c) {
+          const float v = img.at(x, y, c);
+          ok = std::isfinite(v) && v < clip;
+        }
+        if (ok) {
+          const int r = RegionAt(impl, cam, x + 0.5, y + 0.5);
+          ok = r >= 0;
+          for (int k = 0; k < 4 && ok; ++k) {
+            ok = RegionAt(impl, cam, x + 0.05 + 0.9 * (k & 1), y + 0.05 + 0.9 * (k >> 1)) == r;
+          }
+        }
+        valid.at(x, y, 0) = ok ? 1.0f : 0.0f;
+      }
+    });
+  }
+  return set;
+}
+
+std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options,
+                                  uint64_t seed) {
+  std::vector<Image> sims(model.photos.size());
+  std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
+  for (size_t i = 0; i < model.photos.size(); ++i) {
+    const Photo& p = model.photos[i];
+    if (!renderers[p.lighting]) renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+    RenderOptions ro;
+    ro.spp = options.spp;
+    ro.seed = seed + 7919 * i;
+    ro.num_threads = options.num_threads;
+    ro.show_progress = false;
+    sims[i] = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
+    ApplyExposureAndResponse(p, &sims[i]);
+  }
+  return sims;
+}
+
+namespace {
+
+Eigen::Vector3f AlbedoAt(const Scene& model, const Renderer::Impl& impl, const SurfaceHit& hit) {
+  const ShadingMaterial& m = impl.materials[hit.region];
+  Eigen::Vector3d rho = m.params.rho_d;
+  if (m.rho_d_map && model.mesh.has_uvs()) {
+    const Eigen::Vector3i& t = model.mesh.triangles[hit.triangle];
+    const double b0 = 1 - hit.b1 - hit.b2;
+    const Eigen::Vector2d uv =
+        (b0 * model.mesh.uvs[t[0]] + hit.b1 * model.mesh.uvs[t[1]] + hit.b2 * model.mesh.uvs[t[2]])
+            .cast<double>();
+    rho = SampleTexture(*m.rho_d_map, uv);
+  }
+  return rho.cast<float>();
+}
+
+void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceHit& hit,
+                  int samples, Pcg32& rng, PixelRecord* r) {
+  const double eps = impl.ray_epsilon;
+  const std::vector<int>& ids = model.lightings[model.photos[r->photo].lighting].lights;
+  for (int l = 0; l < int(impl.lights.size()); ++l) {
+    const LightType type = impl.lights[l].type;
+    const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
+                       type == LightType::kDirectional;
+    const int k = delta ? 1 : type == LightType::kAmbient ? 4 * samples : samples;
+    for (int s = 0; s < k; ++s) {
+      const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
+      const LightSample ls = impl.SampleLight(l, hit.position, u);
+      if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0)) continue;
+      const double cos_geo = ls.wi.dot(hit.n_geo), cos_s = ls.wi.dot(hit.n_s);
+      if (!(cos_geo > 0) || !(cos_s > 0)) continue;
+      const double d = std::isfinite(ls.distance)
+                           ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
+                           : ls.distance;
+      if (impl.Occluded(hit.position + hit.n_geo * eps, ls.wi, d, l)) continue;
+      RecordLightSample rs;
+      rs.light = l < int(ids.size()) ? ids[l] : -1;  // the emitter-material light has no id
+      rs.wi = ls.wi.cast<float>();
+      rs.irradiance = (ls.value * (cos_s / (ls.pdf * k))).cast<float>();
+      rs.distance = float(std::isfinite(ls.distance) ? ls.distance : 1e30);
+      r->lights.push_back(rs);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
+                                      const std::vector<Image>& sims,
+                                      const DiagnoseOptions& options) {
+  const auto scenes = LightingScenes(model);
+  const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
+                             options.solve.holdout_seed};
+  std::vector<std::vector<PixelRecord>> rows;
+  std::vector<std::pair<int, int>> row_of;  // (photo, y)
+  for (size_t i = 0; i < model.photos.size(); ++i) {
+    for (int y = 0; y < photos.recorded[i].height; y += options.pixel_stride) {
+      row_of.emplace_back(int(i), y);
+    }
+  }
+  rows.resize(row_of.size());
+  ParallelFor(0, int64_t(row_of.size()), [&](int64_t k) {
+    const auto [i, y] = row_of[k];
+    const Photo& p = model.photos[i];
+    const Camera& cam = model.cameras[p.camera];
+    const Renderer::Impl& impl = *scenes[p.lighting];
+    const Image& rec = photos.recorded[i];
+    const double half_diag2 = 0.25 * (double(cam.width) * cam.width + double(cam.height) * cam.height);
+    Pcg32 rng = PixelSampleRng(options.seed + 17, uint64_t(k), 0);
+    for (int x = 0; x < rec.width; x += options.pixel_stride) {
+      if (photos.valid[i].at(x, y, 0) < 0.5f) continue;
+      const Eigen::Vector3d center = cam.CenterInWorld();
+      const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+      const std::optional<SurfaceHit> hit = TraceSurface(impl, center, dir);
+      if (!hit) continue;
+      PixelRecord r;
+      r.photo = i;
+      r.x = x;
+      r.y = y;
+      r.held_out = holdout.HeldOut(i, x, y);
+      for (int c = 0; c < 3; ++c) {
+        r.recorded[c] = rec.at(x, y, c);
+        r.sim[c] = sims[i].at(x, y, c);
+      }
+      if (!r.sim.allFinite()) continue;
+      r.region = hit->region;
+      r.position = hit->position.cast<float>();
+      r.normal = hit->n_s.cast<float>();
+      r.view = (-dir).cast<float>();
+      const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
+      r.r2 = float((dx * dx + dy * dy) / half_diag2);
+      r.albedo = AlbedoAt(model, impl, *hit);
+      GatherLights(model, impl, *hit, options.light_samples, rng, &r);
+      rows[k].push_back(std::move(r));
+    }
+  }, options.num_threads);
+  std::vector<PixelRecord> out;
+  for (auto& row : rows) {
+    for (PixelRecord& r : row) out.push_back(std::move(r));
+  }
+  FlagOutliers(&out);
+  return out;
+}
+
+void FlagOutliers(std::vector<PixelRecord>* records) {
+  // Residual relative to the pixel's level; flagged beyond 5× its median (≈ 7 σ for Gaussian
+  // errors).
+  std::vector<float> t(records->size());
+  for (size_t i = 0; i < t.size(); ++i) {
+    const PixelRecord& r = (*records)[i];
+    const float level = std::sqrt(0.5f * (r.sim.squaredNorm() + r.recorded.squaredNorm())) + 1e-20f;
+    t[i] = (r.sim - r.recorded).norm() / level;
+  }
+  if (t.empty()) return;
+  std::vector<float> sorted = t;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const float limit = 5 * sorted[sorted.size() / 2];
+  for (size_t i = 0; i < t.size(); ++i) (*records)[i].outlier = t[i] > limit;
+}
+
+ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out) {
+  ResidualSums s;
+  for (const PixelRecord& r : records) {
+    if (r.held_out != held_out) continue;
+    s.sq_err += double((r.sim - r.recorded).squaredNorm());
+    s.sq_photo += double(r.recorded.squaredNorm());
+  }
+  return s;
+}
+
+ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
+                           const PixelHoldout& holdout, bool held_out) {
+  ResidualSums s;
+  for (size_t i = 0; i < sims.size(); ++i) {
+    const Image& rec = photos.recorded[i];
+    for (int y = 0; y < rec.height; ++y) {
+      for (int x = 0; x < rec.width; ++x) {
+        if (photos.valid[i].at(x, y, 0) < 0.5f || holdout.HeldOut(int(i), x, y) != held_out) {
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const double p = rec.at(x, y, c), m = sims[i].at(x, y, c);
+          if (!std::isfinite(m)) continue;
+          s.sq_err += (m - p) * (m - p);
+          s.sq_photo += p * p;
+        }
+      }
+    }
+  }
+  return s;
+}
+
+}  // namespace igi

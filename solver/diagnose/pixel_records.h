@@ -1,0 +1,74 @@
+#pragma once
+// The samples igi-diagnose studies: for every valid residual pixel of every photo, what the
+// photo recorded, what the model predicts, and where the pixel lies in each frame where a kind
+// of physics shows itself (image position, surface, region, light directions).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/diagnose/diagnose_options.h"
+#include "solver/photo_model.h"
+#include "tools/common/image.h"
+
+namespace igi {
+
+// One light sample at a record's surface point: direction to the light and the irradiance it
+// brings (value·cos/pdf, divided by the sample count), unoccluded samples only.
+struct RecordLightSample {
+  int light = -1;  // index into Scene::lights
+  Eigen::Vector3f wi = Eigen::Vector3f::Zero();
+  Eigen::Vector3f irradiance = Eigen::Vector3f::Zero();
+  float distance = 0;
+};
+
+struct PixelRecord {
+  int photo = 0, x = 0, y = 0;
+  bool held_out = false;
+  // A residual far in the tail (Monte Carlo fireflies, a hidden object's edge): left out of the
+  // candidates' fits and scores, so that a handful of pixels cannot steer them.
+  bool outlier = false;
+  Eigen::Vector3f recorded = Eigen::Vector3f::Zero();  // the photo's value
+  Eigen::Vector3f sim = Eigen::Vector3f::Zero();       // the model's prediction of it
+  int region = -1;
+  Eigen::Vector3f position = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // shading normal, toward the camera
+  Eigen::Vector3f view = Eigen::Vector3f::Zero();    // unit, toward the camera
+  float r2 = 0;  // (distance to the principal point / half the image diagonal)²
+  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // the model's ρd at the point
+  std::vector<RecordLightSample> lights;             // direct light at the point
+};
+
+// Recorded photos of a scene (loaded once) and their valid-pixel masks.
+struct PhotoSet {
+  std::vector<Image> recorded;
+  std::vector<Image> valid;  // 1 = a residual sample may come from this pixel
+};
+
+// Reads every photo; a pixel is valid when finite, below the photo's clip level, inside its mask,
+// and its footprint (centre and four corners) lies on one reflective region.
+PhotoSet LoadPhotoSet(const Scene& scene);
+
+// Renders every photo's camera under its lighting and applies the photo model (scale, response).
+std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed);
+
+// The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel.
+std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
+                                      const std::vector<Image>& sims,
+                                      const DiagnoseOptions& options);
+
+// Marks the records whose residual lies far in the tail (see PixelRecord::outlier).
+void FlagOutliers(std::vector<PixelRecord>* records);
+
+// CONTRACT.md §6 residual over records (held_out selects the set).
+struct ResidualSums {
+  double sq_err = 0, sq_photo = 0;
+  double Relative() const { return sq_photo > 0 ? std::sqrt(sq_err / sq_photo) : 0; }
+};
+ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out);
+
+// Residual over every valid pixel of the photos (not only the records' stride).
+ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
+                           const PixelHoldout& holdout, bool held_out);
+
+}  // namespace igi

@@ -1,0 +1,119 @@
+#include "solver/diagnose/residual_fit.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <unordered_map>
+
+namespace igi {
+
+ResidualFitter::ResidualFitter(const std::vector<PixelRecord>& records, std::vector<int> cell,
+                               int num_cells, bool nuisance, int block_px)
+    : records_(records),
+      cell_(std::move(cell)),
+      num_cells_(num_cells),
+      nuisance_(nuisance),
+      block_px_(std::max(1, block_px)) {}
+
+double ResidualFitter::NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
+                                    const Eigen::VectorXd& coef) const {
+  if (!nuisance_) return 0;
+  const int stride = 3 + 2 * k + k * k;
+  const double* st = &stats[((cell * 3 + c) * 2 + 1) * stride];
+  if (!(st[0] > 0)) return 0;
+  double sy = st[1];
+  for (int a = 0; a < coef.size(); ++a) sy -= coef[a] * st[3 + a];
+  return sy / st[0];
+}
+
+double ResidualFitter::Z(const std::vector<double>& gains) {
+  const double n = double(gains.size());
+  if (n < 2) return 0;
+  double mean = 0, sq = 0;
+  for (double x : gains) mean += x;
+  mean /= n;
+  for (double x : gains) sq += (x - mean) * (x - mean);
+  const double se = std::sqrt(sq / (n - 1) / n);
+  return se > 0 ? mean / se : 0;
+}
+
+namespace {
+
+// The projected quantities of one (cell, channel, set) block.
+struct Projected {
+  Eigen::MatrixXd bb;  // Σ b bᵀ − (Σ s b)(Σ s b)ᵀ / Σ s²
+  Eigen::VectorXd by;  // Σ b y − (Σ s b)(Σ s y) / Σ s²
+  double yy = 0;       // Σ y² − (Σ s y)² / Σ s²
+};
+
+Projected Project(const double* st, int k, bool nuisance) {
+  Projected p;
+  p.bb = Eigen::Map<const Eigen::MatrixXd>(st + 3 + 2 * k, k, k);
+  p.by = Eigen::Map<const Eigen::VectorXd>(st + 3 + k, k);
+  p.yy = st[2];
+  if (nuisance && st[0] > 0) {
+    const Eigen::Map<const Eigen::VectorXd> sb(st + 3, k);
+    p.bb -= sb * sb.transpose() / st[0];
+    p.by -= sb * (st[1] / st[0]);
+    p.yy -= st[1] * st[1] / st[0];
+  }
+  return p;
+}
+
+}  // namespace
+
+ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const {
+  const int stride = 3 + 2 * k + k * k;
+  ResidualFit fit;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(k);
+  for (int cell = 0; cell < num_cells_; ++cell) {
+    for (int c = 0; c < 3; ++c) {
+      const Projected p = Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_);
+      a += p.bb;
+      g += p.by;
+      fit.train_before += p.yy;
+    }
+  }
+  const double ridge = 1e-9 * std::max(1e-300, a.diagonal().cwiseAbs().maxCoeff());
+  a.diagonal().array() += ridge;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+  if (ldlt.info() != Eigen::Success || !(a.diagonal().maxCoeff() > 0)) return fit;
+  fit.coef = ldlt.solve(g);
+  if (!fit.coef.allFinite()) {
+    fit.coef.resize(0);
+    return fit;
+  }
+  fit.train_after = fit.train_before - 2 * fit.coef.dot(g) + fit.coef.dot(a * fit.coef);
+  // Held out: the same coefficients, the set's own nuisance.
+  for (int cell = 0; cell < num_cells_; ++cell) {
+    for (int c = 0; c < 3; ++c) {
+      const double* st = &stats[((size_t(cell) * 3 + c) * 2 + 1) * stride];
+      const Projected p = Project(st, k, nuisance_);
+      fit.held_before += p.yy;
+      fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.bb * fit.coef));
+    }
+  }
+  return fit;
+}
+
+std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
+                             double cell_m, int* num_cells) {
+  std::unordered_map<int64_t, int> ids;
+  std::vector<int> cell(records.size());
+  for (size_t i = 0; i < records.size(); ++i) {
+    const PixelRecord& r = records[i];
+    int64_t key = int64_t(r.region) << 48;
+    if (model.materials[r.region].rho_d_map) {
+      const Eigen::Vector3f q = r.position / float(cell_m);
+      key += ((int64_t(std::floor(q.x())) & 0xFFFF) << 32) +
+             ((int64_t(std::floor(q.y())) & 0xFFFF) << 16) + (int64_t(std::floor(q.z())) & 0xFFFF) +
+             1;
+    }
+    auto [it, added] = ids.emplace(key, int(ids.size()));
+    cell[i] = it->second;
+  }
+  *num_cells = int(ids.size());
+  return cell;
+}
+
+}  // namespace igi

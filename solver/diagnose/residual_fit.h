@@ -1,0 +1,114 @@
+#pragma once
+// Fitting an effect's amplitudes to the residual (photo − model) of the residual samples, with
+// the albedo left free: when the materials are solved, any change of the model is followed by a
+// refit of the albedos, so a candidate is only credited with what it explains BEYOND a free
+// albedo scale per "cell" (per region for regions of constant albedo, per small surface cell for
+// regions with an albedo map), per colour channel. The nuisance is projected out exactly
+// (Frisch–Waugh–Lovell): for each cell and channel, every quantity v is replaced by
+// v − sim·(Σ v·sim / Σ sim²).
+//
+// Fits use the fitted (not held-out) samples; the same coefficients are scored on the held-out
+// samples (with their own nuisance), and the held-out gain's significance is measured with the
+// cells as independent units. Samples flagged as outliers take no part.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <unordered_map>
+#include <vector>
+
+#include "solver/diagnose/pixel_records.h"
+
+namespace igi {
+
+struct ResidualFit {
+  Eigen::VectorXd coef;  // empty: singular
+  double train_before = 0, train_after = 0;  // squared-error sums after the nuisance
+  double held_before = 0, held_after = 0;
+  double z = 0;  // held-out gain / its standard error over cells
+  double Gain() const { return held_before > 0 ? 1 - held_after / held_before : 0; }
+};
+
+class ResidualFitter {
+ public:
+  // `cell` per record (dense ids 0..num_cells-1); nuisance = the albedo is refitted.
+  ResidualFitter(const std::vector<PixelRecord>& records, std::vector<int> cell, int num_cells,
+                 bool nuisance, int block_px);
+
+  // basis(record, channel, double* b) writes K values (b is zeroed before each call).
+  template <class F>
+  ResidualFit Fit(int k, F basis) const;
+
+  const std::vector<PixelRecord>& records() const { return records_; }
+  bool nuisance() const { return nuisance_; }
+
+ private:
+  struct Sums;
+  ResidualFit Solve(int k, const std::vector<double>& stats) const;
+  // Σ s y / Σ s² of the held-out set per (cell, channel), before and after the fit.
+  double NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
+                      const Eigen::VectorXd& coef) const;
+  static double Z(const std::vector<double>& gains);
+
+  const std::vector<PixelRecord>& records_;
+  std::vector<int> cell_;
+  int num_cells_;
+  bool nuisance_;
+  int block_px_;
+};
+
+// Cells for `model`'s records: per region, or per (region, voxel of `cell_m`) where the region
+// has an albedo map.
+std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
+                             double cell_m, int* num_cells);
+
+// ------------------------------------------------------------------ implementation
+// Per (cell, channel, set) the statistics are laid out as:
+//   [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ.
+template <class F>
+ResidualFit ResidualFitter::Fit(int k, F basis) const {
+  const int stride = 3 + 2 * k + k * k;
+  std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
+  std::vector<double> b(k);
+  for (size_t i = 0; i < records_.size(); ++i) {
+    const PixelRecord& r = records_[i];
+    if (r.outlier) continue;
+    for (int c = 0; c < 3; ++c) {
+      std::fill(b.begin(), b.end(), 0.0);
+      basis(r, c, b.data());
+      const double s = r.sim[c], y = double(r.recorded[c]) - s;
+      double* st = &stats[((size_t(cell_[i]) * 3 + c) * 2 + (r.held_out ? 1 : 0)) * stride];
+      st[0] += s * s, st[1] += s * y, st[2] += y * y;
+      for (int a = 0; a < k; ++a) {
+        st[3 + a] += s * b[a];
+        st[3 + k + a] += b[a] * y;
+        for (int e = 0; e < k; ++e) st[3 + 2 * k + a * k + e] += b[a] * b[e];
+      }
+    }
+  }
+  ResidualFit fit = Solve(k, stats);
+  if (fit.coef.size() == 0) return fit;
+  // Held-out gain per block (photo, block_px square) for its standard error.
+  std::unordered_map<int64_t, double> gains;
+  for (size_t i = 0; i < records_.size(); ++i) {
+    const PixelRecord& r = records_[i];
+    if (r.outlier || !r.held_out) continue;
+    double g = 0;
+    for (int c = 0; c < 3; ++c) {
+      std::fill(b.begin(), b.end(), 0.0);
+      basis(r, c, b.data());
+      const double s = r.sim[c], y = double(r.recorded[c]) - s;
+      double cb = 0;
+      for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
+      const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd());
+      const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef);
+      g += (y - a0 * s) * (y - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
+    }
+    gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_] += g;
+  }
+  std::vector<double> list;
+  for (const auto& [key, g] : gains) list.push_back(g);
+  fit.z = Z(list);
+  return fit;
+}
+
+}  // namespace igi

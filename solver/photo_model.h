@@ -1,0 +1,36 @@
+#pragma once
+// How a photo's recorded values relate to the scene's radiance (igi extensions of scene.json:
+// a camera's "vignetting", a photo's "exposure_scale" and "response"), and the block split of
+// photo pixels into fitted and held-out sets used by igi-diagnose.
+//
+// Forward model of a recorded value v at pixel x:  v = R(s · V(x) · L(x)), with L the radiance,
+// V the camera's vignetting factor (applied by Renderer::Render already), s the exposure scale and
+// R the response (identity by default).
+
+#include <cstdint>
+
+#include "recon/scene.h"
+#include "tools/common/image.h"
+
+namespace igi {
+
+// Pixels are held out in square blocks chosen by a hash of (photo, block, seed); fraction 0 =
+// nothing held out.
+struct PixelHoldout {
+  double fraction = 0;
+  int block_px = 16;
+  uint64_t seed = 1;
+
+  bool HeldOut(int photo, int x, int y) const;
+};
+
+// True when the photo's values are not plain radiance (a response, a scale or vignetting).
+bool HasPhotoModel(const Photo& photo, const Camera& camera);
+
+// Radiance from recorded values: inverse response, / exposure scale, / vignetting.
+Image LinearRadianceOfPhoto(const Photo& photo, const Camera& camera, const Image& recorded);
+
+// Recorded values from a render (which carries the camera's vignetting): × scale, response.
+void ApplyExposureAndResponse(const Photo& photo, Image* render);
+
+}  // namespace igi
