@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstring>
 
 #include "tools/common/strings.h"
@@ -93,7 +95,9 @@ void CameraOptions::Validate() const {
     problems.Add("", "--frame-rate", FormatNumber(frame_rate_hz), "must be >= 0");
   if (width < 0) problems.Add("", "--width", std::to_string(width), "must be >= 0");
   if (height < 0) problems.Add("", "--height", std::to_string(height), "must be >= 0");
-  if (num_buffers < 2) problems.Add("", "--buffers", std::to_string(num_buffers), "must be >= 2");
+  if (num_buffers != 0 && num_buffers < 2) {
+    problems.Add("", "--buffers", std::to_string(num_buffers), "must be 0 (auto) or >= 2");
+  }
   if (frame_retention_ms < 10) {
     problems.Add("", "--frame-retention-ms", std::to_string(frame_retention_ms), "must be >= 10");
   }
@@ -227,9 +231,15 @@ void Camera::Impl::CreateStream() {
   }
   const guint payload = arv_camera_get_payload(camera, &error);
   Check(error, Name() + ": cannot read the payload size");
-  for (int i = 0; i < options.num_buffers; ++i) {
+  int buffers = options.num_buffers;
+  if (buffers == 0) {
+    constexpr size_t kAutoBufferBytes = size_t(64) << 20;
+    buffers = int(std::clamp<size_t>(kAutoBufferBytes / std::max<guint>(payload, 1), 64, 1024));
+  }
+  for (int i = 0; i < buffers; ++i) {
     arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
   }
+  spdlog::debug("{}: {} stream buffers of {} bytes", Name(), buffers, payload);
 }
 
 Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
@@ -250,10 +260,13 @@ Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
                                 " " + format.name,
                             false);
   }
-  frame.levels.resize(samples);
   if (format.bytes_per_sample == 1) {
-    for (size_t i = 0; i < samples; ++i) frame.levels[i] = data[i];
+    frame.levels.assign(data, data + samples);
+  } else if constexpr (std::endian::native == std::endian::little) {
+    frame.levels.resize(samples);
+    std::memcpy(frame.levels.data(), data, samples * 2);
   } else {
+    frame.levels.resize(samples);
     for (size_t i = 0; i < samples; ++i) {
       frame.levels[i] = static_cast<uint16_t>(data[2 * i] | (data[2 * i + 1] << 8));
     }
@@ -391,6 +404,23 @@ Frame Camera::NextFrame() {
       throw;
     }
   }
+}
+
+StreamStatistics Camera::Statistics() const {
+  StreamStatistics statistics;
+  if (impl_->stream == nullptr) return statistics;
+  guint64 completed = 0, failures = 0, underruns = 0;
+  arv_stream_get_statistics(impl_->stream, &completed, &failures, &underruns);
+  statistics.completed = completed;
+  statistics.failures = failures;
+  statistics.underruns = underruns;
+  if (ARV_IS_GV_STREAM(impl_->stream)) {
+    guint64 resent = 0, missing = 0;
+    arv_gv_stream_get_statistics(ARV_GV_STREAM(impl_->stream), &resent, &missing);
+    statistics.resent_packets = resent;
+    statistics.missing_packets = missing;
+  }
+  return statistics;
 }
 
 }  // namespace igi::capture

@@ -57,13 +57,24 @@ struct CameraOptions {
   double frame_rate_hz = 0.0;    // > 0 sets AcquisitionFrameRate; 0 = keep
   int width = 0;                 // > 0 sets the region of interest width (pixels), from x = 0
   int height = 0;                // > 0 sets the region height (pixels), from y = 0
-  int num_buffers = 64;          // stream buffers queued in Aravis (absorbs write bursts)
+  // Stream buffers queued in Aravis; 0 = enough for 64 MiB of frames (at least
+  // 64, at most 1024). They hold frames the receiving thread has not taken yet.
+  int num_buffers = 0;
   int frame_timeout_ms = 3000;   // a frame later than this (+ exposure) ends the run
   bool packet_resend = true;     // GigE: ask the camera to resend lost packets
   int frame_retention_ms = 500;  // GigE: a frame still missing packets this long is lost
 
   // InputError naming the flag when a value is out of range.
   void Validate() const;
+};
+
+// The stream's own counts since the camera was opened (Aravis's statistics).
+struct StreamStatistics {
+  uint64_t completed = 0;        // frames received whole
+  uint64_t failures = 0;         // frames given up (missing packets, timeout)
+  uint64_t underruns = 0;        // frames dropped for want of a free buffer
+  uint64_t missing_packets = 0;  // GigE: packets never received
+  uint64_t resent_packets = 0;   // GigE: packets received after a resend request
 };
 
 // One frame as delivered, levels unscaled (0 … 2^significant_bits - 1).
@@ -106,6 +117,7 @@ class Camera {
   void Abandon();
   // The next frame exposed at the current setting. Throws CameraStreamError.
   Frame NextFrame();
+  StreamStatistics Statistics() const;
 
  private:
   struct Impl;

@@ -2,6 +2,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <vector>
+
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 
@@ -18,12 +20,37 @@ uint16_t WidenTo16Bits(uint16_t level, int significant_bits) {
   return static_cast<uint16_t>(wide);
 }
 
+namespace {
+
+// The 16-bit samples to store: `frame.levels` itself when it already has 16
+// significant bits, else widened into a buffer reused by the calling thread
+// (no allocation per frame).
+const uint16_t* WideSamples(const Frame& frame) {
+  const int bits = frame.format.significant_bits;
+  if (bits >= 16) return frame.levels.data();
+  thread_local std::vector<uint16_t> wide;
+  wide.resize(frame.levels.size());
+  const uint16_t* in = frame.levels.data();
+  const size_t count = frame.levels.size();
+  if (bits >= 8) {
+    // One copy of the top bits fills the low ones (same result as
+    // WidenTo16Bits, in a loop the compiler vectorises).
+    const int shift = 16 - bits;
+    const int down = 2 * bits - 16;
+    for (size_t i = 0; i < count; ++i) {
+      wide[i] = static_cast<uint16_t>((in[i] << shift) | (in[i] >> down));
+    }
+  } else {
+    for (size_t i = 0; i < count; ++i) wide[i] = WidenTo16Bits(in[i], bits);
+  }
+  return wide.data();
+}
+
+}  // namespace
+
 void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool durable) {
   const int channels = frame.format.channels;
-  std::vector<uint16_t> wide(frame.levels.size());
-  for (size_t i = 0; i < wide.size(); ++i) {
-    wide[i] = WidenTo16Bits(frame.levels[i], frame.format.significant_bits);
-  }
+  const uint16_t* samples = WideSamples(frame);
   AtomicOutput output(path);
   auto out = OIIO::ImageOutput::create(output.temp_path().string());
   if (!out) {
@@ -39,7 +66,7 @@ void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool dura
   spec.attribute("igi:pixel_format", frame.format.name);
   spec.attribute("igi:significant_bits", frame.format.significant_bits);
   if (!out->open(output.temp_path().string(), spec) ||
-      !out->write_image(OIIO::TypeDesc::UINT16, wide.data()) || !out->close()) {
+      !out->write_image(OIIO::TypeDesc::UINT16, samples) || !out->close()) {
     throw Error(path.string() + ": cannot write: " + out->geterror());
   }
   if (durable) {
