@@ -180,13 +180,17 @@ void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
   std::exception_ptr failure;
   try {
     ReceiveFrames(options, plan, done, camera, &pipeline, summary);
+    // Every frame is in hand: stop the camera now rather than after the
+    // writers finish, or its frames pile up meanwhile as underruns.
+    summary->stream = camera.Statistics();
+    camera.Stop();
   } catch (...) {
     failure = std::current_exception();
+    summary->stream = camera.Statistics();
   }
   pipeline.Finish();
   summary->frames_written = pipeline.frames_listed();
   summary->seconds = pipeline.seconds_to_last_listed();
-  summary->stream = camera.Statistics();
   if (const auto error = pipeline.error()) {
     summary->stopped_because = "a frame could not be written: " + *error;
   }

@@ -32,13 +32,17 @@ const uint16_t* WideSamples(const Frame& frame) {
   wide.resize(frame.levels.size());
   const uint16_t* in = frame.levels.data();
   const size_t count = frame.levels.size();
-  if (bits >= 8) {
+  uint16_t* out = wide.data();
+  if (bits == 8) {
+    // v * 257 = v << 8 | v: one 16-bit multiply per sample (vectorised).
+    for (size_t i = 0; i < count; ++i) out[i] = static_cast<uint16_t>(in[i] * 257u);
+  } else if (bits > 8) {
     // One copy of the top bits fills the low ones (same result as
-    // WidenTo16Bits, in a loop the compiler vectorises).
-    const int shift = 16 - bits;
-    const int down = 2 * bits - 16;
+    // WidenTo16Bits).
+    const unsigned shift = 16u - unsigned(bits);
+    const unsigned down = 2u * unsigned(bits) - 16u;
     for (size_t i = 0; i < count; ++i) {
-      wide[i] = static_cast<uint16_t>((in[i] << shift) | (in[i] >> down));
+      out[i] = static_cast<uint16_t>(uint16_t(in[i] << shift) | uint16_t(in[i] >> down));
     }
   } else {
     for (size_t i = 0; i < count; ++i) wide[i] = WidenTo16Bits(in[i], bits);
