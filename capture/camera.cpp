@@ -239,9 +239,9 @@ void Camera::Impl::CreateStream() {
   for (int i = 0; i < buffers; ++i) {
     arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
   }
-  spdlog::debug("{}: {} stream buffers of {} bytes, packets of {} bytes", Name(), buffers, payload,
-                arv_camera_is_gv_device(camera) ? arv_camera_gv_get_packet_size(camera, nullptr)
-                                                : 0u);
+  spdlog::debug(
+      "{}: {} stream buffers of {} bytes, packets of {} bytes", Name(), buffers, payload,
+      arv_camera_is_gv_device(camera) ? arv_camera_gv_get_packet_size(camera, nullptr) : 0u);
 }
 
 Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {

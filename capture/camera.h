@@ -52,11 +52,11 @@ struct CameraOptions {
   // cameras found by id are opened through their address (Aravis streams over
   // loopback only when opened so).
   std::string id_or_address;
-  std::string pixel_format;      // GenICam name; empty = keep the camera's current format
-  double gain = -1.0;            // camera gain units (dB on most cameras); < 0 = keep
-  double frame_rate_hz = 0.0;    // > 0 sets AcquisitionFrameRate; 0 = keep
-  int width = 0;                 // > 0 sets the region of interest width (pixels), from x = 0
-  int height = 0;                // > 0 sets the region height (pixels), from y = 0
+  std::string pixel_format;    // GenICam name; empty = keep the camera's current format
+  double gain = -1.0;          // camera gain units (dB on most cameras); < 0 = keep
+  double frame_rate_hz = 0.0;  // > 0 sets AcquisitionFrameRate; 0 = keep
+  int width = 0;               // > 0 sets the region of interest width (pixels), from x = 0
+  int height = 0;              // > 0 sets the region height (pixels), from y = 0
   // Stream buffers queued in Aravis; 0 = enough for 64 MiB of frames (at least
   // 64, at most 1024). They hold frames the receiving thread has not taken yet.
   int num_buffers = 0;

@@ -263,8 +263,8 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
     TakeFrames(options, summary.plan, done, camera, &summary);
   } catch (const CameraStreamError& e) {
     // A write failure, if any, stays first (it came first or at the same time).
-    summary.stopped_because += (summary.stopped_because.empty() ? "" : "; then ") +
-                               std::string(e.what());
+    summary.stopped_because +=
+        (summary.stopped_because.empty() ? "" : "; then ") + std::string(e.what());
     if (e.camera_may_be_gone()) camera.Abandon();
   }
   camera.Stop();

@@ -38,8 +38,7 @@ bool FramePipeline::Push(FrameJob job) {
   const size_t bytes = job.frame.levels.size() * sizeof(uint16_t);
   std::unique_lock lock(queue_mutex_);
   queue_changed_.wait(lock, [&] {
-    return queue_.empty() || queued_bytes_ + bytes <= options_.queue_bytes || error_ ||
-           finishing_;
+    return queue_.empty() || queued_bytes_ + bytes <= options_.queue_bytes || error_ || finishing_;
   });
   if (error_ || finishing_) return false;
   queued_bytes_ += bytes;

@@ -46,8 +46,8 @@ struct FramePipelineOptions {
   // Memory for frames waiting for a writer (their levels), in bytes; one frame
   // is always let in, however large.
   size_t queue_bytes = size_t(256) << 20;
-  bool durable = true;                  // fsync each file and manifest line (see frame_writer.h)
-  FrameFileWriter write_file;           // empty: WriteFrame(path, frame, durable)
+  bool durable = true;         // fsync each file and manifest line (see frame_writer.h)
+  FrameFileWriter write_file;  // empty: WriteFrame(path, frame, durable)
 
   // InputError naming the flag (--writer-threads, --queue-mib) when out of
   // range.
