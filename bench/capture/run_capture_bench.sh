@@ -8,12 +8,13 @@
 # The peer runs before and after igi-capture (the load of a shared machine drifts); its rate is
 # the mean of the two, and igi-capture takes as many frames as the first peer run received.
 #
-# Usage: bench/capture/run_capture_bench.sh [BUILD_DIR] [SECONDS]
+# Usage: bench/capture/run_capture_bench.sh [BUILD_DIR] [SECONDS] [SIZES]   (SIZES: "512 256 128")
 # Prints a Markdown table with frames/s of both and the ratio igi-capture / peer.
 set -euo pipefail
 
 build_dir=${1:-build}
 seconds=${2:-5}
+sizes=${3:-512 256 128}
 capture="$(cd "$build_dir" && pwd)/bin/igi-capture"
 work=$(mktemp -d /tmp/igi_capture_bench.XXXXXX)
 
@@ -55,15 +56,17 @@ run_peer() {
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "| frame | peer frames/s (before, after) | peer lost | igi-capture frames/s | igi lost (gaps/underruns/failed) | igi exit | frames listed and on disk | ratio igi/peer |"
 echo "|---|---|---|---|---|---|---|---|"
-for size in 512 256 128; do
+for size in $sizes; do
   # The peer runs before and after igi-capture and the two are averaged: on a
   # shared machine the load drifts during a run.
   read -r peer_a lost_a < <(run_peer "$size")
   frames=$(awk -v f="$peer_a" -v s="$seconds" 'BEGIN {printf "%d", f * s}')
   start_fake
-  rm -rf "$work/out"
+  # A folder per size, all removed at the end: deleting thousands of files between runs would
+  # slow the next run's file creation (ext4 skips recently freed inodes).
+  out="$work/out_$size"
   set +e
-  "$capture" --camera 127.0.0.1 --out "$work/out" --exposures-us 10000 --frames "$frames" \
+  "$capture" --camera 127.0.0.1 --out "$out" --exposures-us 10000 --frames "$frames" \
     --frame-rate 1000 --width "$size" --height "$size" --pixel-format Mono8 --format tiff \
     --no-fsync --settle-frames 0 --quiet >"$work/igi.log" 2>&1
   code=$?
@@ -76,11 +79,11 @@ for size in 512 256 128; do
   underruns=$(grep -o '[0-9]* underruns' "$work/igi.log" | awk '{print $1}')
   failed=$(grep -o '[0-9]* failed,' "$work/igi.log" | awk '{print $1}')
   # Every manifest line names a file that is there, and there is one line per frame.
-  listed=$(wc -l <"$work/out/manifest.jsonl" 2>/dev/null || echo 0)
+  listed=$(wc -l <"$out/manifest.jsonl" 2>/dev/null || echo 0)
   on_disk=0
-  if [[ -f "$work/out/manifest.jsonl" ]]; then
-    on_disk=$(grep -o '"file":"[^"]*"' "$work/out/manifest.jsonl" | cut -d'"' -f4 |
-      while read -r f; do [[ -f "$work/out/$f" ]] && echo; done | wc -l)
+  if [[ -f "$out/manifest.jsonl" ]]; then
+    on_disk=$(grep -o '"file":"[^"]*"' "$out/manifest.jsonl" | cut -d'"' -f4 |
+      while read -r f; do [[ -f "$out/$f" ]] && echo; done | wc -l)
   fi
   ratio=$(awk -v a="${igi_fps:-0}" -v b="$peer_fps" 'BEGIN {printf "%.2f", a / b}')
   echo "| ${size}x${size} Mono8 | $peer_fps ($peer_a, $peer_b) | $((lost_a + lost_b)) | ${igi_fps:-?} | ${gaps:-?}/${underruns:-?}/${failed:-?} | $code | $listed/$on_disk of $frames | $ratio |"
