@@ -16,7 +16,10 @@ build_dir=${1:-build}
 seconds=${2:-5}
 sizes=${3:-512 256 128}
 capture="$(cd "$build_dir" && pwd)/bin/igi-capture"
-work=$(mktemp -d /tmp/igi_capture_bench.XXXXXX)
+# Where the frames go: IGI_BENCH_DIR (default /tmp). Choose the disk a capture would use; on
+# ext4 a folder where thousands of files were just deleted creates files about half as fast
+# (the allocator skips recently freed inodes for a few minutes).
+work=$(mktemp -d "${IGI_BENCH_DIR:-/tmp}/igi_capture_bench.XXXXXX")
 
 # A private network namespace keeps this run's fake camera away from anyone else's.
 if [[ -z "${IGI_BENCH_IN_NETNS:-}" ]] && unshare -rn true 2>/dev/null; then
@@ -53,7 +56,7 @@ run_peer() {
   awk -v n="${completed:-0}" -v s="$seconds" -v l="$lost" 'BEGIN {printf "%.1f %d\n", n / s, l}'
 }
 
-echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "frames written under $work; load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "| frame | peer frames/s (before, after) | peer lost | igi-capture frames/s | igi lost (gaps/underruns/failed) | igi exit | frames listed and on disk | ratio igi/peer |"
 echo "|---|---|---|---|---|---|---|---|"
 for size in $sizes; do
