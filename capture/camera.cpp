@@ -382,8 +382,16 @@ Frame Camera::NextFrame() {
                         : status == ARV_BUFFER_STATUS_TIMEOUT       ? "timed out"
                         : status == ARV_BUFFER_STATUS_SIZE_MISMATCH ? "had the wrong size"
                                                                     : "failed";
+      guint64 completed = 0, failures = 0, underruns = 0;
+      arv_stream_get_statistics(impl.stream, &completed, &failures, &underruns);
+      // Without a free buffer Aravis drops a frame's packets: the writers fell
+      // behind the camera and frames were lost on the way (reported as such).
+      const std::string cause =
+          underruns > 0 ? "; the stream ran out of buffers before (" + std::to_string(underruns) +
+                              " underruns): frames arrive faster than they are written"
+                        : "";
       throw CameraStreamError(impl.Name() + ": frame " + std::to_string(frame_id) + " " + why +
-                                  " (buffer status " + std::to_string(int(status)) + ")",
+                                  " (buffer status " + std::to_string(int(status)) + ")" + cause,
                               false);
     }
     if (arrived_ns < impl.changed_at_ns) {
