@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cstring>
 
 #include "tools/common/strings.h"
@@ -69,6 +68,24 @@ void OnStreamEvent(void* /*data*/, ArvStreamCallbackType type, ArvBuffer* /*buff
 }
 
 }  // namespace
+
+std::vector<uint16_t> Frame::Levels() const {
+  std::vector<uint16_t> levels(sample_count());
+  for (size_t i = 0; i < levels.size(); ++i) levels[i] = level(i);
+  return levels;
+}
+
+void Frame::SetLevels(const std::vector<uint16_t>& levels) {
+  data.resize(levels.size() * size_t(format.bytes_per_sample));
+  for (size_t i = 0; i < levels.size(); ++i) {
+    if (format.bytes_per_sample == 1) {
+      data[i] = static_cast<uint8_t>(levels[i]);
+    } else {
+      data[2 * i] = static_cast<uint8_t>(levels[i] & 0xff);
+      data[2 * i + 1] = static_cast<uint8_t>(levels[i] >> 8);
+    }
+  }
+}
 
 uint64_t HostTimeNs() { return static_cast<uint64_t>(g_get_real_time()) * 1000u; }
 
@@ -262,17 +279,7 @@ Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
                                 " " + format.name,
                             false);
   }
-  if (format.bytes_per_sample == 1) {
-    frame.levels.assign(data, data + samples);
-  } else if constexpr (std::endian::native == std::endian::little) {
-    frame.levels.resize(samples);
-    std::memcpy(frame.levels.data(), data, samples * 2);
-  } else {
-    frame.levels.resize(samples);
-    for (size_t i = 0; i < samples; ++i) {
-      frame.levels[i] = static_cast<uint16_t>(data[2 * i] | (data[2 * i + 1] << 8));
-    }
-  }
+  frame.data.assign(data, data + samples * size_t(format.bytes_per_sample));
   return frame;
 }
 

@@ -77,15 +77,28 @@ struct StreamStatistics {
   uint64_t resent_packets = 0;   // GigE: packets received after a resend request
 };
 
-// One frame as delivered, levels unscaled (0 … 2^significant_bits - 1).
+// One frame as delivered: the samples exactly as the camera sent them, so
+// receiving costs one copy and no conversion (levels are unscaled, 0 …
+// 2^significant_bits - 1).
 struct Frame {
   int width = 0;
   int height = 0;
   PixelFormatInfo format;
-  std::vector<uint16_t> levels;      // width * height * channels, interleaved, top row first
+  // width * height * channels samples, interleaved, top row first, of
+  // format.bytes_per_sample bytes each (2: little-endian).
+  std::vector<uint8_t> data;
   uint64_t frame_id = 0;             // the camera's block id
   uint64_t camera_timestamp_ns = 0;  // the camera's clock
   uint64_t system_timestamp_ns = 0;  // host clock at arrival, ns since the Unix epoch
+
+  size_t sample_count() const { return data.size() / size_t(format.bytes_per_sample); }
+  uint16_t level(size_t i) const {
+    return format.bytes_per_sample == 1 ? data[i]
+                                        : static_cast<uint16_t>(data[2 * i] | data[2 * i + 1] << 8);
+  }
+  std::vector<uint16_t> Levels() const;
+  // Stores `levels` in this frame's format (for frames made by hand).
+  void SetLevels(const std::vector<uint16_t>& levels);
 };
 
 class Camera {

@@ -35,7 +35,7 @@ FramePipeline::FramePipeline(FramePipelineOptions options, FrameListedCallback o
 FramePipeline::~FramePipeline() { Finish(); }
 
 bool FramePipeline::Push(FrameJob job) {
-  const size_t bytes = job.frame.levels.size() * sizeof(uint16_t);
+  const size_t bytes = job.frame.data.size();
   std::unique_lock lock(queue_mutex_);
   queue_changed_.wait(lock, [&] {
     return queue_.empty() || queued_bytes_ + bytes <= options_.queue_bytes || error_ || finishing_;

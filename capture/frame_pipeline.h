@@ -43,7 +43,7 @@ using FrameFileWriter = std::function<void(const std::filesystem::path& path, co
 struct FramePipelineOptions {
   std::filesystem::path manifest_path;  // DIR/manifest.jsonl
   int writer_threads = 2;               // files written at once
-  // Memory for frames waiting for a writer (their levels), in bytes; one frame
+  // Memory for frames waiting for a writer (their data), in bytes; one frame
   // is always let in, however large.
   size_t queue_bytes = size_t(256) << 20;
   bool durable = true;         // fsync each file and manifest line (see frame_writer.h)

@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <bit>
 #include <vector>
 
 #include "tools/common/atomic_file.h"
@@ -22,32 +23,40 @@ uint16_t WidenTo16Bits(uint16_t level, int significant_bits) {
 
 namespace {
 
-// The 16-bit samples to store: `frame.levels` itself when it already has 16
-// significant bits, else widened into a buffer reused by the calling thread
-// (no allocation per frame).
+// The 16-bit samples to store, in one pass over the camera's data into a
+// buffer reused by the calling thread (no allocation per frame); the data
+// itself when it is already 16-bit little-endian on a little-endian host.
 const uint16_t* WideSamples(const Frame& frame) {
   const int bits = frame.format.significant_bits;
-  if (bits >= 16) return frame.levels.data();
+  const size_t count = frame.sample_count();
+  const uint8_t* in = frame.data.data();
+  if (frame.format.bytes_per_sample == 2 && bits >= 16 &&
+      std::endian::native == std::endian::little) {
+    return reinterpret_cast<const uint16_t*>(in);  // operator new's alignment suffices
+  }
   thread_local std::vector<uint16_t> wide;
-  wide.resize(frame.levels.size());
-  const uint16_t* in = frame.levels.data();
-  const size_t count = frame.levels.size();
+  wide.resize(count);
   uint16_t* out = wide.data();
-  if (bits == 8) {
-    // v * 257 = v << 8 | v: one 16-bit multiply per sample (vectorised).
-    for (size_t i = 0; i < count; ++i) out[i] = static_cast<uint16_t>(in[i] * 257u);
-  } else if (bits > 8) {
+  if (frame.format.bytes_per_sample == 1) {
+    if (bits == 8) {
+      // v * 257 = v << 8 | v (vectorised).
+      for (size_t i = 0; i < count; ++i) out[i] = static_cast<uint16_t>(in[i] * 257u);
+    } else {
+      for (size_t i = 0; i < count; ++i) out[i] = WidenTo16Bits(in[i], bits);
+    }
+    return out;
+  }
+  for (size_t i = 0; i < count; ++i) out[i] = frame.level(i);
+  if (bits < 16) {
     // One copy of the top bits fills the low ones (same result as
-    // WidenTo16Bits).
+    // WidenTo16Bits when bits >= 8).
     const unsigned shift = 16u - unsigned(bits);
     const unsigned down = 2u * unsigned(bits) - 16u;
     for (size_t i = 0; i < count; ++i) {
-      out[i] = static_cast<uint16_t>(uint16_t(in[i] << shift) | uint16_t(in[i] >> down));
+      out[i] = static_cast<uint16_t>(uint16_t(out[i] << shift) | uint16_t(out[i] >> down));
     }
-  } else {
-    for (size_t i = 0; i < count; ++i) wide[i] = WidenTo16Bits(in[i], bits);
   }
-  return wide.data();
+  return out;
 }
 
 }  // namespace

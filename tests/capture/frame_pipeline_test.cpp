@@ -21,7 +21,7 @@ FrameJob MakeJob(const fs::path& dir, int index) {
   job.frame.width = 16;
   job.frame.height = 8;
   job.frame.format = *FindPixelFormat("Mono8");
-  job.frame.levels.assign(16 * 8, uint16_t(index % 256));
+  job.frame.data.assign(16 * 8, uint8_t(index % 256));
   job.frame.frame_id = uint64_t(index + 1);
   job.file = dir / "frames" / ("f" + std::to_string(index) + ".tif");
   job.entry.file = "frames/f" + std::to_string(index) + ".tif";
@@ -51,7 +51,7 @@ TEST(FramePipeline, ListsEveryFrameInPushOrderAfterItsFileIsInPlace) {
   options.writer_threads = 4;
   options.durable = false;
   options.write_file = [](const fs::path& path, const Frame& frame) {
-    const int index = frame.levels[0];
+    const int index = frame.data[0];
     std::this_thread::sleep_for(std::chrono::microseconds(200 * (kFrames - index) % 3000));
     WriteFrame(path, frame, /*durable=*/false);
   };
@@ -88,10 +88,10 @@ TEST(FramePipeline, AWriteFailureStopsThePipelineAndKeepsWhatWasWritten) {
   options.writer_threads = 2;
   options.durable = false;
   options.write_file = [](const fs::path& path, const Frame& frame) {
-    if (frame.levels[0] == 5) throw Error(path.string() + ": cannot write: disk full");
+    if (frame.data[0] == 5) throw Error(path.string() + ": cannot write: disk full");
     WriteFrame(path, frame, /*durable=*/false);
   };
-  options.queue_bytes = 4 * 16 * 8 * sizeof(uint16_t);  // four frames: Push soon waits
+  options.queue_bytes = 4 * 16 * 8;  // four frames: Push soon waits
   FramePipeline pipeline(options);
   int pushed = 0;
   for (int i = 0; i < 100000; ++i) {
@@ -143,7 +143,7 @@ TEST(FramePipeline, PushBlocksWhileTheQueueIsFull) {
   options.manifest_path = dir / "manifest.jsonl";
   options.writer_threads = 1;
   options.durable = false;
-  options.queue_bytes = 2 * 16 * 8 * sizeof(uint16_t);  // two frames
+  options.queue_bytes = 2 * 16 * 8;  // two frames
   options.write_file = [&](const fs::path& path, const Frame& frame) {
     while (!release.load()) std::this_thread::yield();
     WriteFrame(path, frame, /*durable=*/false);
