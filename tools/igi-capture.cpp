@@ -11,6 +11,7 @@
 // listed; --resume finishes the plan).
 
 #include <fmt/format.h>
+#include <malloc.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -76,6 +77,12 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
   if (!flags.format.empty()) options.file_format = flags.format;
   options.resume = flags.resume;
   options.stop_requested = &g_stop;
+  // Frames (up to a few MiB each) are allocated on reception and freed by the
+  // writers hundreds of times a second: keep them on the heap and the freed
+  // memory in the process, so that each frame does not map fresh pages (page
+  // faults and zeroing cost about as much as copying the frame).
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   const auto summary = igi::capture::RunCapture(options);
