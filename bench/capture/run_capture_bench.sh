@@ -16,10 +16,6 @@ build_dir=${1:-build}
 seconds=${2:-5}
 sizes=${3:-512 256 128}
 capture="$(cd "$build_dir" && pwd)/bin/igi-capture"
-# Where the frames go: IGI_BENCH_DIR (default /tmp). Choose the disk a capture would use; on
-# ext4 a folder where thousands of files were just deleted creates files about half as fast
-# (the allocator skips recently freed inodes for a few minutes).
-work=$(mktemp -d "${IGI_BENCH_DIR:-/tmp}/igi_capture_bench.XXXXXX")
 
 # A private network namespace keeps this run's fake camera away from anyone else's.
 if [[ -z "${IGI_BENCH_IN_NETNS:-}" ]] && unshare -rn true 2>/dev/null; then
@@ -27,6 +23,11 @@ if [[ -z "${IGI_BENCH_IN_NETNS:-}" ]] && unshare -rn true 2>/dev/null; then
   exec unshare -rn "$0" "$@"
 fi
 [[ -n "${IGI_BENCH_IN_NETNS:-}" ]] && ip link set lo up
+
+# Where the frames go: IGI_BENCH_DIR (default /tmp). Choose the disk a capture would use; on
+# ext4 a folder where thousands of files were just deleted creates files about half as fast
+# (the allocator skips recently freed inodes for a few minutes).
+work=$(mktemp -d "${IGI_BENCH_DIR:-/tmp}/igi_capture_bench.XXXXXX")
 
 fake_pid=""
 cleanup() {
