@@ -76,6 +76,7 @@ TEST(FramePipeline, ListsEveryFrameInPushOrderAfterItsFileIsInPlace) {
   for ([[maybe_unused]] const auto& item : fs::directory_iterator(dir / "frames")) ++files;
   EXPECT_EQ(files, kFrames);
   EXPECT_FALSE(pipeline.Push(MakeJob(dir, 99))) << "no frame after Finish";
+  fs::remove_all(dir);
 }
 
 // A frame that cannot be written stops the pipeline: it is never listed, what
@@ -115,6 +116,7 @@ TEST(FramePipeline, AWriteFailureStopsThePipelineAndKeepsWhatWasWritten) {
     EXPECT_TRUE(fs::exists(dir / "frames" / ("f" + std::to_string(listed[i]) + ".tif")));
   }
   EXPECT_FALSE(fs::exists(dir / "frames" / "f5.tif"));
+  fs::remove_all(dir);
 }
 
 // A manifest that cannot be appended to is a failure too (not a lost line).
@@ -130,6 +132,7 @@ TEST(FramePipeline, AManifestFailureIsReported) {
   pipeline.Finish();
   ASSERT_TRUE(pipeline.error());
   EXPECT_EQ(pipeline.frames_listed(), 0);
+  fs::remove_all(dir);
 }
 
 // With the writer stuck, Push blocks once the queue's memory is used up (the
@@ -164,6 +167,7 @@ TEST(FramePipeline, PushBlocksWhileTheQueueIsFull) {
   pipeline.Finish();
   EXPECT_EQ(pushed.load(), 6);
   EXPECT_EQ(ListedFrames(options.manifest_path), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  fs::remove_all(dir);
 }
 
 TEST(FramePipelineOptions, RejectsBadValues) {
