@@ -121,7 +121,7 @@ void AutoMeterOptions::Validate() const {
 }
 
 MeterReading ReadMeter(const Frame& frame, const AutoMeterOptions& options) {
-  std::vector<uint16_t> levels = frame.levels;
+  std::vector<uint16_t> levels = frame.Levels();
   MeterReading reading;
   if (levels.empty()) return reading;
   const double full_scale = double((1 << frame.format.significant_bits) - 1);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 
@@ -68,6 +69,24 @@ void OnStreamEvent(void* /*data*/, ArvStreamCallbackType type, ArvBuffer* /*buff
 
 }  // namespace
 
+std::vector<uint16_t> Frame::Levels() const {
+  std::vector<uint16_t> levels(sample_count());
+  for (size_t i = 0; i < levels.size(); ++i) levels[i] = level(i);
+  return levels;
+}
+
+void Frame::SetLevels(const std::vector<uint16_t>& levels) {
+  data.resize(levels.size() * size_t(format.bytes_per_sample));
+  for (size_t i = 0; i < levels.size(); ++i) {
+    if (format.bytes_per_sample == 1) {
+      data[i] = static_cast<uint8_t>(levels[i]);
+    } else {
+      data[2 * i] = static_cast<uint8_t>(levels[i] & 0xff);
+      data[2 * i + 1] = static_cast<uint8_t>(levels[i] >> 8);
+    }
+  }
+}
+
 uint64_t HostTimeNs() { return static_cast<uint64_t>(g_get_real_time()) * 1000u; }
 
 std::vector<CameraInfo> ListCameras() {
@@ -93,7 +112,9 @@ void CameraOptions::Validate() const {
     problems.Add("", "--frame-rate", FormatNumber(frame_rate_hz), "must be >= 0");
   if (width < 0) problems.Add("", "--width", std::to_string(width), "must be >= 0");
   if (height < 0) problems.Add("", "--height", std::to_string(height), "must be >= 0");
-  if (num_buffers < 2) problems.Add("", "--buffers", std::to_string(num_buffers), "must be >= 2");
+  if (num_buffers != 0 && num_buffers < 2) {
+    problems.Add("", "--buffers", std::to_string(num_buffers), "must be 0 (auto) or >= 2");
+  }
   if (frame_retention_ms < 10) {
     problems.Add("", "--frame-retention-ms", std::to_string(frame_retention_ms), "must be >= 10");
   }
@@ -227,9 +248,17 @@ void Camera::Impl::CreateStream() {
   }
   const guint payload = arv_camera_get_payload(camera, &error);
   Check(error, Name() + ": cannot read the payload size");
-  for (int i = 0; i < options.num_buffers; ++i) {
+  int buffers = options.num_buffers;
+  if (buffers == 0) {
+    constexpr size_t kAutoBufferBytes = size_t(64) << 20;
+    buffers = int(std::clamp<size_t>(kAutoBufferBytes / std::max<guint>(payload, 1), 64, 1024));
+  }
+  for (int i = 0; i < buffers; ++i) {
     arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
   }
+  spdlog::debug(
+      "{}: {} stream buffers of {} bytes, packets of {} bytes", Name(), buffers, payload,
+      arv_camera_is_gv_device(camera) ? arv_camera_gv_get_packet_size(camera, nullptr) : 0u);
 }
 
 Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
@@ -250,14 +279,7 @@ Frame Camera::Impl::CopyFrame(ArvBuffer* buffer) const {
                                 " " + format.name,
                             false);
   }
-  frame.levels.resize(samples);
-  if (format.bytes_per_sample == 1) {
-    for (size_t i = 0; i < samples; ++i) frame.levels[i] = data[i];
-  } else {
-    for (size_t i = 0; i < samples; ++i) {
-      frame.levels[i] = static_cast<uint16_t>(data[2 * i] | (data[2 * i + 1] << 8));
-    }
-  }
+  frame.data.assign(data, data + samples * size_t(format.bytes_per_sample));
   return frame;
 }
 
@@ -367,8 +389,16 @@ Frame Camera::NextFrame() {
                         : status == ARV_BUFFER_STATUS_TIMEOUT       ? "timed out"
                         : status == ARV_BUFFER_STATUS_SIZE_MISMATCH ? "had the wrong size"
                                                                     : "failed";
+      guint64 completed = 0, failures = 0, underruns = 0;
+      arv_stream_get_statistics(impl.stream, &completed, &failures, &underruns);
+      // Without a free buffer Aravis drops a frame's packets: the writers fell
+      // behind the camera and frames were lost on the way (reported as such).
+      const std::string cause =
+          underruns > 0 ? "; the stream ran out of buffers before (" + std::to_string(underruns) +
+                              " underruns): frames arrive faster than they are written"
+                        : "";
       throw CameraStreamError(impl.Name() + ": frame " + std::to_string(frame_id) + " " + why +
-                                  " (buffer status " + std::to_string(int(status)) + ")",
+                                  " (buffer status " + std::to_string(int(status)) + ")" + cause,
                               false);
     }
     if (arrived_ns < impl.changed_at_ns) {
@@ -391,6 +421,23 @@ Frame Camera::NextFrame() {
       throw;
     }
   }
+}
+
+StreamStatistics Camera::Statistics() const {
+  StreamStatistics statistics;
+  if (impl_->stream == nullptr) return statistics;
+  guint64 completed = 0, failures = 0, underruns = 0;
+  arv_stream_get_statistics(impl_->stream, &completed, &failures, &underruns);
+  statistics.completed = completed;
+  statistics.failures = failures;
+  statistics.underruns = underruns;
+  if (ARV_IS_GV_STREAM(impl_->stream)) {
+    guint64 resent = 0, missing = 0;
+    arv_gv_stream_get_statistics(ARV_GV_STREAM(impl_->stream), &resent, &missing);
+    statistics.resent_packets = resent;
+    statistics.missing_packets = missing;
+  }
+  return statistics;
 }
 
 }  // namespace igi::capture

@@ -52,12 +52,14 @@ struct CameraOptions {
   // cameras found by id are opened through their address (Aravis streams over
   // loopback only when opened so).
   std::string id_or_address;
-  std::string pixel_format;      // GenICam name; empty = keep the camera's current format
-  double gain = -1.0;            // camera gain units (dB on most cameras); < 0 = keep
-  double frame_rate_hz = 0.0;    // > 0 sets AcquisitionFrameRate; 0 = keep
-  int width = 0;                 // > 0 sets the region of interest width (pixels), from x = 0
-  int height = 0;                // > 0 sets the region height (pixels), from y = 0
-  int num_buffers = 64;          // stream buffers queued in Aravis (absorbs write bursts)
+  std::string pixel_format;    // GenICam name; empty = keep the camera's current format
+  double gain = -1.0;          // camera gain units (dB on most cameras); < 0 = keep
+  double frame_rate_hz = 0.0;  // > 0 sets AcquisitionFrameRate; 0 = keep
+  int width = 0;               // > 0 sets the region of interest width (pixels), from x = 0
+  int height = 0;              // > 0 sets the region height (pixels), from y = 0
+  // Stream buffers queued in Aravis; 0 = enough for 64 MiB of frames (at least
+  // 64, at most 1024). They hold frames the receiving thread has not taken yet.
+  int num_buffers = 0;
   int frame_timeout_ms = 3000;   // a frame later than this (+ exposure) ends the run
   bool packet_resend = true;     // GigE: ask the camera to resend lost packets
   int frame_retention_ms = 500;  // GigE: a frame still missing packets this long is lost
@@ -66,15 +68,37 @@ struct CameraOptions {
   void Validate() const;
 };
 
-// One frame as delivered, levels unscaled (0 … 2^significant_bits - 1).
+// The stream's own counts since the camera was opened (Aravis's statistics).
+struct StreamStatistics {
+  uint64_t completed = 0;        // frames received whole
+  uint64_t failures = 0;         // frames given up (missing packets, timeout)
+  uint64_t underruns = 0;        // frames dropped for want of a free buffer
+  uint64_t missing_packets = 0;  // GigE: packets never received
+  uint64_t resent_packets = 0;   // GigE: packets received after a resend request
+};
+
+// One frame as delivered: the samples exactly as the camera sent them, so
+// receiving costs one copy and no conversion (levels are unscaled, 0 …
+// 2^significant_bits - 1).
 struct Frame {
   int width = 0;
   int height = 0;
   PixelFormatInfo format;
-  std::vector<uint16_t> levels;      // width * height * channels, interleaved, top row first
+  // width * height * channels samples, interleaved, top row first, of
+  // format.bytes_per_sample bytes each (2: little-endian).
+  std::vector<uint8_t> data;
   uint64_t frame_id = 0;             // the camera's block id
   uint64_t camera_timestamp_ns = 0;  // the camera's clock
   uint64_t system_timestamp_ns = 0;  // host clock at arrival, ns since the Unix epoch
+
+  size_t sample_count() const { return data.size() / size_t(format.bytes_per_sample); }
+  uint16_t level(size_t i) const {
+    return format.bytes_per_sample == 1 ? data[i]
+                                        : static_cast<uint16_t>(data[2 * i] | data[2 * i + 1] << 8);
+  }
+  std::vector<uint16_t> Levels() const;
+  // Stores `levels` in this frame's format (for frames made by hand).
+  void SetLevels(const std::vector<uint16_t>& levels);
 };
 
 class Camera {
@@ -106,6 +130,7 @@ class Camera {
   void Abandon();
   // The next frame exposed at the current setting. Throws CameraStreamError.
   Frame NextFrame();
+  StreamStatistics Statistics() const;
 
  private:
   struct Impl;

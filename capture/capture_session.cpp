@@ -5,9 +5,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <set>
 
-#include "capture/frame_writer.h"
+#include "capture/frame_pipeline.h"
 #include "capture/manifest.h"
 #include "tools/common/error.h"
 #include "tools/common/progress.h"
@@ -134,13 +135,12 @@ bool StopRequested(const CaptureOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
 }
 
-// Takes every slot not in `done`, bracket by bracket. Returns normally when
-// finished or stopped; CameraStreamError escapes.
-void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
-                const std::set<PlanSlot>& done, Camera& camera, CaptureSummary* summary) {
-  const fs::path manifest = options.out_dir / kManifestFile;
-  Progress progress("capture", summary->frames_planned - summary->frames_already_done);
-  const auto start = std::chrono::steady_clock::now();
+// Receives every slot not in `done`, bracket by bracket, and hands each frame
+// to the writers. Returns normally when finished, stopped, or the writers
+// failed; CameraStreamError escapes.
+void ReceiveFrames(const CaptureOptions& options, const BracketPlan& plan,
+                   const std::set<PlanSlot>& done, Camera& camera, FramePipeline* pipeline,
+                   CaptureSummary* summary) {
   for (int bracket = 0; bracket < int(plan.exposures_us.size()); ++bracket) {
     std::vector<PlanSlot> todo;
     for (int frame = 0; frame < plan.frames; ++frame) {
@@ -154,19 +154,47 @@ void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
         summary->stopped_because = "stopped on request (signal)";
         return;
       }
-      const Frame frame = camera.NextFrame();
-      if (previous_id && frame.frame_id > *previous_id + 1) {
-        summary->frames_skipped += int64_t(frame.frame_id - *previous_id - 1);
+      FrameJob job;
+      job.frame = camera.NextFrame();
+      if (previous_id && job.frame.frame_id > *previous_id + 1) {
+        summary->frames_skipped += int64_t(job.frame.frame_id - *previous_id - 1);
       }
-      previous_id = frame.frame_id;
-      WriteFrame(options.out_dir / SlotFileName(plan, slot), frame, options.fsync_each_frame);
-      AppendManifest(manifest, MakeEntry(plan, slot, camera, frame), options.fsync_each_frame);
-      ++summary->frames_written;
-      summary->seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress.Add();
+      previous_id = job.frame.frame_id;
+      job.file = options.out_dir / SlotFileName(plan, slot);
+      job.entry = MakeEntry(plan, slot, camera, job.frame);
+      if (!pipeline->Push(std::move(job))) return;  // a write failed: see pipeline->error()
     }
   }
+}
+
+// Receives on this thread while the pipeline's threads write (see
+// frame_pipeline.h). Every frame received before a stream failure is written
+// and listed before the failure propagates.
+void TakeFrames(const CaptureOptions& options, const BracketPlan& plan,
+                const std::set<PlanSlot>& done, Camera& camera, CaptureSummary* summary) {
+  Progress progress("capture", summary->frames_planned - summary->frames_already_done);
+  FramePipelineOptions pipeline_options = options.writing;
+  pipeline_options.manifest_path = options.out_dir / kManifestFile;
+  pipeline_options.durable = options.fsync_each_frame;
+  FramePipeline pipeline(pipeline_options, [&](int) { progress.Add(); });
+  std::exception_ptr failure;
+  try {
+    ReceiveFrames(options, plan, done, camera, &pipeline, summary);
+    // Every frame is in hand: stop the camera now rather than after the
+    // writers finish, or its frames pile up meanwhile as underruns.
+    summary->stream = camera.Statistics();
+    camera.Stop();
+  } catch (...) {
+    failure = std::current_exception();
+    summary->stream = camera.Statistics();
+  }
+  pipeline.Finish();
+  summary->frames_written = pipeline.frames_listed();
+  summary->seconds = pipeline.seconds_to_last_listed();
+  if (const auto error = pipeline.error()) {
+    summary->stopped_because = "a frame could not be written: " + *error;
+  }
+  if (failure) std::rethrow_exception(failure);
   progress.Finish();
 }
 
@@ -189,6 +217,7 @@ void CaptureOptions::Validate() const {
     problems.Add("", "--format", *file_format, "must be png or tiff");
   }
   problems.ThrowIfAny();
+  writing.Validate();
   if (auto_expose) auto_meter.Validate();
   camera.Validate();
 }
@@ -233,7 +262,9 @@ CaptureSummary RunCapture(const CaptureOptions& options) {
     if (!stored) WritePlan(plan_path, summary.plan);
     TakeFrames(options, summary.plan, done, camera, &summary);
   } catch (const CameraStreamError& e) {
-    summary.stopped_because = e.what();
+    // A write failure, if any, stays first (it came first or at the same time).
+    summary.stopped_because +=
+        (summary.stopped_because.empty() ? "" : "; then ") + std::string(e.what());
     if (e.camera_may_be_gone()) camera.Abandon();
   }
   camera.Stop();

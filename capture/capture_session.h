@@ -7,6 +7,10 @@
 //   frames/…         one 16-bit PNG/TIFF per frame (see frame_writer.h)
 //   manifest.jsonl   one line per finished frame (see manifest.h)
 //
+// Frames are received on the calling thread and written on writer threads
+// (frame_pipeline.h), so writing never holds up reception; a frame that cannot
+// be written ends the run like a stream failure (partial, exit 3).
+//
 // Nothing lost: everything that can be checked is checked before the first file
 // is written (bad values: InputError, exit 2). A stream failure (timeout, lost
 // packets, disconnect) or a stop request ends the run early with the frames so
@@ -22,6 +26,7 @@
 #include "capture/auto_meter.h"
 #include "capture/bracket_plan.h"
 #include "capture/camera.h"
+#include "capture/frame_pipeline.h"
 
 namespace igi::capture {
 
@@ -42,6 +47,9 @@ struct CaptureOptions {
   // igi-capture or a pulled cable), flushed to disk together at the end of the
   // run.
   bool fsync_each_frame = true;
+  // Writer threads and the memory for frames waiting for them (manifest_path
+  // and durable are set by the run).
+  FramePipelineOptions writing;
   const std::atomic<bool>* stop_requested = nullptr;  // set by a signal handler: stop cleanly
 
   // InputError when the combination is unusable (both or neither of exposures
@@ -62,12 +70,14 @@ struct CaptureSummary {
   // measurement needs this to be 0.
   int64_t frames_skipped = 0;
   double seconds = 0.0;         // from the first frame requested to the last written
+  StreamStatistics stream;      // the camera stream's own counts (underruns, lost packets)
   bool complete = false;        // every planned frame is on disk and listed
   std::string stopped_because;  // why not complete
 };
 
-// Runs the capture; throws igi::Error only before anything is written (or when
-// the disk fails); stream failures end up in the summary.
+// Runs the capture; throws igi::Error only before the first frame (or when the
+// plan cannot be written); stream failures and frames that cannot be written
+// end up in the summary (not complete, stopped_because says why).
 CaptureSummary RunCapture(const CaptureOptions& options);
 
 }  // namespace igi::capture

@@ -2,6 +2,9 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <bit>
+#include <vector>
+
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 
@@ -18,12 +21,49 @@ uint16_t WidenTo16Bits(uint16_t level, int significant_bits) {
   return static_cast<uint16_t>(wide);
 }
 
+namespace {
+
+// The 16-bit samples to store, in one pass over the camera's data into a
+// buffer reused by the calling thread (no allocation per frame); the data
+// itself when it is already 16-bit little-endian on a little-endian host.
+const uint16_t* WideSamples(const Frame& frame) {
+  const int bits = frame.format.significant_bits;
+  const size_t count = frame.sample_count();
+  const uint8_t* in = frame.data.data();
+  if (frame.format.bytes_per_sample == 2 && bits >= 16 &&
+      std::endian::native == std::endian::little) {
+    return reinterpret_cast<const uint16_t*>(in);  // operator new's alignment suffices
+  }
+  thread_local std::vector<uint16_t> wide;
+  wide.resize(count);
+  uint16_t* out = wide.data();
+  if (frame.format.bytes_per_sample == 1) {
+    if (bits == 8) {
+      // v * 257 = v << 8 | v (vectorised).
+      for (size_t i = 0; i < count; ++i) out[i] = static_cast<uint16_t>(in[i] * 257u);
+    } else {
+      for (size_t i = 0; i < count; ++i) out[i] = WidenTo16Bits(in[i], bits);
+    }
+    return out;
+  }
+  for (size_t i = 0; i < count; ++i) out[i] = frame.level(i);
+  if (bits < 16) {
+    // One copy of the top bits fills the low ones (same result as
+    // WidenTo16Bits when bits >= 8).
+    const unsigned shift = 16u - unsigned(bits);
+    const unsigned down = 2u * unsigned(bits) - 16u;
+    for (size_t i = 0; i < count; ++i) {
+      out[i] = static_cast<uint16_t>(uint16_t(out[i] << shift) | uint16_t(out[i] >> down));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool durable) {
   const int channels = frame.format.channels;
-  std::vector<uint16_t> wide(frame.levels.size());
-  for (size_t i = 0; i < wide.size(); ++i) {
-    wide[i] = WidenTo16Bits(frame.levels[i], frame.format.significant_bits);
-  }
+  const uint16_t* samples = WideSamples(frame);
   AtomicOutput output(path);
   auto out = OIIO::ImageOutput::create(output.temp_path().string());
   if (!out) {
@@ -39,7 +79,7 @@ void WriteFrame(const std::filesystem::path& path, const Frame& frame, bool dura
   spec.attribute("igi:pixel_format", frame.format.name);
   spec.attribute("igi:significant_bits", frame.format.significant_bits);
   if (!out->open(output.temp_path().string(), spec) ||
-      !out->write_image(OIIO::TypeDesc::UINT16, wide.data()) || !out->close()) {
+      !out->write_image(OIIO::TypeDesc::UINT16, samples) || !out->close()) {
     throw Error(path.string() + ": cannot write: " + out->geterror());
   }
   if (durable) {

@@ -11,6 +11,7 @@
 // listed; --resume finishes the plan).
 
 #include <fmt/format.h>
+#include <malloc.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -76,6 +77,12 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
   if (!flags.format.empty()) options.file_format = flags.format;
   options.resume = flags.resume;
   options.stop_requested = &g_stop;
+  // Frames (up to a few MiB each) are allocated on reception and freed by the
+  // writers hundreds of times a second: keep them on the heap and the freed
+  // memory in the process, so that each frame does not map fresh pages (page
+  // faults and zeroing cost about as much as copying the frame).
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   const auto summary = igi::capture::RunCapture(options);
@@ -86,6 +93,16 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
       "skipped\n",
       summary.camera.id.c_str(), summary.frames_written, summary.frames_planned,
       summary.frames_already_done, fps, static_cast<long long>(summary.frames_skipped));
+  // Aravis's own counts: frames it dropped for want of a buffer (underruns) or
+  // gave up on (failures) are lost frames too.
+  std::printf(
+      "stream: %llu frames received, %llu failed, %llu underruns, %llu packets missing, "
+      "%llu resent\n",
+      static_cast<unsigned long long>(summary.stream.completed),
+      static_cast<unsigned long long>(summary.stream.failures),
+      static_cast<unsigned long long>(summary.stream.underruns),
+      static_cast<unsigned long long>(summary.stream.missing_packets),
+      static_cast<unsigned long long>(summary.stream.resent_packets));
   if (summary.meter) {
     std::printf("--auto: %zu exposures from %g to %g us; highlights %s, shadows %s\n",
                 summary.meter->exposures_us.size(), summary.meter->shortest_us,
@@ -152,7 +169,16 @@ int main(int argc, char** argv) {
                  "Region of interest width in pixels (default: keep)");
   app.add_option("--height", options.camera.height,
                  "Region of interest height in pixels (default: keep)");
-  app.add_option("--buffers", options.camera.num_buffers, "Stream buffers (default 64)");
+  app.add_option("--buffers", options.camera.num_buffers,
+                 "Camera stream buffers (default 0: 64 MiB worth, 64 to 1024)");
+  app.add_option("--writer-threads", options.writing.writer_threads,
+                 "Threads writing frame files while frames are received (default 2)")
+      ->check(CLI::Range(1, 64));
+  app.add_option_function<double>(
+         "--queue-mib",
+         [&](double mib) { options.writing.queue_bytes = size_t(mib * double(1 << 20)); },
+         "Memory for received frames waiting to be written, MiB (default 256)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--timeout-ms", options.camera.frame_timeout_ms,
                  "A frame later than this ends the run (default 3000)");
   app.add_option("--frame-retention-ms", options.camera.frame_retention_ms,

@@ -21,11 +21,13 @@ struct LinearScene {
     frame.width = samples;
     frame.height = 1;
     frame.format = {"Mono12", 1, 12, 2, false};
+    std::vector<uint16_t> levels;
     for (int i = 0; i < samples; ++i) {
       const double radiance = dark * std::pow(bright / dark, double(i) / (samples - 1));
       const double level = std::min(1.0, radiance * exposure_us);
-      frame.levels.push_back(uint16_t(std::lround(level * 4095)));
+      levels.push_back(uint16_t(std::lround(level * 4095)));
     }
+    frame.SetLevels(levels);
     return frame;
   }
 };
@@ -35,7 +37,9 @@ TEST(ReadMeter, ReadsPercentilesAsFractionsOfFullScale) {
   frame.width = 100;
   frame.height = 1;
   frame.format = {"Mono8", 1, 8, 1, false};
-  for (int i = 0; i < 100; ++i) frame.levels.push_back(uint16_t(i));
+  std::vector<uint16_t> levels;
+  for (int i = 0; i < 100; ++i) levels.push_back(uint16_t(i));
+  frame.SetLevels(levels);
   AutoMeterOptions options;
   options.highlight_percentile = 90;
   options.shadow_percentile = 10;

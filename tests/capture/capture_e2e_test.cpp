@@ -194,6 +194,41 @@ TEST_F(CaptureE2eTest, LostPacketsEndTheRunWithExit3) {
   EXPECT_NE(output.find("--resume"), std::string::npos) << output;
 }
 
+// A frame file that cannot be put in place (here a folder is in its way) ends
+// the run with exit 3: the frames written before it are intact and listed, it
+// is not, and --resume finishes the plan once the obstacle is gone.
+TEST_F(CaptureE2eTest, AFrameThatCannotBeWrittenEndsTheRunWithExit3AndResumes) {
+  StartCamera("IGIW1");
+  const fs::path blocker = out_ / "frames" / "b00_e000010000us_f003.png";
+  fs::create_directories(blocker / "in_the_way");
+  std::string output;
+  ASSERT_EQ(RunProcess(CaptureArgs({"--exposures-us", "10000", "--frames", "8"}), 20, &output), 3)
+      << output;
+  EXPECT_NE(output.find("could not be written"), std::string::npos) << output;
+  EXPECT_NE(output.find("--resume"), std::string::npos) << output;
+  std::vector<Json> lines = Manifest();
+  ASSERT_GE(lines.size(), 3u);
+  ASSERT_LT(lines.size(), 8u);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    SCOPED_TRACE(lines[i].dump());
+    if (i < 3) {
+      EXPECT_EQ(lines[i]["frame"], int(i));
+    }
+    EXPECT_NE(lines[i]["frame"], 3);
+    EXPECT_EQ(PatternMatch(out_, lines[i]), 1.0);
+  }
+  fs::remove_all(blocker);
+  ASSERT_EQ(RunProcess(CaptureArgs({"--resume"}), 20, &output), 0) << output;
+  lines = Manifest();
+  std::set<int> frames;
+  for (const Json& line : lines) {
+    frames.insert(line["frame"].get<int>());
+    EXPECT_EQ(PatternMatch(out_, line), 1.0) << line.dump();
+  }
+  EXPECT_EQ(lines.size(), 8u);
+  EXPECT_EQ(frames.size(), 8u);
+}
+
 TEST_F(CaptureE2eTest, ExistingCaptureIsNotOverwrittenWithoutResume) {
   StartCamera("IGIR1");
   std::string output;

@@ -29,9 +29,12 @@ Frame TestFrame(const PixelFormatInfo& format, int width, int height) {
   frame.height = height;
   frame.format = format;
   const int max_level = (1 << format.significant_bits) - 1;
+  std::vector<uint16_t> levels;
   for (int i = 0; i < width * height * format.channels; ++i) {
-    frame.levels.push_back(uint16_t((i * 7919) % (max_level + 1)));
+    levels.push_back(uint16_t((i * 7919) % (max_level + 1)));
   }
+  frame.SetLevels(levels);
+  EXPECT_EQ(frame.Levels(), levels);
   return frame;
 }
 
@@ -46,15 +49,17 @@ void ExpectRoundTrip(const Frame& frame, const std::string& extension) {
   ASSERT_EQ(image.height, frame.height);
   ASSERT_EQ(image.channels, frame.format.channels);
   const int shift = 16 - frame.format.significant_bits;
-  for (size_t i = 0; i < frame.levels.size(); ++i) {
+  for (size_t i = 0; i < frame.sample_count(); ++i) {
     const long stored = std::lround(image.pixels[i] * 65535.0);
-    ASSERT_EQ(stored >> shift, frame.levels[i]) << "sample " << i;
+    ASSERT_EQ(stored, WidenTo16Bits(frame.level(i), frame.format.significant_bits))
+        << "sample " << i;
+    ASSERT_EQ(stored >> shift, frame.level(i)) << "sample " << i;
   }
   std::filesystem::remove(path);
 }
 
 TEST(WriteFrame, PngAndTiffAreLosslessForEveryDepth) {
-  for (const char* name : {"Mono8", "Mono12", "Mono16", "RGB8", "BayerRG12"}) {
+  for (const char* name : {"Mono8", "Mono10", "Mono12", "Mono14", "Mono16", "RGB8", "BayerRG12"}) {
     SCOPED_TRACE(name);
     const Frame frame = TestFrame(*FindPixelFormat(name), 37, 11);
     ExpectRoundTrip(frame, ".png");
