@@ -172,7 +172,10 @@ RunSummary RunPipeline(const RunOptions& options) {
     if (!redo && marker && marker->fingerprint == hex) {
       spdlog::info("{}: kept (finished {}, inputs unchanged)", stage.name, marker->finished_utc);
       summary.stages.push_back({stage.name, "kept", 0});
-      if (marker->status == "partial") summary.partial = true;
+      if (marker->status == "partial") {
+        summary.partial = true;
+        summary.partial_lines.push_back(stage.name + ": kept; it finished partly (see its log.txt)");
+      }
       continue;
     }
     redo = true;  // every later stage is redone
