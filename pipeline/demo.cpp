@@ -133,7 +133,7 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json) 
   Json regions = Json::array();
   for (const auto& [name, t] : truth.items()) {
     if (!solved.contains(name)) continue;
-    Json r = {{"region", name}, {"brdf", t.value("brdf", "")}};
+    Json r = {{"region", name}, {"brdf", t.contains("brdf") ? t["brdf"] : Json("")}};
     for (const char* key : {"rho_d", "rho_s", "alpha"}) {
       if (!t.contains(key) || !solved[name].contains(key)) continue;
       const std::vector<double> tv = Rgb(t[key]), sv = Rgb(solved[name][key]);

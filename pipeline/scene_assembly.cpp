@@ -45,6 +45,14 @@ void TonemapForRegistration(const fs::path& radiance, const fs::path& png) {
 
 namespace {
 
+// `target` relative to the folder `base` (both made absolute first).
+std::string RelativeTo(const fs::path& target, const fs::path& base) {
+  std::error_code ec;
+  const fs::path abs = fs::weakly_canonical(fs::absolute(target), ec);
+  const fs::path rel = abs.lexically_relative(fs::weakly_canonical(fs::absolute(base), ec));
+  return rel.empty() ? abs.string() : rel.generic_string();
+}
+
 std::string Rebase(const std::string& path, const fs::path& from, const fs::path& to) {
   const fs::path p(path);
   if (p.is_absolute()) return path;
@@ -102,11 +110,11 @@ Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unre
       continue;
     }
     cameras[p.name] = registered[p.name];
-    Json photo = {{"file", Rebase((in.hdr_dir / (p.name + ".exr")).string(), ".", in.out_dir)},
+    Json photo = {{"file", RelativeTo(in.hdr_dir / (p.name + ".exr"), in.out_dir)},
                   {"camera", p.name},
                   {"lighting", p.lighting}};
     const fs::path mask = in.hdr_dir / (p.name + "_mask.png");
-    if (fs::exists(mask)) photo["mask"] = Rebase(mask.string(), ".", in.out_dir);
+    if (fs::exists(mask)) photo["mask"] = RelativeTo(mask, in.out_dir);
     photos.push_back(photo);
   }
   scene["cameras"] = cameras;

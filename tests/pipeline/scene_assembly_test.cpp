@@ -30,7 +30,13 @@ TEST(SceneAssemblyTest, RebasesPathsAndPairsPhotosWithCameras) {
   const Json cam = {{"model", "PINHOLE"}, {"width", 4}, {"height", 3},
                     {"params", {1, 1, 2, 1.5}}, {"qvec", {1, 0, 0, 0}}, {"tvec", {0, 0, 0}}};
   in.registered_scene = {{"cameras", {{"a_L0", cam}, {"b_L1", cam}}}};
-  in.photos = {{"a_L0", "L0"}, {"b_L1", "L1"}, {"c_L0", "L0"}};
+  for (const auto& [name, lighting] : std::vector<std::pair<std::string, std::string>>{
+           {"a_L0", "L0"}, {"b_L1", "L1"}, {"c_L0", "L0"}}) {
+    PhotoSource p;
+    p.name = name;
+    p.lighting = lighting;
+    in.photos.push_back(p);
+  }
   in.hdr_dir = dir / "run" / "02-hdr";
   in.out_dir = dir / "run" / "03-register";
   std::vector<std::string> unregistered;
