@@ -22,9 +22,9 @@ namespace igi {
 struct DemoOptions {
   std::filesystem::path out;
   std::filesystem::path bin_dir;  // empty = igi-run's folder
-  int cameras = 12;
-  int width = 320;
-  int height = 240;
+  int cameras = 16;  // 12 at 320x240 registered nothing (measured); 16 at 480x360 as in tests/recon
+  int width = 480;
+  int height = 360;
   int spp = 8;
   int brackets = 3;
   double stops = 2;

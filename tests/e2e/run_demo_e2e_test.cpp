@@ -46,8 +46,8 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   const fs::path dir = test::UniqueTempDir("igi_run_demo");
   const fs::path out = dir / "demo";
   const std::string args = "--demo --out " + Quote(out.string()) +
-                           " --skip-diagnose --threads 2 --demo-cameras 12 --demo-width 320"
-                           " --demo-height 240 --demo-spp 8";
+                           " --skip-diagnose --threads 2 --demo-cameras 16 --demo-width 480"
+                           " --demo-height 360 --demo-spp 8";
   auto t0 = std::chrono::steady_clock::now();
   auto r = RunTool("igi-run", args);
   std::printf("demo: %.0f s\n%s", Seconds(t0), r.out.c_str());
