@@ -63,7 +63,7 @@ TEST(RunE2eTest, BadLayoutExits2WithOneLinePerProblem) {
   EXPECT_NE(r.err.find("cam0_L7: lighting: cam0_L7: folder name must end in _LIGHTING"),
             std::string::npos)
       << r.err;
-  EXPECT_NE(r.err.find("exposures.txt: : 1 exposures: must list one per image (2)"),
+  EXPECT_NE(r.err.find("exposures.txt: 1 exposures: must list one per image (2)"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out));
