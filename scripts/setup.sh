@@ -11,6 +11,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libceres-dev libembree-dev libraw-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev
   colmap libgtest-dev libgmock-dev
+  chromium  # igi-run report test (headless)
 )
 
 SUDO=""

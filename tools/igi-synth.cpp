@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
   app.add_flag("--overwrite", o.overwrite, "Allow a non-empty --out folder");
   app.add_flag("--textured-walls", o.textured_walls,
                "Give every region a high-frequency albedo texture (for registration tests)");
+  app.add_flag("--unposed", o.unposed,
+               "scene.json without cameras and photos (poses to be recovered); truth keeps them");
   app.add_option("--cameras", o.cameras, "Number of cameras (first ones see the highlights)");
   app.add_option("--width", o.width, "Photo width, pixels");
   app.add_option("--height", o.height, "Photo height, pixels");

@@ -85,6 +85,9 @@ struct SynthOptions {
   // structure-from-motion finds features everywhere (registration tests). Off: only the floor
   // is textured.
   bool textured_walls = false;
+  // scene.json declares no "cameras" and no "photos" (an unposed capture: the poses must be
+  // recovered, e.g. by igi-register); truth/scene.json keeps the true cameras.
+  bool unposed = false;
 
   // Every problem as one InputError (flag name, value, rule).
   void Validate() const;

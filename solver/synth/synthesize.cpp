@@ -342,6 +342,10 @@ SynthSummary Synthesize(const SynthOptions& options) {
   for (size_t i = 0; i < validation.size(); ++i) pipeline.Validation(validation[i], int(i), &r);
 
   scenes.declared_scene["photos"] = r.photos;
+  if (options.unposed) {
+    scenes.declared_scene.erase("cameras");
+    scenes.declared_scene.erase("photos");
+  }
   WriteJsonFile(out / "scene.json", scenes.declared_scene);
   if (response) {
     const int levels = options.brackets.bits == 8 ? 256 : 65536;

@@ -1,0 +1,50 @@
+#pragma once
+// igi-run --demo: a synthetic capture (igi-synth: a textured room, LDR brackets through a gamma
+// response, unposed cameras) run through the whole chain, and the recovered parameters compared
+// with the truth (DIR/demo_summary.json).
+//
+// The capture's PHOTOS_DIR is DIR/00-capture/synth/brackets (one NAME_L0 folder per photo), with
+// camera.json (the true intrinsics, as igi-calib intrinsics would give) and markers.json (the
+// room's corners at their exact pixels, as a user would click them). HDR maps from a recovered
+// response are radiance up to one constant (Debevec–Malik's g has a free offset), so the
+// comparison states that constant k (median over regions of recovered/true ρd) and each
+// region's ρd and ρs errors after dividing by k; α does not depend on it.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "tools/common/json.h"
+
+namespace igi {
+
+struct DemoOptions {
+  std::filesystem::path out;
+  std::filesystem::path bin_dir;  // empty = igi-run's folder
+  int cameras = 16;  // 12 at 320x240 registered nothing (measured); 16 at 480x360 as in tests/recon
+  int width = 480;
+  int height = 360;
+  int spp = 8;
+  int brackets = 3;
+  double stops = 2;
+  bool skip_diagnose = false;
+  int num_threads = 0;
+  std::vector<std::string> solve_args = {"--refine-iterations", "0"};
+  int report_spp = 16;
+  void Validate() const;
+};
+
+struct DemoSummary {
+  RunSummary run;
+  Json summary;  // DIR/demo_summary.json
+  std::vector<std::string> table;  // lines: region, parameter, truth, recovered, error
+};
+
+DemoSummary RunDemo(const DemoOptions& options);
+
+// Compares a solved scene with truth.json: per region and parameter (see demo.h's note on k).
+Json CompareWithTruth(const std::filesystem::path& solved_scene,
+                      const std::filesystem::path& truth_json);
+
+}  // namespace igi

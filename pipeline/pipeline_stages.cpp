@@ -1,0 +1,114 @@
+// The stage bodies of igi-run (pipeline.h): response, HDR, registration, solve, diagnose.
+// The report stage is in run_report.cpp.
+#include <spdlog/spdlog.h>
+
+#include "pipeline/pipeline_internal.h"
+#include "pipeline/scene_assembly.h"
+#include "tools/common/error.h"
+#include "tools/common/image.h"
+
+namespace igi::pipeline_internal {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> Paths(const std::vector<fs::path>& files) {
+  std::vector<std::string> out;
+  for (const fs::path& f : files) out.push_back(f.string());
+  return out;
+}
+
+void Append(std::vector<std::string>* args, const std::vector<std::string>& more) {
+  args->insert(args->end(), more.begin(), more.end());
+}
+
+}  // namespace
+
+void ResponseStage(const Context& ctx, StageRun* run) {
+  const PhotoSource& p = ctx.layout.photos[ctx.layout.ResponseSource()];
+  std::vector<std::string> args = ThreadArgs(ctx);
+  args.push_back("response");
+  Append(&args, Paths(p.images));
+  if (!p.exposure_file.empty()) Append(&args, {"--exposure-file", p.exposure_file.string()});
+  Append(&args, {"--out", (run->dir() / "response.json").string()});
+  run->Tool("igi-calib", args);
+  run->details["bracket"] = p.name;
+  run->details["images"] = p.images.size();
+}
+
+void HdrStage(const Context& ctx, StageRun* run) {
+  const fs::path response = ctx.Dir("01-response") / "response.json";
+  Json photos = Json::array();
+  for (const PhotoSource& p : ctx.layout.photos) {
+    const fs::path out = run->dir() / (p.name + ".exr");
+    photos.push_back({{"name", p.name}, {"kind", KindName(p.kind)}, {"lighting", p.lighting}});
+    if (p.kind == PhotoSourceKind::kRadiance) {
+      WriteImageOptions wo;
+      wo.type = PixelType::kFloat;
+      WriteImage(out, ReadImage(p.images[0], 3), wo);
+      continue;
+    }
+    std::vector<std::string> args = ThreadArgs(ctx);
+    if (p.kind == PhotoSourceKind::kCapture) {
+      Append(&args, {"--manifest", p.manifest.string()});
+    } else {
+      Append(&args, Paths(p.images));
+      if (p.kind == PhotoSourceKind::kBracket) Append(&args, {"--response", response.string()});
+      if (!p.exposure_file.empty()) Append(&args, {"--exposure-file", p.exposure_file.string()});
+    }
+    Append(&args, {"--out", out.string()});
+    run->Tool("igi-hdr", args);
+  }
+  run->details["photos"] = photos;
+}
+
+void RegisterStage(const Context& ctx, StageRun* run) {
+  const fs::path images = run->dir() / "images";
+  for (const PhotoSource& p : ctx.layout.photos) {
+    TonemapForRegistration(ctx.Dir("02-hdr") / (p.name + ".exr"), images / (p.name + ".png"));
+  }
+  const fs::path out = run->dir() / "register";
+  std::vector<std::string> args = ThreadArgs(ctx);
+  Append(&args, {"--images", images.string(), "--scene", ctx.options.scene.string(), "--out",
+                 out.string()});
+  if (!ctx.layout.camera.empty()) Append(&args, {"--camera", ctx.layout.camera.string()});
+  if (!ctx.layout.markers.empty()) Append(&args, {"--markers", ctx.layout.markers.string()});
+  Append(&args, ctx.options.register_args);
+  run->Tool("igi-register", args, /*partial_ok=*/true);
+
+  SolvableSceneInputs in;
+  in.input_scene = ctx.scene_json;
+  in.input_dir = ctx.scene.dir;
+  in.registered_scene = ReadJsonFile(out / "scene.json");
+  in.photos = ctx.layout.photos;
+  in.hdr_dir = ctx.Dir("02-hdr");
+  in.out_dir = run->dir();
+  std::vector<std::string> unregistered;
+  const Json scene = SolvableScene(in, &unregistered);
+  if (scene["photos"].empty()) {
+    throw Error("stage 03-register failed: no photo registered (see " +
+                (out / "report.json").string() + ")");
+  }
+  WriteJsonFile(run->dir() / "scene.json", scene);
+  run->details["registered"] = scene["photos"].size();
+  run->details["unregistered"] = unregistered;
+}
+
+void SolveStage(const Context& ctx, StageRun* run) {
+  std::vector<std::string> args = {ctx.SolveInput().string(), "--out", run->dir().string()};
+  Append(&args, ThreadArgs(ctx));
+  Append(&args, ctx.options.solve_args);
+  run->Tool("igi-solve", args, /*partial_ok=*/true);
+}
+
+void DiagnoseStage(const Context& ctx, StageRun* run) {
+  std::vector<std::string> args = {(ctx.Dir("04-solve") / "scene.json").string(), "--out",
+                                   run->dir().string()};
+  Append(&args, ThreadArgs(ctx));
+  if (ctx.options.diagnose_spp > 0) {
+    Append(&args, {"--spp", std::to_string(ctx.options.diagnose_spp)});
+  }
+  run->Tool("igi-diagnose", args, /*partial_ok=*/true);
+}
+
+}  // namespace igi::pipeline_internal

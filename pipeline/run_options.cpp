@@ -1,0 +1,28 @@
+#include "pipeline/run_options.h"
+
+#include "tools/common/error.h"
+
+namespace igi {
+
+void RunOptions::Validate() const {
+  ProblemList problems;
+  if (scene.empty()) problems.Add("", "--scene", "", "is required");
+  if (out.empty()) problems.Add("", "--out", "", "is required");
+  if (photos_dir.empty() && !hdr_photos) {
+    problems.Add("", "PHOTOS_DIR", "", "is required (unless --hdr-photos)");
+  }
+  if (report_spp < 1) problems.Add("", "--report-spp", std::to_string(report_spp), "must be >= 1");
+  if (report_photos < 1) {
+    problems.Add("", "--report-photos", std::to_string(report_photos), "must be >= 1");
+  }
+  if (report_lightings < 1) {
+    problems.Add("", "--report-lightings", std::to_string(report_lightings), "must be >= 1");
+  }
+  if (diagnose_spp < 0) {
+    problems.Add("", "--diagnose-spp", std::to_string(diagnose_spp), "must be >= 0");
+  }
+  if (num_threads < 0) problems.Add("", "--threads", std::to_string(num_threads), "must be >= 0");
+  problems.ThrowIfAny();
+}
+
+}  // namespace igi

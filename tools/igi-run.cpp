@@ -1,0 +1,101 @@
+// igi-run: end to end from a folder of photos (CONTRACT.md §4).
+//   igi-run PHOTOS_DIR --scene scene.json --out DIR
+//   igi-run --hdr-photos --scene scene.json --out DIR     (photos and cameras in the scene)
+//   igi-run --demo --out DIR                              (a synthetic capture, then the chain)
+// Stages: response -> HDR -> registration -> solve -> diagnose -> report, each in DIR/NN-name/
+// with a marker; a rerun resumes from the first unfinished stage (pipeline/pipeline.h).
+#include <cstdio>
+
+#include "pipeline/demo.h"
+#include "pipeline/pipeline.h"
+#include "tools/common/cli.h"
+
+namespace {
+
+constexpr const char* kLayout = R"(
+PHOTOS_DIR layout (one sub-folder per photo):
+  PHOTOS_DIR/NAME_LIGHTING/   LIGHTING = a lighting of scene.json (suffix may be left out when
+                              the scene has one lighting); NAME_LIGHTING names the photo and
+                              its camera. It holds one of:
+      an LDR bracket          00.png 01.png ... (PNG/JPEG/TIFF) + exposures.txt (one time per
+                              line, file-name order; without it EXIF exposure times are read)
+      raw files               *.dng *.cr2 *.nef ... decoded linearly (no response needed)
+      one radiance map        *.exr or *.hdr, used as it is
+      a capture               manifest.jsonl of igi-capture (merged with igi-hdr --manifest)
+  PHOTOS_DIR/camera.json      optional known intrinsics (igi-calib intrinsics) for registration
+  PHOTOS_DIR/markers.json     optional control points (igi-markers) for registration
+Output: DIR/01-response 02-hdr 03-register 04-solve 05-diagnose 06-report, DIR/report.html.
+Exit codes: 0 ok, 1 a stage failed (named; finished stages kept), 2 bad input (nothing
+written), 3 partial (e.g. photos that did not register).)";
+
+void PrintSummary(const igi::RunSummary& s) {
+  for (const auto& st : s.stages) {
+    std::printf("  %-12s %-8s %6.1f s\n", st.stage.c_str(), st.status.c_str(), st.seconds);
+  }
+  std::printf("report: %s\nsolved scene: %s\n%.1f s\n", s.report.c_str(),
+              s.solved_scene.c_str(), s.seconds);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"igi-run: end to end from a folder of photos (response, HDR, registration, "
+               "solve, diagnose, report)",
+               "igi-run"};
+  app.footer(kLayout);
+  igi::CommonFlags flags;
+  igi::AddCommonFlags(app, &flags, /*computes=*/true);
+  igi::RunOptions o;
+  igi::DemoOptions demo;
+  bool run_demo = false;
+  std::string photos, scene, out, bin;
+  app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
+  app.add_option("--scene", scene, "scene.json: geometry, materials, lights, lightings");
+  app.add_option("--out", out, "Output folder (stages resume from it)")->required();
+  app.add_flag("--demo", run_demo, "Generate a synthetic capture (igi-synth) and run the chain");
+  app.add_flag("--hdr-photos", o.hdr_photos,
+               "Photos are radiance maps and the scene has cameras and photos: solve directly");
+  app.add_flag("--skip-diagnose", o.skip_diagnose, "Skip the diagnosis stage");
+  app.add_option("--solve-arg", o.solve_args, "Argument passed to igi-solve (repeatable)")
+      ->allow_extra_args(false);
+  app.add_option("--register-arg", o.register_args,
+                 "Argument passed to igi-register (repeatable)")
+      ->allow_extra_args(false);
+  app.add_option("--diagnose-spp", o.diagnose_spp, "igi-diagnose --spp (0 = its default)");
+  app.add_option("--report-spp", o.report_spp, "Samples per pixel of the report's renders")
+      ->capture_default_str();
+  app.add_option("--report-photos", o.report_photos, "Photos re-rendered in the report")
+      ->capture_default_str();
+  app.add_option("--report-lightings", o.report_lightings, "Lightings of the relit renders")
+      ->capture_default_str();
+  app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
+  app.add_option("--demo-cameras", demo.cameras, "--demo: cameras")->capture_default_str();
+  app.add_option("--demo-width", demo.width, "--demo: photo width")->capture_default_str();
+  app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
+  app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();
+  return igi::RunMain(app, flags, argc, argv, [&]() -> int {
+    o.photos_dir = photos;
+    o.scene = scene;
+    o.out = out;
+    o.bin_dir = bin;
+    o.num_threads = flags.threads;
+    igi::RunSummary summary;
+    if (run_demo) {
+      demo.out = out;
+      demo.bin_dir = bin;
+      demo.skip_diagnose = o.skip_diagnose;
+      demo.num_threads = flags.threads;
+      if (!o.solve_args.empty()) demo.solve_args = o.solve_args;
+      const igi::DemoSummary d = igi::RunDemo(demo);
+      summary = d.run;
+      PrintSummary(summary);
+      std::printf("recovered parameters beside the truth (%s/demo_summary.json):\n", out.c_str());
+      for (const std::string& line : d.table) std::printf("  %s\n", line.c_str());
+    } else {
+      summary = igi::RunPipeline(o);
+      PrintSummary(summary);
+    }
+    if (summary.partial) throw igi::PartialError(summary.partial_lines);
+    return 0;
+  });
+}
