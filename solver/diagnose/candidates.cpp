@@ -409,11 +409,12 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
       }
       b[0] = s;
     });
-    if (fit.coef.size() == 0 || !(fit.coef[0] > 0)) continue;
+    // A physical lobe only (0 < ρs < 1): a region no highlight reaches leaves the amplitude free.
+    if (fit.coef.size() == 0 || !(fit.coef[0] > 0) || !(fit.coef[0] < 1)) continue;
     if (best.coef.size() == 0 || fit.train_after < best.train_after) best = fit, best_alpha = alpha;
   }
   if (best.coef.size() == 0) {
-    out.note = "no positive lobe fits region " + name;
+    out.note = "no lobe with 0 < rho_s < 1 fits region " + name;
     return out;
   }
   Fill(best, &out);

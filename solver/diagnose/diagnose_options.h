@@ -17,7 +17,7 @@ struct DiagnoseOptions {
   // A step is kept when its held-out residual² falls by at least this share AND by at least
   // `min_z` standard errors (estimated over the held-out blocks).
   double min_gain = 0.02;
-  double min_z = 3.0;
+  double min_z = 2.5;
   // A candidate is refitted (the real test above) when its predicted held-out gain reaches
   // these; at most `max_tries` candidates per step, best predicted first.
   double candidate_min_gain = 0.01;

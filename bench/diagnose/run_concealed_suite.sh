@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# igi-diagnose on concealed data, full size (issue 8): one igi-synth capture per hidden effect (and
+# pairs, and controls), materials UNKNOWN (igi-diagnose solves them at every step), then a table
+# of what the first kept step named, the final residual against the noise floor (the true model's
+# residual at the same samples per pixel over the same pixels), and the time.
+#
+#   bench/diagnose/run_concealed_suite.sh [BUILD_DIR] [CASE...]
+#
+# A CASE is an effect name, several joined by '+', or "none" (a control). Default: every effect
+# igi-synth can hide, two pairs and two controls. Output: a Markdown table on stdout; the work
+# folders stay under ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
+set -euo pipefail
+BUILD="${1:-build}"
+shift || true
+BIN="$(cd "$BUILD/bin" && pwd)"
+WORK="${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}"
+SPP="${SPP:-256}"
+CASES=("$@")
+if [ ${#CASES[@]} -eq 0 ]; then
+  CASES=(vignetting exposure_scale camera_response ambient_light light_emission_profile
+         light_intensity specular_reflection specular_lobe_shape fresnel anisotropic_reflection
+         light_source_extent pose_error missing_geometry
+         vignetting+exposure_scale light_emission_profile+camera_response none none)
+fi
+mkdir -p "$WORK"
+
+floor_model() {  # capture folder -> truth/true_model.json (true lights/materials + photo effects)
+  python3 - "$1" <<'PY'
+import json, sys, os
+cap = sys.argv[1]
+t = json.load(open(os.path.join(cap, "truth", "scene.json")))
+d = json.load(open(os.path.join(cap, "scene.json")))
+truth = json.load(open(os.path.join(cap, "truth.json")))
+photos = d["photos"]
+for p in photos:
+    p["file"] = "../" + p["file"]
+for e in truth["effects"]:
+    n, q = e["effect"], e["params"]
+    if n == "vignetting":
+        for c in t["cameras"].values():
+            c["vignetting"] = {"k1": q["k1"], "k2": q["k2"]}
+    elif n == "exposure_scale":
+        for p in photos:
+            if p["file"] == "../" + q["photo"]:
+                p["exposure_scale"] = q["scale"]
+    elif n == "camera_response":
+        for p in photos:
+            p["response"] = {"exponent": q["exponent"], "reference": q["reference"]}
+    elif n == "pose_error":
+        pass  # truth/scene.json keeps the true poses
+t["photos"] = photos
+json.dump(t, open(os.path.join(cap, "truth", "true_model.json"), "w"), indent=1)
+PY
+}
+
+echo "| hidden | first kept step | all kept steps | baseline | final | floor | final/floor | seconds |"
+echo "|---|---|---|---|---|---|---|---|"
+i=0
+for case in "${CASES[@]}"; do
+  i=$((i + 1))
+  dir="$WORK/$i-$case"
+  rm -rf "$dir"
+  effects=()
+  if [ "$case" != none ]; then
+    IFS='+' read -ra names <<< "$case"
+    for n in "${names[@]}"; do effects+=(--effect "$n"); done
+  fi
+  "$BIN/igi-synth" --out "$dir/capture" --cameras 6 --width 160 --height 120 --spp 64 \
+      --lamp point --seed $((100 + i)) --quiet "${effects[@]}"
+  start=$(date +%s)
+  "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \
+      --holdout-block-px 8 --refine-iterations 0 --quiet || true
+  end=$(date +%s)
+  floor_model "$dir/capture"
+  "$BIN/igi-diagnose" "$dir/capture/truth/true_model.json" --out "$dir/floor" --spp "$SPP" \
+      --holdout-block-px 8 --max-steps 0 --quiet || true
+  python3 - "$dir" "$case" $((end - start)) <<'PY'
+import json, sys, os
+d, case, secs = sys.argv[1], sys.argv[2], sys.argv[3]
+try:
+    g = json.load(open(os.path.join(d, "diag", "diagnosis.json")))
+    f = json.load(open(os.path.join(d, "floor", "diagnosis.json")))["baseline"]["residual"]
+except Exception as e:
+    print(f"| {case} | (failed: {e}) | | | | | | {secs} |"); sys.exit(0)
+kept = [s["effect"] for s in g["steps"]]
+first = kept[0] if kept else "(none)"
+b, fin = g["baseline"]["residual"], g["final"]["residual"]
+print(f"| {case} | {first} | {', '.join(kept) or '-'} | {b:.4f} | {fin:.4f} | {f:.4f} | {fin / f:.2f} | {secs} |")
+PY
+done
