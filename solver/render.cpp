@@ -82,7 +82,7 @@ void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
                                    const BrdfParams& params, const Eigen::Vector3d& wo_local,
                                    Pcg32& rng) const {
   const int n = static_cast<int>(impl_.lights.size());
-  const int light = std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
+  const int light = n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
   const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
   const LightSample ls = impl_.SampleLight(light, p, u);
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
@@ -149,8 +149,17 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
       n_s = -n_s;
     }
     if (!(n_s.dot(wo) > 0)) n_s = n_geo;
-    const Frame frame =
-        m.tangent ? Frame::FromNormalTangent(n_s, *m.tangent) : Frame::FromNormal(n_s);
+    Frame frame;
+    if (m.tangent) {
+      frame = Frame::FromNormalTangent(n_s, *m.tangent);
+    } else if (ts.flat) {  // n_s = ±ts.normal: the precomputed frame, mirrored for the back
+      const bool back = n_geo.dot(ts.normal) < 0;
+      frame.t = ts.tangent;
+      frame.b = back ? Eigen::Vector3d(-ts.bitangent) : ts.bitangent;
+      frame.n = n_geo;
+    } else {
+      frame = Frame::FromNormal(n_s);
+    }
     BrdfParams params = m.params;
     if (m.rho_d_map && mesh.has_uvs()) {
       const Eigen::Vector2d uv =
@@ -161,7 +170,8 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
     SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng);
 
-    const double u_lobe = rng.UniformDouble();
+    // Lambert has one lobe: no number to pick it.
+    const double u_lobe = HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;
     const Eigen::Vector2d u_dir = rng.Uniform2D();
     const BrdfSample bs = SampleBrdf(params, wo_local, u_lobe, u_dir);
     if (!bs.Valid()) break;

@@ -108,6 +108,9 @@ std::vector<TriangleShading> TriangleRecords(const Renderer::Impl& impl) {
     r.normal = normals[t];
     r.material = mesh.triangle_region[t];
     r.emitter = impl.emitter_triangle_index[t];
+    const Frame frame = Frame::FromNormal(r.normal);
+    r.tangent = frame.t;
+    r.bitangent = frame.b;
     for (int k = 0; k < 3 && mesh.has_normals(); ++k) {
       const Eigen::Vector3d n = mesh.normals[mesh.triangles[t][k]].cast<double>();
       if (!((n - r.normal).cwiseAbs().maxCoeff() <= kFlatTolerance)) r.flat = false;
