@@ -42,6 +42,26 @@ struct PathState {
   uint64_t rays = 0;
 };
 
+// The uniform numbers SampleLight reads for a light of `type`: none for the delta lights, two for
+// a sphere (the cone's θ and φ), three otherwise (triangle, then a point on it).
+Eigen::Vector3d LightNumbers(LightType type, Pcg32& rng) {
+  switch (type) {
+    case LightType::kPoint:
+    case LightType::kSpot:
+    case LightType::kDirectional:
+      return Eigen::Vector3d::Zero();
+    case LightType::kSphere: {
+      const double u0 = rng.UniformDouble();
+      return {u0, rng.UniformDouble(), 0.0};
+    }
+    default: {
+      const double u0 = rng.UniformDouble();
+      const double u1 = rng.UniformDouble();
+      return {u0, u1, rng.UniformDouble()};
+    }
+  }
+}
+
 class PathTracer {
  public:
   PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
@@ -83,8 +103,7 @@ void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
                                    Pcg32& rng) const {
   const int n = static_cast<int>(impl_.lights.size());
   const int light = n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
-  const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
-  const LightSample ls = impl_.SampleLight(light, p, u);
+  const LightSample ls = impl_.SampleLight(light, p, LightNumbers(impl_.lights[light].type, rng));
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
   if (!(wi_local.z() > 0)) return;

@@ -218,7 +218,10 @@ RTCRay MakeRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max)
   ray.dir_y = float(d.y());
   ray.dir_z = float(d.z());
   ray.tnear = 0.0f;
-  ray.tfar = std::isfinite(t_max) ? float(t_max) : std::numeric_limits<float>::infinity();
+  // +infinity and NaN: the whole ray (a finite t_max beyond float's range rounds to +infinity).
+  ray.tfar = t_max < std::numeric_limits<double>::infinity()
+                 ? float(t_max)
+                 : std::numeric_limits<float>::infinity();
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;

@@ -146,36 +146,21 @@ inline void SinCosQuarterPi(double a, double* sin_a, double* cos_a) {
   *cos_a = 1.0 + a2 * c;
 }
 
-// sin(2πu) and cos(2πu) for u in [0, 1) (other u are wrapped into it).
+// sin(2πu) and cos(2πu) for u in [0, 1) (other u are wrapped into it). Without branches on u:
+// 2πu = θq + a with θq = qπ/2 + π/4 the middle of quadrant q and |a| <= π/4, then the angle
+// sum formulas with θq's tabulated sine and cosine (±√2/2).
 inline void SinCos2Pi(double u, double* sin_phi, double* cos_phi) {
   if (!(u >= 0.0 && u < 1.0)) u -= std::floor(u);
   const double t = 4.0 * u;                  // quarter turns, in [0, 4]: exact
-  const int quadrant = static_cast<int>(t);  // 0..3 (4 only if u rounded up to 1)
-  const double f = t - quadrant;             // fraction of the quarter turn: exact
+  const int quadrant = static_cast<int>(t);  // 0..3 (4 only if u rounded up to 1: same as 0)
   double s, c;
-  if (f <= 0.5) {
-    SinCosQuarterPi(f * (0.5 * kPi), &s, &c);
-  } else {  // angle = π/2 - g with g = (1 - f)π/2 <= π/4: swap sin and cos
-    SinCosQuarterPi((1.0 - f) * (0.5 * kPi), &c, &s);
-  }
-  switch (quadrant & 3) {  // rotate by quadrant · π/2
-    case 0:
-      *sin_phi = s;
-      *cos_phi = c;
-      return;
-    case 1:
-      *sin_phi = c;
-      *cos_phi = -s;
-      return;
-    case 2:
-      *sin_phi = -s;
-      *cos_phi = -c;
-      return;
-    default:
-      *sin_phi = -c;
-      *cos_phi = s;
-      return;
-  }
+  SinCosQuarterPi((t - quadrant - 0.5) * (0.5 * kPi), &s, &c);
+  constexpr double h = 0.70710678118654752440;  // √2/2
+  static constexpr double kCos[4] = {h, -h, -h, h};
+  static constexpr double kSin[4] = {h, h, -h, -h};
+  const double cq = kCos[quadrant & 3], sq = kSin[quadrant & 3];
+  *sin_phi = s * cq + c * sq;
+  *cos_phi = c * cq - s * sq;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -186,14 +171,14 @@ inline Eigen::Vector2d SampleUniformDiskConcentric(const Eigen::Vector2d& u) {
   const double x = 2.0 * u.x() - 1.0;
   const double y = 2.0 * u.y() - 1.0;
   if (x == 0.0 && y == 0.0) return Eigen::Vector2d::Zero();
-  // φ = π/4·(y/x), or π/2 − π/4·(x/y): sin and cos of an angle within π/4 of 0 or π/2.
+  // r = x and φ = a = π/4·(y/x), or r = y and φ = π/2 − a with a = π/4·(x/y), where
+  // cos φ = sin a and sin φ = cos a. |a| <= π/4 either way. (Selects, not branches: the
+  // choice is a coin toss per sample.)
+  const bool x_major = std::abs(x) > std::abs(y);
+  const double r = x_major ? x : y;
   double sin_a, cos_a;
-  if (std::abs(x) > std::abs(y)) {
-    SinCosQuarterPi(0.25 * kPi * (y / x), &sin_a, &cos_a);
-    return {x * cos_a, x * sin_a};
-  }
-  SinCosQuarterPi(0.25 * kPi * (x / y), &sin_a, &cos_a);
-  return {y * sin_a, y * cos_a};  // cos(π/2 − a) = sin a, sin(π/2 − a) = cos a
+  SinCosQuarterPi(0.25 * kPi * ((x_major ? y : x) / r), &sin_a, &cos_a);
+  return {r * (x_major ? cos_a : sin_a), r * (x_major ? sin_a : cos_a)};
 }
 
 // Local direction with density cosθ/π over the upper hemisphere (z >= 0).
