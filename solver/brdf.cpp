@@ -53,20 +53,16 @@ double SpecularLobeProbability(const BrdfParams& params) {
   return total > 0.0 ? specular / total : 0.0;
 }
 
-BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
-                        const Eigen::Vector3d& wi) {
+namespace brdf_internal {
+
+BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
+                              const Eigen::Vector3d& wi) {
   BrdfEval out;
   if (!(wo.z() > 0.0)) return out;
   const bool above = wi.z() > 0.0;
-  if (!HasSpecularLobe(params.model)) {  // lambert: no lobe choice, no half vector
-    if (above) out.f = params.rho_d * kInvPi;
-    out.pdf = CosineHemispherePdf(wi.z());
-    return out;
-  }
   const double p_specular = SpecularLobeProbability(params);
   if (above) out.f = params.rho_d * kInvPi;
   out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
-  if (!HasSpecularLobe(params.model)) return out;
 
   // Shared by f and pdf: the unnormalised half vector and the Gaussian of its slopes.
   const double ax = params.AlphaX();
@@ -90,12 +86,8 @@ BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
   return out;
 }
 
-double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
-  return EvalBrdfAndPdf(params, wo, wi).pdf;
-}
-
-BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
-                      const Eigen::Vector2d& u) {
+BrdfSample SampleGlossyBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
+                            const Eigen::Vector2d& u) {
   BrdfSample sample;
   if (!(wo.z() > 0.0)) return sample;
   if (u_lobe < SpecularLobeProbability(params)) {
@@ -103,28 +95,29 @@ BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, doubl
     // Slopes (h.x/h.z, h.y/h.z) ~ Gaussian with deviations αx/√2, αy/√2 (Box-Muller radius);
     // 1 - u.x() is in (0, 1], so the log is finite.
     const double radius = std::sqrt(-std::log(1.0 - u.x()));
-    const double phi = 2.0 * kPi * u.y();
-    const Eigen::Vector3d h = Eigen::Vector3d(params.AlphaX() * radius * std::cos(phi),
-                                              params.AlphaY() * radius * std::sin(phi), 1.0)
-                                  .normalized();
+    double sin_phi, cos_phi;
+    SinCos2Pi(u.y(), &sin_phi, &cos_phi);
+    const Eigen::Vector3d h =
+        Eigen::Vector3d(params.AlphaX() * radius * cos_phi, params.AlphaY() * radius * sin_phi, 1.0)
+            .normalized();
     const double wo_dot_h = wo.dot(h);
     if (!(wo_dot_h > 0.0)) return sample;  // wo would mirror to the back of h: a failed draw
     sample.wi = (2.0 * wo_dot_h * h - wo).normalized();
   } else {
     sample.lobe = BrdfLobe::kDiffuse;
     sample.wi = SampleCosineHemisphere(u);
-    if (!HasSpecularLobe(params.model)) {  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd
-      sample.f = params.rho_d * kInvPi;
-      sample.pdf = CosineHemispherePdf(sample.wi.z());
-      if (sample.Valid()) sample.weight = params.rho_d;
-      return sample;
-    }
   }
-  const BrdfEval eval = EvalBrdfAndPdf(params, wo, sample.wi);
+  const BrdfEval eval = EvalGlossyBrdfAndPdf(params, wo, sample.wi);
   sample.f = eval.f;
   sample.pdf = eval.pdf;
   if (sample.Valid()) sample.weight = sample.f * (sample.wi.z() / sample.pdf);
   return sample;
+}
+
+}  // namespace brdf_internal
+
+double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  return EvalBrdfAndPdf(params, wo, wi).pdf;
 }
 
 }  // namespace igi

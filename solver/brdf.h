@@ -157,22 +157,49 @@ struct BrdfSample {
 // and for an all-black material.
 double SpecularLobeProbability(const BrdfParams& params);
 
+// EvalBrdf and BrdfPdf in one call (shares the half vector): what light sampling with MIS needs.
+struct BrdfEval {
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();
+  double pdf = 0.0;
+};
+
+namespace brdf_internal {
+// SampleBrdf and EvalBrdfAndPdf of the models with a specular lobe (brdf.cpp).
+BrdfSample SampleGlossyBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
+                            const Eigen::Vector2d& u);
+BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
+                              const Eigen::Vector3d& wi);
+}  // namespace brdf_internal
+
 // Draws wi for `wo` (local, unit) from three uniform numbers in [0,1): u_lobe picks the lobe, u
-// the direction. wo at or below the surface gives an invalid sample.
-BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
-                      const Eigen::Vector2d& u);
+// the direction. wo at or below the surface gives an invalid sample. Lambert ignores u_lobe.
+inline BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
+                             const Eigen::Vector2d& u) {
+  if (HasSpecularLobe(params.model)) return brdf_internal::SampleGlossyBrdf(params, wo, u_lobe, u);
+  BrdfSample sample;  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd exactly
+  if (!(wo.z() > 0.0)) return sample;
+  sample.lobe = BrdfLobe::kDiffuse;
+  sample.wi = SampleCosineHemisphere(u);
+  sample.f = params.rho_d * kInvPi;
+  sample.pdf = CosineHemispherePdf(sample.wi.z());
+  if (sample.Valid()) sample.weight = params.rho_d;
+  return sample;
+}
 
 // The density (per steradian, over the whole sphere) with which SampleBrdf draws wi given wo.
 // Below the surface it is the true density of the draws that land there (their f is 0), so over
 // the sphere it integrates to 1 minus the probability of a failed draw; 0 when wo.z <= 0.
 double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
 
-// EvalBrdf and BrdfPdf in one call (shares the half vector): what light sampling with MIS needs.
-struct BrdfEval {
-  Eigen::Vector3d f = Eigen::Vector3d::Zero();
-  double pdf = 0.0;
-};
-BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
-                        const Eigen::Vector3d& wi);
+// EvalBrdf and BrdfPdf together (BrdfEval above).
+inline BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
+                               const Eigen::Vector3d& wi) {
+  if (HasSpecularLobe(params.model)) return brdf_internal::EvalGlossyBrdfAndPdf(params, wo, wi);
+  BrdfEval out;  // lambert: no lobe choice, no half vector
+  if (!(wo.z() > 0.0)) return out;
+  if (wi.z() > 0.0) out.f = params.rho_d * kInvPi;
+  out.pdf = CosineHemispherePdf(wi.z());
+  return out;
+}
 
 }  // namespace igi

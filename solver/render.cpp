@@ -42,6 +42,26 @@ struct PathState {
   uint64_t rays = 0;
 };
 
+// The uniform numbers SampleLight reads for a light of `type`: none for the delta lights, two for
+// a sphere (the cone's θ and φ), three otherwise (triangle, then a point on it).
+Eigen::Vector3d LightNumbers(LightType type, Pcg32& rng) {
+  switch (type) {
+    case LightType::kPoint:
+    case LightType::kSpot:
+    case LightType::kDirectional:
+      return Eigen::Vector3d::Zero();
+    case LightType::kSphere: {
+      const double u0 = rng.UniformDouble();
+      return {u0, rng.UniformDouble(), 0.0};
+    }
+    default: {
+      const double u0 = rng.UniformDouble();
+      const double u1 = rng.UniformDouble();
+      return {u0, u1, rng.UniformDouble()};
+    }
+  }
+}
+
 class PathTracer {
  public:
   PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
@@ -82,9 +102,8 @@ void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
                                    const BrdfParams& params, const Eigen::Vector3d& wo_local,
                                    Pcg32& rng) const {
   const int n = static_cast<int>(impl_.lights.size());
-  const int light = std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
-  const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
-  const LightSample ls = impl_.SampleLight(light, p, u);
+  const int light = n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
+  const LightSample ls = impl_.SampleLight(light, p, LightNumbers(impl_.lights[light].type, rng));
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
   if (!(wi_local.z() > 0)) return;
@@ -149,8 +168,17 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
       n_s = -n_s;
     }
     if (!(n_s.dot(wo) > 0)) n_s = n_geo;
-    const Frame frame =
-        m.tangent ? Frame::FromNormalTangent(n_s, *m.tangent) : Frame::FromNormal(n_s);
+    Frame frame;
+    if (m.tangent) {
+      frame = Frame::FromNormalTangent(n_s, *m.tangent);
+    } else if (ts.flat) {  // n_s = ±ts.normal: the precomputed frame, mirrored for the back
+      const bool back = n_geo.dot(ts.normal) < 0;
+      frame.t = ts.tangent;
+      frame.b = back ? Eigen::Vector3d(-ts.bitangent) : ts.bitangent;
+      frame.n = n_geo;
+    } else {
+      frame = Frame::FromNormal(n_s);
+    }
     BrdfParams params = m.params;
     if (m.rho_d_map && mesh.has_uvs()) {
       const Eigen::Vector2d uv =
@@ -161,7 +189,8 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
     SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng);
 
-    const double u_lobe = rng.UniformDouble();
+    // Lambert has one lobe: no number to pick it.
+    const double u_lobe = HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;
     const Eigen::Vector2d u_dir = rng.Uniform2D();
     const BrdfSample bs = SampleBrdf(params, wo_local, u_lobe, u_dir);
     if (!bs.Valid()) break;

@@ -64,6 +64,10 @@ struct TriangleShading {
   int material = 0;                                   // index into materials
   int emitter = -1;  // index in the emitter-material light's triangles, or -1
   bool flat = true;  // vertex normals all equal the face normal: no interpolation
+  // Frame::FromNormal(normal)'s t and b: the shading frame of a flat triangle seen from its
+  // front; (t, -b, -normal) from its back.
+  Eigen::Vector3d tangent = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d bitangent = Eigen::Vector3d::UnitY();
 };
 
 struct Renderer::Impl {

@@ -108,6 +108,9 @@ std::vector<TriangleShading> TriangleRecords(const Renderer::Impl& impl) {
     r.normal = normals[t];
     r.material = mesh.triangle_region[t];
     r.emitter = impl.emitter_triangle_index[t];
+    const Frame frame = Frame::FromNormal(r.normal);
+    r.tangent = frame.t;
+    r.bitangent = frame.b;
     for (int k = 0; k < 3 && mesh.has_normals(); ++k) {
       const Eigen::Vector3d n = mesh.normals[mesh.triangles[t][k]].cast<double>();
       if (!((n - r.normal).cwiseAbs().maxCoeff() <= kFlatTolerance)) r.flat = false;
@@ -215,7 +218,10 @@ RTCRay MakeRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max)
   ray.dir_y = float(d.y());
   ray.dir_z = float(d.z());
   ray.tnear = 0.0f;
-  ray.tfar = std::isfinite(t_max) ? float(t_max) : std::numeric_limits<float>::infinity();
+  // +infinity and NaN: the whole ray (a finite t_max beyond float's range rounds to +infinity).
+  ray.tfar = t_max < std::numeric_limits<double>::infinity()
+                 ? float(t_max)
+                 : std::numeric_limits<float>::infinity();
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;

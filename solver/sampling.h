@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -96,7 +97,16 @@ struct Frame {
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
 
   // Any frame with normal `n` (unit). Continuous except where n.z changes sign (Duff et al. 2017).
-  static Frame FromNormal(const Eigen::Vector3d& n);
+  static Frame FromNormal(const Eigen::Vector3d& n) {
+    const double sign = std::copysign(1.0, n.z());
+    const double a = -1.0 / (sign + n.z());
+    const double bxy = n.x() * n.y() * a;
+    Frame frame;
+    frame.n = n;
+    frame.t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * bxy, -sign * n.x());
+    frame.b = Eigen::Vector3d(bxy, sign + n.y() * n.y() * a, -n.y());  // = n × t
+    return frame;
+  }
   // The frame with normal `n` (unit) whose t is `tangent` made orthogonal to n and normalised;
   // a tangent (nearly) parallel to n, or zero, falls back to FromNormal(n).
   static Frame FromNormalTangent(const Eigen::Vector3d& n, const Eigen::Vector3d& tangent);
@@ -110,13 +120,72 @@ struct Frame {
 };
 
 // ---------------------------------------------------------------------------------------------
+// Sine and cosine for the warps, without libm's general argument reduction: every angle the
+// warps need is a known fraction of a turn, so the reduction to [-π/4, π/4] is exact and a short
+// polynomial gives sin and cos to within 2 ulp of the correctly rounded values (about 1e-16).
+
+// sin(a) and cos(a) for |a| <= π/4 (Taylor series to a^15 and a^16: remainder < 5e-17).
+inline void SinCosQuarterPi(double a, double* sin_a, double* cos_a) {
+  const double a2 = a * a;
+  double s = -1.0 / 1307674368000.0;  // -1/15!
+  s = s * a2 + 1.0 / 6227020800.0;
+  s = s * a2 - 1.0 / 39916800.0;
+  s = s * a2 + 1.0 / 362880.0;
+  s = s * a2 - 1.0 / 5040.0;
+  s = s * a2 + 1.0 / 120.0;
+  s = s * a2 - 1.0 / 6.0;
+  *sin_a = a + a * a2 * s;
+  double c = 1.0 / 20922789888000.0;  // 1/16!
+  c = c * a2 - 1.0 / 87178291200.0;
+  c = c * a2 + 1.0 / 479001600.0;
+  c = c * a2 - 1.0 / 3628800.0;
+  c = c * a2 + 1.0 / 40320.0;
+  c = c * a2 - 1.0 / 720.0;
+  c = c * a2 + 1.0 / 24.0;
+  c = c * a2 - 0.5;
+  *cos_a = 1.0 + a2 * c;
+}
+
+// sin(2πu) and cos(2πu) for u in [0, 1) (other u are wrapped into it). Without branches on u:
+// 2πu = θq + a with θq = qπ/2 + π/4 the middle of quadrant q and |a| <= π/4, then the angle
+// sum formulas with θq's tabulated sine and cosine (±√2/2).
+inline void SinCos2Pi(double u, double* sin_phi, double* cos_phi) {
+  if (!(u >= 0.0 && u < 1.0)) u -= std::floor(u);
+  const double t = 4.0 * u;                  // quarter turns, in [0, 4]: exact
+  const int quadrant = static_cast<int>(t);  // 0..3 (4 only if u rounded up to 1: same as 0)
+  double s, c;
+  SinCosQuarterPi((t - quadrant - 0.5) * (0.5 * kPi), &s, &c);
+  constexpr double h = 0.70710678118654752440;  // √2/2
+  static constexpr double kCos[4] = {h, -h, -h, h};
+  static constexpr double kSin[4] = {h, h, -h, -h};
+  const double cq = kCos[quadrant & 3], sq = kSin[quadrant & 3];
+  *sin_phi = s * cq + c * sq;
+  *cos_phi = c * cq - s * sq;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Warps. u is uniform in [0,1)^2.
 
 // Uniform point on the unit disk (Shirley-Chiu concentric map: low distortion).
-Eigen::Vector2d SampleUniformDiskConcentric(const Eigen::Vector2d& u);
+inline Eigen::Vector2d SampleUniformDiskConcentric(const Eigen::Vector2d& u) {
+  const double x = 2.0 * u.x() - 1.0;
+  const double y = 2.0 * u.y() - 1.0;
+  if (x == 0.0 && y == 0.0) return Eigen::Vector2d::Zero();
+  // r = x and φ = a = π/4·(y/x), or r = y and φ = π/2 − a with a = π/4·(x/y), where
+  // cos φ = sin a and sin φ = cos a. |a| <= π/4 either way. (Selects, not branches: the
+  // choice is a coin toss per sample.)
+  const bool x_major = std::abs(x) > std::abs(y);
+  const double r = x_major ? x : y;
+  double sin_a, cos_a;
+  SinCosQuarterPi(0.25 * kPi * ((x_major ? y : x) / r), &sin_a, &cos_a);
+  return {r * (x_major ? cos_a : sin_a), r * (x_major ? sin_a : cos_a)};
+}
 
 // Local direction with density cosθ/π over the upper hemisphere (z >= 0).
-Eigen::Vector3d SampleCosineHemisphere(const Eigen::Vector2d& u);
+inline Eigen::Vector3d SampleCosineHemisphere(const Eigen::Vector2d& u) {
+  const Eigen::Vector2d d = SampleUniformDiskConcentric(u);
+  return {d.x(), d.y(), std::sqrt(std::max(0.0, 1.0 - d.squaredNorm()))};
+}
 inline double CosineHemispherePdf(double cos_theta) {
   return cos_theta > 0.0 ? cos_theta * kInvPi : 0.0;
 }
@@ -149,8 +218,44 @@ struct SphereSample {
 };
 // From outside the sphere: uniform in the cone subtended, distance to the near surface. From on
 // or inside the sphere: uniform over all directions (pdf 1/(4π)), distance to the far surface.
-SphereSample SampleSphereFromPoint(const Eigen::Vector3d& point, const Eigen::Vector3d& center,
-                                   double radius, const Eigen::Vector2d& u);
+namespace sampling_internal {
+// The case of a point on or inside the sphere (sampling.cpp).
+SphereSample SampleSphereFromInside(const Eigen::Vector3d& point, const Eigen::Vector3d& center,
+                                    double radius, const Eigen::Vector2d& u);
+}  // namespace sampling_internal
+inline SphereSample SampleSphereFromPoint(const Eigen::Vector3d& point,
+                                          const Eigen::Vector3d& center, double radius,
+                                          const Eigen::Vector2d& u) {
+  const Eigen::Vector3d to_center = center - point;
+  const double dist2 = to_center.squaredNorm();
+  const double radius2 = radius * radius;
+  if (!(dist2 > radius2))
+    return sampling_internal::SampleSphereFromInside(point, center, radius, u);
+  // Cone of half-angle θmax with sin²θmax = r²/d²; 1 - cosθmax = sin²/(1 + cos) keeps precision
+  // for small or distant spheres.
+  const double dist = std::sqrt(dist2);
+  const double inv_dist = 1.0 / dist;
+  const double sin2_max = radius2 / dist2;
+  const double cos_max = std::sqrt(std::max(0.0, 1.0 - sin2_max));
+  const double one_minus_cos_max = sin2_max / (1.0 + cos_max);
+  // θ from the axis: 1 - cosθ uniform in [0, 1 - cosθmax]; φ uniform.
+  const double one_minus_cos = u.x() * one_minus_cos_max;
+  const double cos_theta = 1.0 - one_minus_cos;
+  const double sin2_theta = one_minus_cos * (2.0 - one_minus_cos);
+  const double sin_theta = std::sqrt(std::max(0.0, sin2_theta));
+  double sin_phi, cos_phi;
+  SinCos2Pi(u.y(), &sin_phi, &cos_phi);
+  const Frame frame = Frame::FromNormal(to_center * inv_dist);
+  SphereSample sample;
+  // Unit: an orthonormal frame and a unit local direction.
+  sample.direction =
+      frame.t * (sin_theta * cos_phi) + frame.b * (sin_theta * sin_phi) + frame.n * cos_theta;
+  // Near intersection: the ray passes the centre at dist·cosθ, at a distance dist·sinθ from it.
+  sample.distance =
+      std::max(0.0, dist * cos_theta - std::sqrt(std::max(0.0, radius2 - dist2 * sin2_theta)));
+  sample.pdf = 1.0 / (2.0 * kPi * one_minus_cos_max);
+  return sample;
+}
 // The density SampleSphereFromPoint gives `direction` (unit): 0 for directions missing the sphere.
 double SphereFromPointPdf(const Eigen::Vector3d& point, const Eigen::Vector3d& center,
                           double radius, const Eigen::Vector3d& direction);
