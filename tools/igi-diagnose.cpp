@@ -50,13 +50,7 @@ int main(int argc, char** argv) {
     o.num_threads = common.threads;
     o.show_progress = !common.quiet;
     o.Validate();
-    std::error_code ec;
-    const fs::path scene_dir = fs::absolute(fs::path(scene_path)).parent_path();
-    if (fs::exists(out_dir) && fs::equivalent(fs::path(out_dir), scene_dir, ec)) {
-      throw igi::InputError(igi::DescribeProblem("", "--out", out_dir,
-                                                 "must differ from the scene's folder (inputs "
-                                                 "are never modified)"));
-    }
+    igi::RejectOutputInSceneFolder(out_dir, scene_path);
     const igi::Scene scene = igi::LoadScene(scene_path);
     if (scene.photos.empty()) {
       throw igi::InputError(igi::DescribeProblem(scene.file.string(), "photos", "[]",

@@ -93,8 +93,12 @@ CandidateResult Vignetting(const CandidateContext& cx, const ResidualFitter& f) 
     b[1] = r.sim[c] * r.r2 * r.r2;
   });
   if (fit.coef.size() == 0) return out;
-  Fill(fit, &out);
   const double k1 = fit.coef[0], k2 = fit.coef[1];
+  if (!(std::abs(k1) <= 1) || !(std::abs(k2) <= 1) || !(1 + k1 + k2 >= 0.05)) {
+    out.note = fmt::format("the radial fit (k1 {:.3g}, k2 {:.3g}) is not a lens fall-off", k1, k2);
+    return out;
+  }
+  Fill(fit, &out);
   out.params = {{"k1", k1}, {"k2", k2}};
   out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "image"}};
   out.num_params = 2;
@@ -134,10 +138,17 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   };
   ResidualFit best;
   double best_e = 1;
+  // With the materials known the reference is free too: a scale of the powered values.
+  const int k = f.nuisance() ? 1 : 2;
+  auto basis_at = [&](double e) {
+    return [&, e](const PixelRecord& r, int c, double* b) {
+      const double m = model(r.sim[c], e);
+      b[0] = m - r.sim[c];
+      if (k == 2) b[1] = m;
+    };
+  };
   for (double e : {0.5, 0.6, 0.7, 0.8, 0.9, 1.1, 1.25, 1.4, 1.6, 1.8, 2.0}) {
-    const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-      b[0] = model(r.sim[c], e) - r.sim[c];
-    });
+    const ResidualFit fit = f.Fit(k, basis_at(e));
     if (fit.coef.size() && (best.coef.size() == 0 || fit.train_after < best.train_after)) {
       best = fit, best_e = e;
     }
@@ -147,22 +158,20 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   double lo = best_e * 0.85, hi = best_e * 1.15;
   for (int it = 0; it < 14; ++it) {
     const double m1 = lo + (hi - lo) * 0.382, m2 = lo + (hi - lo) * 0.618;
-    auto err = [&](double e) {
-      return f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-                b[0] = model(r.sim[c], e) - r.sim[c];
-              }).train_after;
-    };
+    auto err = [&](double e) { return f.Fit(k, basis_at(e)).train_after; };
     (err(m1) < err(m2) ? hi : lo) = (err(m1) < err(m2) ? m2 : m1);
   }
   const double e_grid = 0.5 * (lo + hi);
-  best = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-    b[0] = model(r.sim[c], e_grid) - r.sim[c];
-  });
+  best = f.Fit(k, basis_at(e_grid));
   if (best.coef.size() == 0) return out;
   Fill(best, &out);
-  // photo ≈ sim + c·(model_e − sim): for c near 1 the exponent is e; in general 1 + c(e − 1).
+  // photo ≈ sim + c·(model_e − sim) (+ s·model_e): for c near 1 the exponent is e; in general
+  // 1 + c(e − 1). The scale s moves the reference: (1 + s)·r·(u/r)^e = r'·(u/r')^e.
   const double e = 1 + best.coef[0] * (e_grid - 1);
-  out.params = {{"exponent", e}, {"reference", ref}};
+  const double scale = k == 2 ? 1 + best.coef[1] / std::max(1e-6, best.coef[0]) : 1.0;
+  const double reference =
+      k == 2 && scale > 0 && std::abs(e - 1) > 1e-3 ? ref * std::pow(scale, 1 / (1 - e)) : ref;
+  out.params = {{"exponent", e}, {"reference", reference}};
   out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "pixel value"}};
   out.num_params = 1;
   out.evidence = fmt::format(
@@ -170,11 +179,11 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
       "the model's value to the power {:.3f} (slope {:.3f} in log-log)",
       e, e);
   out.valid = true;
-  out.apply = [e, ref](Json* doc) {
+  out.apply = [e, reference](Json* doc) {
     for (Json& p : (*doc)["photos"]) {
       double old = 1;
       if (p.contains("response")) old = p["response"].value("exponent", 1.0);
-      p["response"] = {{"exponent", old * e}, {"reference", ref}};
+      p["response"] = {{"exponent", old * e}, {"reference", reference}};
     }
   };
   return out;
@@ -260,21 +269,30 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   }
   if (lit < 100) return out;
   // The direct light of `light` becomes D·cos^n(angle from the axis).
+  // The direct light becomes D·cos^n (a fixed change of amplitude 1, searched over the axis and
+  // n). The light this light sends after a bounce changes too: what is not its direct diffuse term
+  // gets a free scale (the albedos' nuisance covers it per region when they are solved).
   auto fit_at = [&](const Eigen::Vector3d& axis, double n) {
     const Eigen::Vector3f ax = axis.cast<float>();
-    return f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-      const LightTerm& t = terms[size_t(&r - recs.data())];
-      if (!t.lit) return;
-      const double cs = std::max(0.0f, t.from_light.dot(ax));
-      b[0] = double(t.diffuse[c]) * (std::pow(cs, n) - 1);
-    });
+    return f.Fit(
+        1,
+        [&](const PixelRecord& r, int c, double* b) {
+          const LightTerm& t = terms[size_t(&r - recs.data())];
+          b[0] = f.nuisance() ? 0.0 : double(r.sim[c]) - double(t.diffuse[c]);
+        },
+        [&](const PixelRecord& r, int c) {
+          const LightTerm& t = terms[size_t(&r - recs.data())];
+          if (!t.lit) return 0.0;
+          const double cs = std::max(0.0f, t.from_light.dot(ax));
+          return double(t.diffuse[c]) * (std::pow(cs, n) - 1);
+        });
   };
   ResidualFit best;
   double best_n = 1;
   Eigen::Vector3d best_axis = -Eigen::Vector3d::UnitZ();
   auto consider = [&](const Eigen::Vector3d& axis, double n) {
     const ResidualFit fit = fit_at(axis, n);
-    if (fit.coef.size() == 0 || !(fit.coef[0] > 0)) return false;
+    if (fit.coef.size() == 0) return false;
     if (best.coef.size() && fit.train_after >= best.train_after) return false;
     best = fit, best_axis = axis, best_n = n;
     return true;
@@ -287,7 +305,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     return out;
   }
   for (double step : {0.2, 0.08, 0.03}) {
-    for (int k = 0; k < 10; ++k) {
+    for (int round = 0; round < 10; ++round) {
       bool moved = false;
       for (int d = 0; d < 6; ++d) {
         Eigen::Vector3d axis = best_axis;
@@ -299,7 +317,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     }
   }
   Fill(best, &out);
-  const double n = best_n * best.coef[0];  // cos^(n·c) ≈ first order in the amplitude
+  const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity =
       l.type == LightType::kSphere ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))

@@ -114,30 +114,39 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps,
 // with the held-out blocks as independent units.
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
                                       const std::vector<Image>& after, const PixelHoldout& h) {
-  std::unordered_map<int64_t, double> gain;
+  // Per block: gain and error before; the significance uses the relative gain per block.
+  std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
   for (size_t i = 0; i < before.size(); ++i) {
     const Image& rec = photos.recorded[i];
     for (int y = 0; y < rec.height; ++y) {
       for (int x = 0; x < rec.width; ++x) {
         if (photos.valid[i].at(x, y, 0) < 0.5f || !h.HeldOut(int(i), x, y)) continue;
-        double g = 0;
+        double g = 0, e = 0;
         for (int c = 0; c < 3; ++c) {
           const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
           if (!std::isfinite(a) || !std::isfinite(b)) continue;
-          total_before += (b - p) * (b - p);
+          e += (b - p) * (b - p);
           g += (b - p) * (b - p) - (a - p) * (a - p);
         }
-        gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px] += g;
+        auto& acc = gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px];
+        acc.first += g;
+        acc.second += e;
+        total_before += e;
         total_gain += g;
       }
     }
   }
-  const double n = double(gain.size());
+  std::vector<double> relative;
+  for (const auto& [k, ge] : gain) {
+    if (ge.second > 0) relative.push_back(ge.first / ge.second);
+  }
+  const double n = double(relative.size());
   if (n < 2 || !(total_before > 0)) return {0, 0};
-  const double mean = total_gain / n;
-  double sq = 0;
-  for (const auto& [k, g] : gain) sq += (g - mean) * (g - mean);
+  double mean = 0, sq = 0;
+  for (double r : relative) mean += r;
+  mean /= n;
+  for (double r : relative) sq += (r - mean) * (r - mean);
   const double se = std::sqrt(sq / (n - 1) / n);
   return {total_gain / total_before, se > 0 ? mean / se : 0};
 }
@@ -260,29 +269,35 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                sum.baseline_held_out);
   std::vector<std::string> kept_effects, rejected;
   int attempt = 0;
-  // Refits with candidate `c` (its document change, and the albedo-map mode) and keeps it when
-  // the held-out residual improves significantly.
+  // Refits with candidate `c` (its document change, and the albedo-map mode) and tests the
+  // held-out residual; the step is recorded, not yet applied.
+  struct Trial {
+    DiagnosisStep step;
+    Json next;
+    ModelState state;
+    double gain = 0;
+  };
   auto try_step = [&](CandidateResult c, const std::string& next_maps) {
     spdlog::info("igi-diagnose: trying {} (predicted held-out gain {:.1f}%, z {:.1f})", c.effect,
                  100 * c.Gain(), c.z);
-    Json next = declared;
-    if (c.apply) c.apply(&next);
-    DiagnosisStep ds;
+    Trial t;
+    t.next = declared;
+    if (c.apply) c.apply(&t.next);
+    DiagnosisStep& ds = t.step;
     ds.residual_before = st.train.Relative();
     ds.held_out_before = st.held.Relative();
     ds.model_dir = out_dir / "steps" / fmt::format("{:02d}-{}", ++attempt, c.effect);
-    ModelState next_st;
     try {
-      next_st = FitModel(next, solve, next_maps, ds.model_dir, o, photos);
+      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, photos);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
-      sum.steps.push_back(std::move(ds));
-      return false;
+      return t;
     }
-    ds.residual_after = next_st.train.Relative();
-    ds.held_out_after = next_st.held.Relative();
-    const auto [gain, z] = HeldOutGain(photos, st.sims, next_st.sims, holdout);
+    ds.residual_after = t.state.train.Relative();
+    ds.held_out_after = t.state.held.Relative();
+    const auto [gain, z] = HeldOutGain(photos, st.sims, t.state.sims, holdout);
+    t.gain = gain;
     ds.z = z;
     ds.kept = gain >= o.min_gain && z >= o.min_z;
     ds.verdict = ds.kept ? fmt::format("kept: held-out residual² down {:.1f}% ({:.1f} standard "
@@ -290,14 +305,14 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                          : fmt::format("rejected: held-out residual² changed by {:.1f}% ({:.1f} "
                                        "standard errors): the model does not earn its {} "
                                        "parameter(s)", -100 * gain, z, c.num_params);
-    const size_t img = MostImprovedPhoto(photos, st.sims, next_st.sims);
+    const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
     ds.image_photo = scene.photos[img].file.filename().string();
     ds.residual_before_image = ResidualImage(photos, st.sims, img);
-    ds.residual_after_image = ResidualImage(photos, next_st.sims, img);
+    ds.residual_after_image = ResidualImage(photos, t.state.sims, img);
     spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
     if (c.effect == "albedo_texture" && ds.kept) {
       Json regions = Json::array();
-      for (const Material& m : next_st.model.materials) {
+      for (const Material& m : t.state.model.materials) {
         if (m.rho_d_map) regions.push_back(m.name);
       }
       c.params = {{"regions", regions}};
@@ -305,16 +320,30 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       c.evidence = "the residual follows position on the surfaces of " + regions.dump() +
                    " (the same texture in every photo that sees them): their albedo varies";
     }
-    const bool kept = ds.kept;
-    (kept ? kept_effects : rejected).push_back(c.effect);
     ds.candidate = std::move(c);
-    if (kept) {
-      declared = std::move(next);
-      st = std::move(next_st);
+    return t;
+  };
+  // Applies the best of `trials` that passed; records the others. Returns whether one was kept.
+  auto settle = [&](std::vector<Trial>& trials, const std::string& next_maps) {
+    int best = -1;
+    for (int i = 0; i < int(trials.size()); ++i) {
+      if (trials[i].step.kept && (best < 0 || trials[i].gain > trials[best].gain)) best = i;
+    }
+    for (int i = 0; i < int(trials.size()); ++i) {
+      DiagnosisStep& ds = trials[i].step;
+      if (ds.kept && i != best) {
+        ds.kept = false;
+        ds.verdict += fmt::format("; not applied: {} explained more", trials[best].step.candidate.effect);
+      }
+      (i == best ? kept_effects : rejected).push_back(ds.candidate.effect);
+    }
+    if (best >= 0) {
+      declared = std::move(trials[best].next);
+      st = std::move(trials[best].state);
       maps = next_maps;
     }
-    sum.steps.push_back(std::move(ds));
-    return kept;
+    for (Trial& t : trials) sum.steps.push_back(std::move(t.step));
+    return best >= 0;
   };
   for (int step = 0; step < o.max_steps; ++step) {
     std::vector<std::string> excluded = kept_effects;
@@ -331,17 +360,25 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::sort(ranked.begin(), ranked.end(), [](const CandidateResult* a, const CandidateResult* b) {
       return a->held_before - a->held_after > b->held_before - b->held_after;
     });
-    bool kept = false;
-    for (size_t k = 0; k < ranked.size() && int(k) < o.max_tries && !kept; ++k) {
-      kept = try_step(*ranked[k], maps);
+    // The two best predictions are both refitted and the better kept; a third is tried only
+    // when neither passes.
+    std::vector<Trial> trials;
+    for (size_t k = 0; k < ranked.size() && int(k) < o.max_tries; ++k) {
+      trials.push_back(try_step(*ranked[k], maps));
+      const bool any = std::any_of(trials.begin(), trials.end(),
+                                   [](const Trial& t) { return t.step.kept; });
+      if (trials.size() >= 2 && any) break;
     }
+    bool kept = settle(trials, maps);
     if (!kept && maps == "none") {
       CandidateResult texture;
       texture.effect = "albedo_texture";
       texture.valid = true;
       texture.num_params = -1;  // one albedo per texel of the regions that get a map
       texture.evidence = "albedo maps where the solver finds the albedo varies";
-      kept = try_step(texture, "auto");
+      std::vector<Trial> one;
+      one.push_back(try_step(texture, "auto"));
+      kept = settle(one, "auto");
       if (kept) rejected.clear();  // with free albedos the earlier verdicts may change
     }
     if (!kept) break;

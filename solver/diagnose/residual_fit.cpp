@@ -17,9 +17,11 @@ ResidualFitter::ResidualFitter(const std::vector<PixelRecord>& records, std::vec
 double ResidualFitter::NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
                                     const Eigen::VectorXd& coef) const {
   if (!nuisance_) return 0;
-  const int stride = 3 + 2 * k + k * k;
+  const int stride = Stride(k);
   const double* st = &stats[((cell * 3 + c) * 2 + 1) * stride];
   if (!(st[0] > 0)) return 0;
+  // Before the fit: the plain residual y0; after: y − coef·b.
+  if (coef.size() == 0) return st[stride - 2] / st[0];
   double sy = st[1];
   for (int a = 0; a < coef.size(); ++a) sy -= coef[a] * st[3 + a];
   return sy / st[0];
@@ -43,6 +45,7 @@ struct Projected {
   Eigen::MatrixXd bb;  // Σ b bᵀ − (Σ s b)(Σ s b)ᵀ / Σ s²
   Eigen::VectorXd by;  // Σ b y − (Σ s b)(Σ s y) / Σ s²
   double yy = 0;       // Σ y² − (Σ s y)² / Σ s²
+  double yy0 = 0;      // the same for y0 (no offset)
 };
 
 Projected Project(const double* st, int k, bool nuisance) {
@@ -50,11 +53,14 @@ Projected Project(const double* st, int k, bool nuisance) {
   p.bb = Eigen::Map<const Eigen::MatrixXd>(st + 3 + 2 * k, k, k);
   p.by = Eigen::Map<const Eigen::VectorXd>(st + 3 + k, k);
   p.yy = st[2];
+  const int stride = 5 + 2 * k + k * k;
+  p.yy0 = st[stride - 1];
   if (nuisance && st[0] > 0) {
     const Eigen::Map<const Eigen::VectorXd> sb(st + 3, k);
     p.bb -= sb * sb.transpose() / st[0];
     p.by -= sb * (st[1] / st[0]);
     p.yy -= st[1] * st[1] / st[0];
+    p.yy0 -= st[stride - 2] * st[stride - 2] / st[0];
   }
   return p;
 }
@@ -62,16 +68,18 @@ Projected Project(const double* st, int k, bool nuisance) {
 }  // namespace
 
 ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const {
-  const int stride = 3 + 2 * k + k * k;
+  const int stride = Stride(k);
   ResidualFit fit;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(k);
+  double train_offset = 0;  // projected Σ y² (with the offset) before the fit
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
       const Projected p = Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_);
       a += p.bb;
       g += p.by;
-      fit.train_before += p.yy;
+      fit.train_before += p.yy0;
+      train_offset += p.yy;
     }
   }
   const double ridge = 1e-9 * std::max(1e-300, a.diagonal().cwiseAbs().maxCoeff());
@@ -83,13 +91,13 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const
     fit.coef.resize(0);
     return fit;
   }
-  fit.train_after = fit.train_before - 2 * fit.coef.dot(g) + fit.coef.dot(a * fit.coef);
+  fit.train_after = train_offset - 2 * fit.coef.dot(g) + fit.coef.dot(a * fit.coef);
   // Held out: the same coefficients, the set's own nuisance.
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
       const double* st = &stats[((size_t(cell) * 3 + c) * 2 + 1) * stride];
       const Projected p = Project(st, k, nuisance_);
-      fit.held_before += p.yy;
+      fit.held_before += p.yy0;
       fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.bb * fit.coef));
     }
   }

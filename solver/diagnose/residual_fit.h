@@ -36,7 +36,13 @@ class ResidualFitter {
 
   // basis(record, channel, double* b) writes K values (b is zeroed before each call).
   template <class F>
-  ResidualFit Fit(int k, F basis) const;
+  ResidualFit Fit(int k, F basis) const {
+    return Fit(k, basis, [](const PixelRecord&, int) { return 0.0; });
+  }
+  // The same with a fixed change of the model, offset(record, channel), of amplitude 1 (the
+  // residual fitted is photo − sim − offset; "before" is still photo − sim).
+  template <class F, class G>
+  ResidualFit Fit(int k, F basis, G offset) const;
 
   const std::vector<PixelRecord>& records() const { return records_; }
   bool nuisance() const { return nuisance_; }
@@ -48,6 +54,7 @@ class ResidualFitter {
   double NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
                       const Eigen::VectorXd& coef) const;
   static double Z(const std::vector<double>& gains);
+  static int Stride(int k) { return 5 + 2 * k + k * k; }
 
   const std::vector<PixelRecord>& records_;
   std::vector<int> cell_;
@@ -62,11 +69,12 @@ std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>&
                              double cell_m, int* num_cells);
 
 // ------------------------------------------------------------------ implementation
-// Per (cell, channel, set) the statistics are laid out as:
-//   [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ.
-template <class F>
-ResidualFit ResidualFitter::Fit(int k, F basis) const {
-  const int stride = 3 + 2 * k + k * k;
+// Per (cell, channel, set) the statistics are laid out as (y = photo − sim − offset, y0 = photo −
+// sim): [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ,
+// then Σ s·y0 and Σ y0².
+template <class F, class G>
+ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
+  const int stride = Stride(k);
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
   std::vector<double> b(k);
   for (size_t i = 0; i < records_.size(); ++i) {
@@ -75,9 +83,10 @@ ResidualFit ResidualFitter::Fit(int k, F basis) const {
     for (int c = 0; c < 3; ++c) {
       std::fill(b.begin(), b.end(), 0.0);
       basis(r, c, b.data());
-      const double s = r.sim[c], y = double(r.recorded[c]) - s;
+      const double s = r.sim[c], y0 = double(r.recorded[c]) - s, y = y0 - offset(r, c);
       double* st = &stats[((size_t(cell_[i]) * 3 + c) * 2 + (r.held_out ? 1 : 0)) * stride];
       st[0] += s * s, st[1] += s * y, st[2] += y * y;
+      st[stride - 2] += s * y0, st[stride - 1] += y0 * y0;
       for (int a = 0; a < k; ++a) {
         st[3 + a] += s * b[a];
         st[3 + k + a] += b[a] * y;
@@ -88,25 +97,32 @@ ResidualFit ResidualFitter::Fit(int k, F basis) const {
   ResidualFit fit = Solve(k, stats);
   if (fit.coef.size() == 0) return fit;
   // Held-out gain per block (photo, block_px square) for its standard error.
-  std::unordered_map<int64_t, double> gains;
+  // Relative gain per block (gain / the block's error before), so that a few bright blocks
+  // cannot carry the significance on their own.
+  std::unordered_map<int64_t, std::pair<double, double>> gains;
   for (size_t i = 0; i < records_.size(); ++i) {
     const PixelRecord& r = records_[i];
     if (r.outlier || !r.held_out) continue;
-    double g = 0;
+    double g = 0, e = 0;
     for (int c = 0; c < 3; ++c) {
       std::fill(b.begin(), b.end(), 0.0);
       basis(r, c, b.data());
-      const double s = r.sim[c], y = double(r.recorded[c]) - s;
+      const double s = r.sim[c], y0 = double(r.recorded[c]) - s, y = y0 - offset(r, c);
       double cb = 0;
       for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
       const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd());
       const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef);
-      g += (y - a0 * s) * (y - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
+      g += (y0 - a0 * s) * (y0 - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
+      e += (y0 - a0 * s) * (y0 - a0 * s);
     }
-    gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_] += g;
+    auto& acc = gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_];
+    acc.first += g;
+    acc.second += e;
   }
   std::vector<double> list;
-  for (const auto& [key, g] : gains) list.push_back(g);
+  for (const auto& [key, ge] : gains) {
+    if (ge.second > 0) list.push_back(ge.first / ge.second);
+  }
   fit.z = Z(list);
   return fit;
 }

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include "tools/common/error.h"
 #include "tools/common/logging.h"
@@ -49,6 +50,17 @@ int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: internal: %s\n", program.c_str(), e.what());
     return static_cast<int>(ExitCode::kFailed);
+  }
+}
+
+void RejectOutputInSceneFolder(const std::string& out_dir, const std::string& scene_path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path scene_dir = fs::absolute(fs::path(scene_path)).parent_path();
+  if (fs::exists(out_dir) && fs::equivalent(fs::path(out_dir), scene_dir, ec)) {
+    throw InputError(DescribeProblem("", "--out", out_dir,
+                                     "must differ from the scene's folder (inputs are never "
+                                     "modified)"));
   }
 }
 

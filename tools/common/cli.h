@@ -27,4 +27,8 @@ void AddCommonFlags(CLI::App& app, CommonFlags* flags, bool computes = true);
 int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
             const std::function<int()>& body);
 
+// Throws InputError ("--out: DIR: must differ from the scene's folder") when `out_dir` is the
+// folder of `scene_path`: a tool never writes into its input scene's folder.
+void RejectOutputInSceneFolder(const std::string& out_dir, const std::string& scene_path);
+
 }  // namespace igi
