@@ -169,8 +169,11 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   // 1 + c(e − 1). The scale s moves the reference: (1 + s)·r·(u/r)^e = r'·(u/r')^e.
   const double e = 1 + best.coef[0] * (e_grid - 1);
   const double scale = k == 2 ? 1 + best.coef[1] / std::max(1e-6, best.coef[0]) : 1.0;
-  const double reference =
+  double reference =
       k == 2 && scale > 0 && std::abs(e - 1) > 1e-3 ? ref * std::pow(scale, 1 / (1 - e)) : ref;
+  if (!std::isfinite(reference) || !(reference > 1e-3 * ref) || !(reference < 1e3 * ref)) {
+    reference = ref;  // an exponent near 1 leaves the reference undetermined
+  }
   out.params = {{"exponent", e}, {"reference", reference}};
   out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "pixel value"}};
   out.num_params = 1;
@@ -455,7 +458,79 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   return out;
 }
 
+// Ward-GMD's colourless specular factor (CONTRACT.md §2), h = l + v unnormalised.
+double GmdLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,
+               double alpha) {
+  if (!(n.dot(wi) > 0) || !(n.dot(wo) > 0)) return 0;
+  const Eigen::Vector3f h = wi + wo;
+  const double hn = n.dot(h), hh = h.squaredNorm();
+  if (!(hn > 0)) return 0;
+  const double tan2 = (hh - hn * hn) / (hn * hn);
+  return hh / (kPi * alpha * alpha * hn * hn * hn * hn) * std::exp(-tan2 / (alpha * alpha));
+}
+
+// Schlick's weight of the *_fresnel models over their plain ones at ior 1.5.
+double FresnelWeight(const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {
+  const double c = std::min(1.0, double((wi + wo).norm()) / 2), f0 = 0.04;
+  return 1 + (1 / f0 - 1) * std::pow(1 - c, 5);
+}
+
+// specular_lobe_shape (ward <-> ward_gmd) and fresnel (plain -> *_fresnel) on a glossy region:
+// the change of its specular term, ρs·(S_alt − S)·E, fitted with a free amplitude.
+CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
+                           bool fresnel) {
+  CandidateResult out;
+  out.effect = fresnel ? "fresnel" : "specular_lobe_shape";
+  const Material& m = cx.model.materials[region];
+  const bool gmd = m.brdf == BrdfModel::kWardGmd;
+  if (!(m.brdf == BrdfModel::kWard || gmd) || !m.rho_s || !m.alpha) return out;
+  const double rho_s = m.rho_s->mean(), alpha = *m.alpha;
+  if (!(rho_s > 0)) return out;
+  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    if (r.region != region) return;
+    double d = 0;
+    for (const RecordLightSample& ls : r.lights) {
+      const double plain = gmd ? GmdLobe(r.normal, ls.wi, r.view, alpha)
+                               : WardLobe(r.normal, ls.wi, r.view, alpha);
+      const double alt = fresnel ? plain * FresnelWeight(ls.wi, r.view)
+                                 : (gmd ? WardLobe(r.normal, ls.wi, r.view, alpha)
+                                        : GmdLobe(r.normal, ls.wi, r.view, alpha));
+      d += rho_s * (alt - plain) * ls.irradiance[c];
+    }
+    b[0] = d;
+  });
+  if (fit.coef.size() == 0 || !(fit.coef[0] > 0.3) || !(fit.coef[0] < 3)) {
+    out.note = "the alternative lobe does not fit region " + m.name;
+    return out;
+  }
+  Fill(fit, &out);
+  const std::string to = fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel"
+                                 : (gmd ? "ward" : "ward_gmd");
+  out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)}, {"to", to},
+                {"amplitude", fit.coef[0]}};
+  out.where = {{"regions", {m.name}}, {"frame", fresnel ? "grazing angle" : "half-vector angle"}};
+  out.num_params = 0;
+  out.evidence = fresnel
+      ? fmt::format("region '{}': the photos' highlights grow toward grazing angles faster than "
+                    "the {} lobe; Schlick's Fresnel weight explains it (amplitude {:.2f})",
+                    m.name, BrdfModelName(m.brdf), fit.coef[0])
+      : fmt::format("region '{}': the highlight's fall-off away from its peak follows {} rather "
+                    "than {} (amplitude {:.2f} of the difference)",
+                    m.name, to, BrdfModelName(m.brdf), fit.coef[0]);
+  out.valid = true;
+  const std::string name = m.name;
+  out.apply = [name, to](Json* doc) { (*doc)["materials"][name]["brdf"] = to; };
+  return out;
+}
+
 }  // namespace
+
+std::string CandidateResult::Key() const {
+  for (const char* k : {"region", "light"}) {
+    if (params.contains(k) && params[k].is_string()) return effect + ":" + params[k].get<std::string>();
+  }
+  return effect;
+}
 
 std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
                                                 const std::vector<PixelRecord>& records,
@@ -479,6 +554,16 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
     if (point_like && allowed("light_emission_profile")) out.push_back(EmissionProfile(cx, f, l));
     if (light.type != LightType::kAmbient && allowed("light_intensity")) {
       out.push_back(LightIntensity(cx, f, l));
+    }
+  }
+  for (int g = 0; g < int(cx.model.materials.size()); ++g) {
+    if (allowed("specular_lobe_shape")) {
+      CandidateResult c = LobeChange(cx, f, g, false);
+      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
+    }
+    if (allowed("fresnel")) {
+      CandidateResult c = LobeChange(cx, f, g, true);
+      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
     }
   }
   if (allowed("specular_reflection")) {

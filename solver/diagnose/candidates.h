@@ -42,6 +42,9 @@ struct CandidateResult {
   std::function<void(Json* declared)> apply;
 
   double Gain() const { return held_before > 0 ? 1 - held_after / held_before : 0; }
+  // The effect and what it applies to ("specular_lobe_shape:glossy_box"): a step is taken once
+  // per key.
+  std::string Key() const;
 };
 
 // Every candidate that applies to this scene, fitted on `records`.

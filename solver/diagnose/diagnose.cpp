@@ -139,7 +139,8 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   }
   std::vector<double> relative;
   for (const auto& [k, ge] : gain) {
-    if (ge.second > 0) relative.push_back(ge.first / ge.second);
+    // Blocks the step left exactly as they were (same seed, same model there) do not count.
+    if (ge.second > 0 && ge.first != 0) relative.push_back(ge.first / ge.second);
   }
   const double n = double(relative.size());
   if (n < 2 || !(total_before > 0)) return {0, 0};
@@ -335,7 +336,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
         ds.kept = false;
         ds.verdict += fmt::format("; not applied: {} explained more", trials[best].step.candidate.effect);
       }
-      (i == best ? kept_effects : rejected).push_back(ds.candidate.effect);
+      (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }
     if (best >= 0) {
       declared = std::move(trials[best].next);
@@ -349,10 +350,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::vector<std::string> excluded = kept_effects;
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
-    std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
+    std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, {});
     sum.last_candidates = cands;
     std::vector<CandidateResult*> ranked;
     for (CandidateResult& c : cands) {
+      if (std::find(excluded.begin(), excluded.end(), c.Key()) != excluded.end()) continue;
       if (c.valid && c.Gain() >= o.candidate_min_gain && c.z >= o.candidate_min_z) {
         ranked.push_back(&c);
       }

@@ -21,7 +21,7 @@ struct DiagnoseOptions {
   // A candidate is refitted (the real test above) when its predicted held-out gain reaches
   // these; at most `max_tries` candidates per step, best predicted first.
   double candidate_min_gain = 0.01;
-  double candidate_min_z = 2.0;
+  double candidate_min_z = 1.5;
   int max_tries = 3;
   int light_samples = 8;   // per extended light, for the direct-light features
   uint64_t seed = 1;

@@ -99,15 +99,19 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
   // Held-out gain per block (photo, block_px square) for its standard error.
   // Relative gain per block (gain / the block's error before), so that a few bright blocks
   // cannot carry the significance on their own.
+  // Only blocks where the candidate changes the model count (its support): a highlight's change
+  // is not diluted by the blocks it never touches.
   std::unordered_map<int64_t, std::pair<double, double>> gains;
   for (size_t i = 0; i < records_.size(); ++i) {
     const PixelRecord& r = records_[i];
     if (r.outlier || !r.held_out) continue;
     double g = 0, e = 0;
+    bool support = false;
     for (int c = 0; c < 3; ++c) {
       std::fill(b.begin(), b.end(), 0.0);
       basis(r, c, b.data());
       const double s = r.sim[c], y0 = double(r.recorded[c]) - s, y = y0 - offset(r, c);
+      support |= y != y0 || std::any_of(b.begin(), b.end(), [](double v) { return v != 0; });
       double cb = 0;
       for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
       const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd());
@@ -115,6 +119,7 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
       g += (y0 - a0 * s) * (y0 - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
       e += (y0 - a0 * s) * (y0 - a0 * s);
     }
+    if (!support) continue;
     auto& acc = gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_];
     acc.first += g;
     acc.second += e;

@@ -12,6 +12,7 @@
 
 #include <string>
 
+#include "tests/e2e/chromium_check.h"
 #include "tests/e2e/run.h"
 #include "tests/temp_dir.h"
 #include "tools/common/json.h"
@@ -72,6 +73,7 @@ fs::path TrueModel(const fs::path& capture) {
 struct Outcome {
   Json diagnosis;
   double floor = 0;
+  test::PageCheck page;  // report.html in headless Chromium
 };
 
 Outcome Diagnose(const std::string& effect, int seed) {
@@ -83,6 +85,7 @@ Outcome Diagnose(const std::string& effect, int seed) {
                        Quote((dir / "diag").string()) + kDiagnose);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   o.diagnosis = ReadJsonFile(dir / "diag" / "diagnosis.json");
+  o.page = test::CheckPageInChromium(dir / "diag" / "report.html", dir / "chromium");
   // The floor: the true model, same renders and pixels, nothing to add.
   r = RunTool("igi-diagnose", Quote(TrueModel(capture).string()) + " --out " +
                                   Quote((dir / "floor").string()) + kDiagnose + " --max-steps 0");
@@ -117,6 +120,12 @@ TEST(ConcealedControlTest, NothingHiddenNothingReported) {
   const Json& d = o.diagnosis;
   EXPECT_TRUE(d["steps"].empty()) << d.dump(1);
   EXPECT_LE(d["final"]["residual"].get<double>(), 1.2 * o.floor);
+  // The report loads in a browser: no console error, every image decoded (photo, render,
+  // residual at least).
+  ASSERT_TRUE(o.page.chromium_found) << "chromium not found: install it (scripts/setup.sh does)";
+  EXPECT_TRUE(o.page.console_errors.empty()) << o.page.console_errors.front();
+  ASSERT_GE(o.page.image_widths.size(), 3u);
+  for (int w : o.page.image_widths) EXPECT_GT(w, 0);
 }
 
 }  // namespace

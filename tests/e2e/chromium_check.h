@@ -72,7 +72,8 @@ inline PageCheck CheckPageInChromium(const std::filesystem::path& page,
   std::stringstream dom_text;
   dom_text << dom_in.rdbuf();
   const std::string d = dom_text.str();
-  const auto a = d.find("IMG_WIDTHS:"), b = d.find(":END", a == std::string::npos ? 0 : a);
+  // The probe script's own text also holds "IMG_WIDTHS:"; its output is the last occurrence.
+  const auto a = d.rfind("IMG_WIDTHS:"), b = d.find(":END", a == std::string::npos ? 0 : a);
   if (a != std::string::npos && b != std::string::npos) {
     std::stringstream list(d.substr(a + 11, b - a - 11));
     std::string item;

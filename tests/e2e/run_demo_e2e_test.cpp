@@ -62,8 +62,9 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   const double k = summary["photometric_scale_k"].get<double>();
   EXPECT_GT(k, 0.0);
   std::map<std::string, std::string> status;
-  for (const Json& g : ReadJsonFile(out / "04-solve" / "report.json")["regions"]) {
-    status[g["name"].get<std::string>()] = g.value("status", "");
+  const Json report = ReadJsonFile(out / "04-solve" / "report.json");  // kept alive for the loop
+  for (const Json& g : report.at("regions")) {
+    status[g.at("name").get<std::string>()] = g.contains("status") ? g.at("status").get<std::string>() : "";
   }
   int checked = 0;
   for (const Json& region : summary["regions"]) {
