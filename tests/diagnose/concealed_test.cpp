@@ -113,7 +113,8 @@ TEST_P(ConcealedEffectTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
 // room fourfold and a per-photo exposure scale explains more of it first (the profile's axis is
 // found, its power is not); see the issue note and bench/RESULTS.md.
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedEffectTest,
-                         testing::Values("vignetting", "exposure_scale", "camera_response"));
+                         testing::Values("vignetting", "exposure_scale", "camera_response",
+                                         "specular_lobe_shape"));
 
 TEST(ConcealedControlTest, NothingHiddenNothingReported) {
   const Outcome o = Diagnose("", 12);
