@@ -131,3 +131,27 @@ TEST(ConcealedControlTest, NothingHiddenNothingReported) {
 
 }  // namespace
 }  // namespace igi
+
+namespace igi {
+namespace {
+
+// Bad input: one line naming the file or flag, exit 2, nothing written.
+TEST(DiagnoseBadInputTest, ExitsTwoWithOneLineAndWritesNothing) {
+  const fs::path dir = test::UniqueTempDir("igi_diagnose_bad");
+  const fs::path out = dir / "out";
+  auto r = RunTool("igi-diagnose", Quote((dir / "missing.json").string()) + " --out " +
+                                       Quote(out.string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  WriteJsonFile(dir / "scene.json", Json{{"format", "igi-scene"}, {"version", 1}});
+  r = RunTool("igi-diagnose", Quote((dir / "scene.json").string()) + " --out " +
+                                  Quote(out.string()) + " --holdout-fraction 0.95");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--holdout-fraction"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace igi
