@@ -1,5 +1,6 @@
 #include "solver/diagnose/pixel_records.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -179,6 +180,20 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
       const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
       r.r2 = float((dx * dx + dy * dy) / half_diag2);
       r.albedo = AlbedoAt(model, impl, *hit);
+      r.point_cam = (cam.cam_from_world * hit->position).cast<float>();
+      const Image& sim = sims[i];
+      auto at = [&](int xx, int yy, int c) {
+        return sim.at(std::clamp(xx, 0, sim.width - 1), std::clamp(yy, 0, sim.height - 1), c);
+      };
+      for (int c = 0; c < 3; ++c) {
+        float gx = 0, gy = 0;
+        for (int d = -1; d <= 1; ++d) {
+          gx += at(x + 1, y + d, c) - at(x - 1, y + d, c);
+          gy += at(x + d, y + 1, c) - at(x + d, y - 1, c);
+        }
+        r.sim_gradient(c, 0) = gx / 6;
+        r.sim_gradient(c, 1) = gy / 6;
+      }
       GatherLights(model, impl, *hit, options.light_samples, rng, &r);
       rows[k].push_back(std::move(r));
     }

@@ -36,6 +36,10 @@ struct PixelRecord {
   Eigen::Vector3f view = Eigen::Vector3f::Zero();    // unit, toward the camera
   float r2 = 0;  // (distance to the principal point / half the image diagonal)²
   Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // the model's ρd at the point
+  Eigen::Vector3f point_cam = Eigen::Vector3f::Zero();  // the point in the camera frame
+  // The model image's gradient at the pixel (Prewitt: a 3×3-smoothed central difference), per
+  // channel: d sim / dx, d sim / dy.
+  Eigen::Matrix<float, 3, 2> sim_gradient = Eigen::Matrix<float, 3, 2>::Zero();
   std::vector<RecordLightSample> lights;             // direct light at the point
 };
 
