@@ -1,7 +1,5 @@
 #include "solver/diagnose/candidates.h"
 
-#include "solver/diagnose/residual_fit.h"
-
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
@@ -12,6 +10,8 @@
 #include <numbers>
 #include <set>
 #include <unordered_map>
+
+#include "solver/diagnose/residual_fit.h"
 
 namespace igi {
 namespace {
@@ -323,9 +323,9 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   Fill(best, &out);
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
-  const Eigen::Vector3d intensity =
-      l.type == LightType::kSphere ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))
-                                   : l.intensity;
+  const Eigen::Vector3d intensity = l.type == LightType::kSphere
+                                        ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))
+                                        : l.intensity;
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
                 {"cos_power", n}};
@@ -386,8 +386,8 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
   out.where = {{"light", l.name}, {"frame", "light"}};
   out.num_params = 1;
   out.evidence = fmt::format(
-      "where light '{}' dominates, the photos are {:.3f}x the model; elsewhere they agree",
-      l.name, factor);
+      "where light '{}' dominates, the photos are {:.3f}x the model; elsewhere they agree", l.name,
+      factor);
   out.valid = true;
   const std::string name = l.name;
   out.apply = [name, factor](Json* doc) {
@@ -491,8 +491,8 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     if (r.region != region) return;
     double d = 0;
     for (const RecordLightSample& ls : r.lights) {
-      const double plain = gmd ? GmdLobe(r.normal, ls.wi, r.view, alpha)
-                               : WardLobe(r.normal, ls.wi, r.view, alpha);
+      const double plain =
+          gmd ? GmdLobe(r.normal, ls.wi, r.view, alpha) : WardLobe(r.normal, ls.wi, r.view, alpha);
       const double alt = fresnel ? plain * FresnelWeight(ls.wi, r.view)
                                  : (gmd ? WardLobe(r.normal, ls.wi, r.view, alpha)
                                         : GmdLobe(r.normal, ls.wi, r.view, alpha));
@@ -505,17 +505,19 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     return out;
   }
   Fill(fit, &out);
-  const std::string to = fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel"
-                                 : (gmd ? "ward" : "ward_gmd");
-  out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)}, {"to", to},
-                {"amplitude", fit.coef[0]}};
+  const std::string to =
+      fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel" : (gmd ? "ward" : "ward_gmd");
+  out.params = {
+      {"region", m.name}, {"from", BrdfModelName(m.brdf)}, {"to", to}, {"amplitude", fit.coef[0]}};
   out.where = {{"regions", {m.name}}, {"frame", fresnel ? "grazing angle" : "half-vector angle"}};
   out.num_params = 0;
-  out.evidence = fresnel
-      ? fmt::format("region '{}': the photos' highlights grow toward grazing angles faster than "
+  out.evidence =
+      fresnel ? fmt::format(
+                    "region '{}': the photos' highlights grow toward grazing angles faster than "
                     "the {} lobe; Schlick's Fresnel weight explains it (amplitude {:.2f})",
                     m.name, BrdfModelName(m.brdf), fit.coef[0])
-      : fmt::format("region '{}': the highlight's fall-off away from its peak follows {} rather "
+              : fmt::format(
+                    "region '{}': the highlight's fall-off away from its peak follows {} rather "
                     "than {} (amplitude {:.2f} of the difference)",
                     m.name, to, BrdfModelName(m.brdf), fit.coef[0]);
   out.valid = true;
@@ -551,8 +553,10 @@ CandidateResult PoseError(const CandidateContext& cx, const ResidualFitter& f, i
   const Eigen::Vector3d omega = fit.coef.head<3>(), delta = fit.coef.tail<3>();
   const double angle_deg = omega.norm() * 180 / kPi;
   if (!(angle_deg < 5) || !(delta.norm() < 0.25)) {
-    out.note = fmt::format("camera {}: the gradient fit ({:.2f} deg, {:.3f} m) is not a small pose "
-                           "error", cam.name, angle_deg, delta.norm());
+    out.note = fmt::format(
+        "camera {}: the gradient fit ({:.2f} deg, {:.3f} m) is not a small pose "
+        "error",
+        cam.name, angle_deg, delta.norm());
     return out;
   }
   Fill(fit, &out);
@@ -592,7 +596,8 @@ CandidateResult PoseError(const CandidateContext& cx, const ResidualFitter& f, i
 
 std::string CandidateResult::Key() const {
   for (const char* k : {"region", "light", "camera"}) {
-    if (params.contains(k) && params[k].is_string()) return effect + ":" + params[k].get<std::string>();
+    if (params.contains(k) && params[k].is_string())
+      return effect + ":" + params[k].get<std::string>();
   }
   return effect;
 }
@@ -613,29 +618,31 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   if (allowed("ambient_light")) out.push_back(Ambient(cx, f));
   for (int l = 0; l < int(cx.model.lights.size()); ++l) {
     const Light& light = cx.model.lights[l];
-    const bool point_like = light.type == LightType::kPoint || light.type == LightType::kSphere ||
-                            (light.type == LightType::kSpot &&
-                             light.profile.kind == SpotProfile::Kind::kNone);
-    if (point_like && allowed("light_emission_profile")) out.push_back(EmissionProfile(cx, f, l));
-    if (light.type != LightType::kAmbient && allowed("light_intensity")) {
+    const bool point_like =
+        light.type == LightType::kPoint || light.type == LightType::kSphere ||
+        (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
+    if (point_like && allowed("light_emission_profile:" + light.name))
+      out.push_back(EmissionProfile(cx, f, l));
+    if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
       out.push_back(LightIntensity(cx, f, l));
     }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
-    if (allowed("specular_lobe_shape")) {
+    const std::string& region = cx.model.materials[g].name;
+    if (allowed("specular_lobe_shape:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, false);
       if (c.valid || !c.note.empty()) out.push_back(std::move(c));
     }
-    if (allowed("fresnel")) {
+    if (allowed("fresnel:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, true);
       if (c.valid || !c.note.empty()) out.push_back(std::move(c));
     }
   }
-  if (allowed("pose_error")) {
-    for (int c = 0; c < int(cx.model.cameras.size()); ++c) out.push_back(PoseError(cx, f, c));
+  for (int c = 0; c < int(cx.model.cameras.size()); ++c) {
+    if (allowed("pose_error:" + cx.model.cameras[c].name)) out.push_back(PoseError(cx, f, c));
   }
-  if (allowed("specular_reflection")) {
-    for (int g = 0; g < int(cx.model.materials.size()); ++g) {
+  for (int g = 0; g < int(cx.model.materials.size()); ++g) {
+    if (allowed("specular_reflection:" + cx.model.materials[g].name)) {
       if (cx.model.materials[g].brdf == BrdfModel::kLambert) {
         out.push_back(SpecularReflection(cx, f, g));
       }

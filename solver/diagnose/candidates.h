@@ -47,7 +47,8 @@ struct CandidateResult {
   std::string Key() const;
 };
 
-// Every candidate that applies to this scene, fitted on `records`.
+// Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
+// `excluded` (they are not fitted at all).
 std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
                                                 const std::vector<PixelRecord>& records,
                                                 const std::vector<std::string>& excluded);

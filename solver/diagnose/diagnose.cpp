@@ -3,13 +3,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <unordered_map>
-
-#include <Eigen/Geometry>
 
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
@@ -80,8 +79,8 @@ struct ModelState {
 };
 
 // Fits (solves, when materials are unknown) the declared document into `dir` and simulates it.
-ModelState FitModel(const Json& declared, bool solve, const std::string& maps,
-                    const fs::path& dir, const DiagnoseOptions& o, const PhotoSet& photos) {
+ModelState FitModel(const Json& declared, bool solve, const std::string& maps, const fs::path& dir,
+                    const DiagnoseOptions& o, const PhotoSet& photos) {
   ModelState st;
   st.dir = dir;
   fs::create_directories(dir);
@@ -166,7 +165,8 @@ double NoiseFloor(const PhotoSet& photos, const std::vector<Image>& sims) {
           const double e2 = sims[i].at(x + 1, y, c) - rec.at(x + 1, y, c);
           if (!std::isfinite(e1) || !std::isfinite(e2)) continue;
           num += 0.5 * (e1 - e2) * (e1 - e2);
-          den += 0.5 * (rec.at(x, y, c) * rec.at(x, y, c) + rec.at(x + 1, y, c) * rec.at(x + 1, y, c));
+          den +=
+              0.5 * (rec.at(x, y, c) * rec.at(x, y, c) + rec.at(x + 1, y, c) * rec.at(x + 1, y, c));
         }
       }
     }
@@ -301,11 +301,15 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     t.gain = gain;
     ds.z = z;
     ds.kept = gain >= o.min_gain && z >= o.min_z;
-    ds.verdict = ds.kept ? fmt::format("kept: held-out residual² down {:.1f}% ({:.1f} standard "
-                                       "errors over the held-out blocks)", 100 * gain, z)
-                         : fmt::format("rejected: held-out residual² changed by {:.1f}% ({:.1f} "
-                                       "standard errors): the model does not earn its {} "
-                                       "parameter(s)", -100 * gain, z, c.num_params);
+    ds.verdict = ds.kept ? fmt::format(
+                               "kept: held-out residual² down {:.1f}% ({:.1f} standard "
+                               "errors over the held-out blocks)",
+                               100 * gain, z)
+                         : fmt::format(
+                               "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
+                               "standard errors): the model does not earn its {} "
+                               "parameter(s)",
+                               -100 * gain, z, c.num_params);
     const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
     ds.image_photo = scene.photos[img].file.filename().string();
     ds.residual_before_image = ResidualImage(photos, st.sims, img);
@@ -334,7 +338,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       DiagnosisStep& ds = trials[i].step;
       if (ds.kept && i != best) {
         ds.kept = false;
-        ds.verdict += fmt::format("; not applied: {} explained more", trials[best].step.candidate.effect);
+        ds.verdict +=
+            fmt::format("; not applied: {} explained more", trials[best].step.candidate.effect);
       }
       (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }
@@ -350,11 +355,10 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::vector<std::string> excluded = kept_effects;
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
-    std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, {});
+    std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
     sum.last_candidates = cands;
     std::vector<CandidateResult*> ranked;
     for (CandidateResult& c : cands) {
-      if (std::find(excluded.begin(), excluded.end(), c.Key()) != excluded.end()) continue;
       if (c.valid && c.Gain() >= o.candidate_min_gain && c.z >= o.candidate_min_z) {
         ranked.push_back(&c);
       }
@@ -367,8 +371,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::vector<Trial> trials;
     for (size_t k = 0; k < ranked.size() && int(k) < o.max_tries; ++k) {
       trials.push_back(try_step(*ranked[k], maps));
-      const bool any = std::any_of(trials.begin(), trials.end(),
-                                   [](const Trial& t) { return t.step.kept; });
+      const bool any =
+          std::any_of(trials.begin(), trials.end(), [](const Trial& t) { return t.step.kept; });
       if (trials.size() >= 2 && any) break;
     }
     bool kept = settle(trials, maps);
@@ -398,8 +402,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                         {render, "re-render of the improved model"},
                         {ResidualImage(photos, st.sims, 0), "residual (render − photo)"}};
   }
-  sum.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return sum;
 }
 
