@@ -53,8 +53,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
       if (c < 0) continue;
       const Camera& camera = truth.cameras[c];
       const auto px = camera.ImgFromWorld(corners[i]);
-      if (!px || px->x() < 0 || px->y() < 0 || px->x() > camera.width ||
-          px->y() > camera.height) {
+      if (!px || px->x() < 0 || px->y() < 0 || px->x() > camera.width || px->y() > camera.height) {
         continue;
       }
       pixels[photo + ".png"][name] = {px->x(), px->y()};
@@ -64,12 +63,31 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
 }
 
 std::vector<std::string> SynthArgs(const DemoOptions& o, const fs::path& synth) {
-  return {"--out", synth.string(), "--overwrite", "--unposed", "--textured-walls",
-          "--cameras", std::to_string(o.cameras), "--width", std::to_string(o.width),
-          "--height", std::to_string(o.height), "--spp", std::to_string(o.spp),
-          "--brackets", std::to_string(o.brackets), "--stops", fmt::format("{}", o.stops),
-          "--lamp", "point", "--validation-lightings", "none",
-          "--threads", std::to_string(o.num_threads)};
+  return {"--out",
+          synth.string(),
+          "--overwrite",
+          "--unposed",
+          "--textured-walls",
+          "--cameras",
+          std::to_string(o.cameras),
+          "--ceiling-cameras",
+          std::to_string(o.ceiling_cameras),
+          "--width",
+          std::to_string(o.width),
+          "--height",
+          std::to_string(o.height),
+          "--spp",
+          std::to_string(o.spp),
+          "--brackets",
+          std::to_string(o.brackets),
+          "--stops",
+          fmt::format("{}", o.stops),
+          "--lamp",
+          "point",
+          "--validation-lightings",
+          "none",
+          "--threads",
+          std::to_string(o.num_threads)};
 }
 
 // DIR/00-capture: igi-synth's capture plus camera.json and markers.json in its PHOTOS_DIR.
@@ -86,8 +104,8 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin) {
   fs::create_directories(dir);
   const auto r = RunProcess(bin / "igi-synth", args, dir / "log.txt");
   if (r.exit_code != 0) {
-    throw Error("stage 00-capture failed: igi-synth exited " + std::to_string(r.exit_code) +
-                ": " + r.last_error + " (log: " + (dir / "log.txt").string() + ")");
+    throw Error("stage 00-capture failed: igi-synth exited " + std::to_string(r.exit_code) + ": " +
+                r.last_error + " (log: " + (dir / "log.txt").string() + ")");
   }
   SceneLoadOptions load;
   load.check_images = false;
@@ -97,12 +115,20 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin) {
     if (e.is_directory()) photos.push_back(e.path().filename().string());
   }
   const Camera& c0 = truth.cameras.at(0);
-  WriteJsonFile(synth / "brackets" / "camera.json",
-                Json{{"format", "igi-camera"}, {"version", 1}, {"model", "PINHOLE"},
-                     {"width", c0.width}, {"height", c0.height}, {"params", c0.params}});
+  WriteJsonFile(synth / "brackets" / "camera.json", Json{{"format", "igi-camera"},
+                                                         {"version", 1},
+                                                         {"model", "PINHOLE"},
+                                                         {"width", c0.width},
+                                                         {"height", c0.height},
+                                                         {"params", c0.params}});
   WriteJsonFile(synth / "brackets" / "markers.json", MarkersOfTruth(truth, photos));
-  WriteStageMarker(dir, StageMarker{"00-capture", fp.Hex(), "done", 0, UtcNow(),
-                                    {CommandLine(bin / "igi-synth", args)}, Json::object()});
+  WriteStageMarker(dir, StageMarker{"00-capture",
+                                    fp.Hex(),
+                                    "done",
+                                    0,
+                                    UtcNow(),
+                                    {CommandLine(bin / "igi-synth", args)},
+                                    Json::object()});
   return synth;
 }
 
@@ -168,25 +194,25 @@ DemoSummary RunDemo(const DemoOptions& o) {
   run.bin_dir = bin;
   run.skip_diagnose = o.skip_diagnose;
   run.solve_args = o.solve_args;
+  run.diagnose_args = o.diagnose_args;
   run.report_spp = o.report_spp;
   run.num_threads = o.num_threads;
   DemoSummary d;
   d.run = RunPipeline(run);
   d.summary = CompareWithTruth(d.run.solved_scene, synth / "truth.json");
   d.summary["seconds"] = d.run.seconds;
-  d.summary["capture"] = {{"cameras", o.cameras}, {"width", o.width}, {"height", o.height},
-                          {"spp", o.spp}, {"brackets", o.brackets}, {"stops", o.stops}};
+  d.summary["capture"] = {{"cameras", o.cameras}, {"width", o.width},       {"height", o.height},
+                          {"spp", o.spp},         {"brackets", o.brackets}, {"stops", o.stops}};
   WriteJsonFile(o.out / "demo_summary.json", d.summary);
   d.table.push_back(fmt::format("{:<14} {:<6} {:>9} {:>9} {:>8}", "region", "param", "truth",
                                 "solved/k", "error"));
   for (const Json& r : d.summary["regions"]) {
     for (const char* key : {"rho_d", "rho_s", "alpha"}) {
       if (!r.contains(key)) continue;
-      d.table.push_back(fmt::format("{:<14} {:<6} {:>9.4f} {:>9.4f} {:>+7.1f}%",
-                                    r["region"].get<std::string>(), key,
-                                    r[key]["truth"].get<double>(),
-                                    r[key]["recovered_over_k"].get<double>(),
-                                    100 * r[key]["relative_error"].get<double>()));
+      d.table.push_back(
+          fmt::format("{:<14} {:<6} {:>9.4f} {:>9.4f} {:>+7.1f}%", r["region"].get<std::string>(),
+                      key, r[key]["truth"].get<double>(), r[key]["recovered_over_k"].get<double>(),
+                      100 * r[key]["relative_error"].get<double>()));
     }
   }
   d.table.push_back(fmt::format("photometric scale k = {:.4f} (see demo_summary.json)",

@@ -63,7 +63,10 @@ void Classify(PhotoSource* p, ProblemList* problems) {
       continue;  // frames/ of a capture, hidden files
     } else {
       const std::string ext = ToLower(e.path().extension().string());
-      (kLdr.count(ext) ? ldr : kRaw.count(ext) ? raw : kRadiance.count(ext) ? radiance : other)
+      (kLdr.count(ext)        ? ldr
+       : kRaw.count(ext)      ? raw
+       : kRadiance.count(ext) ? radiance
+                              : other)
           .push_back(e.path());
     }
   }
@@ -107,10 +110,14 @@ void Classify(PhotoSource* p, ProblemList* problems) {
 
 const char* KindName(PhotoSourceKind kind) {
   switch (kind) {
-    case PhotoSourceKind::kBracket: return "LDR bracket";
-    case PhotoSourceKind::kRaw: return "raw";
-    case PhotoSourceKind::kRadiance: return "radiance map";
-    case PhotoSourceKind::kCapture: return "capture";
+    case PhotoSourceKind::kBracket:
+      return "LDR bracket";
+    case PhotoSourceKind::kRaw:
+      return "raw";
+    case PhotoSourceKind::kRadiance:
+      return "radiance map";
+    case PhotoSourceKind::kCapture:
+      return "capture";
   }
   return "?";
 }

@@ -36,8 +36,8 @@ void StageRun::Tool(const std::string& tool, const std::vector<std::string>& arg
     return;
   }
   throw Error("stage " + stage_ + " failed: " + tool + " exited " + std::to_string(r.exit_code) +
-              (r.last_error.empty() ? "" : ": " + r.last_error) + " (log: " +
-              (dir_ / "log.txt").string() + ")");
+              (r.last_error.empty() ? "" : ": " + r.last_error) +
+              " (log: " + (dir_ / "log.txt").string() + ")");
 }
 
 std::vector<std::string> ThreadArgs(const Context& ctx) {
@@ -131,7 +131,11 @@ std::vector<Stage> Stages(const Context& ctx) {
        },
        SolveStage},
       {"05-diagnose", !o.skip_diagnose,
-       [&](Fingerprint* fp) { fp->AddText(std::to_string(o.diagnose_spp)); }, DiagnoseStage},
+       [&](Fingerprint* fp) {
+         fp->AddText(std::to_string(o.diagnose_spp));
+         for (const std::string& a : o.diagnose_args) fp->AddText(a);
+       },
+       DiagnoseStage},
       {"06-report", true,
        [&](Fingerprint* fp) {
          fp->AddText(std::to_string(o.report_spp) + "/" + std::to_string(o.report_photos) + "/" +
@@ -174,7 +178,8 @@ RunSummary RunPipeline(const RunOptions& options) {
       summary.stages.push_back({stage.name, "kept", 0});
       if (marker->status == "partial") {
         summary.partial = true;
-        summary.partial_lines.push_back(stage.name + ": kept; it finished partly (see its log.txt)");
+        summary.partial_lines.push_back(stage.name +
+                                        ": kept; it finished partly (see its log.txt)");
       }
       continue;
     }
@@ -184,10 +189,10 @@ RunSummary RunPipeline(const RunOptions& options) {
     const auto t0 = std::chrono::steady_clock::now();
     StageRun run(ctx, stage.name);
     if (stage.applies) stage.body(ctx, &run);
-    StageMarker m{stage.name, hex,         !stage.applies ? "skipped"
-                                           : run.partial() ? "partial"
-                                                           : "done",
-                  Since(t0),  UtcNow(),    run.commands, run.details};
+    StageMarker m{
+        stage.name, hex,      !stage.applies ? "skipped" : run.partial() ? "partial" : "done",
+        Since(t0),  UtcNow(), run.commands,
+        run.details};
     WriteStageMarker(dir, m);
     spdlog::info("{}: {} in {:.1f} s", stage.name, m.status, m.seconds);
     summary.stages.push_back({stage.name, m.status, m.seconds});

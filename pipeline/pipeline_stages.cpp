@@ -108,6 +108,7 @@ void DiagnoseStage(const Context& ctx, StageRun* run) {
   if (ctx.options.diagnose_spp > 0) {
     Append(&args, {"--spp", std::to_string(ctx.options.diagnose_spp)});
   }
+  Append(&args, ctx.options.diagnose_args);
   run->Tool("igi-diagnose", args, /*partial_ok=*/true);
 }
 

@@ -20,10 +20,11 @@ struct RunOptions {
   std::vector<std::string> solve_args;     // passed to igi-solve as they are
   std::vector<std::string> register_args;  // passed to igi-register as they are
   int diagnose_spp = 0;                    // --spp of igi-diagnose (0 = its default)
+  std::vector<std::string> diagnose_args;  // passed to igi-diagnose as they are
   int report_spp = 32;                     // samples per pixel of the report's renders, >= 1
-  int report_photos = 4;     // photos shown with their re-render and residual, >= 1
-  int report_lightings = 6;  // lightings of the relit renders, >= 1
-  int num_threads = 0;       // --threads given to every stage (0 = all cores)
+  int report_photos = 4;                   // photos shown with their re-render and residual, >= 1
+  int report_lightings = 6;                // lightings of the relit renders, >= 1
+  int num_threads = 0;                     // --threads given to every stage (0 = all cores)
 
   void Validate() const;  // InputError naming the flag
 };

@@ -99,13 +99,14 @@ void CamerasSection(const fs::path& out, HtmlReport* page) {
     const Eigen::Vector3d centre = c.CenterInWorld();
     const Eigen::Vector3d forward =
         c.cam_from_world.rotation.conjugate() * Eigen::Vector3d(0, 0, 1);
-    rows.push_back({c.name, fmt::format("{:.3f}, {:.3f}, {:.3f}", centre.x(), centre.y(), centre.z()),
+    rows.push_back({c.name,
+                    fmt::format("{:.3f}, {:.3f}, {:.3f}", centre.x(), centre.y(), centre.z()),
                     fmt::format("{:.3f}, {:.3f}, {:.3f}", forward.x(), forward.y(), forward.z()),
                     fmt::format("{:.1f}", c.params.empty() ? 0.0 : c.params[0]), rms[c.name]});
   }
-  page->Table({"camera", "centre (scene frame, m)", "viewing direction", "fx (px)",
-               "reprojection RMS"},
-              rows);
+  page->Table(
+      {"camera", "centre (scene frame, m)", "viewing direction", "fx (px)", "reprojection RMS"},
+      rows);
   if (report.contains("unregistered") && !report["unregistered"].empty()) {
     page->Note("Not registered: " + report["unregistered"].dump(), "warning");
   }
@@ -132,11 +133,11 @@ void ParametersSection(const fs::path& out, HtmlReport* page) {
                     fit.contains("relative_rms") ? Num(fit["relative_rms"]) : "—",
                     std::to_string(r.value("observations", 0))});
   }
-  page->Table({"region", "status", "ρd (mean) ± σ", "ρs ± σ", "α ± σ", "fit rel. RMS",
-               "observations"},
-              rows);
-  page->Paragraph(std::string("Values of the ") + (refined ? "path-traced refinement" : "paper's stage") +
-                  "; render residual " +
+  page->Table(
+      {"region", "status", "ρd (mean) ± σ", "ρs ± σ", "α ± σ", "fit rel. RMS", "observations"},
+      rows);
+  page->Paragraph(std::string("Values of the ") +
+                  (refined ? "path-traced refinement" : "paper's stage") + "; render residual " +
                   Num(report["stages"][refined ? "refined" : "paper"]["render_residual"]) +
                   ". Full solver report: 04-solve/report.html.");
 }
@@ -156,7 +157,8 @@ void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
     const Image render = ReadImage(render_file, 3);
     double exposure = 0;
     const Image photo_display = ToneMapSrgb(photo, 0, &exposure);
-    std::string row = "<div class=\"row\">" + Figure(photo_display, "photo " + p.file.filename().string()) +
+    std::string row = "<div class=\"row\">" +
+                      Figure(photo_display, "photo " + p.file.filename().string()) +
                       Figure(ToneMapSrgb(render, exposure), "re-render (solved model)");
     if (render.width == photo.width && render.height == photo.height) {
       Image residual = render;
@@ -210,12 +212,11 @@ void DiagnosisSection(const fs::path& out, HtmlReport* page) {
                   Num(d["final"].value("residual", Json())) + ".");
   std::vector<std::vector<std::string>> rows;
   for (const Json& s : d.value("steps", Json::array())) {
-    rows.push_back({s.value("effect", "?"), s.value("evidence", ""),
-                    s.contains("params") ? s["params"].dump() : "",
-                    Num(s.value("residual_before", Json())) + " → " +
-                        Num(s.value("residual_after", Json())),
-                    Num(s.value("held_out_before", Json())) + " → " +
-                        Num(s.value("held_out_after", Json()))});
+    rows.push_back(
+        {s.value("effect", "?"), s.value("evidence", ""),
+         s.contains("params") ? s["params"].dump() : "",
+         Num(s.value("residual_before", Json())) + " → " + Num(s.value("residual_after", Json())),
+         Num(s.value("held_out_before", Json())) + " → " + Num(s.value("held_out_after", Json()))});
   }
   page->Table({"effect", "evidence", "parameters", "residual", "held-out residual"}, rows);
   for (const Json& u : d.value("unexplained", Json::array())) {
@@ -250,8 +251,14 @@ void ReportStage(const Context& ctx, StageRun* run) {
   const fs::path renders = run->dir() / "renders";
   fs::create_directories(renders);
   auto render = [&](const Camera& cam, const Lighting& l, const fs::path& file) {
-    std::vector<std::string> args = {solved.string(), "--camera", cam.name, "--lighting", l.name,
-                                     "--spp", std::to_string(ctx.options.report_spp), "--out",
+    std::vector<std::string> args = {solved.string(),
+                                     "--camera",
+                                     cam.name,
+                                     "--lighting",
+                                     l.name,
+                                     "--spp",
+                                     std::to_string(ctx.options.report_spp),
+                                     "--out",
                                      file.string()};
     const auto threads = ThreadArgs(ctx);
     args.insert(args.end(), threads.begin(), threads.end());

@@ -31,7 +31,8 @@ void TonemapForRegistration(const fs::path& radiance, const fs::path& png) {
       for (int c = 0; c < 3; ++c) {
         const float raw = image.pixels[(size_t(y) * image.width + x) * 3 + c];
         const double v = std::isfinite(raw) ? std::clamp(raw / white, 0.0, 1.0) : 0.0;
-        out.at<cv::Vec3b>(y, x)[2 - c] = static_cast<uint8_t>(std::lround(255 * std::pow(v, 1 / 2.2)));
+        out.at<cv::Vec3b>(y, x)[2 - c] =
+            static_cast<uint8_t>(std::lround(255 * std::pow(v, 1 / 2.2)));
       }
     }
   }
@@ -96,9 +97,8 @@ Json RebaseScenePaths(Json scene, const fs::path& from, const fs::path& to) {
 
 Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unregistered) {
   Json scene = RebaseScenePaths(in.input_scene, in.input_dir, in.out_dir);
-  const Json& registered = in.registered_scene.contains("cameras")
-                               ? in.registered_scene["cameras"]
-                               : Json::object();
+  const Json& registered =
+      in.registered_scene.contains("cameras") ? in.registered_scene["cameras"] : Json::object();
   if (!registered.is_object()) {
     throw Error("igi-register's scene.json has no camera list (\"cameras\" is not an object)");
   }

@@ -22,12 +22,12 @@ Json RebaseScenePaths(Json scene, const std::filesystem::path& from,
                       const std::filesystem::path& to);
 
 struct SolvableSceneInputs {
-  Json input_scene;                   // the user's scene.json
-  std::filesystem::path input_dir;    // its folder
-  Json registered_scene;              // igi-register's DIR/scene.json (cameras)
-  std::vector<PhotoSource> photos;    // the layout's photos
-  std::filesystem::path hdr_dir;      // NAME.exr and NAME_mask.png per photo
-  std::filesystem::path out_dir;      // where the result is written
+  Json input_scene;                 // the user's scene.json
+  std::filesystem::path input_dir;  // its folder
+  Json registered_scene;            // igi-register's DIR/scene.json (cameras)
+  std::vector<PhotoSource> photos;  // the layout's photos
+  std::filesystem::path hdr_dir;    // NAME.exr and NAME_mask.png per photo
+  std::filesystem::path out_dir;    // where the result is written
 };
 
 // The input scene (paths rebased to out_dir) with the registered cameras and one photo per

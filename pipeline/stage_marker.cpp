@@ -70,11 +70,10 @@ std::optional<StageMarker> ReadStageMarker(const fs::path& stage_dir) {
 }
 
 void WriteStageMarker(const fs::path& stage_dir, const StageMarker& m) {
-  const Json j = {{"format", "igi-run-stage"}, {"version", 1},
-                  {"stage", m.stage},          {"fingerprint", m.fingerprint},
-                  {"status", m.status},        {"seconds", m.seconds},
-                  {"finished_utc", m.finished_utc}, {"commands", m.commands},
-                  {"details", m.details}};
+  const Json j = {
+      {"format", "igi-run-stage"},      {"version", 1},           {"stage", m.stage},
+      {"fingerprint", m.fingerprint},   {"status", m.status},     {"seconds", m.seconds},
+      {"finished_utc", m.finished_utc}, {"commands", m.commands}, {"details", m.details}};
   WriteJsonFile(MarkerPath(stage_dir), j);
 }
 

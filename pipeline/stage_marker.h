@@ -32,9 +32,9 @@ struct StageMarker {
   std::string fingerprint;  // Fingerprint::Hex() of the stage's inputs
   std::string status;       // "done", "partial" (the tool exited 3) or "skipped"
   double seconds = 0;
-  std::string finished_utc;              // ISO 8601
-  std::vector<std::string> commands;     // the command lines run (for the record)
-  Json details = Json::object();         // stage-specific notes
+  std::string finished_utc;           // ISO 8601
+  std::vector<std::string> commands;  // the command lines run (for the record)
+  Json details = Json::object();      // stage-specific notes
 };
 
 std::filesystem::path MarkerPath(const std::filesystem::path& stage_dir);

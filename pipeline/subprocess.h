@@ -9,7 +9,7 @@
 namespace igi {
 
 struct ProcessResult {
-  int exit_code = -1;     // the child's exit status; -1 when it was killed by a signal
+  int exit_code = -1;      // the child's exit status; -1 when it was killed by a signal
   std::string last_error;  // the last line of the log that contains "error" (may be empty)
 };
 

@@ -32,16 +32,17 @@ void PrintSummary(const igi::RunSummary& s) {
   for (const auto& st : s.stages) {
     std::printf("  %-12s %-8s %6.1f s\n", st.stage.c_str(), st.status.c_str(), st.seconds);
   }
-  std::printf("report: %s\nsolved scene: %s\n%.1f s\n", s.report.c_str(),
-              s.solved_scene.c_str(), s.seconds);
+  std::printf("report: %s\nsolved scene: %s\n%.1f s\n", s.report.c_str(), s.solved_scene.c_str(),
+              s.seconds);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"igi-run: end to end from a folder of photos (response, HDR, registration, "
-               "solve, diagnose, report)",
-               "igi-run"};
+  CLI::App app{
+      "igi-run: end to end from a folder of photos (response, HDR, registration, "
+      "solve, diagnose, report)",
+      "igi-run"};
   app.footer(kLayout);
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
@@ -58,10 +59,11 @@ int main(int argc, char** argv) {
   app.add_flag("--skip-diagnose", o.skip_diagnose, "Skip the diagnosis stage");
   app.add_option("--solve-arg", o.solve_args, "Argument passed to igi-solve (repeatable)")
       ->allow_extra_args(false);
-  app.add_option("--register-arg", o.register_args,
-                 "Argument passed to igi-register (repeatable)")
+  app.add_option("--register-arg", o.register_args, "Argument passed to igi-register (repeatable)")
       ->allow_extra_args(false);
   app.add_option("--diagnose-spp", o.diagnose_spp, "igi-diagnose --spp (0 = its default)");
+  app.add_option("--diagnose-arg", o.diagnose_args, "Argument passed to igi-diagnose (repeatable)")
+      ->allow_extra_args(false);
   app.add_option("--report-spp", o.report_spp, "Samples per pixel of the report's renders")
       ->capture_default_str();
   app.add_option("--report-photos", o.report_photos, "Photos re-rendered in the report")
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
       demo.skip_diagnose = o.skip_diagnose;
       demo.num_threads = flags.threads;
       if (!o.solve_args.empty()) demo.solve_args = o.solve_args;
+      if (!o.diagnose_args.empty()) demo.diagnose_args = o.diagnose_args;
       const igi::DemoSummary d = igi::RunDemo(demo);
       summary = d.run;
       PrintSummary(summary);

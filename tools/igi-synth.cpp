@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
   app.add_flag("--unposed", o.unposed,
                "scene.json without cameras and photos (poses to be recovered); truth keeps them");
   app.add_option("--cameras", o.cameras, "Number of cameras (first ones see the highlights)");
+  app.add_option("--ceiling-cameras", o.ceiling_cameras,
+                 "How many of the last overview cameras look up so that the ceiling is seen");
   app.add_option("--width", o.width, "Photo width, pixels");
   app.add_option("--height", o.height, "Photo height, pixels");
   app.add_option("--fov", o.fov_deg, "Horizontal field of view, degrees");

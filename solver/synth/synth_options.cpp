@@ -105,6 +105,9 @@ void SynthOptions::Validate() const {
   ProblemList p;
   if (out.empty()) p.Add("--out", "", "", "required");
   if (cameras < 1 || cameras > 64) p.Add("--cameras", "", std::to_string(cameras), "must be 1..64");
+  if (ceiling_cameras < 0 || ceiling_cameras > cameras) {
+    p.Add("--ceiling-cameras", "", std::to_string(ceiling_cameras), "must be 0..--cameras");
+  }
   if (width < 8 || width > 8192) p.Add("--width", "", std::to_string(width), "must be 8..8192");
   if (height < 8 || height > 8192) {
     p.Add("--height", "", std::to_string(height), "must be 8..8192");

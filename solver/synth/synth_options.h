@@ -63,7 +63,10 @@ struct SynthOptions {
   std::filesystem::path out;  // scene folder to write (must be empty or absent)
   bool overwrite = false;     // allow a non-empty `out` (files of the same name are replaced)
   int cameras = 5;            // >= 1; the first ones target the glossy regions' highlights
-  int width = 160;            // photo size, pixels
+  // The last N of the overview cameras look up across the room so that the ceiling is seen
+  // (the default views look down at the floor and never see it).
+  int ceiling_cameras = 0;
+  int width = 160;  // photo size, pixels
   int height = 120;
   double fov_deg = 60;               // horizontal field of view
   int spp = 64;                      // render samples per pixel
