@@ -125,17 +125,15 @@ std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions
     bool near_lamp = false;
     for (const SynthLamp& lamp : room.lamps) near_lamp |= (lamp.position - eye).norm() < 0.5;
     if (near_lamp) continue;
-    // A ceiling camera looks at the ceiling's far side from a low eye: the ceiling fills the top
-    // of its frame, the far wall the rest.
+    // A ceiling camera looks at the far edge of the ceiling: the ceiling fills the top of its
+    // frame, the far wall the rest.
     const bool up = options.cameras - int(cameras.size()) <= options.ceiling_cameras;
     const Vector3d target =
-        up ? Vector3d(room.size.x() - eye.x(), room.size.y() - eye.y(), room.size.z() - 0.3)
+        up ? Vector3d(room.size.x() - eye.x(), room.size.y() - eye.y(), room.size.z() - 0.1)
            : center;
-    const Vector3d eye_used = up ? Vector3d(eye.x(), eye.y(), 1.0) : eye;
     PlacedCamera pc;
-    pc.camera =
-        LookAtCamera(name(), eye_used, target, options.width, options.height, options.fov_deg);
-    eyes.push_back(eye_used);
+    pc.camera = LookAtCamera(name(), eye, target, options.width, options.height, options.fov_deg);
+    eyes.push_back(eye);
     cameras.push_back(pc);
   }
   return cameras;

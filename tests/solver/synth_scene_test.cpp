@@ -131,6 +131,49 @@ TEST(SynthCameras, HighlightCamerasMirrorTheLamp) {
       again[2].camera.cam_from_world.ToMatrix().isApprox(cams[2].camera.cam_from_world.ToMatrix()));
 }
 
+// Share of a camera's pixels (a coarse grid of rays) whose first hit is `region`.
+double RegionShare(const SynthRoom& room, const Camera& camera, const std::string& region) {
+  int hits = 0, total = 0;
+  for (int y = 4; y < camera.height; y += 8) {
+    for (int x = 4; x < camera.width; x += 8) {
+      const Vector3d dir = camera.WorldRayFromImg({x + 0.5, y + 0.5});
+      const auto hit = IntersectRay(room.mesh, camera.CenterInWorld(), dir);
+      ++total;
+      if (hit && room.mesh.region_names[room.mesh.triangle_region[hit->triangle]] == region) ++hits;
+    }
+  }
+  return double(hits) / total;
+}
+
+// --ceiling-cameras N: the last N overview cameras see the ceiling (the default views never do,
+// and a region no photo sees cannot be solved); the other cameras are unchanged.
+TEST(SynthCameras, CeilingCamerasSeeTheCeiling) {
+  SynthOptions o;
+  o.cameras = 8;
+  const SynthRoom room = BuildRoom(o);
+  const auto plain = PlaceCameras(room, o);
+  o.ceiling_cameras = 2;
+  const auto up = PlaceCameras(room, o);
+  ASSERT_EQ(up.size(), 8u);
+  for (int i = 0; i < 8; ++i) {
+    const double share = RegionShare(room, up[i].camera, "ceiling");
+    std::printf("cam%d ceiling share %.2f (default view %.2f)\n", i, share,
+                RegionShare(room, plain[i].camera, "ceiling"));
+    if (i < 6) {
+      EXPECT_TRUE(up[i].camera.cam_from_world.ToMatrix().isApprox(
+          plain[i].camera.cam_from_world.ToMatrix()));
+      // The overview cameras look down: no ceiling (a highlight camera may catch an edge).
+      if (i >= 4) {
+        EXPECT_EQ(RegionShare(room, plain[i].camera, "ceiling"), 0.0);
+      }
+    } else {
+      EXPECT_GT(share, 0.2) << "cam" << i;  // measured 0.48, 0.50
+    }
+  }
+  o.ceiling_cameras = 9;
+  EXPECT_THROW(o.Validate(), Error);
+}
+
 TEST(SynthCameras, LookAtFollowsColmapAxes) {
   const Camera cam = LookAtCamera("c", {2, 0.3, 1.5}, {2, 3, 1.5}, 160, 120, 60);
   // Looking along +y with z up: camera x = world +x, camera y = world -z.
