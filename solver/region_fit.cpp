@@ -466,6 +466,25 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
   return var > std::pow(0.03 * mean, 2) && var > 3 * noise;
 }
 
+// The samples whose held-out albedo is known, each with that albedo as its known ρd (in `held`,
+// a copy of `in` with fit_rho_d off); false (and `held` unchanged) when fewer than a fifth of
+// the samples, or fewer than 50, have one.
+bool FitWithHeldAlbedo(const RegionFitInput& in, RegionFitInput* held) {
+  std::vector<FitSample> kept;
+  for (const FitSample& s : in.samples) {
+    if (!s.rho_d_held.allFinite()) continue;
+    kept.push_back(s);
+    kept.back().rho_d_known = s.rho_d_held;
+  }
+  if (kept.size() < 50 || kept.size() * 5 < in.samples.size()) {
+    held->use_held_albedo = false;
+    return false;
+  }
+  held->samples = std::move(kept);
+  held->use_held_albedo = true;
+  return true;
+}
+
 }  // namespace
 
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
@@ -516,7 +535,14 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   RegionFitInput held = in;
   held.fit_rho_d = false;
   AlphaSearch b;
-  for (int round = 0; round < 2; ++round) {
+  if (in.use_held_albedo && FitWithHeldAlbedo(in, &held)) {
+    const Prepared ph = Prepare(held);
+    b = SearchAlpha(held, ph, false);
+    t = SpecularTerms(in, b.ax, b.ay);
+    patch.rho_s = b.linear.rho_s;
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+  }
+  for (int round = 0; round < 2 && !held.use_held_albedo; ++round) {
     for (FitSample& smp : held.samples) {
       const Eigen::Vector3d& v = patch.slot_rho_d[smp.slot];
       smp.rho_d_known = v.allFinite() ? v : r.rho_d;
@@ -550,7 +576,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   }
   // Uncertainties from the projected problem: ρs from its normal equation, α from the
   // curvature of the profile cost in log α (the patches' albedos held).
-  const double dof = std::max(1.0, 3.0 * in.samples.size() - 2);
+  const double dof = std::max(1.0, 3.0 * held.samples.size() - 2);
   const double s2 = b.linear.cost / dof;
   r.sigma_rho_s = b.linear.sum_v2 > 0 ? std::sqrt(s2 / b.linear.sum_v2) : kNan;
   r.sigma_alpha = r.sigma_alpha_x = r.sigma_alpha_y =
