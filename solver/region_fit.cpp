@@ -557,18 +557,31 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.alpha = r.alpha_x = b.ax;
   r.alpha_y = b.ay;
   r.slot_rho_d = patch.slot_rho_d;
-  // The region's mean albedo with the lobe fitted: Σ(L − specular)/Σ E/π over every sample (a
-  // ratio of sums, as the constant model computes it). The patches' own albedos come from the
-  // samples off the highlights, which favour bright texels there; their mean would be biased.
+  // The region's mean albedo with the lobe fitted: per patch Σ(L − specular)/Σ E/π over all its
+  // samples (a ratio of sums, highlights included), then the area-weighted mean over the patches
+  // that have samples. A ratio of sums over the whole region would weight each patch by its
+  // sample count (the fit samples crowd around the highlights, near cameras give more pixels),
+  // which biases the mean of a textured region toward the tiles that happen to lie there; the
+  // patches' off-highlight albedos favour bright texels near the highlights.
   {
-    Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = num;
+    std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
     for (size_t i = 0; i < in.samples.size(); ++i) {
+      const FitSample& smp = in.samples[i];
       const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
-      num += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed - r.rho_s.cwiseProduct(t[i]));
-      den += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+      num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(smp.observed - r.rho_s.cwiseProduct(t[i]));
+      den[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero(), area = sum;
+    for (int k = 0; k < in.num_slots; ++k) {
+      const double area_k = k < int(in.slot_area.size()) ? in.slot_area[k] : 1.0;
+      for (int c = 0; c < 3; ++c) {
+        if (!(den[k][c] > 0)) continue;
+        sum[c] += area_k * num[k][c] / den[k][c];
+        area[c] += area_k;
+      }
     }
     for (int c = 0; c < 3; ++c) {
-      if (den[c] > 0) r.rho_d[c] = std::max(0.0, num[c] / den[c]);
+      if (area[c] > 0) r.rho_d[c] = std::max(0.0, sum[c] / area[c]);
     }
   }
   for (Eigen::Vector3d& v : r.slot_rho_d) {

@@ -3,6 +3,7 @@
 // (relative errors, %), and each albedo map's PSNR against the true texture over all texels and
 // over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), spp
 // is not a key (the capture's). For issue 7's experiments; not a test.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,12 +11,38 @@
 
 #include "recon/scene.h"
 #include "solver/albedo_map.h"
+#include "solver/render_internal.h"
 #include "solver/solve.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 #include "tools/common/strings.h"
 
 namespace fs = std::filesystem;
+
+// The estimate resampled at the truth's texels, the truth, and (estimate − truth)·10 + 0.5 (grey
+// where equal, black where unseen), as PNGs in the current folder; prints the mean difference.
+void DumpComparison(const igi::Image& mine, const igi::Image& seen, const igi::Image& want) {
+  igi::Image est(want.width, want.height, 3), err(want.width, want.height, 3);
+  double bias = 0;
+  int n = 0;
+  for (int y = 0; y < want.height; ++y) {
+    for (int x = 0; x < want.width; ++x) {
+      const Eigen::Vector2d uv((x + 0.5) / want.width, 1.0 - (y + 0.5) / want.height);
+      const Eigen::Vector3d v = igi::SampleTexture(mine, uv);
+      const double s = igi::SampleTexture(seen, uv)[0];
+      for (int c = 0; c < 3; ++c) {
+        est.at(x, y, c) = float(v[c]);
+        const double d = v[c] - want.at(x, y, c);
+        err.at(x, y, c) = s >= 1 ? float(std::clamp(0.5 + 10 * d, 0.0, 1.0)) : 0.f;
+        if (s >= 1) bias += d, ++n;
+      }
+    }
+  }
+  std::printf("mean difference over the seen texels %+.4f\n", bias / std::max(1, n));
+  igi::WriteImage("bench_solve_truth_estimate.png", est);
+  igi::WriteImage("bench_solve_truth_truth.png", want);
+  igi::WriteImage("bench_solve_truth_error.png", err);
+}
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -27,6 +54,7 @@ int main(int argc, char** argv) {
   o.num_threads = 2;
   o.refine_iterations = 1;
   o.show_progress = false;
+  bool dump = false;  // dump=1: writes bench_solve_truth_{estimate,truth,error}.png in the cwd
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     const size_t eq = arg.find('=');
@@ -38,6 +66,8 @@ int main(int argc, char** argv) {
     else if (key == "refine") o.refine_iterations = int(v);
     else if (key == "held") o.held_out_albedo = v != 0;
     else if (key == "rays") o.indirect_rays = int(v);
+    else if (key == "dump") dump = v != 0;
+    else if (key == "smooth") o.smoothing_radius_m = v;
     else {
       std::fprintf(stderr, "unknown key %s\n", key.c_str());
       return 2;
@@ -75,6 +105,46 @@ int main(int argc, char** argv) {
       const igi::AlbedoComparison all = igi::CompareAlbedoMaps(*r.albedo_map, nullptr, want, peak);
       const igi::AlbedoComparison seen =
           igi::CompareAlbedoMaps(*r.albedo_map, &*r.albedo_map_seen, want, peak);
+      if (dump) DumpComparison(*r.albedo_map, *r.albedo_map_seen, want);
+      {  // region means over the texels some photo sees (area means: the floor's UVs are affine)
+        Eigen::Vector3d sum_t = Eigen::Vector3d::Zero(), sum_e = sum_t;
+        int n = 0;
+        for (int y = 0; y < want.height; ++y) {
+          for (int x = 0; x < want.width; ++x) {
+            const Eigen::Vector2d uv((x + 0.5) / want.width, 1.0 - (y + 0.5) / want.height);
+            if (igi::SampleTexture(*r.albedo_map_seen, uv)[0] < 1) continue;
+            sum_e += igi::SampleTexture(*r.albedo_map, uv);
+            for (int c = 0; c < 3; ++c) sum_t[c] += want.at(x, y, c);
+            ++n;
+          }
+        }
+        const Eigen::Vector3d mt = sum_t / n, me = sum_e / n;
+        const Eigen::Vector3d full(t["rho_d"][0].get<double>(), t["rho_d"][1].get<double>(),
+                                   t["rho_d"][2].get<double>());
+        std::printf("%s over the seen texels: true mean %+.2f %% of the whole texture's, map mean "
+                    "%+.2f %%, fit's rho_d %+.2f %% of the seen true mean\n",
+                    r.name.c_str(), 100 * (mt.mean() / full.mean() - 1), 100 * (me.mean() / mt.mean() - 1),
+                    100 * (r.stage1.rho_d.mean() / mt.mean() - 1));
+      }
+      for (int r_erode : {2, 4}) {  // away from unseen texels and the region's border
+        igi::Image eroded = *r.albedo_map_seen;
+        const igi::Image& m = *r.albedo_map_seen;
+        for (int y = 0; y < m.height; ++y) {
+          for (int x = 0; x < m.width; ++x) {
+            bool ok = true;
+            for (int dy = -r_erode; dy <= r_erode && ok; ++dy) {
+              for (int dx = -r_erode; dx <= r_erode && ok; ++dx) {
+                const int xi = x + dx, yi = y + dy;
+                ok = xi >= 0 && yi >= 0 && xi < m.width && yi < m.height && m.at(xi, yi, 0) > 0.5f;
+              }
+            }
+            eroded.at(x, y, 0) = ok ? 1.f : 0.f;
+          }
+        }
+        const igi::AlbedoComparison e = igi::CompareAlbedoMaps(*r.albedo_map, &eroded, want, peak);
+        std::printf("  %d texels away from unseen texels and the border: PSNR %.2f dB over %.0f %%\n",
+                    r_erode, e.psnr_db, 100 * e.compared);
+      }
       std::printf("%s albedo map %dx%d: PSNR %.2f dB (all), %.2f dB over the %.0f %% seen "
                   "(rms %.4f, peak %.3f)\n",
                   r.name.c_str(), r.albedo_map->width, r.albedo_map->height, all.psnr_db,

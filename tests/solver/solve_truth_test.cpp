@@ -41,6 +41,22 @@ fs::path StrippedScene(const fs::path& scene_json, const fs::path& dir) {
 
 double RelErr(double a, double b) { return std::abs(a - b) / std::abs(b); }
 
+// The mean of `truth` (a texture on the region's UVs) over its texels whose centres look up seen
+// texels of the solver's map (`seen`, 1 = estimated from observations).
+Eigen::Vector3d SeenMean(const Image& truth, const Image& seen) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (int y = 0; y < truth.height; ++y) {
+    for (int x = 0; x < truth.width; ++x) {
+      const Eigen::Vector2d uv((x + 0.5) / truth.width, 1.0 - (y + 0.5) / truth.height);
+      if (SampleTexture(seen, uv)[0] < 1.0) continue;
+      for (int c = 0; c < 3; ++c) sum[c] += truth.at(x, y, c);
+      ++n;
+    }
+  }
+  return sum / std::max(1, n);
+}
+
 TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
   const fs::path tmp = test::UniqueTempDir("solve_radiance");
   const Scene scene = LoadScene(StrippedScene(kRoom / "scene.json", tmp));
@@ -103,9 +119,20 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     const Json& t = truth[r.name];
     const RegionFitResult& f = r.stage1;
     if (r.name == "floor") {
-      // The textured glossy floor is the weak case (see the issue note): measured rho_d
-      // +2.3..2.9 %, rho_s +2.5 %, alpha -6 % (clean). Guarded at 5 %, 15 %, 15 %.
-      for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.05);
+      // The textured glossy floor. Its region mean is compared with the true texture's mean over
+      // the texels some photo sees (a quarter of the floor is hidden, and the tiles there
+      // differ: the whole texture's mean is 2 % off the seen part's).
+      ASSERT_TRUE(r.albedo_map_seen.has_value());
+      const Eigen::Vector3d seen_mean =
+          SeenMean(ReadImage(so.out / t["rho_d_map"].get<std::string>(), 3), *r.albedo_map_seen);
+      std::printf("floor: rho_d %+.2f %+.2f %+.2f %% (of the seen texels' true mean), rho_s "
+                  "%+.2f %%, alpha %+.2f %%\n",
+                  100 * (f.rho_d[0] / seen_mean[0] - 1), 100 * (f.rho_d[1] / seen_mean[1] - 1),
+                  100 * (f.rho_d[2] / seen_mean[2] - 1),
+                  100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
+                  100 * (f.alpha / t["alpha"].get<double>() - 1));
+      // MEASURED_FLOOR
+      for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.05);
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.15);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.15);
       EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
