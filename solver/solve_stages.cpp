@@ -233,8 +233,9 @@ void SolverState::ComputeSpecularTerms() {
 }
 
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every observation's
-// albedo as the other photos see it off their highlights (specular part under 10 % of the
-// radiance in every channel, from the current ρs and T), per texel of the albedo map's size.
+// albedo as the other photos see it off their highlights (modelled specular part under 10 % of
+// the modelled radiance in every channel, from the current parameters), per texel of the albedo
+// map's size.
 void SolverState::HeldOutAlbedos() {
   obs_rho_d_held.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   held_atlases.resize(materials.size());
@@ -255,7 +256,10 @@ void SolverState::HeldOutAlbedos() {
       if (o.region != int(r)) continue;
       const Eigen::Vector3d l = o.radiance.cast<double>();
       const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
-      if ((spec.array() > 0.1 * l.array().max(0.0)).any()) continue;
+      // Off the highlight by the model (the patch's albedo), not by the observation: a test on
+      // the observed radiance would let noise that brightens a pixel pass and bias the albedo.
+      const Eigen::Vector3d diffuse = PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi;
+      if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
       held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * (l - spec), obs_e[i]);
     }
     for (size_t i = 0; i < obs.size(); ++i) {
