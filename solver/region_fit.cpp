@@ -568,7 +568,8 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& smp = in.samples[i];
       const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
-      num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(smp.observed - r.rho_s.cwiseProduct(t[i]));
+      const Eigen::Vector3d diffuse = smp.observed - r.rho_s.cwiseProduct(t[i]);
+      num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(diffuse);
       den[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
     }
     Eigen::Vector3d sum = Eigen::Vector3d::Zero(), area = sum;

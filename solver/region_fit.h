@@ -16,6 +16,7 @@
 // the gathered irradiance (either would bias the fit).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>

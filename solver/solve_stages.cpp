@@ -264,7 +264,8 @@ void SolverState::HeldOutAlbedos() {
     }
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
-      if (o.region == int(r) && in_fit[i]) obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
+      if (o.region != int(r) || !in_fit[i]) continue;
+      obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
     }
   }
 }

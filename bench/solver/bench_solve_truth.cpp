@@ -46,7 +46,8 @@ void DumpComparison(const igi::Image& mine, const igi::Image& seen, const igi::I
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_solve_truth CAPTURE [threads=2 stride=2 texel=0 refine=1 held=1]\n");
+    std::fprintf(stderr,
+                 "usage: bench_solve_truth CAPTURE [threads=2 stride=2 texel=0 refine=1 held=1]\n");
     return 2;
   }
   const fs::path capture = argv[1];
@@ -60,14 +61,22 @@ int main(int argc, char** argv) {
     const size_t eq = arg.find('=');
     const std::string key = arg.substr(0, eq);
     const double v = std::stod(arg.substr(eq + 1));
-    if (key == "threads") o.num_threads = int(v);
-    else if (key == "stride") o.pixel_stride = int(v);
-    else if (key == "texel") o.texel_size_m = v;
-    else if (key == "refine") o.refine_iterations = int(v);
-    else if (key == "held") o.held_out_albedo = v != 0;
-    else if (key == "rays") o.indirect_rays = int(v);
-    else if (key == "dump") dump = v != 0;
-    else if (key == "smooth") o.smoothing_radius_m = v;
+    if (key == "threads")
+      o.num_threads = int(v);
+    else if (key == "stride")
+      o.pixel_stride = int(v);
+    else if (key == "texel")
+      o.texel_size_m = v;
+    else if (key == "refine")
+      o.refine_iterations = int(v);
+    else if (key == "held")
+      o.held_out_albedo = v != 0;
+    else if (key == "rays")
+      o.indirect_rays = int(v);
+    else if (key == "dump")
+      dump = v != 0;
+    else if (key == "smooth")
+      o.smoothing_radius_m = v;
     else {
       std::fprintf(stderr, "unknown key %s\n", key.c_str());
       return 2;
@@ -75,9 +84,11 @@ int main(int argc, char** argv) {
   }
   const auto start = std::chrono::steady_clock::now();
   const igi::Scene scene = igi::LoadScene(capture / "scene.json");
-  const fs::path out = fs::temp_directory_path() / ("bench_solve_truth_" + std::to_string(::getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("bench_solve_truth_" + std::to_string(::getpid()));
   const igi::SolveSummary s = igi::Solve(scene, o, out);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const igi::Json truth = igi::ReadJsonFile(capture / "truth.json")["materials"];
   auto rel = [](double a, double b) { return 100.0 * (a - b) / b; };
   std::printf("solved in %.1f s, texel %.4f m\n", seconds, s.texel_size_m);
@@ -89,7 +100,8 @@ int main(int argc, char** argv) {
     for (int stage = 1; stage <= 2; ++stage) {
       const igi::RegionFitResult& f = stage == 1 ? r.stage1 : r.stage2;
       std::printf("%-14s %-6d", r.name.c_str(), stage);
-      for (int c = 0; c < 3; ++c) std::printf(" %+7.2f", rel(f.rho_d[c], t["rho_d"][c].get<double>()));
+      for (int c = 0; c < 3; ++c)
+        std::printf(" %+7.2f", rel(f.rho_d[c], t["rho_d"][c].get<double>()));
       if (t.contains("rho_s")) {
         std::printf(" %+7.2f %+7.2f", rel(f.rho_s.mean(), t["rho_s"].get<double>()),
                     rel(f.alpha, t["alpha"].get<double>()));
@@ -121,10 +133,11 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d mt = sum_t / n, me = sum_e / n;
         const Eigen::Vector3d full(t["rho_d"][0].get<double>(), t["rho_d"][1].get<double>(),
                                    t["rho_d"][2].get<double>());
-        std::printf("%s over the seen texels: true mean %+.2f %% of the whole texture's, map mean "
-                    "%+.2f %%, fit's rho_d %+.2f %% of the seen true mean\n",
-                    r.name.c_str(), 100 * (mt.mean() / full.mean() - 1), 100 * (me.mean() / mt.mean() - 1),
-                    100 * (r.stage1.rho_d.mean() / mt.mean() - 1));
+        std::printf(
+            "%s over the seen texels: true mean %+.2f %% of the whole texture's, map mean "
+            "%+.2f %%, fit's rho_d %+.2f %% of the seen true mean\n",
+            r.name.c_str(), 100 * (mt.mean() / full.mean() - 1), 100 * (me.mean() / mt.mean() - 1),
+            100 * (r.stage1.rho_d.mean() / mt.mean() - 1));
       }
       for (int r_erode : {2, 4}) {  // away from unseen texels and the region's border
         igi::Image eroded = *r.albedo_map_seen;
@@ -142,13 +155,15 @@ int main(int argc, char** argv) {
           }
         }
         const igi::AlbedoComparison e = igi::CompareAlbedoMaps(*r.albedo_map, &eroded, want, peak);
-        std::printf("  %d texels away from unseen texels and the border: PSNR %.2f dB over %.0f %%\n",
-                    r_erode, e.psnr_db, 100 * e.compared);
+        std::printf(
+            "  %d texels away from unseen texels and the border: PSNR %.2f dB over %.0f %%\n",
+            r_erode, e.psnr_db, 100 * e.compared);
       }
-      std::printf("%s albedo map %dx%d: PSNR %.2f dB (all), %.2f dB over the %.0f %% seen "
-                  "(rms %.4f, peak %.3f)\n",
-                  r.name.c_str(), r.albedo_map->width, r.albedo_map->height, all.psnr_db,
-                  seen.psnr_db, 100 * seen.compared, seen.rms, peak);
+      std::printf(
+          "%s albedo map %dx%d: PSNR %.2f dB (all), %.2f dB over the %.0f %% seen "
+          "(rms %.4f, peak %.3f)\n",
+          r.name.c_str(), r.albedo_map->width, r.albedo_map->height, all.psnr_db, seen.psnr_db,
+          100 * seen.compared, seen.rms, peak);
     }
   }
   std::error_code ec;

@@ -52,7 +52,9 @@ Image GaussianBlur(const Image& in, double sigma) {
   const int radius = static_cast<int>(std::ceil(3 * sigma));
   std::vector<double> kernel(2 * radius + 1);
   double sum = 0;
-  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  for (int k = -radius; k <= radius; ++k) {
+    sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  }
   for (double& k : kernel) k /= sum;
   Image tmp = in, out = in;
   for (int pass = 0; pass < 2; ++pass) {

@@ -301,8 +301,9 @@ TEST(AlbedoMap, DirectMaskMarksTheTexelsTheSamplesReach) {
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
   std::mt19937 rng(3);
   AlbedoMapBuilder builder(atlas);
-  AddSamples(mesh, atlas.triangles, 20000, [](const Eigen::Vector3d& p) { return Albedo(p.x(), p.y()); },
-             [](const Eigen::Vector3d& p) { return p.x() < 0.5; }, &builder, rng);
+  AddSamples(
+      mesh, atlas.triangles, 20000, [](const Eigen::Vector3d& p) { return Albedo(p.x(), p.y()); },
+      [](const Eigen::Vector3d& p) { return p.x() < 0.5; }, &builder, rng);
   const Image mask = builder.DirectMask();
   ASSERT_EQ(mask.width, atlas.width);
   ASSERT_EQ(mask.channels, 1);

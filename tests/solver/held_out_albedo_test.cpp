@@ -42,7 +42,8 @@ TEST(HeldOutAlbedo, EachPhotoReadsTheOtherPhotosOnly) {
       const Point p = At(x, y);
       held.Add(0, 0, p.b1, p.b2, Eigen::Vector3d::Constant(0.5 * 2), Eigen::Vector3d::Constant(2));
       if (x > 0.6) {
-        held.Add(1, 0, p.b1, p.b2, Eigen::Vector3d(0.8, 0.7, 0.6) * 2, Eigen::Vector3d::Constant(2));
+        held.Add(1, 0, p.b1, p.b2, Eigen::Vector3d(0.8, 0.7, 0.6) * 2,
+                 Eigen::Vector3d::Constant(2));
       }
     }
   }

@@ -53,8 +53,8 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
   Synthesize(so);
   const Scene scene = LoadScene(so.out / "scene.json");
   SolveOptions o;
-  o.pixel_stride = 1;        // every pixel: the map averages the photos' Monte Carlo noise
-  o.texel_size_m = 0.0462;   // twice the median pixel footprint (87 × 87 texels on the floor)
+  o.pixel_stride = 1;       // every pixel: the map averages the photos' Monte Carlo noise
+  o.texel_size_m = 0.0462;  // twice the median pixel footprint (87 × 87 texels on the floor)
   o.refine_iterations = 0;
   o.show_progress = false;
   const SolveSummary s = Solve(scene, o, tmp / "out");
@@ -66,25 +66,31 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
   double peak = 0;
   for (float v : want.pixels) peak = std::max(peak, double(v));
   const AlbedoComparison all = CompareAlbedoMaps(*floor.albedo_map, nullptr, want, peak);
-  const AlbedoComparison seen = CompareAlbedoMaps(*floor.albedo_map, &*floor.albedo_map_seen, want, peak);
+  const AlbedoComparison seen =
+      CompareAlbedoMaps(*floor.albedo_map, &*floor.albedo_map_seen, want, peak);
   const Image interior_mask = Eroded(*floor.albedo_map_seen, 2);
-  const AlbedoComparison interior = CompareAlbedoMaps(*floor.albedo_map, &interior_mask, want, peak);
-  std::printf("floor albedo map: PSNR %.2f dB (all texels), %.2f dB over the %.0f %% seen, %.2f dB "
-              "over the %.0f %% two texels inside\n",
-              all.psnr_db, seen.psnr_db, 100 * seen.compared, interior.psnr_db,
-              100 * interior.compared);
+  const AlbedoComparison interior =
+      CompareAlbedoMaps(*floor.albedo_map, &interior_mask, want, peak);
+  std::printf(
+      "floor albedo map: PSNR %.2f dB (all texels), %.2f dB over the %.0f %% seen, %.2f dB "
+      "over the %.0f %% two texels inside\n",
+      all.psnr_db, seen.psnr_db, 100 * seen.compared, interior.psnr_db, 100 * interior.compared);
   // About three quarters of the floor is seen (the boxes and the sphere hide the rest).
   EXPECT_GT(seen.compared, 0.65);
-  // Measured 32.9 dB over the seen texels (33.8 dB with 512-spp photos): the rest of the error
-  // is the photos' Monte Carlo noise (about 7 % per pixel at 256 spp) and the irradiance near
-  // the walls and the boxes' contacts. Two texels (9 cm) inside: 35.3 dB at 512 spp.
+  // Issue 7 asks 35 dB (noise-free). Measured 32.9 dB over the seen texels and 34.4 dB two
+  // texels (9 cm) inside them (33.8 and 35.3 dB with 512-spp photos, bench/RESULTS.md): the rest
+  // is the photos' Monte Carlo noise (about 7 % per pixel at 256 spp), the gathered indirect
+  // irradiance's noise, and its bias near the walls and the boxes' and sphere's contacts.
   // Guarded 1 dB below the measured values.
   EXPECT_GT(seen.psnr_db, 31.9);
-  EXPECT_GT(interior.psnr_db, 33.0);
+  EXPECT_GT(interior.psnr_db, 33.4);
+  std::printf("floor: rho_s %+.2f %%, alpha %+.2f %%\n",
+              100 * (floor.stage1.rho_s.mean() / truth["floor"]["rho_s"].get<double>() - 1),
+              100 * (floor.stage1.alpha / truth["floor"]["alpha"].get<double>() - 1));
   // The floor's lobe, fitted with each sample's albedo from the other photos (held-out, texel
-  // scale): measured ρs −4.5 %, α +3.7 % (issue 7: within 5 %).
-  EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.07);
-  EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.07);
+  // scale): measured rho_s -1.0 %, alpha -0.3 %; guarded at issue 7's bar, 5 %.
+  EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
+  EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
 }
 
 }  // namespace

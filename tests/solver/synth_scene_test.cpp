@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -108,7 +109,9 @@ TEST(SynthRoom, SmoothFloorTextureIsTheTilesLowPassFiltered) {
   auto largest_step = [](const Image& img) {
     double step = 0;
     for (int y = 0; y < img.height; ++y) {
-      for (int x = 0; x + 1 < img.width; ++x) step = std::max(step, double(std::abs(img.at(x + 1, y, 1) - img.at(x, y, 1))));
+      for (int x = 0; x + 1 < img.width; ++x) {
+        step = std::max(step, double(std::abs(img.at(x + 1, y, 1) - img.at(x, y, 1))));
+      }
     }
     return step;
   };
