@@ -167,6 +167,15 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     const RegionSolution& floor_solution = s.regions[scene.FindMaterial("floor")];
     ASSERT_FALSE(floor_solution.albedo_map_file.empty());
     const Image mine = ReadImage(tmp / "out" / floor_solution.albedo_map_file, 3);
+    // Beside the map: which texels the photos estimate (255) and which were filled (0).
+    const Image seen_png = ReadImage(tmp / "out" / "albedo" / "floor_seen.png", 1);
+    ASSERT_EQ(seen_png.width, mine.width);
+    ASSERT_EQ(seen_png.height, mine.height);
+    double seen_share = 0;
+    for (float v : seen_png.pixels) seen_share += v > 0.5f;
+    seen_share /= double(seen_png.pixels.size());
+    EXPECT_GT(seen_share, 0.5);  // about two thirds of the floor's texels (boxes, sphere hide some)
+    EXPECT_LT(seen_share, 0.9);
     const Image want = ReadImage(so.out / truth["floor"]["rho_d_map"].get<std::string>(), 3);
     Image resampled(want.width, want.height, 3);
     double peak = 0;
