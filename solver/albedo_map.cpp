@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "solver/render_internal.h"
 #include "tools/common/error.h"
 
 namespace igi {
@@ -246,6 +247,16 @@ double AlbedoMapBuilder::Coverage() const {
   return total == 0 ? 0.0 : double(direct) / double(total);
 }
 
+Image AlbedoMapBuilder::DirectMask() const {
+  Image mask(atlas_->width, atlas_->height, 1);
+  for (int y = 0; y < atlas_->height; ++y) {
+    for (int x = 0; x < atlas_->width; ++x) {
+      mask.at(x, y, 0) = Direct(x, y, 0) && Direct(x, y, 1) && Direct(x, y, 2) ? 1.f : 0.f;
+    }
+  }
+  return mask;
+}
+
 double AlbedoPsnr(const Image& estimate, const Image& truth, double peak) {
   if (estimate.width != truth.width || estimate.height != truth.height ||
       estimate.channels != truth.channels || estimate.pixels.size() != truth.pixels.size()) {
@@ -263,6 +274,57 @@ double AlbedoPsnr(const Image& estimate, const Image& truth, double peak) {
   }
   const double mse = sum / double(estimate.pixels.size());
   return mse == 0 ? INFINITY : 10.0 * std::log10(peak * peak / mse);
+}
+
+namespace {
+
+// Whether every texel that a bilinear lookup at `uv` reads with a non-zero weight is seen.
+bool LookupSeen(const Image& seen, const Eigen::Vector2d& uv) {
+  const double x = uv.x() * seen.width - 0.5, y = (1.0 - uv.y()) * seen.height - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  for (int dy = 0; dy < 2; ++dy) {
+    for (int dx = 0; dx < 2; ++dx) {
+      if ((dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) <= 0) continue;
+      const int xi = std::clamp(x0 + dx, 0, seen.width - 1);
+      const int yi = std::clamp(y0 + dy, 0, seen.height - 1);
+      if (!(seen.at(xi, yi, 0) > 0.5f)) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, const Image& truth,
+                                   double peak) {
+  if (estimate.empty() || truth.empty()) throw Error("CompareAlbedoMaps: empty image");
+  if (seen != nullptr && (seen->width != estimate.width || seen->height != estimate.height)) {
+    throw Error("CompareAlbedoMaps: the seen mask differs in size from the estimate");
+  }
+  if (!(peak > 0)) throw Error("CompareAlbedoMaps: peak must be > 0");
+  double sum = 0;
+  int64_t count = 0, texels = 0;
+  for (int y = 0; y < truth.height; ++y) {
+    for (int x = 0; x < truth.width; ++x) {
+      ++texels;
+      const Eigen::Vector2d uv((x + 0.5) / truth.width, 1.0 - (y + 0.5) / truth.height);
+      if (seen != nullptr && !LookupSeen(*seen, uv)) continue;
+      const Eigen::Vector3d v = SampleTexture(estimate, uv);
+      for (int c = 0; c < 3; ++c) {
+        const double d = v[c] - truth.at(x, y, std::min(c, truth.channels - 1));
+        sum += d * d;
+      }
+      ++count;
+    }
+  }
+  if (count == 0) throw Error("CompareAlbedoMaps: no texel compared (nothing seen)");
+  AlbedoComparison out;
+  const double mse = sum / double(3 * count);
+  out.rms = std::sqrt(mse);
+  out.psnr_db = mse == 0 ? INFINITY : 10.0 * std::log10(peak * peak / mse);
+  out.compared = double(count) / double(texels);
+  return out;
 }
 
 }  // namespace igi

@@ -52,6 +52,10 @@ class AlbedoMapBuilder {
   // directly (see kDefaultMinTexelWeight); 0 when the region covers no texel centre.
   double Coverage() const;
 
+  // Which texels are estimated directly (1) rather than filled (0): a one-channel image of the
+  // atlas's size, row 0 = top like Finish()'s. Texels seen by no photo are 0.
+  Image DirectMask() const;
+
   int64_t num_samples() const { return num_samples_; }  // samples added (incl. merged)
 
  private:
@@ -71,5 +75,19 @@ class AlbedoMapBuilder {
 // PSNR in dB, 10·log10(peak² / MSE), over all texels and channels (+infinity when equal). Throws
 // igi::Error when the sizes or channel counts differ, the images are empty, or peak <= 0.
 double AlbedoPsnr(const Image& estimate, const Image& truth, double peak);
+
+// An albedo map against a true texture on the same UVs, possibly of another size: the estimate
+// is looked up bilinearly (the renderer's convention) at each true texel's centre. With `seen`
+// (AlbedoMapBuilder::DirectMask()), only the true texels whose lookup reads seen texels alone
+// (of those with a non-zero bilinear weight) are compared.
+struct AlbedoComparison {
+  double psnr_db = 0;         // 10·log10(peak² / MSE) over the compared texels and channels
+  double rms = 0;             // √MSE
+  double compared = 0;        // fraction of the true texels compared
+};
+// Throws igi::Error when an image is empty, `seen` differs in size from `estimate`, peak <= 0,
+// or no texel is compared.
+AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, const Image& truth,
+                                   double peak);
 
 }  // namespace igi

@@ -466,6 +466,25 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
   return var > std::pow(0.03 * mean, 2) && var > 3 * noise;
 }
 
+// The samples whose held-out albedo is known, each with that albedo as its known ρd (in `held`,
+// a copy of `in` with fit_rho_d off); false (and `held` unchanged) when fewer than a fifth of
+// the samples, or fewer than 50, have one.
+bool FitWithHeldAlbedo(const RegionFitInput& in, RegionFitInput* held) {
+  std::vector<FitSample> kept;
+  for (const FitSample& s : in.samples) {
+    if (!s.rho_d_held.allFinite()) continue;
+    kept.push_back(s);
+    kept.back().rho_d_known = s.rho_d_held;
+  }
+  if (kept.size() < 50 || kept.size() * 5 < in.samples.size()) {
+    held->use_held_albedo = false;
+    return false;
+  }
+  held->samples = std::move(kept);
+  held->use_held_albedo = true;
+  return true;
+}
+
 }  // namespace
 
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
@@ -516,7 +535,14 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   RegionFitInput held = in;
   held.fit_rho_d = false;
   AlphaSearch b;
-  for (int round = 0; round < 2; ++round) {
+  if (in.use_held_albedo && FitWithHeldAlbedo(in, &held)) {
+    const Prepared ph = Prepare(held);
+    b = SearchAlpha(held, ph, false);
+    t = SpecularTerms(in, b.ax, b.ay);
+    patch.rho_s = b.linear.rho_s;
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+  }
+  for (int round = 0; round < 2 && !held.use_held_albedo; ++round) {
     for (FitSample& smp : held.samples) {
       const Eigen::Vector3d& v = patch.slot_rho_d[smp.slot];
       smp.rho_d_known = v.allFinite() ? v : r.rho_d;
@@ -531,18 +557,32 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.alpha = r.alpha_x = b.ax;
   r.alpha_y = b.ay;
   r.slot_rho_d = patch.slot_rho_d;
-  // The region's mean albedo with the lobe fitted: Σ(L − specular)/Σ E/π over every sample (a
-  // ratio of sums, as the constant model computes it). The patches' own albedos come from the
-  // samples off the highlights, which favour bright texels there; their mean would be biased.
+  // The region's mean albedo with the lobe fitted: per patch Σ(L − specular)/Σ E/π over all its
+  // samples (a ratio of sums, highlights included), then the area-weighted mean over the patches
+  // that have samples. A ratio of sums over the whole region would weight each patch by its
+  // sample count (the fit samples crowd around the highlights, near cameras give more pixels),
+  // which biases the mean of a textured region toward the tiles that happen to lie there; the
+  // patches' off-highlight albedos favour bright texels near the highlights.
   {
-    Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = num;
+    std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
     for (size_t i = 0; i < in.samples.size(); ++i) {
+      const FitSample& smp = in.samples[i];
       const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
-      num += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed - r.rho_s.cwiseProduct(t[i]));
-      den += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+      const Eigen::Vector3d diffuse = smp.observed - r.rho_s.cwiseProduct(t[i]);
+      num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(diffuse);
+      den[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero(), area = sum;
+    for (int k = 0; k < in.num_slots; ++k) {
+      const double area_k = k < int(in.slot_area.size()) ? in.slot_area[k] : 1.0;
+      for (int c = 0; c < 3; ++c) {
+        if (!(den[k][c] > 0)) continue;
+        sum[c] += area_k * num[k][c] / den[k][c];
+        area[c] += area_k;
+      }
     }
     for (int c = 0; c < 3; ++c) {
-      if (den[c] > 0) r.rho_d[c] = std::max(0.0, num[c] / den[c]);
+      if (area[c] > 0) r.rho_d[c] = std::max(0.0, sum[c] / area[c]);
     }
   }
   for (Eigen::Vector3d& v : r.slot_rho_d) {
@@ -550,7 +590,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   }
   // Uncertainties from the projected problem: ρs from its normal equation, α from the
   // curvature of the profile cost in log α (the patches' albedos held).
-  const double dof = std::max(1.0, 3.0 * in.samples.size() - 2);
+  const double dof = std::max(1.0, 3.0 * held.samples.size() - 2);
   const double s2 = b.linear.cost / dof;
   r.sigma_rho_s = b.linear.sum_v2 > 0 ? std::sqrt(s2 / b.linear.sum_v2) : kNan;
   r.sigma_alpha = r.sigma_alpha_x = r.sigma_alpha_y =

@@ -16,6 +16,7 @@
 // the gathered irradiance (either would bias the fit).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct FitSample {
   Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // E
   Eigen::Vector3d rho_d_known = Eigen::Vector3d::Zero();  // used when the region's ρd is known
   int slot = 0;                                          // its patch among the region's slots
+  // The albedo at this point seen by the other photos off their highlights (solver/
+  // held_out_albedo.h); NaN when unknown. Used by RegionFitInput::use_held_albedo.
+  Eigen::Vector3d rho_d_held = Eigen::Vector3d::Constant(NAN);
   Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();         // local, toward the camera
   int incident_begin = 0, incident_end = 0;              // into RegionFitInput::incident
 };
@@ -54,6 +58,12 @@ struct RegionFitInput {
   // Whether the albedo varies over the region, when an earlier fit decided it (the refinement's
   // noisier irradiance would otherwise tip the test); unset: decided from these samples.
   std::optional<bool> albedo_varies;
+  // When the albedo varies (per patch): fit ρs and α to the samples whose rho_d_held is known,
+  // each with that albedo (texel-scale, from the other photos), instead of their patch's
+  // off-highlight mean. A patch is coarser than a texture's detail, and a highlight patch that
+  // only highlight pixels see would otherwise take the region's mean albedo, its texture's
+  // deviation from the mean going into ρs and α.
+  bool use_held_albedo = false;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot
   std::vector<FitSample> samples;

@@ -50,6 +50,9 @@ struct RegionSolution {
   std::optional<Image> albedo_map;
   std::string albedo_map_file;
   double albedo_map_coverage = 0;
+  // Per texel of albedo_map: 1 where observations estimate it directly, 0 where it was filled
+  // from its neighbours (seen by no photo, or outside the region's charts). One channel.
+  std::optional<Image> albedo_map_seen;
   bool albedo_map_generated_uvs = false;
 };
 

@@ -65,6 +65,10 @@ struct SolverState {
   std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
   std::vector<std::vector<IncidentLocal>> obs_incident;
   std::vector<Eigen::Vector3d> obs_t;
+  // Per observation of a textured glossy region: its albedo from the other photos' observations
+  // off the highlights, at the albedo map's texel (solver/held_out_albedo.h); NaN elsewhere.
+  std::vector<Eigen::Vector3d> obs_rho_d_held;
+  std::vector<std::unique_ptr<RegionAtlas>> held_atlases;  // per region, built when needed
 
   SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
 
@@ -90,6 +94,7 @@ struct SolverState {
   std::vector<Eigen::Vector3d> NeighbourMean(const std::vector<Eigen::Vector3d>& values,
                                              double radius, bool same_photo) const;
   void ComputeSpecularTerms();
+  void HeldOutAlbedos();
   double FitAll(int stage, int iteration);  // returns the largest relative change
   void RunStage1();
   void RunStage2();

@@ -51,7 +51,7 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 // The specular term T of each observation is noisy (few incident samples carry the reflected
 // room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
 static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
-                         const std::vector<Eigen::Vector3d>& obs_t) {
+                         const std::vector<Eigen::Vector3d>& obs_t, Image* seen = nullptr) {
   AlbedoMapBuilder builder(atlas);
   const MaterialState& m = s.materials[r];
   for (size_t i = 0; i < s.obs.size(); ++i) {
@@ -74,6 +74,7 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * e);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
+  if (seen != nullptr) *seen = builder.DirectMask();
   return builder.Finish(m.params.rho_d);
 }
 
@@ -257,7 +258,9 @@ void SolverState::BuildAlbedoMaps() {
     if (!want) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
-    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t);
+    Image seen;
+    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, &seen);
+    rs.albedo_map_seen = std::move(seen);
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     rs.albedo_map_generated_uvs = atlas.generated;
     if (atlas.generated) generated.push_back(atlas);

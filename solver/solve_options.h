@@ -32,6 +32,9 @@ struct SolveOptions {
   // declare UVs and vary), "all" for every region with an unknown albedo, "none".
   std::string albedo_maps = "auto";
   double texel_size_m = 0;  // albedo map texel, metres; 0 = auto (the median pixel footprint)
+  // A textured glossy region's ρs and α are fitted with each sample's albedo as the other photos
+  // see that texel off their highlights (false: its patch's off-highlight albedo).
+  bool held_out_albedo = true;
   // Beyond the paper: re-render the light arriving at every observation with the full path
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;

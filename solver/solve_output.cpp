@@ -14,6 +14,12 @@ namespace igi {
 namespace fs = std::filesystem;
 namespace {
 
+// The seen-texel mask beside an albedo map: albedo/floor.exr -> albedo/floor_seen.png.
+std::string SeenFile(const std::string& map_file) {
+  const fs::path p(map_file);
+  return (p.parent_path() / (p.stem().string() + "_seen.png")).generic_string();
+}
+
 Json Num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json Vec(const Eigen::Vector3d& v) { return Json::array({Num(v[0]), Num(v[1]), Num(v[2])}); }
 
@@ -142,6 +148,8 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                           {"height", r.albedo_map ? r.albedo_map->height : 0},
                           {"coverage", Num(r.albedo_map_coverage)},
                           {"generated_uvs", r.albedo_map_generated_uvs}};
+      // Which texels the photos estimate (255) and which were filled from neighbours (0).
+      if (r.albedo_map_seen) rj["albedo_map"]["seen_file"] = SeenFile(r.albedo_map_file);
     }
     regions.push_back(rj);
   }
@@ -197,6 +205,11 @@ void WriteSolveOutputs(const SolveSummary& s, const SolveOptions& o, const fs::p
     WriteImageOptions wo;
     wo.type = PixelType::kFloat;
     WriteImage(out / r.albedo_map_file, *r.albedo_map, wo);
+    if (r.albedo_map_seen) {
+      WriteImageOptions mo;
+      mo.type = PixelType::kUInt8;
+      WriteImage(out / SeenFile(r.albedo_map_file), *r.albedo_map_seen, mo);
+    }
   }
   if (s.charted_mesh) {
     fs::create_directories(out / "geometry");

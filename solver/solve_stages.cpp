@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "solver/albedo_map.h"
+#include "solver/held_out_albedo.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
@@ -231,8 +232,47 @@ void SolverState::ComputeSpecularTerms() {
       options.num_threads);
 }
 
+// For each glossy region with an unknown, varying albedo and a fitted lobe: every observation's
+// albedo as the other photos see it off their highlights (modelled specular part under 10 % of
+// the modelled radiance in every channel, from the current parameters), per texel of the albedo
+// map's size.
+void SolverState::HeldOutAlbedos() {
+  obs_rho_d_held.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
+  held_atlases.resize(materials.size());
+  for (size_t r = 0; r < materials.size(); ++r) {
+    const MaterialState& m = materials[r];
+    if (!m.NeedsFit() || !m.unknown_rho_d || m.no_highlight || !HasSpecularLobe(m.params.model) ||
+        !m.last_fit.fitted || !m.last_fit.albedo_varies || m.observations == 0) {
+      continue;
+    }
+    if (!held_atlases[r]) {
+      AtlasOptions ao;
+      ao.texel_size_m = summary.texel_size_m;
+      held_atlases[r] = std::make_unique<RegionAtlas>(BuildRegionAtlas(scene.mesh, int(r), ao));
+    }
+    HeldOutAlbedo held(*held_atlases[r]);
+    for (size_t i = 0; i < obs.size(); ++i) {
+      const Observation& o = obs[i];
+      if (o.region != int(r)) continue;
+      const Eigen::Vector3d l = o.radiance.cast<double>();
+      const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
+      // Off the highlight by the model (the patch's albedo), not by the observation: a test on
+      // the observed radiance would let noise that brightens a pixel pass and bias the albedo.
+      const Eigen::Vector3d diffuse = PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi;
+      if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
+      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * (l - spec), obs_e[i]);
+    }
+    for (size_t i = 0; i < obs.size(); ++i) {
+      const Observation& o = obs[i];
+      if (o.region != int(r) || !in_fit[i]) continue;
+      obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
+    }
+  }
+}
+
 double SolverState::FitAll(int stage, int iteration) {
   const auto start = std::chrono::steady_clock::now();
+  HeldOutAlbedos();
   std::vector<int> regions;
   for (size_t r = 0; r < materials.size(); ++r) {
     if (materials[r].NeedsFit() && materials[r].observations > 0) regions.push_back(int(r));
@@ -260,6 +300,7 @@ double SolverState::FitAll(int stage, int iteration) {
     in.ior = m.params.ior;
     if (m.last_fit.fitted && HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
+    in.use_held_albedo = options.held_out_albedo;
     in.num_slots = static_cast<int>(region_patches[r].size());
     for (int q : region_patches[r]) in.slot_area.push_back(patches.area[q]);
   }
@@ -274,6 +315,7 @@ double SolverState::FitAll(int stage, int iteration) {
     s.irradiance = obs_e[i];
     s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : KnownAlbedo(o);
     s.slot = patch_slot[o.patch];
+    s.rho_d_held = obs_rho_d_held[i];
     s.wo = LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.incident_begin = static_cast<int>(in.incident.size());
     in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());

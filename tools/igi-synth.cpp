@@ -42,6 +42,9 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "Random seed (same seed, same files)");
   app.add_option("--glossy-brdf", o.glossy_brdf, "True model of the glossy regions: ward|ward_gmd");
   app.add_option("--lamp", o.lamp, "Lamp type: sphere (r = 4 cm) or point");
+  app.add_option("--floor-texture", o.floor_texture,
+                 "Floor albedo: tiles (grout lines and grain finer than a pixel) or smooth (the "
+                 "tiles low-pass filtered, sigma 6 cm, resolved by the photos)");
   app.add_option("--unknowns", unknowns,
                  "Material keys left out of scene.json: list of rho_d,rho_s,alpha or none");
   app.add_option("--photo-lightings", photo_lightings, "Lightings photographed: L0[,L1]");

@@ -20,8 +20,9 @@ Json Glossy(const std::string& brdf, const Vector3d& rho_d, double rho_s, double
   return Json{{"brdf", brdf}, {"rho_d", Rgb(rho_d)}, {"rho_s", rho_s}, {"alpha", alpha}};
 }
 
-// Floor tiles: 4 × 4 tiles of 1 m, each with its own albedo, dark grout, and a faint grain.
-Image MakeFloorTexture(uint64_t seed) {
+// Floor tiles: 4 × 4 tiles of 1 m, each with its own albedo, dark grout, and a faint grain
+// (`grain` false: none).
+Image MakeFloorTexture(uint64_t seed, bool grain_on = true) {
   constexpr int kSize = 128;
   constexpr int kTiles = 4;
   Image img(kSize, kSize, 3);
@@ -38,12 +39,42 @@ Image MakeFloorTexture(uint64_t seed) {
       const int lx = x % tile_px, ly = y % tile_px;
       const bool grout = lx < 1 || ly < 1;
       Pcg32 grain_rng(seed ^ 0x9a11, uint64_t(y) * kSize + x);
-      const double grain = 1.0 + 0.06 * (grain_rng.UniformDouble() - 0.5);
+      const double grain = grain_on ? 1.0 + 0.06 * (grain_rng.UniformDouble() - 0.5) : 1.0;
       const Vector3d a = grout ? Vector3d(0.12, 0.12, 0.11) : tile_albedo[ty * kTiles + tx] * grain;
       for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(a[c]);
     }
   }
   return img;
+}
+
+// Separable Gaussian blur (σ in texels, ±3σ support, indices clamped at the edges).
+Image GaussianBlur(const Image& in, double sigma) {
+  const int radius = static_cast<int>(std::ceil(3 * sigma));
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0;
+  for (int k = -radius; k <= radius; ++k) {
+    sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  }
+  for (double& k : kernel) k /= sum;
+  Image tmp = in, out = in;
+  for (int pass = 0; pass < 2; ++pass) {
+    const Image& src = pass == 0 ? in : tmp;
+    Image& dst = pass == 0 ? tmp : out;
+    for (int y = 0; y < in.height; ++y) {
+      for (int x = 0; x < in.width; ++x) {
+        for (int c = 0; c < in.channels; ++c) {
+          double v = 0;
+          for (int k = -radius; k <= radius; ++k) {
+            const int xi = pass == 0 ? std::clamp(x + k, 0, in.width - 1) : x;
+            const int yi = pass == 1 ? std::clamp(y + k, 0, in.height - 1) : y;
+            v += kernel[k + radius] * src.at(xi, yi, c);
+          }
+          dst.at(x, y, c) = float(v);
+        }
+      }
+    }
+  }
+  return out;
 }
 
 // Value noise in [0, 1]: octaves of bilinearly interpolated random grids (4 to 256 cells across),
@@ -186,7 +217,9 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   room.mesh.AddSphere({1.3, 1.4, 0.35}, 0.35, 16, 32, "glossy_sphere");
   room.mesh.AddBox({0.9, 3.1}, 0.0, {0.6, 0.6, 1.4}, -15.0, "matte_box");
 
-  room.floor_albedo = MakeFloorTexture(options.seed);
+  room.floor_albedo = options.floor_texture == "smooth"
+                          ? GaussianBlur(MakeFloorTexture(options.seed, false), 2.0)
+                          : MakeFloorTexture(options.seed);
   const bool rho_d_known = !Contains(options.unknowns, "rho_d");
   room.floor_albedo_file =
       rho_d_known ? "textures/floor_albedo.exr" : "truth/textures/floor_albedo.exr";

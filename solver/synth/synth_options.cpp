@@ -118,6 +118,9 @@ void SynthOptions::Validate() const {
     p.Add("--glossy-brdf", "", glossy_brdf, "must be ward or ward_gmd");
   }
   if (lamp != "sphere" && lamp != "point") p.Add("--lamp", "", lamp, "must be sphere or point");
+  if (floor_texture != "tiles" && floor_texture != "smooth") {
+    p.Add("--floor-texture", "", floor_texture, "must be tiles or smooth");
+  }
   for (const std::string& u : unknowns) {
     if (u != "rho_d" && u != "rho_s" && u != "alpha") {
       p.Add("--unknowns", "", u, "must be a list of rho_d, rho_s, alpha (or none)");

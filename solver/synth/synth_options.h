@@ -88,6 +88,11 @@ struct SynthOptions {
   // structure-from-motion finds features everywhere (registration tests). Off: only the floor
   // is textured.
   bool textured_walls = false;
+  // The floor's albedo texture: "tiles" (4 × 4 tiles, one-texel grout lines and a per-texel
+  // grain: detail finer than the photos' pixel footprint), or "smooth": the same tiles and grout
+  // without the grain, low-pass filtered (Gaussian, σ = 2 texels = 6.25 cm) so that the photos
+  // resolve it (albedo-map accuracy tests: the truth is then recoverable from the pixels).
+  std::string floor_texture = "tiles";
   // scene.json declares no "cameras" and no "photos" (an unposed capture: the poses must be
   // recovered, e.g. by igi-register); truth/scene.json keeps the true cameras.
   bool unposed = false;

@@ -275,6 +275,7 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
                 {"validation", r.validation},
                 {"scene", "truth/scene.json"},
                 {"unknowns", options.unknowns},
+                {"floor_texture", options.floor_texture},
                 {"cameras", CameraTruth(cameras)},
                 {"photos", r.photo_truth},
                 {"sensor", SensorTruth(options)},

@@ -2,6 +2,7 @@
 // and PSNR.
 #include "solver/albedo_map.h"
 #include "solver/render_internal.h"
+#include "tools/common/error.h"
 
 #include <gtest/gtest.h>
 
@@ -289,6 +290,60 @@ TEST(AlbedoPsnr, KnownImages) {
   EXPECT_THROW(AlbedoPsnr(Image(4, 4, 3), truth, 1.0), Error);
   EXPECT_THROW(AlbedoPsnr(Image(4, 3, 1), truth, 1.0), Error);
   EXPECT_THROW(AlbedoPsnr(truth, truth, 0.0), Error);
+}
+
+// The seen mask marks exactly the texels estimated directly: samples only on the left half of
+// the quad leave the right half unseen (0) while Finish() fills it.
+TEST(AlbedoMap, DirectMaskMarksTheTexelsTheSamplesReach) {
+  const TriangleMesh mesh = Quad();
+  AtlasOptions options;
+  options.texel_size_m = 0.02;
+  const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
+  std::mt19937 rng(3);
+  AlbedoMapBuilder builder(atlas);
+  AddSamples(
+      mesh, atlas.triangles, 20000, [](const Eigen::Vector3d& p) { return Albedo(p.x(), p.y()); },
+      [](const Eigen::Vector3d& p) { return p.x() < 0.5; }, &builder, rng);
+  const Image mask = builder.DirectMask();
+  ASSERT_EQ(mask.width, atlas.width);
+  ASSERT_EQ(mask.channels, 1);
+  int left = 0, right = 0;
+  for (int y = 0; y < mask.height; ++y) {
+    for (int x = 0; x < mask.width; ++x) {
+      const double u = (x + 0.5) / mask.width;
+      if (u < 0.45) left += mask.at(x, y) > 0.5f;
+      if (u > 0.55) right += mask.at(x, y) > 0.5f;
+    }
+  }
+  EXPECT_EQ(left, mask.height * 22);  // every texel centre at u < 0.45 (22 columns) is seen
+  EXPECT_EQ(right, 0);
+}
+
+// CompareAlbedoMaps resamples the estimate at the truth's texels and, with a mask, compares only
+// where the estimate was seen: an estimate wrong only in its unseen half is perfect over the seen.
+TEST(AlbedoMap, CompareAlbedoMapsCountsOnlyTheSeenTexels) {
+  Image truth(64, 32, 3), estimate(32, 16, 3), seen(32, 16, 1);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      for (int c = 0; c < 3; ++c) truth.at(x, y, c) = 0.5f;
+    }
+  }
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      for (int c = 0; c < 3; ++c) estimate.at(x, y, c) = x < 16 ? 0.5f : 0.9f;
+      seen.at(x, y) = x < 16 ? 1.f : 0.f;
+    }
+  }
+  const AlbedoComparison all = CompareAlbedoMaps(estimate, nullptr, truth, 1.0);
+  EXPECT_NEAR(all.compared, 1.0, 1e-12);
+  EXPECT_LT(all.psnr_db, 12.0);  // half the texels off by 0.4: rms ≈ 0.28
+  const AlbedoComparison part = CompareAlbedoMaps(estimate, &seen, truth, 1.0);
+  // Truth columns whose lookup reads estimate columns < 16 only: x < 31 of 64.
+  EXPECT_NEAR(part.compared, 31.0 / 64.0, 1e-12);
+  EXPECT_TRUE(std::isinf(part.psnr_db));
+  Image nothing(32, 16, 1);
+  EXPECT_THROW(CompareAlbedoMaps(estimate, &nothing, truth, 1.0), Error);
+  EXPECT_THROW(CompareAlbedoMaps(estimate, &truth, truth, 1.0), Error);  // mask size differs
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -40,11 +41,12 @@ TEST(SynthOptions, ValidateRejectsBadValues) {
   o.cameras = 0;
   o.spp = 0;
   o.unknowns = {"colour"};
+  o.floor_texture = "marble";
   try {
     o.Validate();
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(e.problems().size(), 3u);
+    EXPECT_EQ(e.problems().size(), 4u);
   }
 }
 
@@ -93,6 +95,31 @@ TEST(SynthRoom, HasGlossyAndLambertianRegionsATexturedFloorAndTwoLamps) {
   EXPECT_EQ(room.lamps.size(), 2u);
   o.unknowns = {"rho_s"};
   EXPECT_EQ(BuildRoom(o).floor_albedo_file, "textures/floor_albedo.exr");
+}
+
+// --floor-texture smooth: the same tiles without detail finer than a few texels (neighbouring
+// texels differ by little where the default's grout lines jump by 0.2 or more), the same mean.
+TEST(SynthRoom, SmoothFloorTextureIsTheTilesLowPassFiltered) {
+  SynthOptions o;
+  const Image tiles = BuildRoom(o).floor_albedo;
+  o.floor_texture = "smooth";
+  const SynthRoom room = BuildRoom(o);
+  const Image& smooth = room.floor_albedo;
+  ASSERT_EQ(smooth.width, tiles.width);
+  auto largest_step = [](const Image& img) {
+    double step = 0;
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x + 1 < img.width; ++x) {
+        step = std::max(step, double(std::abs(img.at(x + 1, y, 1) - img.at(x, y, 1))));
+      }
+    }
+    return step;
+  };
+  EXPECT_GT(largest_step(tiles), 0.2);
+  // A tile edge of up to 0.48 (0.6 against grout 0.12) blurred with σ = 2 texels: ≤ 0.48·0.2.
+  EXPECT_LT(largest_step(smooth), 0.1);
+  EXPECT_NEAR(ImageMean(smooth).y(), ImageMean(tiles).y(), 0.01 * ImageMean(tiles).y());
+  EXPECT_NEAR(room.materials["floor"]["rho_d"][1].get<double>(), ImageMean(smooth).y(), 1e-12);
 }
 
 // Each highlight camera sits on the mirror direction of the lamp about the surface normal at its
