@@ -33,6 +33,10 @@ struct DemoOptions {
   // Two of the overview cameras look up: a ceiling no photo sees keeps placeholder values,
   // its missing light biases every other region's rho_d (measured: ~+25 %, rho_s/k ~-30 %).
   int ceiling_cameras = 2;
+  // The synthetic camera is calibrated absolutely (igi-run --radiance-scale), as a lab camera
+  // measured against a radiance standard: without it the albedos come out in the HDR maps'
+  // arbitrary scale, which weakens every bounce (measured: rho_s/k -27..-29 %).
+  bool absolute_calibration = true;
   std::vector<std::string> solve_args = {"--refine-iterations", "0"};
   // The demo's diagnosis: coarser samples and at most two steps (it is the slowest stage).
   std::vector<std::string> diagnose_args = {"--pixel-stride", "4",  "--max-steps",         "2",
@@ -48,6 +52,12 @@ struct DemoSummary {
 };
 
 DemoSummary RunDemo(const DemoOptions& options);
+
+// The camera's absolute calibration, as a lab measures it against a known radiance: the median
+// ratio of the HDR maps (hdr_dir/NAME.exr) to igi-synth's noise-free radiance of the same
+// brackets (truth.json "brackets"), over every 7th pixel value.
+double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
+                            const std::filesystem::path& synth_dir);
 
 // Compares a solved scene with truth.json: per region and parameter (see demo.h's note on k).
 Json CompareWithTruth(const std::filesystem::path& solved_scene,

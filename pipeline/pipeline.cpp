@@ -1,5 +1,6 @@
 #include "pipeline/pipeline.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -128,6 +129,7 @@ std::vector<Stage> Stages(const Context& ctx) {
        [&](Fingerprint* fp) {
          if (o.hdr_photos) AddSceneFiles(ctx, fp, true);
          for (const std::string& a : o.solve_args) fp->AddText(a);
+         fp->AddText(fmt::format("radiance_scale {:.17g}", o.radiance_scale));
        },
        SolveStage},
       {"05-diagnose", !o.skip_diagnose,
@@ -181,6 +183,7 @@ RunSummary RunPipeline(const RunOptions& options) {
         summary.partial_lines.push_back(stage.name +
                                         ": kept; it finished partly (see its log.txt)");
       }
+      if (stage.name == options.stop_after) break;
       continue;
     }
     redo = true;  // every later stage is redone
@@ -198,6 +201,7 @@ RunSummary RunPipeline(const RunOptions& options) {
     summary.stages.push_back({stage.name, m.status, m.seconds});
     summary.partial = summary.partial || run.partial();
     for (const std::string& l : run.partial_lines) summary.partial_lines.push_back(l);
+    if (stage.name == options.stop_after) break;
   }
   summary.report = options.out / "report.html";
   summary.solved_scene = ctx.Dir("04-solve") / "scene.json";

@@ -6,6 +6,7 @@
 #include "pipeline/scene_assembly.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
+#include "tools/common/json.h"
 
 namespace igi::pipeline_internal {
 namespace fs = std::filesystem;
@@ -94,11 +95,30 @@ void RegisterStage(const Context& ctx, StageRun* run) {
   run->details["unregistered"] = unregistered;
 }
 
+// The scene igi-solve gets: the solvable scene as it is, or with --radiance-scale written as
+// every photo's exposure_scale (a copy in DIR/04-solve/input/, its paths rebased).
+fs::path SolveScene(const Context& ctx, const fs::path& stage_dir) {
+  if (ctx.options.radiance_scale == 1.0) return ctx.SolveInput();
+  const fs::path input = ctx.SolveInput();
+  const fs::path dir = stage_dir / "input";
+  fs::create_directories(dir);
+  Json scene = RebaseScenePaths(ReadJsonFile(input), input.parent_path(), dir);
+  for (Json& photo : scene["photos"]) {
+    const double given =
+        photo.contains("exposure_scale") ? photo["exposure_scale"].get<double>() : 1.0;
+    photo["exposure_scale"] = given * ctx.options.radiance_scale;
+  }
+  WriteJsonFile(dir / "scene.json", scene);
+  return dir / "scene.json";
+}
+
 void SolveStage(const Context& ctx, StageRun* run) {
-  std::vector<std::string> args = {ctx.SolveInput().string(), "--out", run->dir().string()};
+  std::vector<std::string> args = {SolveScene(ctx, run->dir()).string(), "--out",
+                                   run->dir().string()};
   Append(&args, ThreadArgs(ctx));
   Append(&args, ctx.options.solve_args);
   run->Tool("igi-solve", args, /*partial_ok=*/true);
+  run->details["radiance_scale"] = ctx.options.radiance_scale;
 }
 
 void DiagnoseStage(const Context& ctx, StageRun* run) {

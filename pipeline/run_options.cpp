@@ -1,5 +1,10 @@
 #include "pipeline/run_options.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
 #include "tools/common/error.h"
 
 namespace igi {
@@ -20,6 +25,14 @@ void RunOptions::Validate() const {
   }
   if (diagnose_spp < 0) {
     problems.Add("", "--diagnose-spp", std::to_string(diagnose_spp), "must be >= 0");
+  }
+  if (!(radiance_scale > 0) || !std::isfinite(radiance_scale)) {
+    problems.Add("", "--radiance-scale", std::to_string(radiance_scale), "must be > 0 and finite");
+  }
+  const std::vector<std::string> stages = {"",         "01-response", "02-hdr",   "03-register",
+                                           "04-solve", "05-diagnose", "06-report"};
+  if (std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
+    problems.Add("", "stop_after", stop_after, "must name a stage (01-response ... 06-report)");
   }
   if (num_threads < 0) problems.Add("", "--threads", std::to_string(num_threads), "must be >= 0");
   problems.ThrowIfAny();

@@ -21,10 +21,17 @@ struct RunOptions {
   std::vector<std::string> register_args;  // passed to igi-register as they are
   int diagnose_spp = 0;                    // --spp of igi-diagnose (0 = its default)
   std::vector<std::string> diagnose_args;  // passed to igi-diagnose as they are
-  int report_spp = 32;                     // samples per pixel of the report's renders, >= 1
-  int report_photos = 4;                   // photos shown with their re-render and residual, >= 1
-  int report_lightings = 6;                // lightings of the relit renders, >= 1
-  int num_threads = 0;                     // --threads given to every stage (0 = all cores)
+  // Absolute calibration: the HDR maps are this many times the radiance in the scene's units
+  // (W sr^-1 m^-2 for the declared light intensities), e.g. measured against a radiance
+  // standard or a grey card. Written as every photo's "exposure_scale" in the scene igi-solve
+  // gets (04-solve/input/scene.json). 1 = the maps are absolute already. It matters beyond a
+  // scale: light bounces between surfaces in proportion to their absolute albedo.
+  double radiance_scale = 1.0;
+  std::string stop_after;    // a stage name: stop after it (empty = run every stage)
+  int report_spp = 32;       // samples per pixel of the report's renders, >= 1
+  int report_photos = 4;     // photos shown with their re-render and residual, >= 1
+  int report_lightings = 6;  // lightings of the relit renders, >= 1
+  int num_threads = 0;       // --threads given to every stage (0 = all cores)
 
   void Validate() const;  // InputError naming the flag
 };

@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
   app.add_option("--register-arg", o.register_args, "Argument passed to igi-register (repeatable)")
       ->allow_extra_args(false);
   app.add_option("--diagnose-spp", o.diagnose_spp, "igi-diagnose --spp (0 = its default)");
+  app.add_option("--radiance-scale", o.radiance_scale,
+                 "Absolute calibration: the HDR maps are this many times the radiance in the "
+                 "scene's units (1 = absolute already)")
+      ->capture_default_str();
   app.add_option("--diagnose-arg", o.diagnose_args, "Argument passed to igi-diagnose (repeatable)")
       ->allow_extra_args(false);
   app.add_option("--report-spp", o.report_spp, "Samples per pixel of the report's renders")
