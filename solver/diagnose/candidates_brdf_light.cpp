@@ -7,10 +7,12 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <unordered_map>
 
 #include "solver/brdf.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "solver/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
@@ -186,7 +188,7 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
   const double explained = best.train_before - best.train_after;
   const double share = iso.coef.size() ? (iso.train_after - best.train_after) / explained : 1.0;
   const double ratio = std::max(bp.ax, bp.ay) / std::min(bp.ax, bp.ay);
-  if (!(explained > 0) || !(share >= 0.25) || !(ratio >= 1.5)) {
+  if (!(explained > 0) || !(share >= 0.1) || !(ratio >= 1.5)) {
     out.note = fmt::format(
         "region {}: an isotropic lobe explains as much (anisotropic lobe ratio {:.2f}, "
         "{:.0f}% of its gain beyond the best isotropic one)",
@@ -230,68 +232,77 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
 }
 
 // ---------------------------------------------------------------- light_source_extent
-constexpr int kExtentSamples = 64;  // 8×8 strata over the light's solid angle, per record
+// Per record: kFootprint points of the pixel's footprint (the photo and the model's render average
+// the pixel, and a hard shadow edge inside a pixel is no edge of the record's centre), each with
+// kConeSamples directions toward the light: 64 samples, the same for every radius.
+constexpr int kFootprint = 16, kConeSamples = 4;
+constexpr float kMinChange = 0.15f;
+constexpr int kMinBlockRecords = 4;
 
-// A light as a sphere of `intensity` (W/sr) at `center`, seen from a record.
+// A light as a sphere of `intensity` (W/sr) at `center`.
 struct SphereSource {
   Vector3d center = Vector3d::Zero();
   Vector3d intensity = Vector3d::Zero();
 };
 
+// A surface point seen through the record's pixel.
+struct FootprintPoint {
+  Eigen::Vector3f position, normal, view;  // normal toward the camera
+  int region = -1;
+};
+
 // The direct radiance a sphere source of radius `radius` (0: a point) sends toward the camera
-// from record `r` (BRDF of its region, shadow rays through the model's geometry), and the
-// unoccluded share of its samples above the horizon. `u` holds the record's fixed sample points.
-Vector3d DirectOf(const Renderer::Impl& impl, int target, const SphereSource& s,
-                  const PixelRecord& r, double radius, const std::vector<Eigen::Vector2d>& u,
-                  double* visible) {
-  const ShadingMaterial& sm = impl.materials[r.region];
+// from footprint point `q` (BRDF of its region with the record's albedo, shadow rays through the
+// model's geometry), from the cone samples `u`; adds the unoccluded share to `lit`/`above`.
+Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
+                  const FootprintPoint& q, const Eigen::Vector3f& albedo, double radius,
+                  const Eigen::Vector2d* u, int* lit, int* above) {
+  const ShadingMaterial& sm = impl.materials[q.region];
   BrdfParams params = sm.params;
-  params.rho_d = r.albedo.cast<double>();
-  const Vector3d p = r.position.cast<double>(), n = r.normal.cast<double>();
-  const Vector3d wo = r.view.cast<double>();
+  params.rho_d = albedo.cast<double>();
+  const Vector3d p = q.position.cast<double>(), n = q.normal.cast<double>();
   const Frame frame = IsAnisotropic(params.model) && sm.tangent
                           ? Frame::FromNormalTangent(n, *sm.tangent)
                           : Frame::FromNormal(n);
-  const Vector3d lo = frame.ToLocal(wo);
+  const Vector3d lo = frame.ToLocal(q.view.cast<double>());
   const Vector3d origin = p + n * (4 * impl.ray_epsilon);
   const Vector3d to = s.center - p;
   const double d = to.norm();
-  *visible = 0;
   if (!(d > 0)) return Vector3d::Zero();
   const Vector3d w = to / d;
-  if (radius <= 0 || radius >= 0.95 * d) {  // a point (or a record inside the sphere)
-    const double cs = w.dot(n);
-    if (!(cs > 0) || impl.Occluded(origin, w, d - 4 * impl.ray_epsilon, target)) return {0, 0, 0};
-    *visible = 1;
-    return EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) * (cs / (d * d));
+  const double cos_center = w.dot(n);
+  if (radius <= 0 || radius >= 0.95 * d) {  // a point (or a point inside the sphere)
+    if (!(cos_center > 0)) return Vector3d::Zero();
+    ++*above;
+    if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon, target)) return Vector3d::Zero();
+    ++*lit;
+    return EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) *
+           (cos_center / (d * d));
   }
   const double sin2 = radius * radius / (d * d), cos_max = std::sqrt(1 - sin2);
   const double one_minus = sin2 / (1 + cos_max);  // 1 − cos θmax without cancellation
   const Frame cone = Frame::FromNormal(w);
   const Vector3d radiance = s.intensity / (kPi * radius * radius);
-  Vector3d sum = Vector3d::Zero(), diffuse = Vector3d::Zero();
   const Vector3d rho_pi = params.rho_d * kInvPi;
-  int above = 0, lit = 0;
-  for (const Eigen::Vector2d& uv : u) {
-    const double ct = 1 - uv.x() * one_minus, st = std::sqrt(std::max(0.0, 1 - ct * ct));
-    const double ph = 2 * kPi * uv.y();
+  Vector3d sum = Vector3d::Zero(), diffuse = Vector3d::Zero();
+  for (int k = 0; k < kConeSamples; ++k) {
+    const double ct = 1 - u[k].x() * one_minus, st = std::sqrt(std::max(0.0, 1 - ct * ct));
+    const double ph = 2 * kPi * u[k].y();
     const Vector3d dir = cone.ToWorld({st * std::cos(ph), st * std::sin(ph), ct});
     const double cs = dir.dot(n);
     if (!(cs > 0)) continue;
-    ++above;
+    ++*above;
     diffuse += rho_pi.cwiseProduct(radiance) * cs;
     const double t = d * ct - std::sqrt(std::max(0.0, radius * radius - d * d * st * st));
     if (impl.Occluded(origin, dir, t - 4 * impl.ray_epsilon, target)) continue;
-    ++lit;
+    ++*lit;
     sum += EvalBrdf(params, lo, frame.ToLocal(dir)).cwiseProduct(radiance) * cs;
   }
-  *visible = above ? double(lit) / above : 0;
   // pdf = 1 / (2π (1 − cos θmax)) per sample.
-  const double weight = 2 * kPi * one_minus / double(u.size());
+  const double weight = 2 * kPi * one_minus / kConeSamples;
   // Control variate: a sphere wholly above the horizon gives exactly the irradiance of a point
   // of the same intensity at its centre, I·cos/d²; the samples' estimate of that unoccluded
-  // diffuse term is swapped for the exact value, so a fully lit diffuse record shows no change.
-  const double cos_center = w.dot(n);
+  // diffuse term is swapped for the exact value, so a fully lit diffuse point shows no change.
   if (cos_center > std::sqrt(sin2)) {
     const Vector3d exact = rho_pi.cwiseProduct(s.intensity) * (cos_center / (d * d));
     return (sum - diffuse) * weight + exact;
@@ -299,34 +310,50 @@ Vector3d DirectOf(const Renderer::Impl& impl, int target, const SphereSource& s,
   return sum * weight;
 }
 
+// The change is kept where it can show: on records where it reaches kMinChange of the model's
+// value (below that, the render's own noise at a few hundred paths per pixel hides it), in
+// held-out blocks with at least kMinBlockRecords such records (a block of one changed record
+// scores noise). Elsewhere it is set to zero: those records are outside the candidate's support.
+void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px,
+                       std::vector<Eigen::Vector3f>* change) {
+  std::unordered_map<int64_t, int> count;
+  auto block = [&](const PixelRecord& r) {
+    return (int64_t(r.photo) << 40) + (int64_t(r.y / block_px) << 20) + r.x / block_px;
+  };
+  for (size_t i = 0; i < recs.size(); ++i) {
+    if ((*change)[i].norm() <= kMinChange * recs[i].sim.norm()) {
+      (*change)[i].setZero();
+    } else {
+      ++count[block(recs[i])];
+    }
+  }
+  for (size_t i = 0; i < recs.size(); ++i) {
+    if (count[block(recs[i])] < kMinBlockRecords) (*change)[i].setZero();
+  }
+}
+
 class ExtentModel {
  public:
   ExtentModel(const CandidateContext& cx, const std::vector<PixelRecord>& records, int light)
       : cx_(cx), records_(records), impls_(cx.model.lightings.size()),
-        target_(cx.model.lightings.size(), -1), u_(records.size()) {
+        target_(cx.model.lightings.size(), -1), u_(records.size()), points_(records.size()) {
     const Light& l = cx.model.lights[light];
     source_.center = l.type == LightType::kSphere ? l.center : l.position;
-    source_.intensity = l.type == LightType::kSphere ? Vector3d(l.radiance * (kPi * l.radius * l.radius))
-                                                    : l.intensity;
+    source_.intensity = l.type == LightType::kSphere
+                            ? Vector3d(l.radiance * (kPi * l.radius * l.radius))
+                            : l.intensity;
     declared_radius_ = l.type == LightType::kSphere ? l.radius : 0.0;
     for (size_t g = 0; g < cx.model.lightings.size(); ++g) {
       const std::vector<int>& ids = cx.model.lightings[g].lights;
       const auto it = std::find(ids.begin(), ids.end(), light);
-      if (it == ids.end()) continue;
-      target_[g] = int(it - ids.begin());
+      if (it != ids.end()) target_[g] = int(it - ids.begin());
     }
     for (const Photo& p : cx.model.photos) {
       if (target_[p.lighting] >= 0 && !impls_[p.lighting]) {
         impls_[p.lighting] = BuildRenderScene(cx.model, p.lighting);
       }
     }
-    for (size_t i = 0; i < records.size(); ++i) {
-      Pcg32 rng = PixelSampleRng(0x5eed, i, 0);
-      for (int k = 0; k < kExtentSamples; ++k) {
-        const double a = (k % 8 + rng.UniformDouble()) / 8, b = (k / 8 + rng.UniformDouble()) / 8;
-        u_[i].emplace_back(a, b);
-      }
-    }
+    ParallelFor(0, int64_t(records.size()), [&](int64_t i) { Prepare(size_t(i)); });
   }
 
   double declared_radius() const { return declared_radius_; }
@@ -340,27 +367,69 @@ class ExtentModel {
     ParallelFor(0, int64_t(records_.size()), [&](int64_t i) {
       const PixelRecord& r = records_[i];
       const Photo& photo = cx_.model.photos[r.photo];
-      if (target_[photo.lighting] < 0 || r.region < 0) return;
-      double v = 0;
-      const Vector3d d = DirectOf(*impls_[photo.lighting], target_[photo.lighting], source_, r,
-                                  radius, u_[i], &v);
-      double scale = photo.exposure_scale;
-      if (photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size())) {
-        scale *= cx_.model.cameras[photo.camera].VignettingFactor(
-            Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
+      if (target_[photo.lighting] < 0 || points_[i].empty()) return;
+      const Renderer::Impl& impl = *impls_[photo.lighting];
+      Vector3d sum = Vector3d::Zero();
+      int lit = 0, above = 0;
+      for (size_t k = 0; k < points_[i].size(); ++k) {
+        sum += DirectAt(impl, target_[photo.lighting], source_, points_[i][k], r.albedo, radius,
+                        &u_[i][k * kConeSamples], &lit, &above);
       }
-      out[i] = (d * scale).cast<float>();
-      if (visible) (*visible)[i] = float(v);
+      out[i] = (sum * (Scale(r) / double(points_[i].size()))).cast<float>();
+      if (visible) (*visible)[i] = above ? float(lit) / float(above) : 0.0f;
     });
     return out;
   }
 
  private:
+  // The photo's exposure scale and its camera's vignetting at the record's pixel.
+  double Scale(const PixelRecord& r) const {
+    const Photo& photo = cx_.model.photos[r.photo];
+    double scale = photo.exposure_scale;
+    if (photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size())) {
+      scale *= cx_.model.cameras[photo.camera].VignettingFactor(
+          Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
+    }
+    return scale;
+  }
+
+  // The record's footprint points and cone samples.
+  void Prepare(size_t i) {
+    const PixelRecord& r = records_[i];
+    const Photo& photo = cx_.model.photos[r.photo];
+    if (target_[photo.lighting] < 0 || r.region < 0) return;
+    Pcg32 rng = PixelSampleRng(0x5eed, i, 0);
+    const bool camera = photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size());
+    for (int k = 0; k < kFootprint; ++k) {  // without a camera: the centre kFootprint times
+      FootprintPoint q{r.position, r.normal, r.view, r.region};
+      if (camera) {
+        const Camera& cam = cx_.model.cameras[photo.camera];
+        const double sx = (k % 4 + rng.UniformDouble()) / 4, sy = (k / 4 + rng.UniformDouble()) / 4;
+        const Vector3d eye = cam.CenterInWorld();
+        const Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(r.x + sx, r.y + sy));
+        const std::optional<SurfaceHit> hit = TraceSurface(*impls_[photo.lighting], eye, dir);
+        if (!hit || hit->region != r.region) continue;  // off the record's surface
+        q = {hit->position.cast<float>(), hit->n_s.cast<float>(), (-dir).cast<float>(),
+             hit->region};
+      }
+      points_[i].push_back(q);
+    }
+    // Cone samples: stratified over the points together (8×8 strata for 16 points × 4).
+    const int n = int(points_[i].size()) * kConeSamples;
+    const int side = std::max(1, int(std::lround(std::sqrt(double(n)))));
+    for (int k = 0; k < n; ++k) {
+      const int cell = int((uint64_t(k) * 37) % uint64_t(n));  // decorrelated from the points
+      u_[i].emplace_back((cell % side + rng.UniformDouble()) / side,
+                         std::min(0.999999, ((cell / side) % side + rng.UniformDouble()) / side));
+    }
+  }
+
   const CandidateContext& cx_;
   const std::vector<PixelRecord>& records_;
   std::vector<std::unique_ptr<Renderer::Impl>> impls_;
   std::vector<int> target_;  // per lighting: the light's index among its emitters, or -1
   std::vector<std::vector<Eigen::Vector2d>> u_;
+  std::vector<std::vector<FootprintPoint>> points_;
   SphereSource source_;
   double declared_radius_ = 0;
 };
@@ -370,6 +439,15 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   out.effect = "light_source_extent";
   const Light& l = cx.model.lights[light];
   const std::vector<PixelRecord>& recs = f.records();
+  bool photographed = false;
+  for (const Photo& p : cx.model.photos) {
+    const std::vector<int>& ids = cx.model.lightings[p.lighting].lights;
+    photographed |= std::find(ids.begin(), ids.end(), light) != ids.end();
+  }
+  if (!photographed) {
+    out.note = "light '" + l.name + "' lights no photo";
+    return out;
+  }
   const ExtentModel model(cx, recs, light);
   const double r0 = model.declared_radius();
   std::vector<float> vis0;
@@ -377,35 +455,28 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   Change ch;
   auto fit_at = [&](double radius) {
     ch.basis = model.Direct(radius);
-    // Rounding-level differences (a fully lit diffuse record) are no change: the record stays
-    // out of the candidate's support.
-    for (size_t i = 0; i < recs.size(); ++i) {
-      ch.basis[i] -= d0[i];
-      if (ch.basis[i].norm() <= 1e-6f * d0[i].norm()) ch.basis[i].setZero();
-    }
+    for (size_t i = 0; i < recs.size(); ++i) ch.basis[i] -= d0[i];
+    KeepMarkedChanges(recs, cx.block_px, &ch.basis);
     return FitChange(f, ch);
   };
   auto physical = [](const ResidualFit& fit) {
     return fit.coef.size() == 1 && fit.coef[0] > 0.3 && fit.coef[0] < 3;
+  };
+  // The model has no free amplitude (a sphere of the same intensity): the fit's amplitude is a
+  // check, and r is chosen by the train error at amplitude 1. The error is quadratic in the
+  // amplitude a: E(1) = E(a*) + (1 − a*)² (E(0) − E(a*)) / a*².
+  auto error_at_one = [](const ResidualFit& fit) {
+    const double a = fit.coef[0];
+    return fit.train_after + (1 - a) * (1 - a) * (fit.train_before - fit.train_after) / (a * a);
   };
   std::vector<std::pair<double, ResidualFit>> tried;
   for (double radius : {0.02, 0.035, 0.05, 0.08, 0.12, 0.17, 0.23, 0.3, 0.4, 0.5}) {
     if (radius > 1.25 * r0 + 0.005) tried.emplace_back(radius, fit_at(radius));
   }
   int best = -1;
-  {
-    int no = 0;
-    for (const PixelRecord& r : recs) no += r.outlier;
-    fprintf(stderr, "DEBUG outliers %d\n", no);
-  }
-  for (const auto& [rr, ff] : tried) {
-    fprintf(stderr, "DEBUG r %.3f amp %.3f before %.5g after %.5g held %.5g -> %.5g z %.2f\n", rr,
-            ff.coef.size() ? ff.coef[0] : -1.0, ff.train_before, ff.train_after, ff.held_before,
-            ff.held_after, ff.z);
-  }
   for (int i = 0; i < int(tried.size()); ++i) {
     if (physical(tried[i].second) &&
-        (best < 0 || tried[i].second.train_after < tried[best].second.train_after)) {
+        (best < 0 || error_at_one(tried[i].second) < error_at_one(tried[best].second))) {
       best = i;
     }
   }
@@ -421,20 +492,13 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   for (int it = 0; it < 6; ++it) {
     const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
     const ResidualFit f1 = fit_at(std::exp(m1)), f2 = fit_at(std::exp(m2));
-    const bool left = f1.train_after < f2.train_after;
+    if (!physical(f1) || !physical(f2)) break;
+    const bool left = error_at_one(f1) < error_at_one(f2);
     (left ? hi : lo) = left ? m2 : m1;
     const ResidualFit& fb = left ? f1 : f2;
-    if (physical(fb) && fb.train_after < fit.train_after) {
+    if (error_at_one(fb) < error_at_one(fit)) {
       fit = fb, radius = std::exp(left ? m1 : m2);
     }
-  }
-  {
-    int nz = 0, nh = 0;
-    const std::vector<Eigen::Vector3f> b = model.Direct(radius);
-    for (size_t i = 0; i < recs.size(); ++i) {
-      if ((b[i] - d0[i]).norm() > 1e-6f * d0[i].norm()) ++nz, nh += recs[i].held_out;
-    }
-    fprintf(stderr, "DEBUG support %d held %d of %zu\n", nz, nh, recs.size());
   }
   // Where the change lies: at shadow edges (penumbrae) or elsewhere (highlights).
   std::vector<float> vis;
