@@ -503,14 +503,12 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   // Where the change lies: at shadow edges (penumbrae) or elsewhere (highlights).
   std::vector<float> vis;
   const std::vector<Eigen::Vector3f> dr = model.Direct(radius, &vis);
-  double edge = 0, other = 0;
+  int edge = 0, other = 0;  // records the change marks (KeepMarkedChanges' first rule)
   for (size_t i = 0; i < recs.size(); ++i) {
-    const double c2 = double((dr[i] - d0[i]).squaredNorm());
-    const bool penumbra =
-        (vis[i] > 0.02f && vis[i] < 0.98f) || ((vis0[i] > 0.5f) != (vis[i] > 0.5f));
-    (penumbra ? edge : other) += c2;
+    if (!((dr[i] - d0[i]).norm() > kMinChange * recs[i].sim.norm())) continue;
+    const bool penumbra = (vis[i] > 0.02f && vis[i] < 0.98f) || std::abs(vis[i] - vis0[i]) > 0.02f;
+    ++(penumbra ? edge : other);
   }
-  const double total = std::max(1e-30, edge + other);
   Fill(fit, &out);
   const double amplitude = fit.coef[0];
   const Vector3d center = model.source().center, intensity = model.source().intensity;
@@ -520,10 +518,11 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   out.num_params = 1;
   out.evidence = fmt::format(
       "light '{}': the photos show softer shadow edges and broader highlights than a {} casts: "
-      "a sphere of radius {:.3f} m with the same intensity predicts them ({:.0f}% of the change "
-      "in penumbrae at shadow edges, {:.0f}% in highlights and lit areas; amplitude {:.2f})",
+      "a sphere of radius {:.3f} m with the same intensity predicts them ({} samples changed by "
+      "more than {:.0f}% in penumbrae at shadow edges, {} in highlights; fitted amplitude {:.2f} "
+      "of the predicted change)",
       l.name, r0 > 0 ? fmt::format("sphere of {:.3f} m", r0) : std::string("point"), radius,
-      100 * edge / total, 100 * other / total, amplitude);
+      edge, 100 * kMinChange, other, amplitude);
   out.valid = true;
   const std::string name = l.name;
   out.apply = [name, center, intensity, radius](Json* doc) {

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <iostream>
 #include <random>
 
 #include "solver/brdf.h"
@@ -253,7 +252,6 @@ TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
   const CandidateResult c = LightSourceExtent({model, declared, false}, f, 0);
   ASSERT_TRUE(c.valid) << c.note;
   EXPECT_EQ(c.effect, "light_source_extent");
-  std::cerr << c.params.dump() << " gain " << c.Gain() << " z " << c.z << " " << c.evidence << "\n";
   EXPECT_GT(c.Gain(), 0.5);
   EXPECT_GT(c.z, 5);
   // The photo's penumbrae carry 256-sample noise, the candidate's prediction 16 samples per
