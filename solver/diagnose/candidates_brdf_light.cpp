@@ -75,7 +75,9 @@ double Specular(BrdfModel model, double ax, double ay, double ior, const Frame& 
 class RegionLobe {
  public:
   RegionLobe(const std::vector<PixelRecord>& records, int region, const Material& m)
-      : records_(records), region_(region), rho_s_(m.rho_s.value_or(Vector3d::Zero())),
+      : records_(records),
+        region_(region),
+        rho_s_(m.rho_s.value_or(Vector3d::Zero())),
         ior_(m.ior.value_or(Material::kDefaultIor)) {}
 
   // ρs_c Σ S(wo, wi)·E_c per record (zero off the region); tangent only for anisotropic models.
@@ -200,8 +202,9 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
   const Vector3d tangent = tangent_of(bp.phi);
   const double k = best.coef[0];
   const std::string to_name(BrdfModelName(to));
-  out.params = {{"region", m.name},   {"from", BrdfModelName(m.brdf)}, {"to", to_name},
-                {"tangent", Vec(tangent)}, {"alpha_x", bp.ax},           {"alpha_y", bp.ay},
+  out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)},
+                {"to", to_name},    {"tangent", Vec(tangent)},
+                {"alpha_x", bp.ax}, {"alpha_y", bp.ay},
                 {"rho_s_factor", k}};
   out.where = {{"regions", {m.name}}, {"frame", "half-vector azimuth in the tangent frame"}};
   out.num_params = 4;  // tangent angle, two roughnesses, ρs scale
@@ -335,8 +338,12 @@ void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px,
 class ExtentModel {
  public:
   ExtentModel(const CandidateContext& cx, const std::vector<PixelRecord>& records, int light)
-      : cx_(cx), records_(records), impls_(cx.model.lightings.size()),
-        target_(cx.model.lightings.size(), -1), u_(records.size()), points_(records.size()) {
+      : cx_(cx),
+        records_(records),
+        impls_(cx.model.lightings.size()),
+        target_(cx.model.lightings.size(), -1),
+        u_(records.size()),
+        points_(records.size()) {
     const Light& l = cx.model.lights[light];
     source_.center = l.type == LightType::kSphere ? l.center : l.position;
     source_.intensity = l.type == LightType::kSphere
@@ -387,8 +394,8 @@ class ExtentModel {
     const Photo& photo = cx_.model.photos[r.photo];
     double scale = photo.exposure_scale;
     if (photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size())) {
-      scale *= cx_.model.cameras[photo.camera].VignettingFactor(
-          Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
+      scale *=
+          cx_.model.cameras[photo.camera].VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
     }
     return scale;
   }
@@ -512,8 +519,8 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
   Fill(fit, &out);
   const double amplitude = fit.coef[0];
   const Vector3d center = model.source().center, intensity = model.source().intensity;
-  out.params = {{"light", l.name}, {"radius", radius}, {"declared_radius", r0},
-                {"amplitude", amplitude}};
+  out.params = {
+      {"light", l.name}, {"radius", radius}, {"declared_radius", r0}, {"amplitude", amplitude}};
   out.where = {{"light", l.name}, {"frame", "shadow and highlight edges"}};
   out.num_params = 1;
   out.evidence = fmt::format(
@@ -521,14 +528,16 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
       "a sphere of radius {:.3f} m with the same intensity predicts them ({} samples changed by "
       "more than {:.0f}% in penumbrae at shadow edges, {} in highlights; fitted amplitude {:.2f} "
       "of the predicted change)",
-      l.name, r0 > 0 ? fmt::format("sphere of {:.3f} m", r0) : std::string("point"), radius,
-      edge, 100 * kMinChange, other, amplitude);
+      l.name, r0 > 0 ? fmt::format("sphere of {:.3f} m", r0) : std::string("point"), radius, edge,
+      100 * kMinChange, other, amplitude);
   out.valid = true;
   const std::string name = l.name;
   out.apply = [name, center, intensity, radius](Json* doc) {
     const Vector3d radiance = intensity / (kPi * radius * radius);
-    (*doc)["lights"][name] = {
-        {"type", "sphere"}, {"center", Vec(center)}, {"radius", radius}, {"radiance", Vec(radiance)}};
+    (*doc)["lights"][name] = {{"type", "sphere"},
+                              {"center", Vec(center)},
+                              {"radius", radius},
+                              {"radiance", Vec(radiance)}};
   };
   return out;
 }
@@ -555,8 +564,7 @@ CandidateResult AnisotropicReflection(const CandidateContext& cx, const Residual
   return AnisotropicFit(cx, f, region);
 }
 
-CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f,
-                                  int light) {
+CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light) {
   const Light& l = cx.model.lights[light];
   if (l.type != LightType::kPoint && l.type != LightType::kSphere) {
     CandidateResult out;

@@ -39,9 +39,10 @@ Scene PlateScene() {
 }
 
 Json PlateDocument() {
-  return Json{{"materials",
-               {{"plate",
-                 {{"brdf", "ward"}, {"rho_d", {0.1, 0.2, 0.5}}, {"rho_s", kRhoS}, {"alpha", kAlpha}}}}}};
+  return Json{
+      {"materials",
+       {{"plate",
+         {{"brdf", "ward"}, {"rho_d", {0.1, 0.2, 0.5}}, {"rho_s", kRhoS}, {"alpha", kAlpha}}}}}};
 }
 
 // Specular factor of a Ward lobe on the plate (normal +z) with tangent at `angle` in the xy plane.
