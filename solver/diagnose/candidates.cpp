@@ -11,6 +11,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "solver/diagnose/candidates_brdf_light.h"
 #include "solver/diagnose/residual_fit.h"
 
 namespace igi {
@@ -626,6 +627,10 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
       out.push_back(LightIntensity(cx, f, l));
     }
+    if ((light.type == LightType::kPoint || light.type == LightType::kSphere) &&
+        allowed("light_source_extent:" + light.name)) {
+      out.push_back(LightSourceExtent(cx, f, l));
+    }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
     const std::string& region = cx.model.materials[g].name;
@@ -635,6 +640,10 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
     }
     if (allowed("fresnel:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, true);
+      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
+    }
+    if (allowed("anisotropic_reflection:" + region)) {
+      CandidateResult c = AnisotropicReflection(cx, f, g);
       if (c.valid || !c.note.empty()) out.push_back(std::move(c));
     }
   }

@@ -1,0 +1,37 @@
+#pragma once
+// The candidates of two effects of CONTRACT.md §6 that change the shape of reflected light:
+//
+// anisotropic_reflection — a glossy region whose highlight is stretched along a surface
+//   direction. Studied in the region's tangent frame (the azimuth of the half vector around the
+//   normal): the region's lobe ρs·S(α) is replaced by k·ρs·S_aniso(t, αx, αy), with the tangent t
+//   (an angle in the plane of the region's highlight-weighted mean normal) and the two roughnesses
+//   searched on a grid and refined, and k linear. Named only when the anisotropic lobe explains
+//   clearly more than the best isotropic one.
+//
+// light_source_extent — a point (or small sphere) light that is really a larger sphere of the
+//   same intensity. Studied at shadow and highlight edges: the light's direct term for a sphere
+//   of radius r (its solid angle sampled with shadow rays through the model's geometry, the same
+//   samples for every r) minus the current one is the change, with a free amplitude; r is
+//   searched on a grid and refined.
+//
+// Both follow candidates.h: fitted by a ResidualFitter on the fitted records, scored on the
+// held-out ones, with apply() writing the fitted model into the declared scene document.
+
+#include "solver/diagnose/candidates.h"
+#include "solver/diagnose/residual_fit.h"
+
+namespace igi {
+
+// anisotropic_reflection of region `region` (a ward / ward_gmd model, with or without _fresnel,
+// and complete values in cx.model). apply() switches the region to the *_aniso model with the
+// fitted "tangent"; "alpha_x"/"alpha_y" and a scaled "rho_s" are written where the declared
+// region had those values (otherwise igi-solve fits them, given the tangent).
+CandidateResult AnisotropicReflection(const CandidateContext& cx, const ResidualFitter& f,
+                                      int region);
+
+// light_source_extent of light `light` (point or sphere) in cx.model. apply() makes it a
+// "sphere" light at its position with the fitted radius and the same intensity
+// (radiance = intensity / (π r²)).
+CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light);
+
+}  // namespace igi
