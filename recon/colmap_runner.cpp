@@ -223,4 +223,17 @@ ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
   return summary;
 }
 
+ColmapRunSummary LoadColmapRun(const std::filesystem::path& images_dir,
+                               const std::filesystem::path& model_dir) {
+  ColmapRunSummary summary;
+  summary.version = "not run";
+  summary.images = ListColmapImages(images_dir);
+  summary.model = ReadColmapModel(model_dir);
+  summary.num_models = 1;
+  for (const std::string& name : summary.images) {
+    if (summary.model.FindImageByName(name) == nullptr) summary.unregistered.push_back(name);
+  }
+  return summary;
+}
+
 }  // namespace igi

@@ -58,4 +58,9 @@ std::vector<std::string> ListColmapImages(const std::filesystem::path& images_di
 ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
                            const std::filesystem::path& work_dir, const ColmapRunOptions& options);
 
+// A run's summary from an existing model of the photos in `images_dir` (COLMAP not run: version
+// "not run", no log): the model in `model_dir` (TXT or BIN; InputError when unreadable).
+ColmapRunSummary LoadColmapRun(const std::filesystem::path& images_dir,
+                               const std::filesystem::path& model_dir);
+
 }  // namespace igi
