@@ -76,10 +76,11 @@ struct MarkerPose {
 // Poses each photo of `photos` that is not in `model` but sees at least `min_markers` markers
 // (PnP with the intrinsics of the model's first camera, then Levenberg-Marquardt), and adds it
 // to the model as an image without 2D points when the markers' reprojection RMS is below
-// `max_rms_px`. Returns the photos added.
+// `max_rms_px` (with known intrinsics 4 points in general position fix a pose and leave 2
+// residuals to check it). Returns the photos added.
 std::vector<MarkerPose> PoseImagesFromMarkers(const Markers& markers,
                                               const std::vector<std::string>& photos,
-                                              ColmapModel* model, int min_markers = 6,
+                                              ColmapModel* model, int min_markers = 4,
                                               double max_rms_px = 2.0);
 
 }  // namespace igi

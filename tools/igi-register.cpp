@@ -4,12 +4,17 @@
 // With --scene the model is brought into the scene's frame: by the markers' control points when
 // given, then by fitting the sparse points to the scene mesh (robust point-to-plane ICP with
 // scale; without markers from a principal-axes start), then each pose is refined against the
-// mesh (report.json "alignment" says what was done and how well).
+// mesh; photos COLMAP did not register but that see 4+ markers are posed from them (PnP); last,
+// every pose and sparse point is refined jointly (Ceres: COLMAP's tracks, the markers'
+// reprojection and the points' distance to the mesh, robust losses; recon/
+// registration_refinement.h). report.json "alignment" says what was done and how well, and
+// "registered" gives every photo's final reprojection RMS (tracks and markers).
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
-// COLMAP's own database, models and log go to DIR/colmap/. Exit 3 when some photos did not
-// register (listed in report.json); exit 1 when COLMAP is missing, of another version than 3.8,
-// or reconstructs nothing; exit 2 for bad input (nothing written).
+// COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
+// instead). Exit 3 when some photos did not register (listed in report.json); exit 1 when COLMAP
+// is missing, of another version than 3.8, or reconstructs nothing; exit 2 for bad input
+// (nothing written).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -49,7 +54,9 @@ struct Args {
   bool no_mesh_fit = false;
   bool no_pose_refinement = false;
   bool no_joint_refinement = false;
-  std::string colmap_model;  // an existing COLMAP model instead of running COLMAP
+  double marker_sigma_px = 1.0;  // accuracy of the markers' pixels
+  double mesh_sigma_m = 0;       // accuracy of the mesh; 0 = from the mesh fit's residuals
+  std::string colmap_model;      // an existing COLMAP model instead of running COLMAP
 };
 
 struct Inputs {
@@ -366,7 +373,13 @@ igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapRunSummary
   if (!args.no_joint_refinement) {
     igi::BundleRefinementOptions options;
     options.threads = args.colmap.threads;
-    options.use_mesh = !args.no_mesh_fit;
+    options.use_mesh = fit.has_value();
+    options.marker_sigma_px = args.marker_sigma_px;
+    // The points' spread about the mesh after the fit (before the pose refinement snapped them).
+    options.mesh_sigma_m =
+        args.mesh_sigma_m > 0
+            ? args.mesh_sigma_m
+            : (fit ? fit->inlier_threshold_m / igi::MeshAlignmentOptions{}.inlier_sigmas : 0);
     const igi::BundleRefinementSummary b = igi::RefineBundle(
         in.markers ? &*in.markers : nullptr, options.use_mesh ? &mesh : nullptr, model, options);
     a["joint_refinement"] = JointRefinementJson(b);
@@ -423,6 +436,8 @@ int main(int argc, char** argv) {
   app.add_option("--markers", args.markers, "Control points (igi-markers JSON) for --scene");
   app.add_option("--camera", args.camera, "camera.json: known intrinsics, held fixed");
   app.add_option("--colmap", args.colmap.executable, "COLMAP executable");
+  app.add_option("--min-pose-inliers", args.colmap.min_pose_inliers,
+                 "COLMAP's mapper registers a photo with this many 2D-3D inliers");
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
   app.add_flag(
@@ -433,6 +448,14 @@ int main(int argc, char** argv) {
   app.add_flag("--no-joint-refinement", args.no_joint_refinement,
                "With --scene: skip the final joint refinement of poses and points (tracks, "
                "markers, mesh)");
+  app.add_option("--marker-sigma", args.marker_sigma_px,
+                 "Accuracy of the markers' pixel positions (px), their weight in the joint "
+                 "refinement")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--mesh-sigma", args.mesh_sigma_m,
+                 "Accuracy of the scene mesh (m), its weight in the joint refinement (default: "
+                 "the sparse points' spread about it after the mesh fit)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--colmap-model", args.colmap_model,
                  "Use this COLMAP model (TXT or BIN folder) of the --images photos instead of "
                  "running COLMAP");
