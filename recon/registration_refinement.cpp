@@ -11,6 +11,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <set>
 
 #include "recon/camera.h"
 #include "recon/mesh_closest_point.h"
@@ -148,12 +149,14 @@ struct Stats {
   Sums all_tracks, all_markers;
 };
 
-Stats ComputeStats(const ColmapModel& model, const Markers* markers) {
+Stats ComputeStats(const ColmapModel& model, const Markers* markers,
+                   const std::set<std::pair<uint32_t, uint32_t>>& dropped) {
   Stats s;
   for (const auto& [id, image] : model.images) {
     const Camera camera = CameraOfImage(model, image);
-    for (const ColmapPoint2D& p : image.points2d) {
-      if (p.point3d_id < 0) continue;
+    for (size_t i = 0; i < image.points2d.size(); ++i) {
+      const ColmapPoint2D& p = image.points2d[i];
+      if (p.point3d_id < 0 || dropped.count({id, static_cast<uint32_t>(i)}) > 0) continue;
       const auto it = model.points3d.find(static_cast<uint64_t>(p.point3d_id));
       if (it == model.points3d.end() || it->second.track.size() < 2) continue;
       const auto px = camera.ImgFromWorld(it->second.xyz);
@@ -182,14 +185,18 @@ struct Blocks {
   std::map<uint64_t, Vector3d> points;
 };
 
+// A track observation: image id, index of its 2D point.
+using Observation = std::pair<uint32_t, uint32_t>;
+
 int AddTrackTerms(const ColmapModel& model, const BundleRefinementOptions& options,
-                  const std::map<uint32_t, Intrinsics>& intrinsics, Blocks* blocks,
-                  ceres::Problem* problem) {
+                  const std::map<uint32_t, Intrinsics>& intrinsics,
+                  const std::set<Observation>& dropped, Blocks* blocks, ceres::Problem* problem) {
   int observations = 0;
   for (const auto& [point_id, point] : model.points3d) {
     // The observations with the point in front of the camera; a point needs two.
     std::vector<std::pair<uint32_t, TrackCost>> costs;
     for (const ColmapTrackElement& t : point.track) {
+      if (dropped.count({t.image_id, t.point2d_idx}) > 0) continue;
       const ColmapImage& image = model.images.at(t.image_id);
       TrackCost cost{intrinsics.at(image.camera_id), image.points2d[t.point2d_idx].xy,
                      options.track_sigma_px};
@@ -248,6 +255,24 @@ std::pair<int, double> AddMeshTerms(const MeshClosestPoint& closest, double sigm
                               new ceres::HuberLoss(huber_sigmas), x.data());
   }
   return {sums.count, sums.Rms()};
+}
+
+// Adds to `dropped` the track observations (of points with 2+ observations) that reproject
+// farther than `max_error_px`; returns how many were added.
+int DropOutliers(const ColmapModel& model, double max_error_px, std::set<Observation>* dropped) {
+  std::map<uint32_t, Camera> cameras;
+  for (const auto& [id, image] : model.images) cameras.emplace(id, CameraOfImage(model, image));
+  int count = 0;
+  for (const auto& [point_id, point] : model.points3d) {
+    if (point.track.size() < 2) continue;
+    for (const ColmapTrackElement& t : point.track) {
+      const auto px = cameras.at(t.image_id).ImgFromWorld(point.xyz);
+      const Vector2d& seen = model.images.at(t.image_id).points2d[t.point2d_idx].xy;
+      if (px && (*px - seen).norm() <= max_error_px) continue;
+      count += dropped->insert({t.image_id, t.point2d_idx}).second ? 1 : 0;
+    }
+  }
+  return count;
 }
 
 double MeshSigma(const MeshClosestPoint& closest, const ColmapModel& model) {
@@ -330,11 +355,17 @@ BundleRefinementSummary RefineBundle(const Markers* markers, const TriangleMesh*
   }
   const double max_distance_m =
       options.mesh_max_distance_m > 0 ? options.mesh_max_distance_m : 3 * s.mesh_sigma_m;
-  const Stats before = ComputeStats(*model, markers);
+  const Stats before = ComputeStats(*model, markers, {});
+  std::set<Observation> dropped;
   for (int round = 0; round < options.rounds; ++round) {
+    if (round > 0) {
+      const int outliers = DropOutliers(*model, options.max_error_px, &dropped);
+      s.outliers += outliers;
+      if (outliers == 0 && !with_mesh) break;
+    }
     Blocks blocks;
     ceres::Problem problem;
-    s.observations = AddTrackTerms(*model, options, intrinsics, &blocks, &problem);
+    s.observations = AddTrackTerms(*model, options, intrinsics, dropped, &blocks, &problem);
     if (markers != nullptr) {
       s.marker_observations =
           AddMarkerTerms(*model, *markers, options, intrinsics, &blocks, &problem);
@@ -364,7 +395,7 @@ BundleRefinementSummary RefineBundle(const Markers* markers, const TriangleMesh*
                  round + 1, summary.initial_cost, summary.final_cost, summary.iterations.size(),
                  s.termination);
   }
-  const Stats after = ComputeStats(*model, markers);
+  const Stats after = ComputeStats(*model, markers, dropped);
   s.rms_before_px = before.all_tracks.Rms();
   s.rms_after_px = after.all_tracks.Rms();
   s.marker_rms_before_px = before.all_markers.Rms();

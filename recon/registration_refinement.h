@@ -6,7 +6,8 @@
 //     frame, held fixed, and their pixels in some photos), and optionally
 //   - the distance of the sparse points to the scene mesh (the closest mesh point found again at
 //     every evaluation, so points near edges are not held to a wrong face's plane),
-// each under a robust (Huber) loss. Intrinsics stay fixed (known, or COLMAP's). The markers and
+// each under a robust (Huber) loss; observations still beyond max_error_px after a solve are
+// dropped and the problem solved again. Intrinsics stay fixed (known, or COLMAP's). The markers and
 // the mesh fix the frame and scale, so the result does not inherit the error of a similarity fit:
 // every photo with markers is pinned by them directly.
 //
@@ -31,8 +32,11 @@ struct BundleRefinementOptions {
   bool use_mesh = true;            // point-to-plane term (when a mesh is given)
   double mesh_sigma_m = 0;         // its sigma; 0 = 1.4826 x the points' median distance
   double mesh_max_distance_m = 0;  // points farther from the mesh get no term; 0 = 3 sigma
-  int rounds = 1;                  // solves; the points given a mesh term chosen before each
-  int max_iterations = 100;        // per solve
+  int rounds = 2;                  // solves; before each but the first, track observations
+                                   // reprojecting beyond max_error_px are dropped and the
+                                   // points given a mesh term chosen again
+  double max_error_px = 4.0;       // COLMAP's own filter (--Mapper.filter_max_reproj_error)
+  int max_iterations = 200;        // per solve
   int threads = 1;
   void Validate() const;  // throws igi::Error (a programming error)
 };
@@ -50,12 +54,13 @@ struct BundleRefinementSummary {
   int points = 0;               // 3D points refined (tracks of 2+ observations)
   int observations = 0;         // track observations
   int marker_observations = 0;  // marker pixels in registered photos
-  int mesh_points = 0;          // points with a point-to-plane term (last round)
+  int mesh_points = 0;          // points with a mesh-distance term (last round)
+  int outliers = 0;             // track observations dropped (beyond max_error_px)
   double mesh_sigma_m = 0;
   int iterations = 0;  // over every round
   double initial_cost = 0, final_cost = 0;
-  std::string termination;                                   // Ceres's last termination type
-  double rms_before_px = 0, rms_after_px = 0;                // every track observation
+  std::string termination;                     // Ceres's last termination type
+  double rms_before_px = 0, rms_after_px = 0;  // track observations (after: those kept)
   double marker_rms_before_px = 0, marker_rms_after_px = 0;  // every marker observation
   double mesh_rms_before_m = 0, mesh_rms_after_m = 0;        // points with a mesh term
   std::vector<ImageRefinement> per_image;                    // in image-name order

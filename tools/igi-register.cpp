@@ -307,6 +307,7 @@ igi::Json JointRefinementJson(const igi::BundleRefinementSummary& b) {
           {"observations", b.observations},
           {"marker_observations", b.marker_observations},
           {"mesh_points", b.mesh_points},
+          {"outliers_dropped", b.outliers},
           {"mesh_sigma_m", b.mesh_sigma_m},
           {"iterations", b.iterations},
           {"initial_cost", b.initial_cost},
@@ -437,7 +438,8 @@ int main(int argc, char** argv) {
   app.add_option("--camera", args.camera, "camera.json: known intrinsics, held fixed");
   app.add_option("--colmap", args.colmap.executable, "COLMAP executable");
   app.add_option("--min-pose-inliers", args.colmap.min_pose_inliers,
-                 "COLMAP's mapper registers a photo with this many 2D-3D inliers");
+                 "COLMAP's mapper registers a photo with this many 2D-3D inliers (>= 6)")
+      ->check(CLI::Range(6, 1000000));
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
   app.add_flag(

@@ -39,12 +39,17 @@ using test::Quote;
 using test::RunTool;
 
 constexpr int kCameras = 16;  // 4 close-ups of the highlights + 12 overviews around the room
-// Issue 6 asks for 0.1 degrees and 0.5 % of the room size (2 cm). COLMAP reaches ~0.9 px
-// reprojection RMS on these 480 x 360 renders, and runs differ (multi-threaded matching): the
-// worst photo measured 0.21-0.31 degrees and 12-24 mm over five runs. The test holds 0.4 degrees
-// and 3 cm (0.75 %) so that it is not flaky, until the photos or the refinement get better.
-constexpr double kMaxRotationDeg = 0.4;
-constexpr double kMaxPositionM = 0.03;
+// The markers are the exact projections of the corners; igi-register is told they are good to
+// 0.1 px (--marker-sigma), what targets detected with sub-pixel refinement (ArUco/ChArUco
+// corners) give. Issue 6's bars: 0.1 degrees and 0.5 % of the room size (2 cm) for every photo.
+// Measured over 3 runs (COLMAP's runs differ): worst photo TBD.
+constexpr double kMarkerSigmaPx = 0.1;
+constexpr double kMaxRotationDeg = 0.1;
+constexpr double kMaxPositionM = 0.02;
+// The same COLMAP model with the markers weighted as if clicked by hand (1 px, the default):
+// measured TBD. Checked loosely, so that the default stays sane.
+constexpr double kMaxRotationHandDeg = 0.3;
+constexpr double kMaxPositionHandM = 0.03;
 constexpr int kWidth = 480;
 constexpr int kHeight = 360;
 constexpr int kSpp = 8;
@@ -117,9 +122,10 @@ struct PoseErrors {
   double max_position_m = 0;
 };
 
-// Compares every camera of `registered` with the same-named camera of `truth`.
+// Compares every camera of `registered` with the same-named camera of `truth`; checks the
+// errors against the limits when they are given (> 0) and prints them per camera when `print`.
 PoseErrors ComparePoses(const Scene& truth, const std::vector<Camera>& registered,
-                        bool check = true) {
+                        double max_rotation_deg = 0, double max_position_m = 0, bool print = true) {
   PoseErrors e;
   for (const Camera& camera : registered) {
     const int i = truth.FindCamera(camera.name);
@@ -128,11 +134,16 @@ PoseErrors ComparePoses(const Scene& truth, const std::vector<Camera>& registere
     const Camera& t = truth.cameras[i];
     const double rot = AngleDeg(camera.cam_from_world.rotation, t.cam_from_world.rotation);
     const double pos = (camera.CenterInWorld() - t.CenterInWorld()).norm();
-    if (check) {
-      EXPECT_LT(rot, kMaxRotationDeg) << camera.name;
-      EXPECT_LT(pos, kMaxPositionM) << camera.name;
+    if (max_rotation_deg > 0) {
+      EXPECT_LT(rot, max_rotation_deg) << camera.name;
     }
-    std::printf("  %s: rotation %.4f deg, position %.2f mm\n", camera.name.c_str(), rot, 1e3 * pos);
+    if (max_position_m > 0) {
+      EXPECT_LT(pos, max_position_m) << camera.name;
+    }
+    if (print) {
+      std::printf("  %s: rotation %.4f deg, position %.2f mm\n", camera.name.c_str(), rot,
+                  1e3 * pos);
+    }
     e.max_rotation_deg = std::max(e.max_rotation_deg, rot);
     e.max_position_m = std::max(e.max_position_m, pos);
   }
@@ -150,15 +161,16 @@ std::vector<Camera> CamerasOf(const ColmapModel& model) {
 }
 
 void PrintStage(const char* stage, const Scene& truth, const ColmapModel& model) {
-  std::printf("stage: %s\n", stage);
-  const PoseErrors e = ComparePoses(truth, CamerasOf(model), /*check=*/false);
-  std::printf("stage %-44s max rotation %.4f deg, max position %.2f mm\n", stage,
-              e.max_rotation_deg, 1e3 * e.max_position_m);
+  const PoseErrors e = ComparePoses(truth, CamerasOf(model), 0, 0, /*print=*/false);
+  std::printf("stage %-50s max rotation %.4f deg, max position %.2f mm (%zu photos)\n", stage,
+              e.max_rotation_deg, 1e3 * e.max_position_m, model.images.size());
 }
 
 // COLMAP's model (a) with the similarity that best maps its camera centres onto the true ones
 // (what COLMAP's own shape allows), then as igi-register goes: (b) the markers' similarity,
-// (c) + mesh ICP, (d) + per-pose refinement against the mesh, (e) + joint refinement.
+// (c) + mesh ICP, (d) + per-pose refinement against the mesh, (e) + joint refinement with the
+// markers weighted as clicked by hand (1 px), (f) as the test's igi-register run (0.1 px),
+// (g) as (f) without the mesh term.
 void PrintStages(const Scene& truth, const ColmapModel& colmap, const Markers& markers) {
   {
     ColmapModel m = colmap;
@@ -188,14 +200,25 @@ void PrintStages(const Scene& truth, const ColmapModel& colmap, const Markers& m
   PrintStage("(c) + mesh ICP", truth, m);
   RefinePosesAgainstMesh(truth.mesh, fit.inlier_threshold_m, &m);
   PrintStage("(d) + per-pose refinement against the mesh", truth, m);
-  ColmapModel tracks_only = m;
   BundleRefinementOptions options;
   options.threads = 2;
-  RefineBundle(&markers, &truth.mesh, &m, options);
-  PrintStage("(e) + joint refinement (tracks, markers, mesh)", truth, m);
+  options.mesh_sigma_m = fit.inlier_threshold_m / MeshAlignmentOptions{}.inlier_sigmas;
+  const std::vector<std::string> photos = [&] {
+    std::vector<std::string> names;
+    for (const auto& [photo, seen] : markers.pixels) names.push_back(photo);
+    return names;
+  }();
+  PoseImagesFromMarkers(markers, photos, &m);
+  ColmapModel e = m;
+  RefineBundle(&markers, &truth.mesh, &e, options);
+  PrintStage("(e) + joint refinement, markers at 1 px", truth, e);
+  options.marker_sigma_px = kMarkerSigmaPx;
+  ColmapModel f = m;
+  RefineBundle(&markers, &truth.mesh, &f, options);
+  PrintStage("(f) + joint refinement, markers at 0.1 px", truth, f);
   options.use_mesh = false;
-  RefineBundle(&markers, nullptr, &tracks_only, options);
-  PrintStage("(e') + joint refinement without the mesh term", truth, tracks_only);
+  RefineBundle(&markers, nullptr, &m, options);
+  PrintStage("(g) + joint refinement, markers at 0.1 px, no mesh term", truth, m);
 }
 
 TEST(RegistrationSynthTest, RecoversKnownPosesOfTexturedRoom) {
@@ -226,50 +249,77 @@ TEST(RegistrationSynthTest, RecoversKnownPosesOfTexturedRoom) {
                                           {"height", cam0.height},
                                           {"params", cam0.params}});
   const auto t1 = std::chrono::steady_clock::now();
+  const std::string common = " --camera " + Quote((dir / "camera.json").string()) + " --scene " +
+                             Quote((synth / "scene.json").string()) + " --markers " +
+                             Quote((dir / "markers.json").string()) + " --threads 2 --images " +
+                             Quote((dir / "images").string());
   const auto r =
-      RunTool("igi-register", "--images " + Quote((dir / "images").string()) + " --camera " +
-                                  Quote((dir / "camera.json").string()) + " --scene " +
-                                  Quote((synth / "scene.json").string()) + " --markers " +
-                                  Quote((dir / "markers.json").string()) + " --threads 2 --out " +
-                                  Quote((dir / "out").string()));
+      RunTool("igi-register", common + " --marker-sigma " + std::to_string(kMarkerSigmaPx) +
+                                  " --out " + Quote((dir / "out").string()));
   const auto t2 = std::chrono::steady_clock::now();
   std::printf("igi-synth + tone mapping %.0f s, igi-register %.0f s\n",
               std::chrono::duration<double>(t1 - t0).count(),
               std::chrono::duration<double>(t2 - t1).count());
-  // The noise photo does not register: exit 3, listed in report.json.
+  // The noise photo does not register: exit 3, listed in report.json; every other photo does
+  // (a close-up that COLMAP's mapper leaves out is posed from its markers).
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("zz_noise.png"), std::string::npos) << r.err;
   const Json report = ReadJsonFile(dir / "out" / "report.json");
-  const auto unregistered = report["unregistered"].get<std::vector<std::string>>();
-  EXPECT_NE(std::find(unregistered.begin(), unregistered.end(), "zz_noise.png"),
-            unregistered.end());
-  // One close-up of a highlight (cam3) does not register either (measured); every other does.
-  EXPECT_GE(report["registered"].size(), static_cast<size_t>(kCameras - 1));
-  std::printf("unregistered: %s\n", report["unregistered"].dump().c_str());
+  EXPECT_EQ(report["unregistered"], Json::array({"zz_noise.png"}));
+  EXPECT_EQ(report["registered"].size(), static_cast<size_t>(kCameras));
+  std::printf("unregistered: %s, posed from markers: %s\n", report["unregistered"].dump().c_str(),
+              report["alignment"]["posed_from_markers"].dump().c_str());
   EXPECT_TRUE(report["known_intrinsics"].get<bool>());
   ASSERT_EQ(report["cameras"].size(), 1u);  // the known intrinsics, held fixed
   const auto params = report["cameras"][0]["params"].get<std::vector<double>>();
   for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(params[k], cam0.params[k], 1e-9);
-  std::printf("alignment: %s\n", report["alignment"].dump(1).c_str());
+  Json brief = report["alignment"];
+  brief["joint_refinement"].erase("per_image");
+  std::printf("alignment: %s\n", brief.dump(1).c_str());
   EXPECT_EQ(report["alignment"]["method"], "markers+mesh+pose_refinement+joint_refinement");
   EXPECT_GT(report["alignment"]["mesh"]["inlier_fraction"].get<double>(), 0.8);
   EXPECT_LT(report["alignment"]["mesh"]["rms_m"].get<double>(), 0.01);
+  // Every photo's final reprojection: tracks below 1.5 px RMS (COLMAP's are 0.7-1 px on these
+  // renders), markers below 0.1 px (they are exact).
+  for (const Json& p : report["registered"]) {
+    EXPECT_LT(p["reprojection_rms_px"].get<double>(), 1.5) << p.dump();
+    EXPECT_LT(p["marker_rms_px"].get<double>(), 0.1) << p.dump();
+  }
+  const Json& joint = report["alignment"]["joint_refinement"];
+  EXPECT_EQ(joint["per_image"].size(), static_cast<size_t>(kCameras));
+  EXPECT_LT(joint["rms_after_px"].get<double>(), joint["rms_before_px"].get<double>());
 
   SceneLoadOptions no_images;
   no_images.check_images = false;
   const Scene registered = LoadScene(dir / "out" / "scene.json", no_images);
-  EXPECT_GE(registered.cameras.size(), static_cast<size_t>(kCameras - 1));
-  const PoseErrors e = ComparePoses(truth, registered.cameras);
-  std::printf("markers+mesh: max rotation error %.4f deg, max position error %.2f mm\n",
-              e.max_rotation_deg, 1e3 * e.max_position_m);
+  EXPECT_EQ(registered.cameras.size(), static_cast<size_t>(kCameras));
+  const PoseErrors e = ComparePoses(truth, registered.cameras, kMaxRotationDeg, kMaxPositionM);
+  std::printf("markers at %.1f px: max rotation error %.4f deg, max position error %.2f mm\n",
+              kMarkerSigmaPx, e.max_rotation_deg, 1e3 * e.max_position_m);
 
-  // Where the error comes from: COLMAP's own model (the largest under out/colmap/models/)
-  // brought into the scene frame step by step as igi-register does, with each step's errors.
+  // COLMAP's model again (no new COLMAP run), the markers at the default weight (1 px).
+  fs::path model_dir;
   ColmapModel model;
   for (const auto& entry : fs::directory_iterator(dir / "out" / "colmap" / "models")) {
     ColmapModel m = ReadColmapModel(entry.path());
-    if (m.images.size() > model.images.size()) model = std::move(m);
+    if (m.images.size() > model.images.size()) {
+      model = std::move(m);
+      model_dir = entry.path();
+    }
   }
+  const auto hand =
+      RunTool("igi-register", common + " --colmap-model " + Quote(model_dir.string()) + " --out " +
+                                  Quote((dir / "out_hand").string()));
+  EXPECT_EQ(hand.exit_code, 3) << hand.err;
+  const Scene by_hand = LoadScene(dir / "out_hand" / "scene.json", no_images);
+  EXPECT_EQ(by_hand.cameras.size(), static_cast<size_t>(kCameras));
+  const PoseErrors eh =
+      ComparePoses(truth, by_hand.cameras, kMaxRotationHandDeg, kMaxPositionHandM, false);
+  std::printf("markers at 1 px: max rotation error %.4f deg, max position error %.2f mm\n",
+              eh.max_rotation_deg, 1e3 * eh.max_position_m);
+
+  // Where the error comes from: COLMAP's own model brought into the scene frame step by step
+  // as igi-register does, with each step's errors.
   PrintStages(truth, model, ReadMarkers(dir / "markers.json"));
 
   // COLMAP's own model fitted to the mesh with no start (principal axes + random rotations).
@@ -280,7 +330,7 @@ TEST(RegistrationSynthTest, RecoversKnownPosesOfTexturedRoom) {
   // asymmetric room of registration_mesh_test.cpp checks the coarse start.
   const MeshAlignmentSummary fit = AlignPointsToMeshCoarse(ModelPoints(model), truth.mesh);
   TransformModel(fit.scene_from_model, &model);
-  const PoseErrors coarse = ComparePoses(truth, CamerasOf(model), /*check=*/false);
+  const PoseErrors coarse = ComparePoses(truth, CamerasOf(model), 0, 0, /*print=*/false);
   std::printf(
       "mesh only (principal axes start): max rotation error %.4f deg, position %.2f mm, "
       "inliers %.3f, rms %.2f mm\n",
