@@ -326,6 +326,52 @@ void FillPerImage(const ColmapModel& model, const Stats& before, const Stats& af
             [](const auto& a, const auto& b) { return a.name < b.name; });
 }
 
+// What every solve shares.
+struct Problem {
+  const Markers* markers = nullptr;
+  std::map<uint32_t, Intrinsics> intrinsics;
+  std::optional<MeshClosestPoint> closest;  // with the mesh term
+  double max_distance_m = 0;                // points farther from the mesh get no term
+};
+
+// One solve over the current model; writes the refined poses and points back. Returns false
+// (model unchanged) when Ceres gives no usable solution.
+bool SolveOnce(const Problem& p, const BundleRefinementOptions& options,
+               const std::set<Observation>& dropped, int round, ColmapModel* model,
+               BundleRefinementSummary* s) {
+  Blocks blocks;
+  ceres::Problem problem;
+  s->observations = AddTrackTerms(*model, options, p.intrinsics, dropped, &blocks, &problem);
+  if (p.markers != nullptr) {
+    s->marker_observations =
+        AddMarkerTerms(*model, *p.markers, options, p.intrinsics, &blocks, &problem);
+  }
+  if (p.closest) {
+    const auto [count, rms] = AddMeshTerms(*p.closest, s->mesh_sigma_m, p.max_distance_m,
+                                           options.huber_sigmas, &blocks, &problem);
+    s->mesh_points = count;
+    if (round == 0) s->mesh_rms_before_m = rms;
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(SolverOptions(options, blocks.poses.size()), &problem, &summary);
+  if (round == 0) s->initial_cost = summary.initial_cost;
+  s->final_cost = summary.final_cost;
+  s->iterations += static_cast<int>(summary.iterations.size());
+  s->termination = ceres::TerminationTypeToString(summary.termination_type);
+  s->images = static_cast<int>(blocks.poses.size());
+  s->points = static_cast<int>(blocks.points.size());
+  if (!summary.IsSolutionUsable()) {
+    spdlog::warn("joint refinement: {}; poses kept", summary.message);
+    return false;
+  }
+  for (const auto& [id, pose] : blocks.poses) SetImagePose(pose, &model->images.at(id));
+  for (const auto& [id, x] : blocks.points) model->points3d.at(id).xyz = x;
+  if (p.closest) s->mesh_rms_after_m = MeshRms(*p.closest, blocks, p.max_distance_m);
+  spdlog::info("joint refinement round {}: cost {:.6g} -> {:.6g} in {} iterations ({})", round + 1,
+               summary.initial_cost, summary.final_cost, summary.iterations.size(), s->termination);
+  return true;
+}
+
 }  // namespace
 
 void BundleRefinementOptions::Validate() const {
@@ -342,19 +388,19 @@ BundleRefinementSummary RefineBundle(const Markers* markers, const TriangleMesh*
   if (markers == nullptr && !with_mesh) {
     throw Error("the joint refinement needs markers or a mesh to fix the scene's frame");
   }
-  std::map<uint32_t, Intrinsics> intrinsics;
+  Problem p{markers, {}, std::nullopt, 0};
   for (const auto& [id, image] : model->images) {
-    intrinsics.emplace(image.camera_id, Intrinsics(CameraOfImage(*model, image)));
+    p.intrinsics.emplace(image.camera_id, Intrinsics(CameraOfImage(*model, image)));
   }
-  std::optional<MeshClosestPoint> closest;
-  if (with_mesh) closest.emplace(*mesh);
   BundleRefinementSummary s;
   if (with_mesh) {
-    s.mesh_sigma_m = options.mesh_sigma_m > 0 ? options.mesh_sigma_m : MeshSigma(*closest, *model);
+    p.closest.emplace(*mesh);
+    s.mesh_sigma_m =
+        options.mesh_sigma_m > 0 ? options.mesh_sigma_m : MeshSigma(*p.closest, *model);
     s.mesh_sigma_m = std::max(s.mesh_sigma_m, 1e-6);
+    p.max_distance_m =
+        options.mesh_max_distance_m > 0 ? options.mesh_max_distance_m : 3 * s.mesh_sigma_m;
   }
-  const double max_distance_m =
-      options.mesh_max_distance_m > 0 ? options.mesh_max_distance_m : 3 * s.mesh_sigma_m;
   const Stats before = ComputeStats(*model, markers, {});
   std::set<Observation> dropped;
   for (int round = 0; round < options.rounds; ++round) {
@@ -363,37 +409,7 @@ BundleRefinementSummary RefineBundle(const Markers* markers, const TriangleMesh*
       s.outliers += outliers;
       if (outliers == 0 && !with_mesh) break;
     }
-    Blocks blocks;
-    ceres::Problem problem;
-    s.observations = AddTrackTerms(*model, options, intrinsics, dropped, &blocks, &problem);
-    if (markers != nullptr) {
-      s.marker_observations =
-          AddMarkerTerms(*model, *markers, options, intrinsics, &blocks, &problem);
-    }
-    if (with_mesh) {
-      const auto [count, rms] = AddMeshTerms(*closest, s.mesh_sigma_m, max_distance_m,
-                                             options.huber_sigmas, &blocks, &problem);
-      s.mesh_points = count;
-      if (round == 0) s.mesh_rms_before_m = rms;
-    }
-    ceres::Solver::Summary summary;
-    ceres::Solve(SolverOptions(options, blocks.poses.size()), &problem, &summary);
-    if (round == 0) s.initial_cost = summary.initial_cost;
-    s.final_cost = summary.final_cost;
-    s.iterations += static_cast<int>(summary.iterations.size());
-    s.termination = ceres::TerminationTypeToString(summary.termination_type);
-    s.images = static_cast<int>(blocks.poses.size());
-    s.points = static_cast<int>(blocks.points.size());
-    if (!summary.IsSolutionUsable()) {
-      spdlog::warn("joint refinement: {}; poses kept", summary.message);
-      break;
-    }
-    for (const auto& [id, pose] : blocks.poses) SetImagePose(pose, &model->images.at(id));
-    for (const auto& [id, x] : blocks.points) model->points3d.at(id).xyz = x;
-    if (with_mesh) s.mesh_rms_after_m = MeshRms(*closest, blocks, max_distance_m);
-    spdlog::info("joint refinement round {}: cost {:.6g} -> {:.6g} in {} iterations ({})",
-                 round + 1, summary.initial_cost, summary.final_cost, summary.iterations.size(),
-                 s.termination);
+    if (!SolveOnce(p, options, dropped, round, model, &s)) break;
   }
   const Stats after = ComputeStats(*model, markers, dropped);
   s.rms_before_px = before.all_tracks.Rms();

@@ -2,11 +2,22 @@
 // region textured (--textured-walls) from 16 cameras; the photos (tone-mapped to 8-bit PNG) and
 // one photo of noise that cannot register go to igi-register with the true intrinsics
 // (--camera), the scene and control points (the room's and the boxes' corners projected with
-// the true poses). Checked: exit 3 with the noise photo listed as unregistered, the known
-// intrinsics kept, and every registered photo's pose in the scene frame within 0.4 degrees and
-// 3 cm of the truth (issue 6 asks 0.1 degrees and 2 cm: not reached yet, see below); then
-// COLMAP's own model is fitted to the mesh from no start at all (printed only).
-// Takes 2-3 minutes on 2 shared cores (igi-synth ~45-70 s, igi-register ~70-120 s): LABELS slow.
+// the true poses). Checked: exit 3 with only the noise photo unregistered, the known intrinsics
+// kept, every photo's final reprojection RMS, and every photo's pose in the scene frame within
+// issue 6's bars (0.1 degrees, 2 cm); then the same COLMAP model with the markers weighted as if
+// clicked by hand (checked loosely), and the error of each stage of the alignment (printed).
+// Takes 3-5 minutes on 2 shared cores (igi-synth ~45-160 s, igi-register ~70-270 s, most of it
+// COLMAP's exhaustive matching): LABELS slow.
+//
+// Where the error comes from (measured, worst photo; stages printed by PrintStages): COLMAP's
+// own model, even under the similarity that best maps its camera centres onto the true ones, is
+// off by 0.25-0.27 degrees (up to 1.8 degrees for a close-up registered from few inliers), and
+// the markers' similarity, the mesh ICP and the per-pose refinement against the mesh leave
+// 0.27-0.31 degrees and 15-21 mm: the similarity fits cannot remove errors of COLMAP's shape.
+// The joint refinement (tracks + markers + mesh, recon/registration_refinement.h) brings the
+// worst photo to 0.10-0.13 degrees / 5-9 mm with the markers at 1 px and to 0.017-0.018 degrees
+// / 0.8-1.0 mm at 0.1 px (their weight decides: they are exact here). Larger renders (640 x 480,
+// 16 spp) did not make COLMAP's model better (0.27 degrees) and made the test 3x slower.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -120,6 +131,8 @@ double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
 struct PoseErrors {
   double max_rotation_deg = 0;
   double max_position_m = 0;
+  std::string worst;  // the photo with the largest rotation error
+  double median_rotation_deg = 0;
 };
 
 // Compares every camera of `registered` with the same-named camera of `truth`; checks the
@@ -127,6 +140,7 @@ struct PoseErrors {
 PoseErrors ComparePoses(const Scene& truth, const std::vector<Camera>& registered,
                         double max_rotation_deg = 0, double max_position_m = 0, bool print = true) {
   PoseErrors e;
+  std::vector<double> rotations;
   for (const Camera& camera : registered) {
     const int i = truth.FindCamera(camera.name);
     EXPECT_GE(i, 0) << camera.name;
@@ -144,8 +158,14 @@ PoseErrors ComparePoses(const Scene& truth, const std::vector<Camera>& registere
       std::printf("  %s: rotation %.4f deg, position %.2f mm\n", camera.name.c_str(), rot,
                   1e3 * pos);
     }
+    if (rot >= e.max_rotation_deg) e.worst = camera.name;
     e.max_rotation_deg = std::max(e.max_rotation_deg, rot);
     e.max_position_m = std::max(e.max_position_m, pos);
+    rotations.push_back(rot);
+  }
+  if (!rotations.empty()) {
+    std::nth_element(rotations.begin(), rotations.begin() + rotations.size() / 2, rotations.end());
+    e.median_rotation_deg = rotations[rotations.size() / 2];
   }
   return e;
 }
@@ -162,8 +182,11 @@ std::vector<Camera> CamerasOf(const ColmapModel& model) {
 
 void PrintStage(const char* stage, const Scene& truth, const ColmapModel& model) {
   const PoseErrors e = ComparePoses(truth, CamerasOf(model), 0, 0, /*print=*/false);
-  std::printf("stage %-50s max rotation %.4f deg, max position %.2f mm (%zu photos)\n", stage,
-              e.max_rotation_deg, 1e3 * e.max_position_m, model.images.size());
+  std::printf(
+      "stage %-50s max rotation %.4f deg (%s), median %.4f deg, max position %.2f mm (%zu "
+      "photos)\n",
+      stage, e.max_rotation_deg, e.worst.c_str(), e.median_rotation_deg, 1e3 * e.max_position_m,
+      model.images.size());
 }
 
 // COLMAP's model (a) with the similarity that best maps its camera centres onto the true ones
