@@ -275,6 +275,31 @@ int DropOutliers(const ColmapModel& model, double max_error_px, std::set<Observa
   return count;
 }
 
+// Removes the dropped observations from the model (as COLMAP's own filter does): their 2D
+// points lose their 3D point, which leaves the track; a point left with fewer than 2
+// observations is removed.
+void RemoveObservations(const std::set<Observation>& dropped, ColmapModel* model) {
+  for (const auto& [image_id, index] : dropped) {
+    ColmapPoint2D& p = model->images.at(image_id).points2d[index];
+    if (p.point3d_id < 0) continue;
+    auto& track = model->points3d.at(static_cast<uint64_t>(p.point3d_id)).track;
+    std::erase_if(track, [&, image_id = image_id, index = index](const ColmapTrackElement& t) {
+      return t.image_id == image_id && t.point2d_idx == index;
+    });
+    p.point3d_id = -1;
+  }
+  for (auto it = model->points3d.begin(); it != model->points3d.end();) {
+    if (it->second.track.size() >= 2) {
+      ++it;
+      continue;
+    }
+    for (const ColmapTrackElement& t : it->second.track) {
+      model->images.at(t.image_id).points2d[t.point2d_idx].point3d_id = -1;
+    }
+    it = model->points3d.erase(it);
+  }
+}
+
 double MeshSigma(const MeshClosestPoint& closest, const ColmapModel& model) {
   std::vector<double> d;
   for (const auto& [id, p] : model.points3d) {
@@ -411,7 +436,9 @@ BundleRefinementSummary RefineBundle(const Markers* markers, const TriangleMesh*
     }
     if (!SolveOnce(p, options, dropped, round, model, &s)) break;
   }
-  const Stats after = ComputeStats(*model, markers, dropped);
+  s.outliers += DropOutliers(*model, options.max_error_px, &dropped);
+  RemoveObservations(dropped, model);
+  const Stats after = ComputeStats(*model, markers, {});
   s.rms_before_px = before.all_tracks.Rms();
   s.rms_after_px = after.all_tracks.Rms();
   s.marker_rms_before_px = before.all_markers.Rms();

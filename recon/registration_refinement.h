@@ -7,7 +7,8 @@
 //   - the distance of the sparse points to the scene mesh (the closest mesh point found again at
 //     every evaluation, so points near edges are not held to a wrong face's plane),
 // each under a robust (Huber) loss; observations still beyond max_error_px after a solve are
-// dropped and the problem solved again. Intrinsics stay fixed (known, or COLMAP's). The markers and
+// dropped and the problem solved again. The observations dropped (also those still beyond
+// max_error_px at the end) leave the model, and points left with fewer than 2 observations go. Intrinsics stay fixed (known, or COLMAP's). The markers and
 // the mesh fix the frame and scale, so the result does not inherit the error of a similarity fit:
 // every photo with markers is pinned by them directly.
 //
@@ -55,7 +56,7 @@ struct BundleRefinementSummary {
   int observations = 0;         // track observations
   int marker_observations = 0;  // marker pixels in registered photos
   int mesh_points = 0;          // points with a mesh-distance term (last round)
-  int outliers = 0;             // track observations dropped (beyond max_error_px)
+  int outliers = 0;             // track observations removed (beyond max_error_px)
   double mesh_sigma_m = 0;
   int iterations = 0;  // over every round
   double initial_cost = 0, final_cost = 0;

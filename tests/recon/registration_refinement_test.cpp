@@ -260,6 +260,34 @@ TEST(RegistrationRefinementTest, MarkersAloneFixTheFrameWithDistortion) {
   ExpectRecovered(t, model, s);
 }
 
+// A mismatched feature (50 px off) is dropped from the model after the first solve; the rest
+// comes back exactly.
+TEST(RegistrationRefinementTest, DropsOutlierObservations) {
+  const Truth t = MakeTruth(false);
+  ColmapModel model = t.model;
+  ColmapImage& image = model.images.begin()->second;
+  size_t bad = 0;
+  while (image.points2d[bad].point3d_id < 0) ++bad;
+  image.points2d[bad].xy += Vector2d(50, -20);
+  const uint64_t point_id = static_cast<uint64_t>(image.points2d[bad].point3d_id);
+  const size_t track_size = model.points3d.at(point_id).track.size();
+  Disturb(&model);
+  BundleRefinementOptions options;
+  options.use_mesh = false;
+  const BundleRefinementSummary s = RefineBundle(&t.markers, nullptr, &model, options);
+  EXPECT_EQ(s.outliers, 1);
+  EXPECT_EQ(model.images.begin()->second.points2d[bad].point3d_id, -1);
+  if (track_size > 2) {
+    EXPECT_EQ(model.points3d.at(point_id).track.size(), track_size - 1);
+  } else {
+    EXPECT_EQ(model.points3d.count(point_id), 0u);
+  }
+  const Errors e = MaxPoseErrors(t, model);
+  EXPECT_LT(e.rotation_deg, kRotationTolDeg);
+  EXPECT_LT(e.position_m, kPositionTolM);
+  EXPECT_LT(s.rms_after_px, 1e-4);
+}
+
 TEST(RegistrationRefinementTest, NeedsMarkersOrMesh) {
   const Truth t = MakeTruth(false);
   ColmapModel model = t.model;
