@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -351,6 +352,59 @@ void FillPerImage(const ColmapModel& model, const Stats& before, const Stats& af
             [](const auto& a, const auto& b) { return a.name < b.name; });
 }
 
+// RMS reprojection of the markers `seen` in a photo (infinite when one is behind the camera).
+double MarkerRms(const Camera& camera, const Markers& markers,
+                 const std::map<std::string, Vector2d>& seen) {
+  Sums sums;
+  for (const auto& [name, pixel] : seen) {
+    const auto px = camera.ImgFromWorld(markers.points.at(name));
+    if (!px) return std::numeric_limits<double>::infinity();
+    sums.Add((*px - pixel).squaredNorm());
+  }
+  return sums.Rms();
+}
+
+// Poses `image` (its camera from the model) from the markers it sees: PnP (SQPnP) and
+// Levenberg-Marquardt with the fixed intrinsics. Returns the markers' RMS, or nullopt (image
+// unchanged) when PnP fails, a marker ends behind the camera or the RMS exceeds max_rms_px.
+std::optional<double> PoseFromMarkers(const ColmapModel& model, const Markers& markers,
+                                      const std::map<std::string, Vector2d>& seen,
+                                      double max_rms_px, ColmapImage* image) {
+  const ColmapCamera& colmap_camera = model.cameras.at(image->camera_id);
+  const auto converted = ConvertColmapCameraModel(colmap_camera.model, colmap_camera.params);
+  if (!converted) return std::nullopt;
+  const std::vector<double>& p = converted->second;
+  const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
+  cv::Mat dist = cv::Mat::zeros(4, 1, CV_64F);
+  if (converted->first == CameraModel::kOpenCv) {
+    for (int i = 0; i < 4; ++i) dist.at<double>(i) = p[4 + i];
+  }
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> pixels;
+  for (const auto& [name, px] : seen) {
+    const Vector3d& x = markers.points.at(name);
+    object.emplace_back(x.x(), x.y(), x.z());
+    pixels.emplace_back(px.x(), px.y());
+  }
+  cv::Mat rvec, tvec;
+  if (!cv::solvePnP(object, pixels, k, dist, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) {
+    return std::nullopt;
+  }
+  cv::solvePnPRefineLM(object, pixels, k, dist, rvec, tvec);
+  ColmapImage posed = *image;
+  SetImagePose({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2), tvec.at<double>(0),
+                tvec.at<double>(1), tvec.at<double>(2)},
+               &posed);
+  const double rms = MarkerRms(CameraOfImage(model, posed), markers, seen);
+  if (!(rms <= max_rms_px)) {
+    spdlog::warn("{}: pose from {} markers rejected (RMS {:.2f} px)", image->name, seen.size(),
+                 rms);
+    return std::nullopt;
+  }
+  *image = posed;
+  return rms;
+}
+
 // What every solve shares.
 struct Problem {
   const Markers* markers = nullptr;
@@ -453,15 +507,7 @@ std::vector<MarkerPose> PoseImagesFromMarkers(const Markers& markers,
                                               double max_rms_px) {
   std::vector<MarkerPose> added;
   if (model->cameras.empty()) return added;
-  const ColmapCamera& colmap_camera = model->cameras.begin()->second;
-  const auto converted = ConvertColmapCameraModel(colmap_camera.model, colmap_camera.params);
-  if (!converted) return added;
-  const std::vector<double>& p = converted->second;
-  const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
-  cv::Mat dist = cv::Mat::zeros(4, 1, CV_64F);
-  if (converted->first == CameraModel::kOpenCv) {
-    for (int i = 0; i < 4; ++i) dist.at<double>(i) = p[4 + i];
-  }
+  const uint32_t camera_id = model->cameras.begin()->first;
   uint32_t next_id = model->images.empty() ? 1 : model->images.rbegin()->first + 1;
   for (const std::string& photo : photos) {
     const auto seen = markers.pixels.find(photo);
@@ -469,40 +515,44 @@ std::vector<MarkerPose> PoseImagesFromMarkers(const Markers& markers,
         static_cast<int>(seen->second.size()) < min_markers) {
       continue;
     }
-    std::vector<cv::Point3d> object;
-    std::vector<cv::Point2d> pixels;
-    for (const auto& [name, px] : seen->second) {
-      const Vector3d& x = markers.points.at(name);
-      object.emplace_back(x.x(), x.y(), x.z());
-      pixels.emplace_back(px.x(), px.y());
-    }
-    cv::Mat rvec, tvec;
-    if (!cv::solvePnP(object, pixels, k, dist, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) continue;
-    cv::solvePnPRefineLM(object, pixels, k, dist, rvec, tvec);
     ColmapImage image;
     image.image_id = next_id;
-    image.camera_id = colmap_camera.camera_id;
+    image.camera_id = camera_id;
     image.name = photo;
-    const Pose pose = {rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2),
-                       tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)};
-    SetImagePose(pose, &image);
-    Camera camera = CameraOfImage(*model, image);
-    Sums sums;
-    bool in_front = true;
-    for (size_t i = 0; i < object.size(); ++i) {
-      const auto px = camera.ImgFromWorld(Vector3d(object[i].x, object[i].y, object[i].z));
-      in_front = in_front && px.has_value();
-      if (px) sums.Add((*px - Vector2d(pixels[i].x, pixels[i].y)).squaredNorm());
-    }
-    if (!in_front || !(sums.Rms() <= max_rms_px)) {
-      spdlog::warn("{}: pose from {} markers rejected (RMS {:.2f} px)", photo, object.size(),
-                   sums.Rms());
-      continue;
-    }
+    const auto rms = PoseFromMarkers(*model, markers, seen->second, max_rms_px, &image);
+    if (!rms) continue;
     model->images.emplace(next_id++, image);
-    added.push_back({photo, static_cast<int>(object.size()), sums.Rms()});
+    added.push_back({photo, static_cast<int>(seen->second.size()), *rms, 0});
   }
   return added;
+}
+
+std::vector<MarkerPose> RePoseImagesFromMarkers(const Markers& markers, ColmapModel* model,
+                                                double disagree_px, int min_markers,
+                                                double max_rms_px) {
+  std::vector<MarkerPose> reposed;
+  std::set<Observation> dropped;
+  for (auto& [id, image] : model->images) {
+    const auto seen = markers.pixels.find(image.name);
+    if (seen == markers.pixels.end() || static_cast<int>(seen->second.size()) < min_markers) {
+      continue;
+    }
+    const double before = MarkerRms(CameraOfImage(*model, image), markers, seen->second);
+    if (before <= disagree_px) continue;
+    ColmapImage moved = image;
+    const auto rms = PoseFromMarkers(*model, markers, seen->second, max_rms_px, &moved);
+    if (!rms) continue;
+    spdlog::warn("{}: COLMAP's pose misses its markers by {:.1f} px RMS; posed from them",
+                 image.name, before);
+    image.qvec = moved.qvec;
+    image.tvec = moved.tvec;
+    for (size_t i = 0; i < image.points2d.size(); ++i) {
+      if (image.points2d[i].point3d_id >= 0) dropped.insert({id, static_cast<uint32_t>(i)});
+    }
+    reposed.push_back({image.name, static_cast<int>(seen->second.size()), *rms, before});
+  }
+  RemoveObservations(dropped, model);
+  return reposed;
 }
 
 }  // namespace igi

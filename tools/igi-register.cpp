@@ -4,7 +4,8 @@
 // With --scene the model is brought into the scene's frame: by the markers' control points when
 // given, then by fitting the sparse points to the scene mesh (robust point-to-plane ICP with
 // scale; without markers from a principal-axes start), then each pose is refined against the
-// mesh; photos COLMAP did not register but that see 4+ markers are posed from them (PnP); last,
+// mesh; photos whose COLMAP pose misses their markers by > 10 px RMS, and photos COLMAP did not
+// register, are posed from their markers when they see 4+ (PnP); last,
 // every pose and sparse point is refined jointly (Ceres: COLMAP's tracks, the markers'
 // reprojection and the points' distance to the mesh, robust losses; recon/
 // registration_refinement.h). report.json "alignment" says what was done and how well, and
@@ -249,11 +250,12 @@ void AddRegistered(const igi::ColmapModel& model, const igi::Json& alignment, ig
   std::map<std::string, std::string> posed_by;
   if (alignment.contains("posed_from_markers")) {
     for (const auto& p : alignment["posed_from_markers"]) posed_by[p["file"]] = "markers";
+    for (const auto& p : alignment["reposed_from_markers"]) posed_by[p["file"]] = "markers";
   }
   igi::Json registered = igi::Json::array();
   for (const igi::ImageReprojection& r : igi::ReprojectionErrors(model)) {
     igi::Json entry = {{"file", r.name},
-                       {"posed_by", posed_by.count(r.name) ? "markers" : "colmap"},
+                       {"posed_by", posed_by.count(r.name) > 0 ? "markers" : "colmap"},
                        {"observations", r.observations},
                        {"reprojection_rms_px", r.rms_px}};
     const auto it = refined.find(r.name);
@@ -370,7 +372,17 @@ igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapRunSummary
                             {"rms_after_px", p.rms_after_px}};
     steps.push_back("pose_refinement");
   }
-  if (in.markers) a["posed_from_markers"] = PoseFromMarkers(*in.markers, run);
+  if (in.markers) {
+    igi::Json reposed = igi::Json::array();
+    for (const igi::MarkerPose& p : igi::RePoseImagesFromMarkers(*in.markers, model)) {
+      reposed.push_back({{"file", p.name},
+                         {"markers", p.markers},
+                         {"rms_before_px", p.rms_before_px},
+                         {"rms_px", p.rms_px}});
+    }
+    a["reposed_from_markers"] = reposed;
+    a["posed_from_markers"] = PoseFromMarkers(*in.markers, run);
+  }
   if (!args.no_joint_refinement) {
     igi::BundleRefinementOptions options;
     options.threads = args.colmap.threads;
