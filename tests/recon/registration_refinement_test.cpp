@@ -288,6 +288,32 @@ TEST(RegistrationRefinementTest, DropsOutlierObservations) {
   EXPECT_LT(s.rms_after_px, 1e-4);
 }
 
+// A photo posed 20 degrees off (as COLMAP has posed a close-up from wrong matches) misses its
+// markers: it is posed from them again and its track observations leave the model. The others
+// are left alone.
+TEST(RegistrationRefinementTest, RePosesPhotoThatMissesItsMarkers) {
+  const Truth t = MakeTruth(false);
+  ColmapModel model = t.model;
+  ColmapImage& image = model.images.at(4);
+  ASSERT_GE(t.markers.pixels.at(image.name).size(), 4u);
+  image.qvec = QvecFromQuaternion(Eigen::AngleAxisd(20 * M_PI / 180, Vector3d::UnitY()) *
+                                  QuaternionFromQvec(image.qvec));
+  const auto reposed = RePoseImagesFromMarkers(t.markers, &model);
+  ASSERT_EQ(reposed.size(), 1u);
+  EXPECT_EQ(reposed[0].name, image.name);
+  EXPECT_GT(reposed[0].rms_before_px, 10);
+  EXPECT_LT(reposed[0].rms_px, 1e-6);
+  const Errors e = MaxPoseErrors(t, model);
+  EXPECT_LT(e.rotation_deg, 1e-6);
+  EXPECT_LT(e.position_m, 1e-8);
+  for (const ColmapPoint2D& p : model.images.at(4).points2d) EXPECT_EQ(p.point3d_id, -1);
+  for (const auto& [id, p] : model.points3d) {
+    EXPECT_GE(p.track.size(), 2u);
+    for (const ColmapTrackElement& el : p.track) EXPECT_NE(el.image_id, 4u);
+  }
+  EXPECT_TRUE(RePoseImagesFromMarkers(t.markers, &model).empty());  // all agree now
+}
+
 TEST(RegistrationRefinementTest, NeedsMarkersOrMesh) {
   const Truth t = MakeTruth(false);
   ColmapModel model = t.model;
