@@ -191,9 +191,9 @@ void PrintStage(const char* stage, const Scene& truth, const ColmapModel& model)
 
 // COLMAP's model (a) with the similarity that best maps its camera centres onto the true ones
 // (what COLMAP's own shape allows), then as igi-register goes: (b) the markers' similarity,
-// (c) + mesh ICP, (d) + per-pose refinement against the mesh, (e) + joint refinement with the
-// markers weighted as clicked by hand (1 px), (f) as the test's igi-register run (0.1 px),
-// (g) as (f) without the mesh term.
+// (c) + mesh ICP, (d) + per-pose refinement against the mesh, then photos posed from markers
+// where COLMAP missed them and (e) + joint refinement with the markers weighted as clicked by
+// hand (1 px), (f) as the test's igi-register run (0.1 px), (g) as (f) without the mesh term.
 void PrintStages(const Scene& truth, const ColmapModel& colmap, const Markers& markers) {
   {
     ColmapModel m = colmap;
@@ -231,6 +231,7 @@ void PrintStages(const Scene& truth, const ColmapModel& colmap, const Markers& m
     for (const auto& [photo, seen] : markers.pixels) names.push_back(photo);
     return names;
   }();
+  RePoseImagesFromMarkers(markers, &m);
   PoseImagesFromMarkers(markers, photos, &m);
   ColmapModel e = m;
   RefineBundle(&markers, &truth.mesh, &e, options);
