@@ -6,18 +6,21 @@
 // kept, every photo's final reprojection RMS, and every photo's pose in the scene frame within
 // issue 6's bars (0.1 degrees, 2 cm); then the same COLMAP model with the markers weighted as if
 // clicked by hand (checked loosely), and the error of each stage of the alignment (printed).
-// Takes 3-5 minutes on 2 shared cores (igi-synth ~45-160 s, igi-register ~70-270 s, most of it
-// COLMAP's exhaustive matching): LABELS slow.
+// Takes 3-7 minutes on the 2 shared cores (measured: igi-synth 45-160 s, igi-register 160-275 s
+// with the machine's load at 10-17, most of it COLMAP's exhaustive matching): LABELS slow.
 //
-// Where the error comes from (measured, worst photo; stages printed by PrintStages): COLMAP's
-// own model, even under the similarity that best maps its camera centres onto the true ones, is
-// off by 0.25-0.27 degrees (up to 1.8 degrees for a close-up registered from few inliers), and
-// the markers' similarity, the mesh ICP and the per-pose refinement against the mesh leave
-// 0.27-0.31 degrees and 15-21 mm: the similarity fits cannot remove errors of COLMAP's shape.
-// The joint refinement (tracks + markers + mesh, recon/registration_refinement.h) brings the
-// worst photo to 0.10-0.13 degrees / 5-9 mm with the markers at 1 px and to 0.017-0.018 degrees
-// / 0.8-1.0 mm at 0.1 px (their weight decides: they are exact here). Larger renders (640 x 480,
-// 16 spp) did not make COLMAP's model better (0.27 degrees) and made the test 3x slower.
+// Where the error comes from (measured, worst photo, on 2 shared cores; stages printed by
+// PrintStages): COLMAP's own model, even under the similarity that best maps its camera centres
+// onto the true ones, is off by 0.25-0.49 degrees (a close-up of a highlight, cam2), and the
+// markers' similarity, the mesh ICP and the per-pose refinement against the mesh leave 0.27-0.66
+// degrees and 15-41 mm: a similarity cannot remove errors of COLMAP's own shape. The other
+// close-up (cam3) shares 25-33 verified matches with the rest: COLMAP's mapper left it out in 3
+// runs of 5 and registered it 18 degrees off in another (17-23 degrees at --min-pose-inliers 15);
+// igi-register poses it from its 5 markers. The joint refinement (tracks + markers + mesh,
+// recon/registration_refinement.h) brings the worst photo to 0.09-0.27 degrees / 4-16 mm with the
+// markers at 1 px and to 0.015-0.022 degrees / 0.8-1.5 mm at 0.1 px (7 runs); the mesh term
+// changes little (0.017-0.021 degrees without it). Larger renders (640 x 480, 16 spp) did not
+// make COLMAP's own model better (0.27 degrees) and made igi-register 3x slower.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -52,15 +55,17 @@ using test::RunTool;
 constexpr int kCameras = 16;  // 4 close-ups of the highlights + 12 overviews around the room
 // The markers are the exact projections of the corners; igi-register is told they are good to
 // 0.1 px (--marker-sigma), what targets detected with sub-pixel refinement (ArUco/ChArUco
-// corners) give. Issue 6's bars: 0.1 degrees and 0.5 % of the room size (2 cm) for every photo.
-// Measured over 3 runs (COLMAP's runs differ): worst photo TBD.
+// corners) give. Issue 6's bars: 0.1 degrees and 0.5 % of the room size (2 cm) for every photo;
+// measured 0.015-0.022 degrees and 0.8-1.5 mm (worst photo, 7 runs), so the bars hold with a
+// 4.5x margin.
 constexpr double kMarkerSigmaPx = 0.1;
 constexpr double kMaxRotationDeg = 0.1;
 constexpr double kMaxPositionM = 0.02;
 // The same COLMAP model with the markers weighted as if clicked by hand (1 px, the default):
-// measured TBD. Checked loosely, so that the default stays sane.
-constexpr double kMaxRotationHandDeg = 0.3;
-constexpr double kMaxPositionHandM = 0.03;
+// measured 0.09-0.27 degrees and 4-16 mm (worst photo, cam2: 4 markers, ~90 features), checked
+// loosely so that the default path stays sane.
+constexpr double kMaxRotationHandDeg = 0.5;
+constexpr double kMaxPositionHandM = 0.04;
 constexpr int kWidth = 480;
 constexpr int kHeight = 360;
 constexpr int kSpp = 8;
