@@ -11,8 +11,7 @@ Camera MakeCamera(CameraModel model) {
   cam.width = 320;
   cam.height = 240;
   cam.params = {277.1, 270.5, 160.0, 120.0};
-  if (model == CameraModel::kOpenCv)
-    cam.params.insert(cam.params.end(), {-0.2, 0.05, 0.001, -0.002});
+  if (model == CameraModel::kOpenCv) cam.params.insert(cam.params.end(), {-0.2, 0.05, 0.001, -0.002});
   // Looking along world +y from (1, -2, 0.5): camera z = world y, camera y = -world z.
   Eigen::Matrix3d r;
   r << 1, 0, 0, 0, 0, -1, 0, 1, 0;

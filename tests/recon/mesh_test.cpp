@@ -7,8 +7,7 @@
 namespace igi {
 namespace {
 
-const std::filesystem::path kMini =
-    std::filesystem::path(IGI_SOURCE_DIR) / "tests/data/scenes/mini";
+const std::filesystem::path kMini = std::filesystem::path(IGI_SOURCE_DIR) / "tests/data/scenes/mini";
 
 TEST(MeshTest, ReadsRegionsUvsAndNormalsFromObj) {
   ProblemList problems;
