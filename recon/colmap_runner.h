@@ -35,7 +35,7 @@ struct ColmapRunOptions {
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share
   // few points with the rest register, but measured on the synthetic room's close-up of a
   // highlight (25-33 verified matches per pair) at 15: registered in 3 of 3 runs, 1.7-23
-  // degrees off; at 30 left out in 3 runs of 4 and registered 18 degrees off in one. With
+  // degrees off; at 30 left out in 3 runs of 5, registered 18 and 0.9 degrees off in two. With
   // markers igi-register poses such a photo from them instead (RePoseImagesFromMarkers).
   int min_pose_inliers = 30;
 
