@@ -98,10 +98,18 @@ std::vector<std::string> MapperArgs(const std::filesystem::path& images_dir,
                                     const std::filesystem::path& db,
                                     const std::filesystem::path& models,
                                     const ColmapRunOptions& o) {
-  std::vector<std::string> a = {o.executable,      "mapper",        "--database_path",
-                                db.string(),       "--image_path",  images_dir.string(),
-                                "--output_path",   models.string(), "--Mapper.num_threads",
-                                Threads(o.threads)};
+  std::vector<std::string> a = {o.executable,
+                                "mapper",
+                                "--database_path",
+                                db.string(),
+                                "--image_path",
+                                images_dir.string(),
+                                "--output_path",
+                                models.string(),
+                                "--Mapper.num_threads",
+                                Threads(o.threads),
+                                "--Mapper.abs_pose_min_num_inliers",
+                                std::to_string(o.min_pose_inliers)};
   if (o.intrinsics) {
     a.insert(a.end(), {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point",
                        "0", "--Mapper.ba_refine_extra_params", "0"});
@@ -129,6 +137,9 @@ void ColmapRunOptions::Validate() const {
   ProblemList problems;
   if (executable.empty()) problems.Add("", "--colmap", "", "must name the colmap executable");
   if (threads < 0) problems.Add("", "--threads", std::to_string(threads), "must be >= 0");
+  if (min_pose_inliers < 6) {
+    problems.Add("", "--min-pose-inliers", std::to_string(min_pose_inliers), "must be >= 6");
+  }
   if (max_image_size < 100) {
     problems.Add("", "--max-image-size", std::to_string(max_image_size), "must be >= 100");
   }
@@ -220,6 +231,19 @@ ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
   }
   spdlog::info("COLMAP registered {} of {} photos ({} model(s))", summary.model.images.size(),
                summary.images.size(), count);
+  return summary;
+}
+
+ColmapRunSummary LoadColmapRun(const std::filesystem::path& images_dir,
+                               const std::filesystem::path& model_dir) {
+  ColmapRunSummary summary;
+  summary.version = "not run";
+  summary.images = ListColmapImages(images_dir);
+  summary.model = ReadColmapModel(model_dir);
+  summary.num_models = 1;
+  for (const std::string& name : summary.images) {
+    if (summary.model.FindImageByName(name) == nullptr) summary.unregistered.push_back(name);
+  }
   return summary;
 }
 

@@ -4,12 +4,18 @@
 // With --scene the model is brought into the scene's frame: by the markers' control points when
 // given, then by fitting the sparse points to the scene mesh (robust point-to-plane ICP with
 // scale; without markers from a principal-axes start), then each pose is refined against the
-// mesh (report.json "alignment" says what was done and how well).
+// mesh; photos whose COLMAP pose misses their markers by > 10 px RMS, and photos COLMAP did not
+// register, are posed from their markers when they see 4+ (PnP); last,
+// every pose and sparse point is refined jointly (Ceres: COLMAP's tracks, the markers'
+// reprojection and the points' distance to the mesh, robust losses; recon/
+// registration_refinement.h). report.json "alignment" says what was done and how well, and
+// "registered" gives every photo's final reprojection RMS (tracks and markers).
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
-// COLMAP's own database, models and log go to DIR/colmap/. Exit 3 when some photos did not
-// register (listed in report.json); exit 1 when COLMAP is missing, of another version than 3.8,
-// or reconstructs nothing; exit 2 for bad input (nothing written).
+// COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
+// instead). Exit 3 when some photos did not register (listed in report.json); exit 1 when COLMAP
+// is missing, of another version than 3.8, or reconstructs nothing; exit 2 for bad input
+// (nothing written).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -26,6 +32,7 @@
 #include "recon/colmap_runner.h"
 #include "recon/mesh_alignment.h"
 #include "recon/registration.h"
+#include "recon/registration_refinement.h"
 #include "recon/scene.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
@@ -47,6 +54,10 @@ struct Args {
   bool multi_camera = false;
   bool no_mesh_fit = false;
   bool no_pose_refinement = false;
+  bool no_joint_refinement = false;
+  double marker_sigma_px = 1.0;  // accuracy of the markers' pixels
+  double mesh_sigma_m = 0;       // accuracy of the mesh; 0 = from the mesh fit's residuals
+  std::string colmap_model;      // an existing COLMAP model instead of running COLMAP
 };
 
 struct Inputs {
@@ -87,6 +98,10 @@ Inputs ValidateInputs(const Args& args) {
     throw igi::InputError(igi::DescribeProblem(args.images, "--images",
                                                std::to_string(in.images.size()) + " photos",
                                                "registration needs at least 2 (JPEG/PNG/TIFF)"));
+  }
+  if (!args.colmap_model.empty() && !fs::is_directory(args.colmap_model)) {
+    throw igi::InputError(
+        igi::DescribeProblem(args.colmap_model, "--colmap-model", "", "is not a folder"));
   }
   if (!args.camera.empty()) {
     in.camera = igi::calib::ReadCameraFile(args.camera);
@@ -215,19 +230,43 @@ igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
   report["unregistered"] = run.unregistered;
   report["models_reconstructed"] = run.num_models;
   report["known_intrinsics"] = !args.camera.empty();
-  igi::Json registered = igi::Json::array();
-  for (const igi::ImageReprojection& r : igi::ReprojectionErrors(run.model)) {
-    registered.push_back(
-        {{"file", r.name}, {"observations", r.observations}, {"reprojection_rms_px", r.rms_px}});
-  }
-  report["registered"] = registered;
   igi::Json cameras = igi::Json::array();
   for (const auto& [id, cam] : run.model.cameras) {
     cameras.push_back({{"camera_id", id}, {"model", cam.model}, {"params", cam.params}});
   }
   report["cameras"] = cameras;
-  report["points3d"] = run.model.points3d.size();
   return report;
+}
+
+// report.json's "registered" (the final poses' reprojection errors; with the joint refinement
+// also the markers') and "points3d".
+void AddRegistered(const igi::ColmapModel& model, const igi::Json& alignment, igi::Json* report) {
+  std::map<std::string, igi::Json> refined;
+  if (alignment.contains("joint_refinement")) {
+    for (const auto& r : alignment["joint_refinement"]["per_image"]) {
+      refined[r["file"].get<std::string>()] = r;
+    }
+  }
+  std::map<std::string, std::string> posed_by;
+  if (alignment.contains("posed_from_markers")) {
+    for (const auto& p : alignment["posed_from_markers"]) posed_by[p["file"]] = "markers";
+    for (const auto& p : alignment["reposed_from_markers"]) posed_by[p["file"]] = "markers";
+  }
+  igi::Json registered = igi::Json::array();
+  for (const igi::ImageReprojection& r : igi::ReprojectionErrors(model)) {
+    igi::Json entry = {{"file", r.name},
+                       {"posed_by", posed_by.count(r.name) > 0 ? "markers" : "colmap"},
+                       {"observations", r.observations},
+                       {"reprojection_rms_px", r.rms_px}};
+    const auto it = refined.find(r.name);
+    if (it != refined.end()) {
+      entry["markers"] = it->second["markers"];
+      entry["marker_rms_px"] = it->second["marker_rms_after_px"];
+    }
+    registered.push_back(entry);
+  }
+  (*report)["registered"] = registered;
+  (*report)["points3d"] = model.points3d.size();
 }
 
 igi::Json MarkersJson(const igi::MarkerAlignment& alignment) {
@@ -254,10 +293,54 @@ igi::Json MeshJson(const igi::MeshAlignmentSummary& m) {
           {"median_m", m.median_m}};
 }
 
-// Brings `model` into the scene's frame: markers (when given) for a start, then the sparse
+igi::Json JointRefinementJson(const igi::BundleRefinementSummary& b) {
+  igi::Json per_image = igi::Json::array();
+  for (const igi::ImageRefinement& r : b.per_image) {
+    per_image.push_back({{"file", r.name},
+                         {"observations", r.observations},
+                         {"markers", r.markers},
+                         {"rms_before_px", r.rms_before_px},
+                         {"rms_after_px", r.rms_after_px},
+                         {"marker_rms_before_px", r.marker_rms_before_px},
+                         {"marker_rms_after_px", r.marker_rms_after_px}});
+  }
+  return {{"images", b.images},
+          {"points", b.points},
+          {"observations", b.observations},
+          {"marker_observations", b.marker_observations},
+          {"mesh_points", b.mesh_points},
+          {"outliers_dropped", b.outliers},
+          {"mesh_sigma_m", b.mesh_sigma_m},
+          {"iterations", b.iterations},
+          {"initial_cost", b.initial_cost},
+          {"final_cost", b.final_cost},
+          {"termination", b.termination},
+          {"rms_before_px", b.rms_before_px},
+          {"rms_after_px", b.rms_after_px},
+          {"marker_rms_before_px", b.marker_rms_before_px},
+          {"marker_rms_after_px", b.marker_rms_after_px},
+          {"mesh_rms_before_m", b.mesh_rms_before_m},
+          {"mesh_rms_after_m", b.mesh_rms_after_m},
+          {"per_image", per_image}};
+}
+
+// Photos COLMAP left out that see enough markers are posed from them (PnP) and join the model.
+igi::Json PoseFromMarkers(const igi::Markers& markers, igi::ColmapRunSummary* run) {
+  igi::Json posed = igi::Json::array();
+  for (const igi::MarkerPose& p :
+       igi::PoseImagesFromMarkers(markers, run->unregistered, &run->model)) {
+    posed.push_back({{"file", p.name}, {"markers", p.markers}, {"rms_px", p.rms_px}});
+    std::erase(run->unregistered, p.name);
+  }
+  return posed;
+}
+
+// Brings the model into the scene's frame: markers (when given) for a start, then the sparse
 // points fitted to the mesh (from the markers' similarity, else from principal axes), then each
-// pose refined against the mesh. Returns report.json's "alignment".
-igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapModel* model) {
+// pose refined against the mesh, photos left out by COLMAP posed from markers, and last every
+// pose and point refined jointly (tracks, markers, mesh). Returns report.json's "alignment".
+igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapRunSummary* run) {
+  igi::ColmapModel* model = &run->model;
   igi::Json a;
   igi::Similarity3d sim;
   std::vector<std::string> steps;
@@ -289,6 +372,32 @@ igi::Json AlignToScene(const Args& args, const Inputs& in, igi::ColmapModel* mod
                             {"rms_after_px", p.rms_after_px}};
     steps.push_back("pose_refinement");
   }
+  if (in.markers) {
+    igi::Json reposed = igi::Json::array();
+    for (const igi::MarkerPose& p : igi::RePoseImagesFromMarkers(*in.markers, model)) {
+      reposed.push_back({{"file", p.name},
+                         {"markers", p.markers},
+                         {"rms_before_px", p.rms_before_px},
+                         {"rms_px", p.rms_px}});
+    }
+    a["reposed_from_markers"] = reposed;
+    a["posed_from_markers"] = PoseFromMarkers(*in.markers, run);
+  }
+  if (!args.no_joint_refinement) {
+    igi::BundleRefinementOptions options;
+    options.threads = args.colmap.threads;
+    options.use_mesh = fit.has_value();
+    options.marker_sigma_px = args.marker_sigma_px;
+    // The points' spread about the mesh after the fit (before the pose refinement snapped them).
+    options.mesh_sigma_m =
+        args.mesh_sigma_m > 0
+            ? args.mesh_sigma_m
+            : (fit ? fit->inlier_threshold_m / igi::MeshAlignmentOptions{}.inlier_sigmas : 0);
+    const igi::BundleRefinementSummary b = igi::RefineBundle(
+        in.markers ? &*in.markers : nullptr, options.use_mesh ? &mesh : nullptr, model, options);
+    a["joint_refinement"] = JointRefinementJson(b);
+    steps.push_back("joint_refinement");
+  }
   a["method"] = igi::Join(steps, "+");
   return a;
 }
@@ -302,9 +411,14 @@ int Run(Args& args, const igi::CommonFlags& flags) {
                                                   in.camera->height, in.camera->params};
   }
   const fs::path out(args.out);
-  igi::ColmapRunSummary run = igi::RunColmap(args.images, out / "colmap", args.colmap);
+  igi::ColmapRunSummary run = args.colmap_model.empty()
+                                  ? igi::RunColmap(args.images, out / "colmap", args.colmap)
+                                  : igi::LoadColmapRun(args.images, args.colmap_model);
+  igi::Json alignment;
+  if (in.scene) alignment = AlignToScene(args, in, &run);
   igi::Json report = BaseReport(run, args);
-  if (in.scene) report["alignment"] = AlignToScene(args, in, &run.model);
+  AddRegistered(run.model, alignment, &report);
+  if (in.scene) report["alignment"] = alignment;
   igi::WriteColmapModelText(run.model, out / "sparse");
   if (in.scene) {
     igi::WriteJsonFile(out / "scene.json", SceneWithCameras(args, *in.scene, run.model, &report));
@@ -335,6 +449,9 @@ int main(int argc, char** argv) {
   app.add_option("--markers", args.markers, "Control points (igi-markers JSON) for --scene");
   app.add_option("--camera", args.camera, "camera.json: known intrinsics, held fixed");
   app.add_option("--colmap", args.colmap.executable, "COLMAP executable");
+  app.add_option("--min-pose-inliers", args.colmap.min_pose_inliers,
+                 "COLMAP's mapper registers a photo with this many 2D-3D inliers (>= 6)")
+      ->check(CLI::Range(6, 1000000));
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
   app.add_flag(
@@ -342,6 +459,20 @@ int main(int argc, char** argv) {
       "With --scene: align by --markers only, without fitting the sparse points to the mesh");
   app.add_flag("--no-pose-refinement", args.no_pose_refinement,
                "With --scene: keep the aligned poses (no per-photo refinement against the mesh)");
+  app.add_flag("--no-joint-refinement", args.no_joint_refinement,
+               "With --scene: skip the final joint refinement of poses and points (tracks, "
+               "markers, mesh)");
+  app.add_option("--marker-sigma", args.marker_sigma_px,
+                 "Accuracy of the markers' pixel positions (px), their weight in the joint "
+                 "refinement")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--mesh-sigma", args.mesh_sigma_m,
+                 "Accuracy of the scene mesh (m), its weight in the joint refinement (default: "
+                 "the sparse points' spread about it after the mesh fit)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--colmap-model", args.colmap_model,
+                 "Use this COLMAP model (TXT or BIN folder) of the --images photos instead of "
+                 "running COLMAP");
   app.add_flag("--multi-camera", args.multi_camera, "One camera per photo (default: one shared)");
   app.add_flag("--allow-other-colmap", args.colmap.allow_other_version,
                "Accept a COLMAP other than 3.8");

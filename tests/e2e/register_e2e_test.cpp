@@ -93,6 +93,25 @@ TEST(RegisterE2eTest, MarkersNamingPointsTheSceneLacksExit2) {
   fs::remove_all(dir);
 }
 
+// The joint refinement's and the model's flags: a --colmap-model that is not a folder, a
+// non-positive --marker-sigma or --mesh-sigma, too few --min-pose-inliers. Exit 2, nothing
+// written.
+TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
+  const fs::path dir = test::UniqueTempDir("igi_register_e2e");
+  const fs::path out = dir / "out";
+  const fs::path images = FlatImages(dir);
+  const std::string base = "--images " + Quote(images.string()) + " --out " + Quote(out.string());
+  auto r = RunTool("igi-register", base + " --colmap-model " + Quote((dir / "none").string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--colmap-model"), std::string::npos) << r.err;
+  for (const std::string flag : {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3"}) {
+    r = RunTool("igi-register", base + " " + flag);
+    EXPECT_EQ(r.exit_code, 2) << flag << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
 TEST(RegisterE2eTest, MissingOrUnknownColmapExits1) {
   const fs::path dir = test::UniqueTempDir("igi_register_e2e");
   const fs::path images = FlatImages(dir);
