@@ -216,6 +216,7 @@ DemoSummary RunDemo(const DemoOptions& o) {
   run.bin_dir = bin;
   run.skip_diagnose = o.skip_diagnose;
   run.solve_args = o.solve_args;
+  run.register_args = o.register_args;
   run.diagnose_args = o.diagnose_args;
   run.report_spp = o.report_spp;
   run.num_threads = o.num_threads;

@@ -37,6 +37,9 @@ struct DemoOptions {
   // measured against a radiance standard: without it the albedos come out in the HDR maps'
   // arbitrary scale, which weakens every bounce (measured: rho_s/k -27..-29 %).
   bool absolute_calibration = true;
+  // The demo's control points are exact projections: weighted like sub-pixel targets
+  // (igi-register's default, 1 px, is for hand-clicked points).
+  std::vector<std::string> register_args = {"--marker-sigma", "0.1"};
   std::vector<std::string> solve_args = {"--refine-iterations", "0"};
   // The demo's diagnosis: coarser samples and at most two steps (it is the slowest stage).
   std::vector<std::string> diagnose_args = {"--pixel-stride", "4",  "--max-steps",         "2",

@@ -28,12 +28,12 @@ TEST(RunDiligentE2eTest, SolvesTheBallFromItsRadianceMaps) {
   const fs::path dir = test::UniqueTempDir("igi_run_diligent");
   const fs::path out = dir / "ball";
   const auto t0 = std::chrono::steady_clock::now();
-  const auto r = RunTool(
-      "igi-run", "--hdr-photos --scene " + Quote((kBall / "scene.json").string()) + " --out " +
-                     Quote(out.string()) +
-                     " --skip-diagnose --threads 2 --report-photos 2 --report-lightings 3"
-                     " --report-spp 4 --solve-arg=--pixel-stride=4"
-                     " --solve-arg=--refine-iterations=0 --solve-arg=--indirect-rays=4");
+  const auto r =
+      RunTool("igi-run", "--hdr-photos --scene " + Quote((kBall / "scene.json").string()) +
+                             " --out " + Quote(out.string()) +
+                             " --skip-diagnose --threads 2 --report-photos 2 --report-lightings 3"
+                             " --report-spp 4 --solve-arg=--pixel-stride=4"
+                             " --solve-arg=--refine-iterations=0 --solve-arg=--indirect-rays=4");
   std::printf("DiLiGenT ball: %.0f s\n%s",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
               r.out.c_str());
@@ -55,6 +55,28 @@ TEST(RunDiligentE2eTest, SolvesTheBallFromItsRadianceMaps) {
   const std::string html = ReadFileToString(out / "report.html");
   EXPECT_NE(html.find("skipped"), std::string::npos);
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+
+  // --radiance-scale 2 (the maps are twice the radiance): 04-solve onwards is redone on a copy
+  // of the scene whose photos carry exposure_scale 2, and the ball (nothing else in the scene to
+  // bounce light) solves to half the reflectances, the same lobe width.
+  const auto r2 =
+      RunTool("igi-run", "--hdr-photos --scene " + Quote((kBall / "scene.json").string()) +
+                             " --out " + Quote(out.string()) +
+                             " --skip-diagnose --threads 2 --report-photos 2 --report-lightings 3"
+                             " --report-spp 4 --solve-arg=--pixel-stride=4"
+                             " --solve-arg=--refine-iterations=0 --solve-arg=--indirect-rays=4"
+                             " --radiance-scale 2");
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  const Json input = ReadJsonFile(out / "04-solve" / "input" / "scene.json");
+  ASSERT_FALSE(input["photos"].empty());
+  for (const Json& p : input["photos"]) EXPECT_EQ(p["exposure_scale"].get<double>(), 2.0);
+  const Json report2 = ReadJsonFile(out / "04-solve" / "report.json");
+  const Json& fit2 = report2["regions"][0]["paper"];
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(fit2["rho_d"][c].get<double>() / fit["rho_d"][c].get<double>(), 0.5, 0.01) << c;
+    EXPECT_NEAR(fit2["rho_s"][c].get<double>() / fit["rho_s"][c].get<double>(), 0.5, 0.02) << c;
+  }
+  EXPECT_NEAR(fit2["alpha"].get<double>(), fit["alpha"].get<double>(), 0.02);
   fs::remove_all(dir);
 }
 

@@ -70,6 +70,20 @@ TEST(RunE2eTest, BadLayoutExits2WithOneLinePerProblem) {
   fs::remove_all(dir);
 }
 
+TEST(RunE2eTest, BadRadianceScaleExits2AndWritesNothing) {
+  const fs::path dir = test::UniqueTempDir("igi_run_e2e");
+  fs::create_directories(dir / "photos");
+  const fs::path out = dir / "out";
+  const auto r =
+      RunTool("igi-run", Quote((dir / "photos").string()) + " --scene " + Quote(kScene.string()) +
+                             " --radiance-scale 0 --out " + Quote(out.string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(ErrorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--radiance-scale"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
 TEST(RunE2eTest, BadSceneExits2) {
   const fs::path dir = test::UniqueTempDir("igi_run_e2e");
   std::ofstream(dir / "scene.json") << R"({"format": "igi-scene", "version": 1, "bogus": 1})";
