@@ -10,6 +10,7 @@
 #include <map>
 #include <unordered_map>
 
+#include "solver/diagnose/missing_geometry.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -252,7 +253,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   o.Validate();
   const auto start = std::chrono::steady_clock::now();
   DiagnosisSummary sum;
-  const PhotoSet photos = LoadPhotoSet(scene);
+  PhotoSet photos = LoadPhotoSet(scene);  // valid pixels; a missing_geometry step masks more
   const bool solve = HasUnknowns(scene);
   sum.solved = solve;
   Json declared = AbsolutePaths(scene.document, scene.dir);
@@ -277,7 +278,9 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     Json next;
     ModelState state;
     double gain = 0;
+    std::optional<PhotoSet> photos;  // the photos' valid pixels after the step (masks)
   };
+  MissingGeometryResult missing;  // the located object of this round, if any
   auto try_step = [&](CandidateResult c, const std::string& next_maps) {
     spdlog::info("igi-diagnose: trying {} (predicted held-out gain {:.1f}%, z {:.1f})", c.effect,
                  100 * c.Gain(), c.z);
@@ -288,8 +291,13 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     ds.residual_before = st.train.Relative();
     ds.held_out_before = st.held.Relative();
     ds.model_dir = out_dir / "steps" / fmt::format("{:02d}-{}", ++attempt, c.effect);
+    // missing_geometry excludes the object and its shadow: the refit and its comparison use the
+    // pixels outside the new masks.
+    const bool masks = c.effect == "missing_geometry";
+    if (masks) t.photos = MaskedPhotoSet(photos, missing.excluded);
+    const PhotoSet& ph = masks ? *t.photos : photos;
     try {
-      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, photos);
+      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
@@ -297,11 +305,27 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     }
     ds.residual_after = t.state.train.Relative();
     ds.held_out_after = t.state.held.Relative();
-    const auto [gain, z] = HeldOutGain(photos, st.sims, t.state.sims, holdout);
+    const auto [gain, z] = HeldOutGain(ph, st.sims, t.state.sims, holdout);
     t.gain = gain;
     ds.z = z;
     ds.kept = gain >= o.min_gain && z >= o.min_z;
-    ds.verdict = ds.kept ? fmt::format(
+    if (masks) {
+      // Excluding pixels cannot be scored by the residual it removes alone. The masks come from
+      // the fitted pixels only, so they predict where the held-out residual lies: the step is kept
+      // when they hold >= min_gain of the held-out residual², at a per-pixel level higher than
+      // outside them by >= min_z standard errors (held-out blocks as units), and the refit does
+      // not make the held-out residual outside them (compared before/after on the same pixels)
+      // worse by min_gain.
+      t.gain = c.Gain();
+      ds.z = c.z;
+      ds.kept = c.Gain() >= o.min_gain && c.z >= o.min_z && gain >= -o.min_gain;
+      ds.verdict = fmt::format(
+          "{}: the masks (fitted on the fitted pixels) hold {:.1f}% of the held-out residual², "
+          "above the level outside them by {:.1f} standard errors; outside the masks the refit "
+          "changed the held-out residual² by {:.1f}% (same pixels before and after)",
+          ds.kept ? "kept" : "rejected", 100 * c.Gain(), c.z, -100 * gain);
+    } else {
+      ds.verdict = ds.kept ? fmt::format(
                                "kept: held-out residual² down {:.1f}% ({:.1f} standard "
                                "errors over the held-out blocks)",
                                100 * gain, z)
@@ -310,10 +334,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                                "standard errors): the model does not earn its {} "
                                "parameter(s)",
                                -100 * gain, z, c.num_params);
+    }
     const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
     ds.image_photo = scene.photos[img].file.filename().string();
     ds.residual_before_image = ResidualImage(photos, st.sims, img);
-    ds.residual_after_image = ResidualImage(photos, t.state.sims, img);
+    ds.residual_after_image = ResidualImage(ph, t.state.sims, img);
     spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
     if (c.effect == "albedo_texture" && ds.kept) {
       Json regions = Json::array();
@@ -344,6 +369,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }
     if (best >= 0) {
+      if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
       maps = next_maps;
@@ -356,6 +382,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
+    if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
+      missing = LocateMissingGeometry(st.model, photos, st.sims, st.records, holdout,
+                                      out_dir / "masks");
+      cands.push_back(missing.candidate);
+    }
     sum.last_candidates = cands;
     std::vector<CandidateResult*> ranked;
     for (CandidateResult& c : cands) {
