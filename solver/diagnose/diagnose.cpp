@@ -6,11 +6,15 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <tuple>
 #include <unordered_map>
 
 #include "solver/diagnose/missing_geometry.h"
+#include "solver/diagnose/pose_error.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -112,8 +116,12 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
 // with the held-out blocks as independent units.
+// `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
+// the signed-rank z of their gains (see EdgeBlocks).
+using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
-                                      const std::vector<Image>& after, const PixelHoldout& h) {
+                                      const std::vector<Image>& after, const PixelHoldout& h,
+                                      const BlockFilter& only = nullptr) {
   // Per block: gain and error before; the significance uses the relative gain per block.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
@@ -122,6 +130,7 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
     for (int y = 0; y < rec.height; ++y) {
       for (int x = 0; x < rec.width; ++x) {
         if (photos.valid[i].at(x, y, 0) < 0.5f || !h.HeldOut(int(i), x, y)) continue;
+        if (only && !only(i, x / h.block_px, y / h.block_px)) continue;
         double g = 0, e = 0;
         for (int c = 0; c < 3; ++c) {
           const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
@@ -137,6 +146,11 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
       }
     }
   }
+  if (only) {  // edge blocks: the signed-rank z of their gains
+    std::vector<double> gains;
+    for (const auto& [k, ge] : gain) gains.push_back(ge.first);
+    return {total_before > 0 ? total_gain / total_before : 0, SignedRankZ(gains)};
+  }
   std::vector<double> relative;
   for (const auto& [k, ge] : gain) {
     // Blocks the step left exactly as they were (same seed, same model there) do not count.
@@ -150,6 +164,41 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   for (double r : relative) sq += (r - mean) * (r - mean);
   const double se = std::sqrt(sq / (n - 1) / n);
   return {total_gain / total_before, se > 0 ? mean / se : 0};
+}
+
+// The held-out blocks of `camera`'s photos whose model image has at least the median gradient
+// energy of those blocks: where a pose error shows (its gain sits on edges; flat blocks only add
+// their noise to the gain's standard error).
+BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>& sims,
+                       const PixelHoldout& h) {
+  auto energies = std::make_shared<std::map<std::tuple<size_t, int, int>, double>>();
+  for (size_t i = 0; i < sims.size(); ++i) {
+    if (model.photos[i].camera != camera) continue;
+    const Image& s = sims[i];
+    for (int y = 1; y + 1 < s.height; ++y) {
+      for (int x = 1; x + 1 < s.width; ++x) {
+        if (!h.HeldOut(int(i), x, y)) continue;
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double gx = s.at(x + 1, y, c) - s.at(x - 1, y, c);
+          const double gy = s.at(x, y + 1, c) - s.at(x, y - 1, c);
+          if (std::isfinite(gx) && std::isfinite(gy)) e += gx * gx + gy * gy;
+        }
+        (*energies)[{i, x / h.block_px, y / h.block_px}] += e;
+      }
+    }
+  }
+  std::vector<double> values;
+  for (const auto& [k, e] : *energies) values.push_back(e);
+  double median = 0;
+  if (!values.empty()) {
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    median = values[values.size() / 2];
+  }
+  return [energies, median](size_t photo, int bx, int by) {
+    const auto it = energies->find({photo, bx, by});
+    return it != energies->end() && it->second >= median;
+  };
 }
 
 // The white part of the residual, from differences of horizontally adjacent valid pixels on the
@@ -287,6 +336,31 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     Trial t;
     t.next = declared;
     if (c.apply) c.apply(&t.next);
+    int pose_camera = -1;
+    if (c.effect == "pose_error") {
+      // Gauss–Newton: the first step is the candidate's; iterate on re-renders of the camera.
+      for (int k = 0; k < int(st.model.cameras.size()); ++k) {
+        if (st.model.cameras[k].name == c.params.value("camera", "")) pose_camera = k;
+      }
+      if (pose_camera >= 0) {
+        const PoseRefinement pr = RefinePose(st.model, pose_camera, photos, st.sims, o, solve,
+                                             CellSize(st.model), 6, &t.next);
+        c.params["iterations"] = pr.iterations + 1;
+        c.params["rotation_deg"] = pr.rotation_deg;
+        c.params["center_shift_m"] = pr.translation_m;
+        c.params.erase("rotation_vector");
+        c.params.erase("translation_m");
+        const Json& cam = t.next["cameras"][c.params["camera"].get<std::string>()];
+        c.params["qvec"] = cam["qvec"];
+        c.params["tvec"] = cam["tvec"];
+        c.evidence = fmt::format(
+            "camera {}: the residual follows the model image's edges, as a shift of the view: "
+            "{} Gauss-Newton steps on re-renders move its pose by {:.3f} deg and its centre by "
+            "{:.1f} mm (last step {:.4f} deg, {:.2f} mm)",
+            c.params["camera"].get<std::string>(), pr.iterations + 1, pr.rotation_deg,
+            1000 * pr.translation_m, pr.last_step_deg, 1000 * pr.last_step_m);
+      }
+    }
     DiagnosisStep& ds = t.step;
     ds.residual_before = st.train.Relative();
     ds.held_out_before = st.held.Relative();
@@ -305,7 +379,12 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     }
     ds.residual_after = t.state.train.Relative();
     ds.held_out_after = t.state.held.Relative();
-    const auto [gain, z] = HeldOutGain(ph, st.sims, t.state.sims, holdout);
+    // A pose error shows on edges: its significance counts the blocks with edges.
+    const BlockFilter only =
+        pose_camera >= 0 ? EdgeBlocks(st.model, pose_camera, st.sims, holdout) : nullptr;
+    const auto [gain_all, z_all] = HeldOutGain(ph, st.sims, t.state.sims, holdout);
+    const double gain = gain_all;
+    const double z = only ? HeldOutGain(ph, st.sims, t.state.sims, holdout, only).second : z_all;
     t.gain = gain;
     ds.z = z;
     ds.kept = gain >= o.min_gain && z >= o.min_z;
