@@ -117,7 +117,7 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
 // with the held-out blocks as independent units.
 // `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
-// the signed-rank z of their gains (see EdgeBlocks).
+// the signed-rank z of their pixels' gains (see EdgeBlocks).
 using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
                                       const std::vector<Image>& after, const PixelHoldout& h,
@@ -125,6 +125,7 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   // Per block: gain and error before; the significance uses the relative gain per block.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
+  std::vector<double> pixel_gains;
   for (size_t i = 0; i < before.size(); ++i) {
     const Image& rec = photos.recorded[i];
     for (int y = 0; y < rec.height; ++y) {
@@ -138,6 +139,7 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
           e += (b - p) * (b - p);
           g += (b - p) * (b - p) - (a - p) * (a - p);
         }
+        if (only) pixel_gains.push_back(g);
         auto& acc = gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px];
         acc.first += g;
         acc.second += e;
@@ -146,10 +148,8 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
       }
     }
   }
-  if (only) {  // edge blocks: the signed-rank z of their gains
-    std::vector<double> gains;
-    for (const auto& [k, ge] : gain) gains.push_back(ge.first);
-    return {total_before > 0 ? total_gain / total_before : 0, SignedRankZ(gains)};
+  if (only) {  // edge blocks: the signed-rank z of their pixels' gains
+    return {total_before > 0 ? total_gain / total_before : 0, SignedRankZ(pixel_gains)};
   }
   std::vector<double> relative;
   for (const auto& [k, ge] : gain) {
@@ -166,9 +166,9 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   return {total_gain / total_before, se > 0 ? mean / se : 0};
 }
 
-// The held-out blocks of `camera`'s photos whose model image has at least the median gradient
-// energy of those blocks: where a pose error shows (its gain sits on edges; flat blocks only add
-// their noise to the gain's standard error).
+// The held-out blocks of `camera`'s photos whose model image's gradient energy is at least
+// kEdgeFactor times the median block's: where a pose error shows (its gain sits on edges; flat
+// blocks only add their noise). Their pixels are the units (pose_error.h).
 BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>& sims,
                        const PixelHoldout& h) {
   auto energies = std::make_shared<std::map<std::tuple<size_t, int, int>, double>>();
@@ -197,7 +197,7 @@ BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>&
   }
   return [energies, median](size_t photo, int bx, int by) {
     const auto it = energies->find({photo, bx, by});
-    return it != energies->end() && it->second >= median;
+    return it != energies->end() && it->second >= kEdgeFactor * median;
   };
 }
 

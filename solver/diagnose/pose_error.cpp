@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <memory>
 #include <tuple>
 #include <numbers>
@@ -25,43 +26,43 @@ void Fill(const ResidualFit& fit, CandidateResult* out) {
   out->held_after = fit.held_after;
   out->z = fit.z;
 }
-// The held-out gain's significance over the blocks with edges: a pose error's residual sits on
-// the model image's edges, so flat blocks add only their noise to the standard error. Blocks of
-// the camera's held-out records whose gradient energy reaches the median of those blocks; per
-// block the gain of the fitted flow (without the albedo nuisance); the signed-rank z.
+// The held-out gain's significance where a pose error shows: on the model image's edges (flat
+// blocks add only their noise). The held-out blocks of the camera whose gradient energy is at
+// least kEdgeFactor times the median block's (the median block is flat: its gradient is noise);
+// the gains of their records (without the albedo nuisance) as units — the photo's noise is
+// independent from pixel to pixel, and a pose fitted to noise gains nothing on held-out pixels —
+// in Wilcoxon's signed-rank z.
 template <class Basis>
 double EdgeBlockZ(const std::vector<PixelRecord>& records, int camera, const Scene& model,
                   int block_px, const Basis& basis, const Eigen::VectorXd& coef) {
-  struct Acc {
-    double energy = 0, before = 0, after = 0;
-  };
-  std::map<std::tuple<int, int, int>, Acc> blocks;
+  std::map<std::tuple<int, int, int>, double> energy;
+  std::vector<std::pair<std::tuple<int, int, int>, double>> gains;
   for (const PixelRecord& r : records) {
     // Outliers too: a pose error's strongest residuals, on the sharpest edges, are flagged so.
     if (!r.held_out || model.photos[r.photo].camera != camera) continue;
-    Acc& a = blocks[{r.photo, r.x / block_px, r.y / block_px}];
-    a.energy += double(r.sim_gradient.squaredNorm());
+    const std::tuple<int, int, int> key{r.photo, r.x / block_px, r.y / block_px};
+    energy[key] += double(r.sim_gradient.squaredNorm());
+    double g = 0;
     for (int c = 0; c < 3; ++c) {
       double b[6] = {0, 0, 0, 0, 0, 0};
       basis(r, c, b);
       double pred = 0;
       for (int k = 0; k < 6; ++k) pred += b[k] * coef[k];
       const double y = double(r.recorded[c]) - r.sim[c];
-      a.before += y * y;
-      a.after += (y - pred) * (y - pred);
+      g += y * y - (y - pred) * (y - pred);
     }
+    gains.emplace_back(key, g);
   }
-  std::vector<double> energy;
-  for (const auto& [k, a] : blocks) energy.push_back(a.energy);
-  if (energy.size() < 4) return 0;
-  const size_t q = energy.size() * 3 / 4;  // the strongest quarter of the edges
-  std::nth_element(energy.begin(), energy.begin() + q, energy.end());
-  const double median = energy[q];
-  std::vector<double> gains;
-  for (const auto& [k, a] : blocks) {
-    if (a.energy >= median) gains.push_back(a.before - a.after);
+  std::vector<double> values;
+  for (const auto& [k, e] : energy) values.push_back(e);
+  if (values.size() < 4) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double threshold = kEdgeFactor * values[values.size() / 2];
+  std::vector<double> edge_gains;
+  for (const auto& [k, g] : gains) {
+    if (energy[k] >= threshold) edge_gains.push_back(g);
   }
-  return SignedRankZ(gains);
+  return SignedRankZ(edge_gains);
 }
 
 }  // namespace
@@ -160,6 +161,8 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
   const Rigid3d start = model.cameras[camera].cam_from_world;
   std::vector<Image> current = sims;
   std::vector<std::unique_ptr<Renderer>> renderers(m.lightings.size());
+  double last_train = std::numeric_limits<double>::infinity();
+  Json last_doc = *doc;
   for (int it = 0; it < max_iterations; ++it) {
     m.cameras[camera].cam_from_world = PoseOfCameraJson((*doc)["cameras"][name]);
     for (size_t i = 0; i < m.photos.size(); ++i) {
@@ -186,7 +189,16 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
                            o.holdout_block_px);
     const CandidateContext cx{m, *doc, materials_solved, cell_m, o.holdout_block_px};
     const CandidateResult step = FitPoseError(cx, f, camera);
+    // Gauss–Newton guarded: a step that made the fitted residual worse than the pose before it is
+    // taken back, and the iteration ends.
+    if (step.valid && step.train_before > last_train) {
+      *doc = last_doc;
+      spdlog::info("igi-diagnose: pose of {}: the last step raised the residual; taken back", name);
+      break;
+    }
     if (!step.valid || !step.apply) break;
+    last_train = step.train_before;
+    last_doc = *doc;
     step.apply(doc);
     ++out.iterations;
     const std::vector<double> d = step.params["translation_m"].get<std::vector<double>>();

@@ -24,6 +24,10 @@ namespace igi {
 CandidateResult FitPoseError(const CandidateContext& context, const ResidualFitter& fitter,
                              int camera);
 
+// Blocks whose model-image gradient energy reaches this many times the median block's are the
+// edges where a pose error is scored.
+constexpr double kEdgeFactor = 4;
+
 // Wilcoxon's signed-rank statistic of `values` (zeros dropped) as a normal z: whether they are
 // mostly positive, robust to the heavy tails of per-block gains on edges.
 double SignedRankZ(std::vector<double> values);
