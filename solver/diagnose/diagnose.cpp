@@ -335,17 +335,19 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                  100 * c.Gain(), c.z);
     Trial t;
     t.next = declared;
-    if (c.apply) c.apply(&t.next);
+    // pose_error is iterated from the declared pose (its candidate's step was fitted without the
+    // sharpest edges, flagged as outliers for the other candidates).
+    if (c.apply && c.effect != "pose_error") c.apply(&t.next);
     int pose_camera = -1;
     if (c.effect == "pose_error") {
-      // Gauss–Newton: the first step is the candidate's; iterate on re-renders of the camera.
+      // Gauss–Newton on re-renders of the camera.
       for (int k = 0; k < int(st.model.cameras.size()); ++k) {
         if (st.model.cameras[k].name == c.params.value("camera", "")) pose_camera = k;
       }
       if (pose_camera >= 0) {
         const PoseRefinement pr = RefinePose(st.model, pose_camera, photos, st.sims, o, solve,
-                                             CellSize(st.model), 6, &t.next);
-        c.params["iterations"] = pr.iterations + 1;
+                                             CellSize(st.model), 8, &t.next);
+        c.params["iterations"] = pr.iterations;
         c.params["rotation_deg"] = pr.rotation_deg;
         c.params["center_shift_m"] = pr.translation_m;
         c.params.erase("rotation_vector");
@@ -357,7 +359,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
             "camera {}: the residual follows the model image's edges, as a shift of the view: "
             "{} Gauss-Newton steps on re-renders move its pose by {:.3f} deg and its centre by "
             "{:.1f} mm (last step {:.4f} deg, {:.2f} mm)",
-            c.params["camera"].get<std::string>(), pr.iterations + 1, pr.rotation_deg,
+            c.params["camera"].get<std::string>(), pr.iterations, pr.rotation_deg,
             1000 * pr.translation_m, pr.last_step_deg, 1000 * pr.last_step_m);
       }
     }

@@ -204,7 +204,7 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
     const std::vector<double> d = step.params["translation_m"].get<std::vector<double>>();
     out.last_step_deg = step.params["rotation_deg"].get<double>();
     out.last_step_m = Eigen::Vector3d(d[0], d[1], d[2]).norm();
-    spdlog::info("igi-diagnose: pose of {}: step {} of {:.3f} deg, {:.2f} mm", name, it + 2,
+    spdlog::info("igi-diagnose: pose of {}: step {} of {:.3f} deg, {:.2f} mm", name, it + 1,
                  out.last_step_deg, 1000 * out.last_step_m);
     if (out.last_step_deg < 0.005 && out.last_step_m < 1e-4) break;
   }
