@@ -6,8 +6,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <tuple>
@@ -407,14 +407,14 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
           ds.kept ? "kept" : "rejected", 100 * c.Gain(), c.z, -100 * gain);
     } else {
       ds.verdict = ds.kept ? fmt::format(
-                               "kept: held-out residual² down {:.1f}% ({:.1f} standard "
-                               "errors over the held-out blocks)",
-                               100 * gain, z)
-                         : fmt::format(
-                               "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
-                               "standard errors): the model does not earn its {} "
-                               "parameter(s)",
-                               -100 * gain, z, c.num_params);
+                                 "kept: held-out residual² down {:.1f}% ({:.1f} standard "
+                                 "errors over the held-out blocks)",
+                                 100 * gain, z)
+                           : fmt::format(
+                                 "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
+                                 "standard errors): the model does not earn its {} "
+                                 "parameter(s)",
+                                 -100 * gain, z, c.num_params);
     }
     const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
     ds.image_photo = scene.photos[img].file.filename().string();
@@ -464,8 +464,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
     if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
-      missing = LocateMissingGeometry(st.model, photos, st.sims, st.records, holdout,
-                                      out_dir / "masks");
+      missing =
+          LocateMissingGeometry(st.model, photos, st.sims, st.records, holdout, out_dir / "masks");
       cands.push_back(missing.candidate);
     }
     sum.last_candidates = cands;

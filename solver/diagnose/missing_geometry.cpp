@@ -88,14 +88,16 @@ std::vector<uint8_t> Dilate(const std::vector<uint8_t>& bin, int w, int h, int r
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       bool any = false;
-      for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r) && !any; ++k) any = bin[y * w + k];
+      for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r) && !any; ++k)
+        any = bin[y * w + k];
       rows[y * w + x] = any;
     }
   }
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       bool any = false;
-      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r) && !any; ++k) any = rows[k * w + x];
+      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r) && !any; ++k)
+        any = rows[k * w + x];
       out[y * w + x] = any;
     }
   }
@@ -133,7 +135,8 @@ Image FindResidualBlobs(const Image& recorded, const Image& sim, const Image& us
   int n_level = 0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      if (usable.at(x, y) > 0.5f) level += recorded.at(x, y, 0) + recorded.at(x, y, 1) + recorded.at(x, y, 2), ++n_level;
+      if (usable.at(x, y) > 0.5f)
+        level += recorded.at(x, y, 0) + recorded.at(x, y, 1) + recorded.at(x, y, 2), ++n_level;
     }
   }
   level = n_level ? level / (3 * n_level) : 0;
@@ -245,7 +248,8 @@ std::vector<uint8_t> NearSurfaceVoxels(const TriangleMesh& mesh, const VoxelGrid
     const double len = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
     const int n = std::max(1, int(std::ceil(len / (0.5 * grid.voxel_m))));
     for (int i = 0; i <= n; ++i) {
-      for (int j = 0; i + j <= n; ++j) mark(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n));
+      for (int j = 0; i + j <= n; ++j)
+        mark(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n));
     }
   }
   // Within 1.5 voxels: the cells the triangles pass through and their 26 neighbours.
@@ -398,7 +402,8 @@ std::vector<CarvedObject> CarvedObjects(const std::vector<uint8_t>& carved_objec
     std::vector<int64_t> front;
     for (int64_t i : obj.box_voxels) {
       ForNeighbours(g, i, [&](int64_t j) {
-        if (!in_box[size_t(j)] && carved[size_t(j)] && near_surface[size_t(j)] && !seen[size_t(j)]) {
+        if (!in_box[size_t(j)] && carved[size_t(j)] && near_surface[size_t(j)] &&
+            !seen[size_t(j)]) {
           seen[size_t(j)] = 1;
           front.push_back(j);
         }
@@ -409,7 +414,8 @@ std::vector<CarvedObject> CarvedObjects(const std::vector<uint8_t>& carved_objec
       front.pop_back();
       obj.shadow_voxels.push_back(i);
       ForNeighbours(g, i, [&](int64_t j) {
-        if (!in_box[size_t(j)] && carved[size_t(j)] && near_surface[size_t(j)] && !seen[size_t(j)]) {
+        if (!in_box[size_t(j)] && carved[size_t(j)] && near_surface[size_t(j)] &&
+            !seen[size_t(j)]) {
           seen[size_t(j)] = 1;
           front.push_back(j);
         }
@@ -668,7 +674,8 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
         keep.at(x, y) = was && !(excluded.at(x, y) > 0.5f) ? 1.0f : 0.0f;
       }
     }
-    const fs::path path = fs::absolute(mask_dir / (model.photos[i].file.stem().string() + "_mask.png"));
+    const fs::path path =
+        fs::absolute(mask_dir / (model.photos[i].file.stem().string() + "_mask.png"));
     WriteImage(path, keep);
     mask_files.emplace_back(i, path.string());
     res.excluded.push_back(std::move(excluded));
@@ -704,9 +711,9 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
       "lacks ({} voxels of {:.3f} m), with {} voxels of its shadow on the modelled surfaces; "
       "fitted on the fitted pixels, its masks hold {:.1f}% of the held-out residual², {:.1f}x "
       "the residual² per pixel outside them",
-      photo_files.size(), largest.size_m.x(), largest.size_m.y(), largest.size_m.z(), largest.center.x(),
-      largest.center.y(), largest.center.z(), largest.core_voxels, voxel, largest.shadow_voxels.size(),
-      100 * out.Gain(), ratio);
+      photo_files.size(), largest.size_m.x(), largest.size_m.y(), largest.size_m.z(),
+      largest.center.x(), largest.center.y(), largest.center.z(), largest.core_voxels, voxel,
+      largest.shadow_voxels.size(), 100 * out.Gain(), ratio);
   out.valid = true;
   out.apply = [mask_files](Json* doc) {
     for (const auto& [i, path] : mask_files) (*doc)["photos"][i]["mask"] = path;

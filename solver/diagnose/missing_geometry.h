@@ -40,14 +40,14 @@
 namespace igi {
 
 struct MissingGeometryOptions {
-  double voxels_per_extent = 80;  // voxel = the scene box's largest extent / this
-  double min_relative = 0.12;     // blob threshold on the smoothed relative residual, at least
-  double median_factor = 4;       // ... and this many times the photo's median
+  double voxels_per_extent = 80;      // voxel = the scene box's largest extent / this
+  double min_relative = 0.12;         // blob threshold on the smoothed relative residual, at least
+  double median_factor = 4;           // ... and this many times the photo's median
   double min_area_fraction = 0.0015;  // a blob covers at least this share of the image
   int min_area_px = 12;
-  int min_views = 2;              // photos that see a carved voxel in a blob
-  int min_core_voxels = 8;        // an object has at least this many off-surface voxels
-  int dilate_px = 3;              // the masks' margin
+  int min_views = 2;        // photos that see a carved voxel in a blob
+  int min_core_voxels = 8;  // an object has at least this many off-surface voxels
+  int dilate_px = 3;        // the masks' margin
 
   void Validate() const;
 };
@@ -57,8 +57,8 @@ struct MissingGeometryOptions {
 struct CarveView {
   Camera camera;
   int camera_id = 0;  // views of one camera (several lightings) count as one view
-  Image depth_m;  // 1 channel
-  Image state;    // 1 channel
+  Image depth_m;      // 1 channel
+  Image state;        // 1 channel
 };
 
 struct VoxelGrid {
@@ -118,7 +118,7 @@ Image ProjectVoxels(const CarveView& view, const VoxelGrid& grid,
                     const std::vector<int64_t>& voxels, int dilate_px);
 
 struct MissingGeometryResult {
-  CandidateResult candidate;  // effect "missing_geometry"; valid when an object was found
+  CandidateResult candidate;      // effect "missing_geometry"; valid when an object was found
   std::vector<Image> keep_masks;  // per photo, 1 = keep (the photo's own mask included)
   std::vector<Image> excluded;    // per photo, 1 = excluded as the object or its shadow
 };

@@ -7,11 +7,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
-#include <tuple>
 #include <numbers>
+#include <tuple>
 
 #include "solver/render.h"
 
@@ -209,8 +209,7 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
     if (out.last_step_deg < 0.005 && out.last_step_m < 1e-4) break;
   }
   const Rigid3d end = PoseOfCameraJson((*doc)["cameras"][name]);
-  out.rotation_deg =
-      Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / kPi;
+  out.rotation_deg = Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / kPi;
   const Eigen::Vector3d c0 = -(start.rotation.inverse() * start.translation);
   const Eigen::Vector3d c1 = -(end.rotation.inverse() * end.translation);
   out.translation_m = (c1 - c0).norm();

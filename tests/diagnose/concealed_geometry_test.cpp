@@ -34,7 +34,8 @@ fs::path Synthesize(const fs::path& dir, const std::string& effect, int seed) {
   const auto r = RunTool("igi-synth", "--out " + Quote(scene.string()) +
                                           " --cameras 4 --width 160 --height 120 --spp 64"
                                           " --lamp point --unknowns none --threads 2 --quiet"
-                                          " --seed " + std::to_string(seed) + " --effect " + effect);
+                                          " --seed " +
+                                          std::to_string(seed) + " --effect " + effect);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   return scene;
 }
@@ -94,9 +95,9 @@ TEST(ConcealedGeometryTest, MissingGeometryIsLocatedAndExcluded) {
 TEST(ConcealedGeometryTest, PoseErrorIsNamedFirst) {
   const fs::path dir = test::UniqueTempDir("igi_concealed_pose_error");
   const fs::path capture = Synthesize(dir, "pose_error", 11);
-  const auto r = RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
-                                             Quote((dir / "diag").string()) + kDiagnose +
-                                             " --max-steps 1");
+  const auto r =
+      RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
+                                  Quote((dir / "diag").string()) + kDiagnose + " --max-steps 1");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Json d = ReadJsonFile(dir / "diag" / "diagnosis.json");
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);

@@ -56,7 +56,8 @@ struct Truth {
 std::vector<CarveView> Views(const Truth& truth) {
   const Eigen::Vector3d target(2.2, 1.8, 0.2);
   std::vector<CarveView> views;
-  const Eigen::Vector3d eyes[] = {{0.3, 0.3, 2.4}, {3.7, 0.3, 2.2}, {3.7, 3.7, 2.5}, {0.3, 3.7, 2.3}};
+  const Eigen::Vector3d eyes[] = {
+      {0.3, 0.3, 2.4}, {3.7, 0.3, 2.2}, {3.7, 3.7, 2.5}, {0.3, 3.7, 2.3}};
   for (int k = 0; k < 4; ++k) {
     CarveView v;
     v.camera = LookAt(eyes[k], target);
@@ -69,8 +70,8 @@ std::vector<CarveView> Views(const Truth& truth) {
         const Eigen::Vector3d d = v.camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
         const double t_floor = d.z() < 0 ? -o.z() / d.z() : std::numeric_limits<double>::infinity();
         v.depth_m.at(x, y) = float(t_floor);
-        const double t_obj =
-            truth.with_object ? HitBox(o, d, truth.object) : std::numeric_limits<double>::infinity();
+        const double t_obj = truth.with_object ? HitBox(o, d, truth.object)
+                                               : std::numeric_limits<double>::infinity();
         const Eigen::Vector3d p = o + t_floor * d;
         const bool shadow = std::isfinite(t_floor) && truth.shadow.contains(p.head<2>());
         v.state.at(x, y) = t_obj < t_floor || shadow ? 1.0f : 0.0f;
@@ -89,9 +90,9 @@ TriangleMesh Floor() {
 }
 
 VoxelGrid Grid() {
-  return VoxelGrid::Over(Eigen::AlignedBox3d(Eigen::Vector3d(-0.05, -0.05, -0.05),
-                                             Eigen::Vector3d(4.05, 4.05, 2.55)),
-                         0.05);
+  return VoxelGrid::Over(
+      Eigen::AlignedBox3d(Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d(4.05, 4.05, 2.55)),
+      0.05);
 }
 
 // The carved box's centre comes within two voxels (0.1 m) of the truth (measured: 0.075, its top
