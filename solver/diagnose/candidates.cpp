@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "solver/diagnose/candidates_brdf_light.h"
+#include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
 
 namespace igi {
@@ -527,70 +528,9 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   return out;
 }
 
-// pose_error of one camera: the photo is the model seen from a slightly moved camera, so the
-// residual follows the model image's gradient along the flow of a small rotation ω (camera frame)
-// and translation δ: photo − sim ≈ −∇sim · J(ω, δ). Six amplitudes per camera.
+// pose_error of one camera (solver/diagnose/pose_error.h).
 CandidateResult PoseError(const CandidateContext& cx, const ResidualFitter& f, int camera) {
-  CandidateResult out;
-  out.effect = "pose_error";
-  const Camera& cam = cx.model.cameras[camera];
-  if (!cx.declared.contains("cameras") || cx.declared["cameras"].contains("colmap")) return out;
-  const double fx = cam.focal_x_px(), fy = cam.focal_y_px();
-  auto basis = [&](const PixelRecord& r, int c, double* b) {
-    if (cx.model.photos[r.photo].camera != camera) return;
-    const Eigen::Vector3d p = r.point_cam.cast<double>();
-    if (!(p.z() > 1e-6)) return;
-    const double gx = r.sim_gradient(c, 0), gy = r.sim_gradient(c, 1);
-    for (int k = 0; k < 6; ++k) {
-      const Eigen::Vector3d d =
-          k < 3 ? Eigen::Vector3d::Unit(k).cross(p) : Eigen::Vector3d(Eigen::Vector3d::Unit(k - 3));
-      const double du = fx * (d.x() / p.z() - p.x() * d.z() / (p.z() * p.z()));
-      const double dv = fy * (d.y() / p.z() - p.y() * d.z() / (p.z() * p.z()));
-      b[k] = -(gx * du + gy * dv);
-    }
-  };
-  const ResidualFit fit = f.Fit(6, basis);
-  if (fit.coef.size() == 0) return out;
-  const Eigen::Vector3d omega = fit.coef.head<3>(), delta = fit.coef.tail<3>();
-  const double angle_deg = omega.norm() * 180 / kPi;
-  if (!(angle_deg < 5) || !(delta.norm() < 0.25)) {
-    out.note = fmt::format(
-        "camera {}: the gradient fit ({:.2f} deg, {:.3f} m) is not a small pose "
-        "error",
-        cam.name, angle_deg, delta.norm());
-    return out;
-  }
-  Fill(fit, &out);
-  out.params = {{"camera", cam.name},
-                {"rotation_deg", angle_deg},
-                {"rotation_vector", {omega.x(), omega.y(), omega.z()}},
-                {"translation_m", {delta.x(), delta.y(), delta.z()}}};
-  Json photos = Json::array();
-  for (const Photo& p : cx.model.photos) {
-    if (p.camera == camera) photos.push_back(p.file.filename().string());
-  }
-  out.where = {{"photos", photos}, {"frame", "image position (edges)"}};
-  out.num_params = 6;
-  out.evidence = fmt::format(
-      "camera {}: the residual follows the model image's edges, as a shift of the view by "
-      "{:.2f} deg and {:.1f} mm: its declared pose is off",
-      cam.name, angle_deg, 1000 * delta.norm());
-  out.valid = true;
-  const std::string name = cam.name;
-  out.apply = [name, omega, delta](Json* doc) {
-    Json& j = (*doc)["cameras"][name];
-    const std::vector<double> q = j["qvec"].get<std::vector<double>>();
-    const std::vector<double> t = j["tvec"].get<std::vector<double>>();
-    const Eigen::Quaterniond r0(q[0], q[1], q[2], q[3]);
-    const double a = omega.norm();
-    const Eigen::Quaterniond dr(a > 0 ? Eigen::AngleAxisd(a, omega / a)
-                                      : Eigen::AngleAxisd::Identity());
-    const Eigen::Quaterniond r1 = (dr * r0).normalized();
-    const Eigen::Vector3d t1 = dr * Eigen::Vector3d(t[0], t[1], t[2]) + delta;
-    j["qvec"] = {r1.w(), r1.x(), r1.y(), r1.z()};
-    j["tvec"] = {t1.x(), t1.y(), t1.z()};
-  };
-  return out;
+  return FitPoseError(cx, f, camera);
 }
 
 }  // namespace

@@ -7,9 +7,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <memory>
+#include <tuple>
 #include <unordered_map>
 
+#include "solver/diagnose/missing_geometry.h"
+#include "solver/diagnose/pose_error.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -111,16 +116,22 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
 // with the held-out blocks as independent units.
+// `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
+// the signed-rank z of their pixels' gains (see EdgeBlocks).
+using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
-                                      const std::vector<Image>& after, const PixelHoldout& h) {
+                                      const std::vector<Image>& after, const PixelHoldout& h,
+                                      const BlockFilter& only = nullptr) {
   // Per block: gain and error before; the significance uses the relative gain per block.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
+  std::vector<double> pixel_gains;
   for (size_t i = 0; i < before.size(); ++i) {
     const Image& rec = photos.recorded[i];
     for (int y = 0; y < rec.height; ++y) {
       for (int x = 0; x < rec.width; ++x) {
         if (photos.valid[i].at(x, y, 0) < 0.5f || !h.HeldOut(int(i), x, y)) continue;
+        if (only && !only(i, x / h.block_px, y / h.block_px)) continue;
         double g = 0, e = 0;
         for (int c = 0; c < 3; ++c) {
           const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
@@ -128,6 +139,7 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
           e += (b - p) * (b - p);
           g += (b - p) * (b - p) - (a - p) * (a - p);
         }
+        if (only) pixel_gains.push_back(g);
         auto& acc = gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px];
         acc.first += g;
         acc.second += e;
@@ -135,6 +147,9 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
         total_gain += g;
       }
     }
+  }
+  if (only) {  // edge blocks: the signed-rank z of their pixels' gains
+    return {total_before > 0 ? total_gain / total_before : 0, SignedRankZ(pixel_gains)};
   }
   std::vector<double> relative;
   for (const auto& [k, ge] : gain) {
@@ -149,6 +164,41 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   for (double r : relative) sq += (r - mean) * (r - mean);
   const double se = std::sqrt(sq / (n - 1) / n);
   return {total_gain / total_before, se > 0 ? mean / se : 0};
+}
+
+// The held-out blocks of `camera`'s photos whose model image's gradient energy is at least
+// kEdgeFactor times the median block's: where a pose error shows (its gain sits on edges; flat
+// blocks only add their noise). Their pixels are the units (pose_error.h).
+BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>& sims,
+                       const PixelHoldout& h) {
+  auto energies = std::make_shared<std::map<std::tuple<size_t, int, int>, double>>();
+  for (size_t i = 0; i < sims.size(); ++i) {
+    if (model.photos[i].camera != camera) continue;
+    const Image& s = sims[i];
+    for (int y = 1; y + 1 < s.height; ++y) {
+      for (int x = 1; x + 1 < s.width; ++x) {
+        if (!h.HeldOut(int(i), x, y)) continue;
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double gx = s.at(x + 1, y, c) - s.at(x - 1, y, c);
+          const double gy = s.at(x, y + 1, c) - s.at(x, y - 1, c);
+          if (std::isfinite(gx) && std::isfinite(gy)) e += gx * gx + gy * gy;
+        }
+        (*energies)[{i, x / h.block_px, y / h.block_px}] += e;
+      }
+    }
+  }
+  std::vector<double> values;
+  for (const auto& [k, e] : *energies) values.push_back(e);
+  double median = 0;
+  if (!values.empty()) {
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    median = values[values.size() / 2];
+  }
+  return [energies, median](size_t photo, int bx, int by) {
+    const auto it = energies->find({photo, bx, by});
+    return it != energies->end() && it->second >= kEdgeFactor * median;
+  };
 }
 
 // The white part of the residual, from differences of horizontally adjacent valid pixels on the
@@ -252,7 +302,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   o.Validate();
   const auto start = std::chrono::steady_clock::now();
   DiagnosisSummary sum;
-  const PhotoSet photos = LoadPhotoSet(scene);
+  PhotoSet photos = LoadPhotoSet(scene);  // valid pixels; a missing_geometry step masks more
   const bool solve = HasUnknowns(scene);
   sum.solved = solve;
   Json declared = AbsolutePaths(scene.document, scene.dir);
@@ -277,19 +327,53 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     Json next;
     ModelState state;
     double gain = 0;
+    std::optional<PhotoSet> photos;  // the photos' valid pixels after the step (masks)
   };
+  MissingGeometryResult missing;  // the located object of this round, if any
   auto try_step = [&](CandidateResult c, const std::string& next_maps) {
     spdlog::info("igi-diagnose: trying {} (predicted held-out gain {:.1f}%, z {:.1f})", c.effect,
                  100 * c.Gain(), c.z);
     Trial t;
     t.next = declared;
-    if (c.apply) c.apply(&t.next);
+    // pose_error is iterated from the declared pose (its candidate's step was fitted without the
+    // sharpest edges, flagged as outliers for the other candidates).
+    if (c.apply && c.effect != "pose_error") c.apply(&t.next);
+    int pose_camera = -1;
+    if (c.effect == "pose_error") {
+      // Gauss–Newton on re-renders of the camera.
+      for (int k = 0; k < int(st.model.cameras.size()); ++k) {
+        if (st.model.cameras[k].name == c.params.value("camera", "")) pose_camera = k;
+      }
+      if (pose_camera >= 0) {
+        const PoseRefinement pr = RefinePose(st.model, pose_camera, photos, st.sims, o, solve,
+                                             CellSize(st.model), 8, &t.next);
+        c.params["iterations"] = pr.iterations;
+        c.params["rotation_deg"] = pr.rotation_deg;
+        c.params["center_shift_m"] = pr.translation_m;
+        c.params.erase("rotation_vector");
+        c.params.erase("translation_m");
+        const Json& cam = t.next["cameras"][c.params["camera"].get<std::string>()];
+        c.params["qvec"] = cam["qvec"];
+        c.params["tvec"] = cam["tvec"];
+        c.evidence = fmt::format(
+            "camera {}: the residual follows the model image's edges, as a shift of the view: "
+            "{} Gauss-Newton steps on re-renders move its pose by {:.3f} deg and its centre by "
+            "{:.1f} mm (last step {:.4f} deg, {:.2f} mm)",
+            c.params["camera"].get<std::string>(), pr.iterations, pr.rotation_deg,
+            1000 * pr.translation_m, pr.last_step_deg, 1000 * pr.last_step_m);
+      }
+    }
     DiagnosisStep& ds = t.step;
     ds.residual_before = st.train.Relative();
     ds.held_out_before = st.held.Relative();
     ds.model_dir = out_dir / "steps" / fmt::format("{:02d}-{}", ++attempt, c.effect);
+    // missing_geometry excludes the object and its shadow: the refit and its comparison use the
+    // pixels outside the new masks.
+    const bool masks = c.effect == "missing_geometry";
+    if (masks) t.photos = MaskedPhotoSet(photos, missing.excluded);
+    const PhotoSet& ph = masks ? *t.photos : photos;
     try {
-      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, photos);
+      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
@@ -297,23 +381,45 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     }
     ds.residual_after = t.state.train.Relative();
     ds.held_out_after = t.state.held.Relative();
-    const auto [gain, z] = HeldOutGain(photos, st.sims, t.state.sims, holdout);
+    // A pose error shows on edges: its significance counts the blocks with edges.
+    const BlockFilter only =
+        pose_camera >= 0 ? EdgeBlocks(st.model, pose_camera, st.sims, holdout) : nullptr;
+    const auto [gain_all, z_all] = HeldOutGain(ph, st.sims, t.state.sims, holdout);
+    const double gain = gain_all;
+    const double z = only ? HeldOutGain(ph, st.sims, t.state.sims, holdout, only).second : z_all;
     t.gain = gain;
     ds.z = z;
     ds.kept = gain >= o.min_gain && z >= o.min_z;
-    ds.verdict = ds.kept ? fmt::format(
-                               "kept: held-out residual² down {:.1f}% ({:.1f} standard "
-                               "errors over the held-out blocks)",
-                               100 * gain, z)
-                         : fmt::format(
-                               "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
-                               "standard errors): the model does not earn its {} "
-                               "parameter(s)",
-                               -100 * gain, z, c.num_params);
+    if (masks) {
+      // Excluding pixels cannot be scored by the residual it removes alone. The masks come from
+      // the fitted pixels only, so they predict where the held-out residual lies: the step is kept
+      // when they hold >= min_gain of the held-out residual², at a per-pixel level higher than
+      // outside them by >= min_z standard errors (held-out blocks as units), and the refit does
+      // not make the held-out residual outside them (compared before/after on the same pixels)
+      // worse by min_gain.
+      t.gain = c.Gain();
+      ds.z = c.z;
+      ds.kept = c.Gain() >= o.min_gain && c.z >= o.min_z && gain >= -o.min_gain;
+      ds.verdict = fmt::format(
+          "{}: the masks (fitted on the fitted pixels) hold {:.1f}% of the held-out residual², "
+          "above the level outside them by {:.1f} standard errors; outside the masks the refit "
+          "changed the held-out residual² by {:.1f}% (same pixels before and after)",
+          ds.kept ? "kept" : "rejected", 100 * c.Gain(), c.z, -100 * gain);
+    } else {
+      ds.verdict = ds.kept ? fmt::format(
+                                 "kept: held-out residual² down {:.1f}% ({:.1f} standard "
+                                 "errors over the held-out blocks)",
+                                 100 * gain, z)
+                           : fmt::format(
+                                 "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
+                                 "standard errors): the model does not earn its {} "
+                                 "parameter(s)",
+                                 -100 * gain, z, c.num_params);
+    }
     const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
     ds.image_photo = scene.photos[img].file.filename().string();
     ds.residual_before_image = ResidualImage(photos, st.sims, img);
-    ds.residual_after_image = ResidualImage(photos, t.state.sims, img);
+    ds.residual_after_image = ResidualImage(ph, t.state.sims, img);
     spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
     if (c.effect == "albedo_texture" && ds.kept) {
       Json regions = Json::array();
@@ -344,6 +450,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }
     if (best >= 0) {
+      if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
       maps = next_maps;
@@ -356,6 +463,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
+    if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
+      missing =
+          LocateMissingGeometry(st.model, photos, st.sims, st.records, holdout, out_dir / "masks");
+      cands.push_back(missing.candidate);
+    }
     sum.last_candidates = cands;
     std::vector<CandidateResult*> ranked;
     for (CandidateResult& c : cands) {

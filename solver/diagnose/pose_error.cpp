@@ -1,0 +1,219 @@
+#include "solver/diagnose/pose_error.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <tuple>
+
+#include "solver/render.h"
+
+namespace igi {
+namespace {
+constexpr double kPi = std::numbers::pi;
+
+void Fill(const ResidualFit& fit, CandidateResult* out) {
+  out->train_before = fit.train_before;
+  out->train_after = fit.train_after;
+  out->held_before = fit.held_before;
+  out->held_after = fit.held_after;
+  out->z = fit.z;
+}
+// The held-out gain's significance where a pose error shows: on the model image's edges (flat
+// blocks add only their noise). The held-out blocks of the camera whose gradient energy is at
+// least kEdgeFactor times the median block's (the median block is flat: its gradient is noise);
+// the gains of their records (without the albedo nuisance) as units — the photo's noise is
+// independent from pixel to pixel, and a pose fitted to noise gains nothing on held-out pixels —
+// in Wilcoxon's signed-rank z.
+template <class Basis>
+double EdgeBlockZ(const std::vector<PixelRecord>& records, int camera, const Scene& model,
+                  int block_px, const Basis& basis, const Eigen::VectorXd& coef) {
+  std::map<std::tuple<int, int, int>, double> energy;
+  std::vector<std::pair<std::tuple<int, int, int>, double>> gains;
+  for (const PixelRecord& r : records) {
+    // Outliers too: a pose error's strongest residuals, on the sharpest edges, are flagged so.
+    if (!r.held_out || model.photos[r.photo].camera != camera) continue;
+    const std::tuple<int, int, int> key{r.photo, r.x / block_px, r.y / block_px};
+    energy[key] += double(r.sim_gradient.squaredNorm());
+    double g = 0;
+    for (int c = 0; c < 3; ++c) {
+      double b[6] = {0, 0, 0, 0, 0, 0};
+      basis(r, c, b);
+      double pred = 0;
+      for (int k = 0; k < 6; ++k) pred += b[k] * coef[k];
+      const double y = double(r.recorded[c]) - r.sim[c];
+      g += y * y - (y - pred) * (y - pred);
+    }
+    gains.emplace_back(key, g);
+  }
+  std::vector<double> values;
+  for (const auto& [k, e] : energy) values.push_back(e);
+  if (values.size() < 4) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double threshold = kEdgeFactor * values[values.size() / 2];
+  std::vector<double> edge_gains;
+  for (const auto& [k, g] : gains) {
+    if (energy[k] >= threshold) edge_gains.push_back(g);
+  }
+  return SignedRankZ(edge_gains);
+}
+
+}  // namespace
+
+// pose_error of one camera: the photo is the model seen from a slightly moved camera, so the
+// residual follows the model image's gradient along the flow of a small rotation ω (camera frame)
+// and translation δ: photo − sim ≈ −∇sim · J(ω, δ). Six amplitudes per camera.
+CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f, int camera) {
+  CandidateResult out;
+  out.effect = "pose_error";
+  const Camera& cam = cx.model.cameras[camera];
+  if (!cx.declared.contains("cameras") || cx.declared["cameras"].contains("colmap")) return out;
+  const double fx = cam.focal_x_px(), fy = cam.focal_y_px();
+  auto basis = [&](const PixelRecord& r, int c, double* b) {
+    if (cx.model.photos[r.photo].camera != camera) return;
+    const Eigen::Vector3d p = r.point_cam.cast<double>();
+    if (!(p.z() > 1e-6)) return;
+    const double gx = r.sim_gradient(c, 0), gy = r.sim_gradient(c, 1);
+    for (int k = 0; k < 6; ++k) {
+      const Eigen::Vector3d d =
+          k < 3 ? Eigen::Vector3d::Unit(k).cross(p) : Eigen::Vector3d(Eigen::Vector3d::Unit(k - 3));
+      const double du = fx * (d.x() / p.z() - p.x() * d.z() / (p.z() * p.z()));
+      const double dv = fy * (d.y() / p.z() - p.y() * d.z() / (p.z() * p.z()));
+      b[k] = -(gx * du + gy * dv);
+    }
+  };
+  const ResidualFit fit = f.Fit(6, basis);
+  if (fit.coef.size() == 0) return out;
+  const Eigen::Vector3d omega = fit.coef.head<3>(), delta = fit.coef.tail<3>();
+  const double angle_deg = omega.norm() * 180 / kPi;
+  if (!(angle_deg < 5) || !(delta.norm() < 0.25)) {
+    out.note = fmt::format(
+        "camera {}: the gradient fit ({:.2f} deg, {:.3f} m) is not a small pose "
+        "error",
+        cam.name, angle_deg, delta.norm());
+    return out;
+  }
+  Fill(fit, &out);
+  out.z = EdgeBlockZ(f.records(), camera, cx.model, cx.block_px, basis, fit.coef);
+  out.params = {{"camera", cam.name},
+                {"rotation_deg", angle_deg},
+                {"rotation_vector", {omega.x(), omega.y(), omega.z()}},
+                {"translation_m", {delta.x(), delta.y(), delta.z()}}};
+  Json photos = Json::array();
+  for (const Photo& p : cx.model.photos) {
+    if (p.camera == camera) photos.push_back(p.file.filename().string());
+  }
+  out.where = {{"photos", photos}, {"frame", "image position (edges)"}};
+  out.num_params = 6;
+  out.evidence = fmt::format(
+      "camera {}: the residual follows the model image's edges, as a shift of the view by "
+      "{:.2f} deg and {:.1f} mm: its declared pose is off",
+      cam.name, angle_deg, 1000 * delta.norm());
+  out.valid = true;
+  const std::string name = cam.name;
+  out.apply = [name, omega, delta](Json* doc) {
+    Json& j = (*doc)["cameras"][name];
+    const std::vector<double> q = j["qvec"].get<std::vector<double>>();
+    const std::vector<double> t = j["tvec"].get<std::vector<double>>();
+    const Eigen::Quaterniond r0(q[0], q[1], q[2], q[3]);
+    const double a = omega.norm();
+    const Eigen::Quaterniond dr(a > 0 ? Eigen::AngleAxisd(a, omega / a)
+                                      : Eigen::AngleAxisd::Identity());
+    const Eigen::Quaterniond r1 = (dr * r0).normalized();
+    const Eigen::Vector3d t1 = dr * Eigen::Vector3d(t[0], t[1], t[2]) + delta;
+    j["qvec"] = {r1.w(), r1.x(), r1.y(), r1.z()};
+    j["tvec"] = {t1.x(), t1.y(), t1.z()};
+  };
+  return out;
+}
+
+double SignedRankZ(std::vector<double> values) {
+  values.erase(std::remove(values.begin(), values.end(), 0.0), values.end());
+  const double n = double(values.size());
+  if (n < 2) return 0;
+  std::sort(values.begin(), values.end(),
+            [](double a, double b) { return std::abs(a) < std::abs(b); });
+  double w = 0;
+  for (size_t k = 0; k < values.size(); ++k) w += values[k] > 0 ? double(k + 1) : -double(k + 1);
+  return w / std::sqrt(n * (n + 1) * (2 * n + 1) / 6);
+}
+
+Rigid3d PoseOfCameraJson(const Json& j) {
+  const std::vector<double> q = j["qvec"].get<std::vector<double>>();
+  const std::vector<double> t = j["tvec"].get<std::vector<double>>();
+  return Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(),
+                 Eigen::Vector3d(t[0], t[1], t[2]));
+}
+
+PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
+                          const std::vector<Image>& sims, const DiagnoseOptions& o,
+                          bool materials_solved, double cell_m, int max_iterations, Json* doc) {
+  PoseRefinement out;
+  Scene m = model;
+  const std::string name = m.cameras[camera].name;
+  const Rigid3d start = model.cameras[camera].cam_from_world;
+  std::vector<Image> current = sims;
+  std::vector<std::unique_ptr<Renderer>> renderers(m.lightings.size());
+  double last_train = std::numeric_limits<double>::infinity();
+  Json last_doc = *doc;
+  for (int it = 0; it < max_iterations; ++it) {
+    m.cameras[camera].cam_from_world = PoseOfCameraJson((*doc)["cameras"][name]);
+    for (size_t i = 0; i < m.photos.size(); ++i) {
+      const Photo& p = m.photos[i];
+      if (p.camera != camera) continue;
+      if (!renderers[p.lighting]) renderers[p.lighting] = std::make_unique<Renderer>(m, p.lighting);
+      RenderOptions ro;  // as SimulatePhotos
+      ro.spp = o.spp;
+      ro.seed = o.seed + 7919 * i;
+      ro.num_threads = o.num_threads;
+      ro.show_progress = false;
+      current[i] = renderers[p.lighting]->Render(m.cameras[camera], ro);
+      ApplyExposureAndResponse(p, &current[i]);
+    }
+    std::vector<PixelRecord> records = BuildRecords(m, photos, current, o);
+    // The camera's residual tail is the pose error's own signal on sharp edges (the outlier flag
+    // is meant for fireflies and unmodelled objects): its records take part.
+    for (PixelRecord& r : records) {
+      if (m.photos[r.photo].camera == camera) r.outlier = false;
+    }
+    int num_cells = 0;
+    std::vector<int> cells = RecordCells(m, records, cell_m, &num_cells);
+    const ResidualFitter f(records, std::move(cells), num_cells, materials_solved,
+                           o.holdout_block_px);
+    const CandidateContext cx{m, *doc, materials_solved, cell_m, o.holdout_block_px};
+    const CandidateResult step = FitPoseError(cx, f, camera);
+    // Gauss–Newton guarded: a step that made the fitted residual worse than the pose before it is
+    // taken back, and the iteration ends.
+    if (step.valid && step.train_before > last_train) {
+      *doc = last_doc;
+      spdlog::info("igi-diagnose: pose of {}: the last step raised the residual; taken back", name);
+      break;
+    }
+    if (!step.valid || !step.apply) break;
+    last_train = step.train_before;
+    last_doc = *doc;
+    step.apply(doc);
+    ++out.iterations;
+    const std::vector<double> d = step.params["translation_m"].get<std::vector<double>>();
+    out.last_step_deg = step.params["rotation_deg"].get<double>();
+    out.last_step_m = Eigen::Vector3d(d[0], d[1], d[2]).norm();
+    spdlog::info("igi-diagnose: pose of {}: step {} of {:.3f} deg, {:.2f} mm", name, it + 1,
+                 out.last_step_deg, 1000 * out.last_step_m);
+    if (out.last_step_deg < 0.005 && out.last_step_m < 1e-4) break;
+  }
+  const Rigid3d end = PoseOfCameraJson((*doc)["cameras"][name]);
+  out.rotation_deg = Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / kPi;
+  const Eigen::Vector3d c0 = -(start.rotation.inverse() * start.translation);
+  const Eigen::Vector3d c1 = -(end.rotation.inverse() * end.translation);
+  out.translation_m = (c1 - c0).norm();
+  return out;
+}
+
+}  // namespace igi

@@ -1,0 +1,53 @@
+#pragma once
+// pose_error (CONTRACT.md §6): a photo's camera pose is off. The photo is then the model seen from
+// a slightly moved camera, so the residual follows the model image's gradient along the flow of a
+// small rotation ω (camera frame) and translation δ: photo − sim ≈ −∇sim · J(ω, δ).
+//
+// FitPoseError is one linear (Gauss–Newton) step of that fit; RefinePose iterates it — apply the
+// step, re-render the camera's photos, rebuild the records, refit — because one step recovers
+// only part of a pose error of a few pixels (the linearisation holds below a pixel).
+
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/diagnose/candidates.h"
+#include "solver/diagnose/diagnose_options.h"
+#include "solver/diagnose/pixel_records.h"
+#include "solver/diagnose/residual_fit.h"
+#include "tools/common/geometry.h"
+#include "tools/common/json.h"
+
+namespace igi {
+
+// One Gauss–Newton step for `camera` (six amplitudes); its apply() composes the step with the
+// camera's qvec/tvec in the declared document.
+CandidateResult FitPoseError(const CandidateContext& context, const ResidualFitter& fitter,
+                             int camera);
+
+// Blocks whose model-image gradient energy reaches this many times the median block's are the
+// edges where a pose error is scored.
+constexpr double kEdgeFactor = 4;
+
+// Wilcoxon's signed-rank statistic of `values` (zeros dropped) as a normal z: whether they are
+// mostly positive, robust to the heavy tails of per-block gains on edges.
+double SignedRankZ(std::vector<double> values);
+
+// The pose of a camera entry of a scene document (qvec w, x, y, z; tvec).
+Rigid3d PoseOfCameraJson(const Json& camera);
+
+struct PoseRefinement {
+  int iterations = 0;        // Gauss–Newton steps made
+  double rotation_deg = 0;   // the whole correction: rotation angle
+  double translation_m = 0;  // and camera-centre shift
+  double last_step_deg = 0, last_step_m = 0;
+};
+
+// Iterates the pose of `camera` in *doc from the model's pose: re-renders the camera's photos
+// with the moved pose, rebuilds the records (the camera's outliers included: its sharpest edges
+// are the signal) and applies the next step, until a step is below 0.005° and 0.1 mm, a step
+// raises the fitted residual (taken back), or max_iterations were made.
+PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
+                          const std::vector<Image>& sims, const DiagnoseOptions& options,
+                          bool materials_solved, double cell_m, int max_iterations, Json* doc);
+
+}  // namespace igi

@@ -1,0 +1,111 @@
+// igi-diagnose on concealed data (issue 8): missing_geometry and pose_error, at the CI size of
+// concealed_test.cpp (4 cameras of 160×120, photos at 64 paths per pixel, a point lamp,
+// materials given).
+//
+// missing_geometry: igi-synth adds a 0.35 × 0.35 × 0.45 m box on the floor that scene.json lacks,
+// at (1.9, 2.0), where three of the four cameras of seed 11 see it (at the effect's default
+// (3.1, 1.0) only cam0 does, and one view cannot place it in 3D). The first kept step names it,
+// its located centre lies within 0.15 m of the truth, and the final residual — over the pixels
+// outside the masks it wrote — comes within 1.2× the true model's residual (truth/scene.json, with
+// the object) over the same pixels.
+//
+// pose_error: cam0's declared pose is off by 1° and 20 mm. The first kept step names it and the
+// residual falls.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "tests/e2e/run.h"
+#include "tests/temp_dir.h"
+#include "tools/common/json.h"
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+using test::Quote;
+using test::RunTool;
+
+const std::string kDiagnose = " --spp 128 --holdout-block-px 8 --threads 2 --quiet";
+
+fs::path Synthesize(const fs::path& dir, const std::string& effect, int seed) {
+  const fs::path scene = dir / "capture";
+  const auto r = RunTool("igi-synth", "--out " + Quote(scene.string()) +
+                                          " --cameras 4 --width 160 --height 120 --spp 64"
+                                          " --lamp point --unknowns none --threads 2 --quiet"
+                                          " --seed " +
+                                          std::to_string(seed) + " --effect " + effect);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return scene;
+}
+
+// The true model (truth/scene.json: the object included) with the photos and masks of `photos_of`
+// (a scene document whose paths are relative to its folder).
+fs::path TrueModel(const fs::path& capture, const fs::path& photos_of) {
+  Json truth_scene = ReadJsonFile(capture / "truth" / "scene.json");
+  Json photos = ReadJsonFile(photos_of)["photos"];
+  for (Json& p : photos) {
+    for (const char* key : {"file", "mask"}) {
+      if (p.contains(key) && p[key].is_string()) {
+        const fs::path path = photos_of.parent_path() / p[key].get<std::string>();
+        p[key] = fs::absolute(path).lexically_normal().string();
+      }
+    }
+  }
+  truth_scene["photos"] = photos;
+  const fs::path out = capture / "truth" / "true_model.json";
+  WriteJsonFile(out, truth_scene);
+  return out;
+}
+
+TEST(ConcealedGeometryTest, MissingGeometryIsLocatedAndExcluded) {
+  const fs::path dir = test::UniqueTempDir("igi_concealed_missing_geometry");
+  const fs::path capture = Synthesize(dir, "missing_geometry:x=1.9,y=2.0", 11);
+  auto r = RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
+                                       Quote((dir / "diag").string()) + kDiagnose);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json d = ReadJsonFile(dir / "diag" / "diagnosis.json");
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  const Json& step = d["steps"][0];
+  ASSERT_EQ(step["effect"], "missing_geometry") << d.dump(1);
+  // Located: the carved volume's centroid (measured 0.07 m off: its top raised by the visual
+  // hull of three views).
+  const Json truth = ReadJsonFile(capture / "truth.json")["effects"][0]["params"];
+  double dist2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double e = step["where"]["center"][k].get<double>() - truth["center"][k].get<double>();
+    dist2 += e * e;
+  }
+  EXPECT_LT(std::sqrt(dist2), 0.15) << step.dump(1);
+  EXPECT_GE(step["where"]["photos"].size(), 2u);
+  // Excluded: the improved scene's photos carry masks; outside them the residual reaches the
+  // true model's (measured 0.145 against 0.143).
+  const fs::path improved = dir / "diag" / "scene.json";
+  for (const Json& p : ReadJsonFile(improved)["photos"]) EXPECT_TRUE(p["mask"].is_string());
+  r = RunTool("igi-diagnose", Quote(TrueModel(capture, improved).string()) + " --out " +
+                                  Quote((dir / "floor").string()) + kDiagnose + " --max-steps 0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double floor =
+      ReadJsonFile(dir / "floor" / "diagnosis.json")["baseline"]["residual"].get<double>();
+  EXPECT_LE(d["final"]["residual"].get<double>(), 1.2 * floor) << "floor " << floor;
+  fs::remove_all(dir);
+}
+
+TEST(ConcealedGeometryTest, PoseErrorIsNamedFirst) {
+  const fs::path dir = test::UniqueTempDir("igi_concealed_pose_error");
+  const fs::path capture = Synthesize(dir, "pose_error", 11);
+  const auto r =
+      RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
+                                  Quote((dir / "diag").string()) + kDiagnose + " --max-steps 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json d = ReadJsonFile(dir / "diag" / "diagnosis.json");
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["effect"], "pose_error") << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["params"]["camera"], "cam0");
+  EXPECT_LT(d["final"]["residual"].get<double>(), 0.95 * d["baseline"]["residual"].get<double>());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace igi
