@@ -30,9 +30,11 @@ struct DemoOptions {
   double stops = 2;
   bool skip_diagnose = false;
   int num_threads = 0;
-  // Two of the overview cameras look up: a ceiling no photo sees keeps placeholder values,
-  // its missing light biases every other region's rho_d (measured: ~+25 %, rho_s/k ~-30 %).
-  int ceiling_cameras = 2;
+  // Overview cameras that look up at the ceiling (igi-synth --ceiling-cameras). A ceiling no
+  // photo sees keeps placeholder values (its light missing, the walls' rho_d come out +4..+14 %),
+  // but 0 here: with 2, neither registered (COLMAP matched none of their features, and they
+  // see one control point each, too few to pose them from the markers).
+  int ceiling_cameras = 0;
   // The synthetic camera is calibrated absolutely (igi-run --radiance-scale), as a lab camera
   // measured against a radiance standard: without it the albedos come out in the HDR maps'
   // arbitrary scale, which weakens every bounce (measured: rho_s/k -27..-29 %).
