@@ -33,14 +33,17 @@ using test::RunTool;
 
 // Tolerances on top of the solver's own (README: 1-7 % on igi-synth rooms from true poses and
 // true radiance): the demo's photos are 8 spp renders, 3 brackets of 8 bits merged with a
-// recovered response (about 1 % in radiance), and COLMAP poses (0.1-0.3 degrees, 1-2 cm).
-// Measured on the first full run (2026-11-21): ρd −4..+15 %, ρs −26..−31 %, α −14..+1 %; the
-// bounds guard those sizes (the solver issue's 1 %/5 % bars are NOT met end to end). Regions no
-// photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are
-// reported by igi-solve and not compared.
+// recovered response (about 1 % in radiance), COLMAP poses refined with the control points, and
+// the camera's absolute calibration measured after 02-hdr (--radiance-scale). Measured
+// 2026-11-21: without the calibration ρd −4..+15 %, ρs −26..−31 %, α −14..+1 % (the HDR maps'
+// arbitrary scale weakened every bounce); with it (absolute, before k): ρd −7.5..+14 %, ρs
+// −0.6 % / −0.3 % / −8.3 %, α +0.2..+4 %. The bounds guard those sizes (the solver issue's
+// 1 %/5 % bars are not met end to end: the ceiling is seen by no photo). Regions no photo sees
+// ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
+// igi-solve and not compared.
 constexpr double kRhoDTolerance = 0.20;   // region-mean albedo after k
-constexpr double kRhoSTolerance = 0.40;   // specular reflectance after k (highlights only)
-constexpr double kAlphaTolerance = 0.25;  // lobe width (scale-free)
+constexpr double kRhoSTolerance = 0.20;   // specular reflectance after k (highlights only)
+constexpr double kAlphaTolerance = 0.15;  // lobe width (scale-free)
 
 double Seconds(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
