@@ -22,14 +22,6 @@ constexpr double kPi = std::numbers::pi;
 
 std::string Pct(double v) { return fmt::format("{:.1f}%", 100 * v); }
 
-void Fill(const ResidualFit& fit, CandidateResult* out) {
-  out->train_before = fit.train_before;
-  out->train_after = fit.train_after;
-  out->held_before = fit.held_before;
-  out->held_after = fit.held_after;
-  out->z = fit.z;
-}
-
 std::vector<std::string> PhotoFiles(const Scene& model) {
   std::vector<std::string> out;
   for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
@@ -48,7 +40,7 @@ CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& 
   const ResidualFit fit =
       f.Fit(n, [&](const PixelRecord& r, int c, double* b) { b[r.photo] = r.sim[c]; });
   if (fit.coef.size() == 0) return out;
-  Fill(fit, &out);
+  FillScores(fit, &out);
   std::vector<double> scale(n);
   for (int j = 0; j < n; ++j) scale[j] = 1 + fit.coef[j];
   std::vector<double> sorted = scale;
@@ -101,7 +93,7 @@ CandidateResult Vignetting(const CandidateContext& cx, const ResidualFitter& f) 
     out.note = fmt::format("the radial fit (k1 {:.3g}, k2 {:.3g}) is not a lens fall-off", k1, k2);
     return out;
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   out.params = {{"k1", k1}, {"k2", k2}};
   out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "image"}};
   out.num_params = 2;
@@ -167,7 +159,7 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   const double e_grid = 0.5 * (lo + hi);
   best = f.Fit(k, basis_at(e_grid));
   if (best.coef.size() == 0) return out;
-  Fill(best, &out);
+  FillScores(best, &out);
   // photo ≈ sim + c·(model_e − sim) (+ s·model_e): for c near 1 the exponent is e; in general
   // 1 + c(e − 1). The scale s moves the reference: (1 + s)·r·(u/r)^e = r'·(u/r')^e.
   const double e = 1 + best.coef[0] * (e_grid - 1);
@@ -208,7 +200,7 @@ CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
     out.note = "the offset that fits is negative in some channel: not an ambient light";
     return out;
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
   out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
   out.num_params = 3;
@@ -322,7 +314,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
       if (!moved) break;
     }
   }
-  Fill(best, &out);
+  FillScores(best, &out);
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity = l.type == LightType::kSphere
@@ -381,7 +373,7 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
                "the albedos";
     return out;
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   const double factor = 1 + fit.coef[0];
   if (!(factor > 0)) return out;
   out.params = {{"light", l.name}, {"factor", factor}};
@@ -441,7 +433,7 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
     out.note = "no lobe with 0 < rho_s < 1 fits region " + name;
     return out;
   }
-  Fill(best, &out);
+  FillScores(best, &out);
   const double rho_s = best.coef[0];
   out.params = {{"region", name}, {"rho_s", rho_s}, {"alpha", best_alpha}};
   out.where = {{"regions", {name}}, {"frame", "half-vector angle"}};
@@ -506,7 +498,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     out.note = "the alternative lobe does not fit region " + m.name;
     return out;
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   const std::string to =
       fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel" : (gmd ? "ward" : "ward_gmd");
   out.params = {
@@ -534,6 +526,14 @@ CandidateResult PoseError(const CandidateContext& cx, const ResidualFitter& f, i
 }
 
 }  // namespace
+
+void FillScores(const ResidualFit& fit, CandidateResult* out) {
+  out->train_before = fit.train_before;
+  out->train_after = fit.train_after;
+  out->held_before = fit.held_before;
+  out->held_after = fit.held_after;
+  out->z = fit.z;
+}
 
 std::string CandidateResult::Key() const {
   for (const char* k : {"region", "light", "camera"}) {

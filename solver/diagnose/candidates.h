@@ -19,11 +19,11 @@
 namespace igi {
 
 struct CandidateContext {
-  const Scene& model;          // the current (complete) model
-  const Json& declared;        // the declared scene document (absolute paths)
-  bool materials_solved;       // unknown materials are re-solved after each step
-  double cell_m = 0.05;        // surface cell of regions with albedo maps (their free albedo)
-  int block_px = 16;           // held-out block: the unit of the gain's standard error
+  const Scene& model;     // the current (complete) model
+  const Json& declared;   // the declared scene document (absolute paths)
+  bool materials_solved;  // unknown materials are re-solved after each step
+  double cell_m = 0.05;   // surface cell of regions with albedo maps (their free albedo)
+  int block_px = 16;      // held-out block: the unit of the gain's standard error
 };
 
 struct CandidateResult {
@@ -37,7 +37,7 @@ struct CandidateResult {
   double held_photo = 0;  // Σ photo² of the held-out records
   double z = 0;           // held-out gain over its standard error (across blocks)
   bool valid = false;
-  std::string note;       // why a candidate could not be fitted (e.g. degenerate)
+  std::string note;  // why a candidate could not be fitted (e.g. degenerate)
   // Writes the fitted model into the declared scene document.
   std::function<void(Json* declared)> apply;
 
@@ -46,6 +46,10 @@ struct CandidateResult {
   // per key.
   std::string Key() const;
 };
+
+struct ResidualFit;
+// Copies a fit's predicted squared-error sums and significance into a candidate.
+void FillScores(const ResidualFit& fit, CandidateResult* out);
 
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).

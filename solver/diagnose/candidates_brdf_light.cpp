@@ -20,14 +20,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-void Fill(const ResidualFit& fit, CandidateResult* out) {
-  out->train_before = fit.train_before;
-  out->train_after = fit.train_after;
-  out->held_before = fit.held_before;
-  out->held_after = fit.held_after;
-  out->z = fit.z;
-}
-
 Json Vec(const Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 // The records' change of model for one parameter set, per record and channel (zero where the
@@ -197,7 +189,7 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
         m.name, ratio, 100 * share);
     return out;
   }
-  Fill(best, &out);
+  FillScores(best, &out);
   // The narrow direction first is a convention only: report the tangent of alpha_x as fitted.
   const Vector3d tangent = tangent_of(bp.phi);
   const double k = best.coef[0];
@@ -516,7 +508,7 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
     const bool penumbra = (vis[i] > 0.02f && vis[i] < 0.98f) || std::abs(vis[i] - vis0[i]) > 0.02f;
     ++(penumbra ? edge : other);
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   const double amplitude = fit.coef[0];
   const Vector3d center = model.source().center, intensity = model.source().intensity;
   out.params = {

@@ -19,13 +19,6 @@ namespace igi {
 namespace {
 constexpr double kPi = std::numbers::pi;
 
-void Fill(const ResidualFit& fit, CandidateResult* out) {
-  out->train_before = fit.train_before;
-  out->train_after = fit.train_after;
-  out->held_before = fit.held_before;
-  out->held_after = fit.held_after;
-  out->z = fit.z;
-}
 // The held-out gain's significance where a pose error shows: on the model image's edges (flat
 // blocks add only their noise). The held-out blocks of the camera whose gradient energy is at
 // least kEdgeFactor times the median block's (the median block is flat: its gradient is noise);
@@ -100,7 +93,7 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
         cam.name, angle_deg, delta.norm());
     return out;
   }
-  Fill(fit, &out);
+  FillScores(fit, &out);
   out.z = EdgeBlockZ(f.records(), camera, cx.model, cx.block_px, basis, fit.coef);
   out.params = {{"camera", cam.name},
                 {"rotation_deg", angle_deg},
