@@ -6,6 +6,7 @@
 #include <string>
 
 #include "solver/render_internal.h"
+#include "solver/texel_splat.h"
 #include "tools/common/error.h"
 
 namespace igi {
@@ -143,26 +144,16 @@ void AlbedoMapBuilder::Add(int triangle, double b1, double b2, const Eigen::Vect
       !std::isfinite(b2)) {
     return;
   }
-  Eigen::Vector2d uv = atlas_->UvAt(triangle, b1, b2);
-  for (int k = 0; k < 2; ++k) {  // wrapped as the renderer does
-    if (uv[k] < 0.0 || uv[k] > 1.0) uv[k] -= std::floor(uv[k]);
-  }
-  const int width = atlas_->width, height = atlas_->height;
-  const double x = uv.x() * width - 0.5, y = (1.0 - uv.y()) * height - 0.5;
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  const double fx = x - x0, fy = y - y0;
-  for (int dy = 0; dy < 2; ++dy) {
-    for (int dx = 0; dx < 2; ++dx) {
-      const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
-      if (w <= 0) continue;
-      const int xi = std::clamp(x0 + dx, 0, width - 1), yi = std::clamp(y0 + dy, 0, height - 1);
-      double* t = TileAt(xi, yi)->texel(xi, yi);
-      for (int c = 0; c < 3; ++c) {
-        t[c] += w * numerator[c];
-        t[3 + c] += w * denominator[c];
-      }
-      t[kWeightSlot] += w;
+  const TexelSplat splat = BilinearTexelSplat(*atlas_, triangle, b1, b2);
+  for (int k = 0; k < 4; ++k) {
+    const double w = splat.weight[k];
+    if (w <= 0) continue;
+    double* t = TileAt(splat.x[k], splat.y[k])->texel(splat.x[k], splat.y[k]);
+    for (int c = 0; c < 3; ++c) {
+      t[c] += w * numerator[c];
+      t[3 + c] += w * denominator[c];
     }
+    t[kWeightSlot] += w;
   }
   ++num_samples_;
 }

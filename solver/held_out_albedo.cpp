@@ -3,23 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/texel_splat.h"
+
 namespace igi {
 
 HeldOutAlbedo::Splat HeldOutAlbedo::SplatOf(int triangle, double b1, double b2) const {
-  Eigen::Vector2d uv = atlas_->UvAt(triangle, b1, b2);
-  for (int k = 0; k < 2; ++k) {  // wrapped as the renderer does
-    if (uv[k] < 0.0 || uv[k] > 1.0) uv[k] -= std::floor(uv[k]);
-  }
-  const int width = atlas_->width, height = atlas_->height;
-  const double x = uv.x() * width - 0.5, y = (1.0 - uv.y()) * height - 0.5;
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  const double fx = x - x0, fy = y - y0;
+  const TexelSplat t = BilinearTexelSplat(*atlas_, triangle, b1, b2);
   Splat s;
   for (int k = 0; k < 4; ++k) {
-    const int dx = k & 1, dy = k >> 1;
-    const int xi = std::clamp(x0 + dx, 0, width - 1), yi = std::clamp(y0 + dy, 0, height - 1);
-    s.texel[k] = int64_t(yi) * width + xi;
-    s.weight[k] = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
+    s.texel[k] = int64_t(t.y[k]) * atlas_->width + t.x[k];
+    s.weight[k] = t.weight[k];
   }
   return s;
 }
