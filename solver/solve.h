@@ -29,6 +29,7 @@
 #include "solver/brdf.h"
 #include "solver/highlight_coverage.h"
 #include "solver/observations.h"
+#include "solver/photometric_scale.h"
 #include "solver/region_fit.h"
 #include "solver/solve_options.h"
 #include "tools/common/image.h"
@@ -89,6 +90,9 @@ struct SolveSummary {
   // Whether the refinement's parameters were kept (false: they explained the photos worse, and
   // the paper stage's are the result; both are reported).
   bool refinement_accepted = true;
+  // The photos' scale k (photo = k × radiance) estimated from the reference regions when
+  // SolveOptions::photo_scale is "solve" (solver/photometric_scale.h); nullopt: given.
+  std::optional<PhotoScaleEstimate> photo_scale;
   double patch_size_m = 0, texel_size_m = 0;
   double scene_diagonal_m = 0;  // of the geometry's bounding box
   int patches = 0, observations = 0;

@@ -292,8 +292,13 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
   s.SelectFitSamples();
   s.ChooseTexelSize();
   s.AnalyseCoverage();
+  if (options.photo_scale == "solve") PhotoScaleReferenceRegions(s);  // before the rays
   s.GatherAll();
-  s.RunStage1();
+  if (options.photo_scale == "solve") {
+    s.summary.photo_scale = RunStage1WithPhotoScale(&s);
+  } else {
+    s.RunStage1();
+  }
   s.RunStage2();
   s.BuildAlbedoMaps();
   s.FinishRegions();

@@ -36,6 +36,8 @@ void SolveOptions::Validate() const {
         std::to_string(refine_iterations), "must be in [0, 20]");
   check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),
         "must be in [1, 4096]");
+  check(photo_scale == "given" || photo_scale == "solve", "--photo-scale", photo_scale,
+        "must be given or solve");
   check(holdout_fraction >= 0 && holdout_fraction < 1, "--holdout-fraction",
         fmt::format("{}", holdout_fraction), "must be in [0, 1)");
   check(holdout_block_px >= 1, "--holdout-block-px", std::to_string(holdout_block_px),

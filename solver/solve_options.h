@@ -39,6 +39,13 @@ struct SolveOptions {
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
+  // The photos' absolute scale. "given": their values are radiance in the scene's units (after
+  // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance
+  // maps from a recovered response are known up to a constant) is estimated from the observed
+  // regions whose reflectance is given in full and diffuse (a reference target), before the
+  // paper's stage (solver/photometric_scale.h); the solved scene.json multiplies every photo's
+  // exposure_scale by k.
+  std::string photo_scale = "given";
   uint64_t seed = 1;
   // Pixels left out of every fit (igi-diagnose measures its held-out residual on them): square
   // blocks of holdout_block_px, a `holdout_fraction` share of them (0 = none).

@@ -89,6 +89,10 @@ Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const 
     for (Json& p : doc["photos"]) {
       RebaseKey(scene, &p, "file", out);
       RebaseKey(scene, &p, "mask", out);
+      if (summary.photo_scale) {
+        const double given = p.contains("exposure_scale") ? p["exposure_scale"].get<double>() : 1.0;
+        p["exposure_scale"] = given * summary.photo_scale->scale;
+      }
     }
   }
   if (doc.contains("cameras")) RebaseKey(scene, &doc["cameras"], "colmap", out);
@@ -130,6 +134,21 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                             {"render_residual_squared_stderr", Num(s.stage2_render_residual_sq_se)},
                             {"accepted", s.refinement_accepted}};
   j["render_residual_spp"] = s.render_residual_spp;
+  if (s.photo_scale) {
+    const PhotoScaleEstimate& k = *s.photo_scale;
+    j["photo_scale"] = {{"scale", Num(k.scale)},
+                        {"sigma", Num(k.sigma)},
+                        {"rgb", Vec(k.rgb)},
+                        {"reference_regions", k.reference_regions},
+                        {"samples", k.samples},
+                        {"rejected", k.rejected},
+                        {"rounds", k.rounds},
+                        {"direct_share", Num(k.direct_share)},
+                        {"meaning",
+                         "photo value = scale x radiance in the scene's units, from the regions of "
+                         "known diffuse reflectance; every photo's exposure_scale in scene.json is "
+                         "multiplied by it"}};
+  }
   j["residual_metric"] =
       "relative RMS residual sqrt(sum (render - photo)^2 / sum photo^2) over the observed pixels, "
       "all channels; renders path traced through each pixel's centre";

@@ -50,6 +50,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--refine-rays", o.refine_rays, "path-traced directions per observation")
       ->capture_default_str();
+  app.add_option("--photo-scale", o.photo_scale,
+                 "given (photos in the scene's radiance units) or solve (one factor for all "
+                 "photos, from the regions of known diffuse reflectance)")
+      ->capture_default_str();
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();
   return igi::RunMain(app, common, argc, argv, [&]() {
     o.num_threads = common.threads;

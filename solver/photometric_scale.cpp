@@ -1,0 +1,193 @@
+#include "solver/photometric_scale.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "solver/sampling.h"
+#include "solver/solve_internal.h"
+#include "tools/common/error.h"
+
+namespace igi {
+namespace {
+
+// One reference sample: photo value P = k·a + b for one channel of one observation.
+struct ScaleSample {
+  double p = 0, a = 0, b = 0;
+};
+
+bool IsReference(const MaterialState& m) {
+  if (!m.reflective || m.NeedsFit() || m.observations == 0) return false;
+  return !HasSpecularLobe(m.params.model) || !(m.params.rho_s.maxCoeff() > 0);
+}
+
+// Least squares k over `samples` (P − b = k·a), with its standard error; `keep` selects.
+std::pair<double, double> FitScale(const std::vector<ScaleSample>& samples,
+                                   const std::vector<char>& keep) {
+  double num = 0, den = 0;
+  int n = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!keep[i]) continue;
+    num += (samples[i].p - samples[i].b) * samples[i].a;
+    den += samples[i].a * samples[i].a;
+    ++n;
+  }
+  if (!(den > 0) || n < 2) return {std::nan(""), 0.0};
+  const double k = num / den;
+  double rss = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (keep[i]) rss += std::pow(samples[i].p - samples[i].b - k * samples[i].a, 2);
+  }
+  return {k, std::sqrt(rss / (n - 1) / den)};
+}
+
+// k with outliers (residual beyond 4 robust standard deviations) left out; counts them.
+std::pair<double, double> RobustScale(const std::vector<ScaleSample>& samples, int* rejected) {
+  std::vector<char> keep(samples.size(), 1);
+  auto [k, sigma] = FitScale(samples, keep);
+  if (!std::isfinite(k)) return {k, sigma};
+  std::vector<double> abs_res(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    abs_res[i] = std::abs(samples[i].p - samples[i].b - k * samples[i].a);
+  }
+  std::vector<double> sorted = abs_res;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = 4 * 1.4826 * sorted[sorted.size() / 2];
+  *rejected = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (abs_res[i] > limit) keep[i] = 0, ++*rejected;
+  }
+  return FitScale(samples, keep);
+}
+
+// The reference samples of the current gathering: per observation and channel of a reference
+// region with direct light on it.
+std::vector<ScaleSample> ReferenceSamples(const SolverState& s, int channel, double* direct_share) {
+  std::vector<ScaleSample> out;
+  double share = 0;
+  for (size_t i = 0; i < s.obs.size(); ++i) {
+    const Observation& o = s.obs[i];
+    if (!IsReference(s.materials[o.region])) continue;
+    const Eigen::Vector3d rho = s.KnownAlbedo(o);
+    const double e_direct = s.obs_e_direct[i][channel];
+    const double e_indirect = s.obs_e[i][channel] - e_direct;
+    if (!(rho[channel] > 0) || !(e_direct > 0)) continue;
+    out.push_back({o.radiance[channel], rho[channel] / kPi * e_direct,
+                   rho[channel] / kPi * e_indirect});
+    share += e_direct / std::max(1e-300, e_direct + e_indirect);
+  }
+  if (direct_share && !out.empty()) *direct_share = share / out.size();
+  return out;
+}
+
+void DividePhotos(SolverState* s, double k) {
+  for (Image& image : s->photo_images) {
+    for (float& v : image.pixels) v = float(v / k);
+  }
+  for (Observation& o : s->obs) o.radiance = (o.radiance.cast<double>() / k).cast<float>();
+}
+
+}  // namespace
+
+std::vector<std::string> PhotoScaleReferenceRegions(const SolverState& s) {
+  std::vector<std::string> names;
+  for (size_t r = 0; r < s.materials.size(); ++r) {
+    if (IsReference(s.materials[r])) names.push_back(s.scene.materials[r].name);
+  }
+  if (names.empty()) {
+    throw InputError(DescribeProblem(
+        s.scene.file.string(), "materials", "no observed region of known diffuse reflectance",
+        "--photo-scale solve needs a reference: a region some photo sees whose rho_d is given "
+        "and that has no specular lobe (or rho_s 0)"));
+  }
+  return names;
+}
+
+namespace {
+
+// One estimate of k from the current state (after a stage-1 run): the measured factor, its
+// standard error and the per-channel factors.
+struct ScaleMeasurement {
+  double k = 1, sigma = 0;
+  Eigen::Vector3d rgb = Eigen::Vector3d::Ones();
+  int samples = 0, rejected = 0;
+};
+
+ScaleMeasurement MeasureScale(const SolverState& s, PhotoScaleEstimate* est) {
+  std::vector<ScaleSample> all;
+  ScaleMeasurement m;
+  for (int c = 0; c < 3; ++c) {
+    const std::vector<ScaleSample> ch = ReferenceSamples(s, c, &est->direct_share);
+    int rejected_c = 0;
+    m.rgb[c] = RobustScale(ch, &rejected_c).first;
+    all.insert(all.end(), ch.begin(), ch.end());
+  }
+  std::tie(m.k, m.sigma) = RobustScale(all, &m.rejected);
+  m.samples = int(all.size()) - m.rejected;
+  if (!std::isfinite(m.k) || !(m.k > 0)) {
+    throw InputError(DescribeProblem(
+        s.scene.file.string(), "materials", fmt::format("{} reference samples", all.size()),
+        "--photo-scale solve: the reference regions get too little direct light to measure "
+        "the photos' scale"));
+  }
+  return m;
+}
+
+// Divides the photos by `step` and scales the fitted reflectances with them (a warm start for
+// the next stage-1 run).
+void ApplyScale(SolverState* s, double step) {
+  DividePhotos(s, step);
+  for (MaterialState& m : s->materials) {
+    if (m.unknown_rho_d) {
+      m.params.rho_d /= step;
+      for (Eigen::Vector3d& v : m.patch_rho_d) v /= step;
+    }
+    if (m.unknown_rho_s) m.params.rho_s /= step;
+  }
+}
+
+}  // namespace
+
+// Each round measures log k on the current photos and divides them by a step toward it. The
+// measured log k responds to a step with a gain g (1 would make one step exact; it is larger
+// because the unseen patches' albedos and the fits move with the photos, which makes plain
+// steps overshoot and alternate): g is re-estimated from the last step and the step taken is
+// log k / g.
+PhotoScaleEstimate RunStage1WithPhotoScale(SolverState* s) {
+  PhotoScaleEstimate est;
+  est.reference_regions = PhotoScaleReferenceRegions(*s);
+  constexpr int kMaxRounds = 6;
+  constexpr double kTolerance = 2e-3;  // relative change of k: well under its standard error
+  s->RunStage1();
+  double gain = 1, last_log_k = 0, last_step = 0;
+  for (int round = 1; round <= kMaxRounds; ++round) {
+    const ScaleMeasurement m = MeasureScale(*s, &est);
+    const double log_k = std::log(m.k);
+    if (round > 1 && std::abs(last_step) > 1e-6) {
+      gain = std::clamp((last_log_k - log_k) / last_step, 0.5, 3.0);
+    }
+    est.rgb = m.rgb * est.scale;
+    est.sigma = m.sigma / m.k * est.scale;  // relative error at the current total
+    est.samples = m.samples;
+    est.rejected = m.rejected;
+    est.rounds = round;
+    if (std::abs(log_k) < kTolerance) {  // the photos as they are now are kept
+      spdlog::info("photo scale: {:.5f} ± {:.5f} after {} rounds", est.scale, est.sigma, round);
+      break;
+    }
+    const double step = log_k / gain;
+    ApplyScale(s, std::exp(step));
+    est.scale *= std::exp(step);
+    spdlog::info("photo scale round {}: measured x{:.5f}, gain {:.2f}, step x{:.5f} (total {:.5f})",
+                 round, m.k, gain, std::exp(step), est.scale);
+    last_log_k = log_k;
+    last_step = step;
+    s->RunStage1();
+  }
+  return est;
+}
+
+}  // namespace igi
