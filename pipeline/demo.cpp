@@ -92,6 +92,23 @@ std::vector<std::string> SynthArgs(const DemoOptions& o, const fs::path& synth) 
           std::to_string(o.num_threads)};
 }
 
+// The reference of known reflectance: `region`'s true material (its albedo map included) copied
+// from truth/scene.json into the capture's scene.json, as if measured beforehand.
+void GiveReference(const fs::path& synth, const std::string& region) {
+  const Json truth = ReadJsonFile(synth / "truth" / "scene.json");
+  if (!truth["materials"].contains(region)) {
+    throw InputError(DescribeProblem((synth / "truth" / "scene.json").string(), "materials",
+                                     region, "the demo's reference region must exist"));
+  }
+  Json material = truth["materials"][region];
+  if (material.contains("rho_d_map")) {
+    material["rho_d_map"] = (fs::path("truth") / material["rho_d_map"].get<std::string>()).string();
+  }
+  Json scene = ReadJsonFile(synth / "scene.json");
+  scene["materials"][region] = material;
+  WriteJsonFile(synth / "scene.json", scene);
+}
+
 // DIR/00-capture: igi-synth's capture plus camera.json and markers.json in its PHOTOS_DIR.
 // Kept when its marker matches the options.
 fs::path Capture(const DemoOptions& o, const fs::path& bin) {
@@ -100,6 +117,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin) {
   const std::vector<std::string> args = SynthArgs(o, synth);
   Fingerprint fp;
   for (const std::string& a : args) fp.AddText(a);
+  if (o.calibration == "reference") fp.AddText("reference " + o.reference_region);
   const auto marker = ReadStageMarker(dir);
   if (marker && marker->fingerprint == fp.Hex()) return synth;
   fs::remove_all(dir);
@@ -124,6 +142,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin) {
                                                          {"height", c0.height},
                                                          {"params", c0.params}});
   WriteJsonFile(synth / "brackets" / "markers.json", MarkersOfTruth(truth, photos));
+  if (o.calibration == "reference") GiveReference(synth, o.reference_region);
   WriteStageMarker(dir, StageMarker{"00-capture",
                                     fp.Hex(),
                                     "done",
@@ -158,6 +177,9 @@ double MeasureRadianceScale(const fs::path& hdr_dir, const fs::path& synth_dir) 
 
 void DemoOptions::Validate() const {
   ProblemList p;
+  if (calibration != "reference" && calibration != "measured" && calibration != "none") {
+    p.Add("", "--demo-calibration", calibration, "must be reference, measured or none");
+  }
   if (out.empty()) p.Add("", "--out", "", "is required");
   if (cameras < 3) p.Add("", "--demo-cameras", std::to_string(cameras), "must be >= 3");
   if (width < 64 || height < 48) {
@@ -167,9 +189,11 @@ void DemoOptions::Validate() const {
   p.ThrowIfAny();
 }
 
-Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json) {
+Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
+                      const std::vector<std::string>& given) {
   const Json solved = ReadJsonFile(solved_scene)["materials"];
-  const Json truth = ReadJsonFile(truth_json)["materials"];
+  Json truth = ReadJsonFile(truth_json)["materials"];
+  for (const std::string& name : given) truth.erase(name);
   std::vector<double> ratios;
   for (const auto& [name, t] : truth.items()) {
     if (!solved.contains(name) || !t.contains("rho_d") || !solved[name].contains("rho_d")) continue;
@@ -224,12 +248,31 @@ DemoSummary RunDemo(const DemoOptions& o) {
   run.stop_after = "02-hdr";
   const RunSummary first = RunPipeline(run);
   run.stop_after.clear();
-  run.radiance_scale = o.absolute_calibration ? MeasureRadianceScale(o.out / "02-hdr", synth) : 1.0;
+  // The HDR maps' true scale (what an absolute calibration measures): given to the chain with
+  // "measured", only compared with the solved scale with "reference".
+  const double true_scale = MeasureRadianceScale(o.out / "02-hdr", synth);
+  run.radiance_scale = o.calibration == "measured" ? true_scale : 1.0;
+  if (o.calibration == "reference") {
+    run.solve_args.insert(run.solve_args.end(), {"--photo-scale", "solve"});
+  }
   DemoSummary d;
   d.run = RunPipeline(run);
   d.run.seconds += first.seconds;
-  d.summary = CompareWithTruth(d.run.solved_scene, synth / "truth.json");
+  d.summary = CompareWithTruth(
+      d.run.solved_scene, synth / "truth.json",
+      o.calibration == "reference" ? std::vector<std::string>{o.reference_region}
+                                   : std::vector<std::string>{});
+  d.summary["calibration"] = o.calibration;
   d.summary["radiance_scale"] = run.radiance_scale;
+  d.summary["true_radiance_scale"] = true_scale;
+  const fs::path solve_report = o.out / "04-solve" / "report.json";
+  if (o.calibration == "reference" && fs::exists(solve_report)) {
+    const Json k = ReadJsonFile(solve_report).value("photo_scale", Json());
+    if (k.is_object()) {
+      d.summary["solved_radiance_scale"] = k;
+      d.summary["solved_radiance_scale_error"] = k["scale"].get<double>() / true_scale - 1;
+    }
+  }
   d.summary["seconds"] = d.run.seconds;
   d.summary["capture"] = {{"cameras", o.cameras}, {"width", o.width},       {"height", o.height},
                           {"spp", o.spp},         {"brackets", o.brackets}, {"stops", o.stops}};
@@ -244,6 +287,12 @@ DemoSummary RunDemo(const DemoOptions& o) {
                       key, r[key]["truth"].get<double>(), r[key]["recovered_over_k"].get<double>(),
                       100 * r[key]["relative_error"].get<double>()));
     }
+  }
+  if (d.summary.contains("solved_radiance_scale_error")) {
+    d.table.push_back(fmt::format(
+        "HDR scale solved from the reference {}: {:.4f} (true {:.4f}, {:+.1f}%)",
+        o.reference_region, d.summary["solved_radiance_scale"]["scale"].get<double>(), true_scale,
+        100 * d.summary["solved_radiance_scale_error"].get<double>()));
   }
   d.table.push_back(fmt::format("photometric scale k = {:.4f} (see demo_summary.json)",
                                 d.summary["photometric_scale_k"].get<double>()));

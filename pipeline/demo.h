@@ -35,10 +35,16 @@ struct DemoOptions {
   // but 0 here: with 2, neither registered (COLMAP matched none of their features, and they
   // see one control point each, too few to pose them from the markers).
   int ceiling_cameras = 0;
-  // The synthetic camera is calibrated absolutely (igi-run --radiance-scale), as a lab camera
-  // measured against a radiance standard: without it the albedos come out in the HDR maps'
-  // arbitrary scale, which weakens every bounce (measured: rho_s/k -27..-29 %).
-  bool absolute_calibration = true;
+  // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
+  // which weakens every bounce; measured: rho_s/k -27..-29 %):
+  //  - "reference": the capture holds a reference of known reflectance (the matte box, its
+  //    material given in scene.json as if measured with a spectrophotometer) and igi-solve
+  //    solves the photos' scale from it (--photo-scale solve);
+  //  - "measured": the camera calibrated absolutely (igi-run --radiance-scale), as a lab camera
+  //    measured against a radiance standard (simulated with igi-synth's noise-free radiance);
+  //  - "none".
+  std::string calibration = "reference";
+  std::string reference_region = "matte_box";
   // The demo's control points are exact projections: weighted like sub-pixel targets
   // (igi-register's default, 1 px, is for hand-clicked points).
   std::vector<std::string> register_args = {"--marker-sigma", "0.1"};
@@ -65,7 +71,9 @@ double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
                             const std::filesystem::path& synth_dir);
 
 // Compares a solved scene with truth.json: per region and parameter (see demo.h's note on k).
+// Regions in `given` (their material was given to the solver, e.g. the reference) are left out.
 Json CompareWithTruth(const std::filesystem::path& solved_scene,
-                      const std::filesystem::path& truth_json);
+                      const std::filesystem::path& truth_json,
+                      const std::vector<std::string>& given = {});
 
 }  // namespace igi

@@ -134,6 +134,7 @@ std::vector<Stage> Stages(const Context& ctx) {
        SolveStage},
       {"05-diagnose", !o.skip_diagnose,
        [&](Fingerprint* fp) {
+         fp->AddText("input: the solve's input, solved exposure_scale");
          fp->AddText(std::to_string(o.diagnose_spp));
          for (const std::string& a : o.diagnose_args) fp->AddText(a);
        },

@@ -121,8 +121,33 @@ void SolveStage(const Context& ctx, StageRun* run) {
   run->details["radiance_scale"] = ctx.options.radiance_scale;
 }
 
+// The scene igi-diagnose gets: the one igi-solve got (materials unknown where they were, so
+// that igi-diagnose solves them itself with its held-out pixels left out, and re-solves them
+// with every candidate model), each photo's exposure_scale taken from the solved scene (which
+// carries --radiance-scale and a scale igi-solve solved from a reference). The solved scene
+// itself would make its refits hold every albedo fixed and let the held-out pixels into the fit.
+fs::path DiagnoseScene(const Context& ctx, const fs::path& stage_dir) {
+  const fs::path input = ctx.SolveInput();
+  const Json solved = ReadJsonFile(ctx.Dir("04-solve") / "scene.json");
+  const fs::path dir = stage_dir / "input";
+  fs::create_directories(dir);
+  Json scene = RebaseScenePaths(ReadJsonFile(input), input.parent_path(), dir);
+  if (scene["photos"].size() != solved["photos"].size()) {
+    throw Error("stage 05-diagnose: " + (ctx.Dir("04-solve") / "scene.json").string() + " has " +
+                std::to_string(solved["photos"].size()) + " photos, its input " +
+                std::to_string(scene["photos"].size()));
+  }
+  for (size_t i = 0; i < scene["photos"].size(); ++i) {
+    if (solved["photos"][i].contains("exposure_scale")) {
+      scene["photos"][i]["exposure_scale"] = solved["photos"][i]["exposure_scale"];
+    }
+  }
+  WriteJsonFile(dir / "scene.json", scene);
+  return dir / "scene.json";
+}
+
 void DiagnoseStage(const Context& ctx, StageRun* run) {
-  std::vector<std::string> args = {(ctx.Dir("04-solve") / "scene.json").string(), "--out",
+  std::vector<std::string> args = {DiagnoseScene(ctx, run->dir()).string(), "--out",
                                    run->dir().string()};
   Append(&args, ThreadArgs(ctx));
   if (ctx.options.diagnose_spp > 0) {

@@ -49,5 +49,38 @@ TEST(DemoCalibrationTest, MedianRatioOfHdrToTrueRadiance) {
   fs::remove_all(dir);
 }
 
+// The comparison leaves out regions whose material was given (the reference) from both the
+// table and the median k, and --demo-calibration takes only its three values.
+TEST(DemoCalibrationTest, ComparisonLeavesOutTheGivenReference) {
+  const fs::path dir = test::UniqueTempDir("demo_compare");
+  fs::create_directories(dir);
+  WriteJsonFile(dir / "truth.json",
+                Json{{"materials",
+                      {{"a", {{"rho_d", {0.5, 0.5, 0.5}}}},
+                       {"b", {{"rho_d", {0.2, 0.2, 0.2}}, {"rho_s", 0.1}}},
+                       {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
+  WriteJsonFile(dir / "scene.json",
+                Json{{"materials",
+                      {{"a", {{"rho_d", {1.0, 1.0, 1.0}}}},
+                       {"b", {{"rho_d", {0.4, 0.4, 0.4}}, {"rho_s", 0.2}}},
+                       {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
+  const Json all = CompareWithTruth(dir / "scene.json", dir / "truth.json");
+  EXPECT_EQ(all["regions"].size(), 3u);
+  const Json without = CompareWithTruth(dir / "scene.json", dir / "truth.json", {"ref"});
+  ASSERT_EQ(without["regions"].size(), 2u);
+  // a and b are both 2x their truth: k = 2 once the reference (1x) is out of the median.
+  EXPECT_NEAR(without["photometric_scale_k"].get<double>(), 2.0, 1e-9);
+  for (const Json& r : without["regions"]) {
+    EXPECT_NE(r["region"], "ref");
+    EXPECT_NEAR(r["rho_d"]["relative_error"].get<double>(), 0.0, 1e-9);
+  }
+  fs::remove_all(dir);
+  DemoOptions o;
+  o.out = dir;
+  EXPECT_NO_THROW(o.Validate());
+  o.calibration = "guess";
+  EXPECT_THROW(o.Validate(), InputError);
+}
+
 }  // namespace
 }  // namespace igi
