@@ -256,9 +256,14 @@ void SolverState::HeldOutAlbedos() {
       if (o.region != int(r)) continue;
       const Eigen::Vector3d l = o.radiance.cast<double>();
       const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
-      // Off the highlight by the model (the patch's albedo), not by the observation: a test on
-      // the observed radiance would let noise that brightens a pixel pass and bias the albedo.
-      const Eigen::Vector3d diffuse = PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi;
+      // Off the highlight by the model, not by the observation: a test on the observed radiance
+      // would let noise that brightens a pixel pass and bias the albedo. The model's diffuse part
+      // takes the region's mean albedo, not the patch's: a patch's albedo follows its texels
+      // (and its own samples' noise), and a bright patch would pass more of its samples closer
+      // to the highlight than a dark one, raising the held-out albedo where the lobe is fitted
+      // (on the true floor texture with exact radiances, the patch's albedo moved rho_s by
+      // several per cent, the region's mean by 0.2 %).
+      const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(obs_e[i]) / kPi;
       if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
       held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * (l - spec), obs_e[i]);
     }
