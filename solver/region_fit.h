@@ -36,8 +36,11 @@ struct FitSample {
   Eigen::Vector3d rho_d_known = Eigen::Vector3d::Zero();  // used when the region's ρd is known
   int slot = 0;                                          // its patch among the region's slots
   // The albedo at this point seen by the other photos off their highlights (solver/
-  // held_out_albedo.h); NaN when unknown. Used by RegionFitInput::use_held_albedo.
+  // held_out_albedo.h), as two parts: their πL/E (rho_d_held) and the lobe they carry per unit
+  // ρs, πT/E (held_lobe, at the previous iteration's α; zero when unknown): the albedo is
+  // rho_d_held − ρs·held_lobe. NaN when unknown. Used by RegionFitInput::use_held_albedo.
   Eigen::Vector3d rho_d_held = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d held_lobe = Eigen::Vector3d::Constant(NAN);
   Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();         // local, toward the camera
   int incident_begin = 0, incident_end = 0;              // into RegionFitInput::incident
 };
@@ -62,7 +65,11 @@ struct RegionFitInput {
   // each with that albedo (texel-scale, from the other photos), instead of their patch's
   // off-highlight mean. A patch is coarser than a texture's detail, and a highlight patch that
   // only highlight pixels see would otherwise take the region's mean albedo, its texture's
-  // deviation from the mean going into ρs and α.
+  // deviation from the mean going into ρs and α. The sample's model is then
+  //   L = (rho_d_held − ρs·held_lobe)·E/π + ρs·T(α) = rho_d_held·E/π + ρs·(T(α) − held_lobe·E/π):
+  // ρs is fitted through both terms at once. (Subtracting the previous iteration's lobe from the
+  // held-out samples instead feeds its error back: a ρs too low leaves lobe in the albedo, which
+  // lowers the next ρs; on the igi-synth floor this doubled ρs's error.)
   bool use_held_albedo = false;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot

@@ -65,9 +65,10 @@ struct SolverState {
   std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
   std::vector<std::vector<IncidentLocal>> obs_incident;
   std::vector<Eigen::Vector3d> obs_t;
-  // Per observation of a textured glossy region: its albedo from the other photos' observations
-  // off the highlights, at the albedo map's texel (solver/held_out_albedo.h); NaN elsewhere.
-  std::vector<Eigen::Vector3d> obs_rho_d_held;
+  // Per observation of a textured glossy region: the other photos' observations off the
+  // highlights at the albedo map's texel (solver/held_out_albedo.h): their πL/E and their lobe
+  // per unit ρs, πT/E (the albedo is the first less ρs times the second); NaN elsewhere.
+  std::vector<Eigen::Vector3d> obs_rho_d_held, obs_held_lobe;
   std::vector<std::unique_ptr<RegionAtlas>> held_atlases;  // per region, built when needed
 
   SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}

@@ -235,9 +235,12 @@ void SolverState::ComputeSpecularTerms() {
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every observation's
 // albedo as the other photos see it off their highlights (modelled specular part under 10 % of
 // the modelled radiance in every channel, from the current parameters), per texel of the albedo
-// map's size.
+// map's size. Kept as two parts, the held-out πL/E (obs_rho_d_held) and the lobe those samples
+// carry per unit ρs, πT/E (obs_held_lobe): the albedo is their difference at the ρs being fitted,
+// so that the fit takes ρs from both (solver/region_fit.h) instead of from the previous iteration.
 void SolverState::HeldOutAlbedos() {
   obs_rho_d_held.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
+  obs_held_lobe.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   held_atlases.resize(materials.size());
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
@@ -250,11 +253,10 @@ void SolverState::HeldOutAlbedos() {
       ao.texel_size_m = summary.texel_size_m;
       held_atlases[r] = std::make_unique<RegionAtlas>(BuildRegionAtlas(scene.mesh, int(r), ao));
     }
-    HeldOutAlbedo held(*held_atlases[r]);
+    HeldOutAlbedo held(*held_atlases[r]), lobe(*held_atlases[r]);
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
       if (o.region != int(r)) continue;
-      const Eigen::Vector3d l = o.radiance.cast<double>();
       const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
       // Off the highlight by the model, not by the observation: a test on the observed radiance
       // would let noise that brightens a pixel pass and bias the albedo. The model's diffuse part
@@ -265,12 +267,14 @@ void SolverState::HeldOutAlbedos() {
       // several per cent, the region's mean by 0.2 %).
       const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(obs_e[i]) / kPi;
       if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
-      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * (l - spec), obs_e[i]);
+      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), obs_e[i]);
+      lobe.Add(o.photo, o.triangle, o.b1, o.b2, kPi * obs_t[i], obs_e[i]);
     }
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
       if (o.region != int(r) || !in_fit[i]) continue;
       obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
+      obs_held_lobe[i] = lobe.At(o.photo, o.triangle, o.b1, o.b2);
     }
   }
 }
@@ -321,6 +325,7 @@ double SolverState::FitAll(int stage, int iteration) {
     s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : KnownAlbedo(o);
     s.slot = patch_slot[o.patch];
     s.rho_d_held = obs_rho_d_held[i];
+    s.held_lobe = obs_held_lobe[i];
     s.wo = LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.incident_begin = static_cast<int>(in.incident.size());
     in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
