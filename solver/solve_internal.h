@@ -25,7 +25,7 @@ struct MaterialState {
   bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
   bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
   std::optional<Eigen::Vector3d> tangent;
-  std::shared_ptr<const Image> known_map;     // a known rho_d_map
+  std::shared_ptr<const Image> known_map;    // a known rho_d_map
   std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
   RegionFitResult last_fit;
   bool stage1_albedo_varies = false;  // stage 1's decision, kept by the refinement
@@ -35,8 +35,8 @@ struct MaterialState {
 
 struct LightingState {
   bool active = false;
-  std::vector<int> obs;        // observations under this lighting
-  GatherSet gather;            // their points first, then one per patch
+  std::vector<int> obs;  // observations under this lighting
+  GatherSet gather;      // their points first, then one per patch
   int first_patch_point = 0;
   std::vector<Eigen::Vector3f> patch_d;  // diffuse radiance leaving each patch
   std::vector<Eigen::Vector3f> patch_e;  // irradiance of each patch
@@ -56,7 +56,7 @@ struct SolverState {
   std::vector<std::optional<Image>> mask_images;
   std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
   std::vector<Observation> obs;
-  std::vector<char> in_fit;  // per observation: used by the region fits
+  std::vector<char> in_fit;    // per observation: used by the region fits
   std::vector<int> obs_point;  // per observation: its point in its lighting's gather
   std::vector<LightingState> lighting_state;
   // Per observation, refreshed each iteration: direct and indirect irradiance (the indirect
@@ -84,8 +84,10 @@ struct SolverState {
   void BuildPatchLobes(LightingState* st) const;
   Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
   Eigen::Vector3d PatchAlbedo(int patch) const;
-  Eigen::Vector3d PatchSpecular(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
-  Eigen::Vector3d PatchRadiance(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
+  Eigen::Vector3d PatchSpecular(const LightingState& st, int q,
+                                const Eigen::Vector3d& toward) const;
+  Eigen::Vector3d PatchRadiance(const LightingState& st, int q,
+                                const Eigen::Vector3d& toward) const;
   void UpdatePatchRadiance(LightingState* st);
 
   // solve_stages.cpp

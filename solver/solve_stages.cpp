@@ -57,7 +57,9 @@ std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherP
   return inc;
 }
 
-double RelChange(double a, double b, double floor) { return std::abs(a - b) / std::max(std::abs(b), floor); }
+double RelChange(double a, double b, double floor) {
+  return std::abs(a - b) / std::max(std::abs(b), floor);
+}
 
 }  // namespace
 
@@ -97,8 +99,8 @@ void SolverState::IncidentFromPatches() {
             const Eigen::Vector3d l = PatchRadiance(st, s.patch, -s.wi.cast<double>());
             e += s.weight * l;
             if (glossy) {
-              inc.push_back({frame.ToLocal(s.wi.cast<double>()).cast<float>(),
-                             (s.weight * l).cast<float>()});
+              inc.push_back(
+                  {frame.ToLocal(s.wi.cast<double>()).cast<float>(), (s.weight * l).cast<float>()});
             }
           }
           obs_e_direct[i] = gp.e_direct.cast<double>();
@@ -144,7 +146,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           const Eigen::Vector3d li = renderers[l]->ReflectedRadiance(
               q.position + q.n_geo * eps, d.wi, 1, Mix(Mix(options.seed, round), i * 4096 + k++));
           e += d.weight * li;
-          if (glossy) inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
+          if (glossy)
+            inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
         }
         rays += k;
         obs_e_direct[i] = gp.e_direct.cast<double>();
@@ -152,7 +155,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         obs_incident[i] = std::move(inc);
       },
       options.num_threads);
-  summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds_rays +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.rays += rays.load();
 }
 
@@ -219,8 +223,8 @@ void SolverState::ComputeSpecularTerms() {
         const MaterialState& m = materials[obs[i].region];
         Eigen::Vector3d t = Eigen::Vector3d::Zero();
         if (HasSpecularLobe(m.params.model)) {
-          const Eigen::Vector3d wo =
-              LocalFrame(obs[i].region, obs[i].normal.cast<double>()).ToLocal(obs[i].view.cast<double>());
+          const Eigen::Vector3d wo = LocalFrame(obs[i].region, obs[i].normal.cast<double>())
+                                         .ToLocal(obs[i].view.cast<double>());
           for (const IncidentLocal& inc : obs_incident[i]) {
             const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
                                             m.params.ior, wo, inc.wi.cast<double>());
@@ -326,7 +330,8 @@ double SolverState::FitAll(int stage, int iteration) {
     s.slot = patch_slot[o.patch];
     s.rho_d_held = obs_rho_d_held[i];
     s.held_lobe = obs_held_lobe[i];
-    s.wo = LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+    s.wo =
+        LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.incident_begin = static_cast<int>(in.incident.size());
     in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
     s.incident_end = static_cast<int>(in.incident.size());
@@ -336,13 +341,15 @@ double SolverState::FitAll(int stage, int iteration) {
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), l = e;
     for (const FitSample& fs : inputs[k].samples) e += fs.irradiance, l += fs.observed;
     const double n = std::max<size_t>(1, inputs[k].samples.size());
-    spdlog::debug("  {}: {} samples, mean irradiance ({:.4g}, {:.4g}, {:.4g}), mean radiance "
-                  "({:.4g}, {:.4g}, {:.4g})",
-                  inputs[k].name, inputs[k].samples.size(), e[0] / n, e[1] / n, e[2] / n,
-                  l[0] / n, l[1] / n, l[2] / n);
+    spdlog::debug(
+        "  {}: {} samples, mean irradiance ({:.4g}, {:.4g}, {:.4g}), mean radiance "
+        "({:.4g}, {:.4g}, {:.4g})",
+        inputs[k].name, inputs[k].samples.size(), e[0] / n, e[1] / n, e[2] / n, l[0] / n, l[1] / n,
+        l[2] / n);
   }
-  ParallelFor(0, int64_t(regions.size()), [&](int64_t k) { results[k] = FitRegion(inputs[k], {}); },
-              options.num_threads, 1);
+  ParallelFor(
+      0, int64_t(regions.size()), [&](int64_t k) { results[k] = FitRegion(inputs[k], {}); },
+      options.num_threads, 1);
   double change = 0, num = 0, den = 0;
   SolveIteration record;
   record.stage = stage;
@@ -380,7 +387,8 @@ double SolverState::FitAll(int stage, int iteration) {
   record.relative_rms = den > 0 ? std::sqrt(num / den) : 0.0;
   record.max_change = change;
   summary.history.push_back(record);
-  summary.seconds_fit += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds_fit +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("stage {} iteration {}: relative rms {:.4f}, largest change {:.2e}", stage,
                iteration, record.relative_rms, change);
   return change;
@@ -400,16 +408,16 @@ void SolverState::RunStage1() {
     summary.stage1_iterations = it;
     if (it > 1 && change < options.tolerance) {
       summary.converged = true;
-      summary.message = fmt::format("converged: largest relative change {:.2e} < {}", change,
-                                    options.tolerance);
+      summary.message =
+          fmt::format("converged: largest relative change {:.2e} < {}", change, options.tolerance);
       break;
     }
   }
   if (!summary.converged) {
-    summary.message = fmt::format("not converged after {} iterations (largest relative change "
-                                  "{:.2e}, tolerance {})",
-                                  options.max_iterations, summary.history.back().max_change,
-                                  options.tolerance);
+    summary.message = fmt::format(
+        "not converged after {} iterations (largest relative change "
+        "{:.2e}, tolerance {})",
+        options.max_iterations, summary.history.back().max_change, options.tolerance);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
   for (size_t r = 0; r < materials.size(); ++r) {
