@@ -195,12 +195,12 @@ int main(int argc, char** argv) {
     double w = 0, wf = 0;
   };
   const int sel_mode = std::getenv("PROBE_SEL") ? std::atoi(std::getenv("PROBE_SEL")) : 0;
-  for (double texel : {0.0462, 0.03, 0.023, 0.015}) {
+  for (double texel : {s.summary.texel_size_m}) {
     AtlasOptions ao;
     ao.texel_size_m = texel;
     const RegionAtlas atlas = BuildRegionAtlas(scene.mesh, floor, ao);
     const int64_t nt = int64_t(atlas.width) * atlas.height;
-    for (double thr : {0.05, 0.1, 0.2}) {
+    for (double thr : {0.1, 0.2, 0.3}) {
       std::string line = fmt::format("texel {:.4f} thr {:.2f}:", texel, thr);
       for (int var = 0; var < 3; ++var) {
         HeldOutAlbedo held(atlas);
