@@ -65,6 +65,10 @@ std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, 
       const double sw = SpecularWeight(in.model, ax, ay, in.ior, wo, inc.wi.cast<double>());
       if (sw > 0) sum += sw * inc.value.cast<double>();
     }
+    // The held-out albedo's own lobe (see RegionFitInput::use_held_albedo).
+    if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
+      sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
+    }
     t[i] = sum;
   }
   return t;

@@ -31,15 +31,18 @@ struct IncidentLocal {
 };
 
 struct FitSample {
-  Eigen::Vector3d observed = Eigen::Vector3d::Zero();    // L
-  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // E
+  Eigen::Vector3d observed = Eigen::Vector3d::Zero();     // L
+  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();   // E
   Eigen::Vector3d rho_d_known = Eigen::Vector3d::Zero();  // used when the region's ρd is known
-  int slot = 0;                                          // its patch among the region's slots
+  int slot = 0;                                           // its patch among the region's slots
   // The albedo at this point seen by the other photos off their highlights (solver/
-  // held_out_albedo.h); NaN when unknown. Used by RegionFitInput::use_held_albedo.
+  // held_out_albedo.h), as two parts: their πL/E (rho_d_held) and the lobe they carry per unit
+  // ρs, πT/E (held_lobe, at the previous iteration's α; zero when unknown): the albedo is
+  // rho_d_held − ρs·held_lobe. NaN when unknown. Used by RegionFitInput::use_held_albedo.
   Eigen::Vector3d rho_d_held = Eigen::Vector3d::Constant(NAN);
-  Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();         // local, toward the camera
-  int incident_begin = 0, incident_end = 0;              // into RegionFitInput::incident
+  Eigen::Vector3d held_lobe = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();  // local, toward the camera
+  int incident_begin = 0, incident_end = 0;       // into RegionFitInput::incident
 };
 
 struct RegionFitInput {
@@ -48,7 +51,7 @@ struct RegionFitInput {
   bool fit_rho_d = true;             // false: FitSample::rho_d_known is used
   std::optional<double> rho_s_grey;  // known ρs (grey) or unknown
   std::optional<Eigen::Vector3d> rho_s_rgb;
-  std::optional<double> alpha;            // isotropic models
+  std::optional<double> alpha;             // isotropic models
   std::optional<double> alpha_x, alpha_y;  // anisotropic models
   double ior = 1.5;
   bool grey_specular = true;  // one ρs for the three channels
@@ -62,7 +65,11 @@ struct RegionFitInput {
   // each with that albedo (texel-scale, from the other photos), instead of their patch's
   // off-highlight mean. A patch is coarser than a texture's detail, and a highlight patch that
   // only highlight pixels see would otherwise take the region's mean albedo, its texture's
-  // deviation from the mean going into ρs and α.
+  // deviation from the mean going into ρs and α. The sample's model is then
+  //   L = (rho_d_held − ρs·held_lobe)·E/π + ρs·T(α) = rho_d_held·E/π + ρs·(T(α) − held_lobe·E/π):
+  // ρs is fitted through both terms at once. (Subtracting the previous iteration's lobe from the
+  // held-out samples instead feeds its error back: a ρs too low leaves lobe in the albedo, which
+  // lowers the next ρs; on the igi-synth floor this doubled ρs's error.)
   bool use_held_albedo = false;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot
@@ -71,12 +78,12 @@ struct RegionFitInput {
 };
 
 struct RegionFitResult {
-  bool fitted = false;  // false: nothing to fit (no samples)
-  std::string albedo_model = "constant";  // "constant" or "per_patch"
-  bool albedo_varies = false;             // per-patch albedo significantly non-uniform
+  bool fitted = false;                              // false: nothing to fit (no samples)
+  std::string albedo_model = "constant";            // "constant" or "per_patch"
+  bool albedo_varies = false;                       // per-patch albedo significantly non-uniform
   Eigen::Vector3d rho_d = Eigen::Vector3d::Zero();  // region mean (area-weighted)
-  std::vector<Eigen::Vector3d> slot_rho_d;           // per slot (NaN where no sample)
-  std::vector<int> slot_count;                       // samples per slot
+  std::vector<Eigen::Vector3d> slot_rho_d;          // per slot (NaN where no sample)
+  std::vector<int> slot_count;                      // samples per slot
   Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
   double alpha = 0, alpha_x = 0, alpha_y = 0;
   // One-sigma uncertainties (NaN where unknown or not fitted).

@@ -25,7 +25,7 @@ struct MaterialState {
   bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
   bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
   std::optional<Eigen::Vector3d> tangent;
-  std::shared_ptr<const Image> known_map;     // a known rho_d_map
+  std::shared_ptr<const Image> known_map;    // a known rho_d_map
   std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
   RegionFitResult last_fit;
   bool stage1_albedo_varies = false;  // stage 1's decision, kept by the refinement
@@ -35,8 +35,8 @@ struct MaterialState {
 
 struct LightingState {
   bool active = false;
-  std::vector<int> obs;        // observations under this lighting
-  GatherSet gather;            // their points first, then one per patch
+  std::vector<int> obs;  // observations under this lighting
+  GatherSet gather;      // their points first, then one per patch
   int first_patch_point = 0;
   std::vector<Eigen::Vector3f> patch_d;  // diffuse radiance leaving each patch
   std::vector<Eigen::Vector3f> patch_e;  // irradiance of each patch
@@ -56,7 +56,7 @@ struct SolverState {
   std::vector<std::optional<Image>> mask_images;
   std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
   std::vector<Observation> obs;
-  std::vector<char> in_fit;  // per observation: used by the region fits
+  std::vector<char> in_fit;    // per observation: used by the region fits
   std::vector<int> obs_point;  // per observation: its point in its lighting's gather
   std::vector<LightingState> lighting_state;
   // Per observation, refreshed each iteration: direct and indirect irradiance (the indirect
@@ -65,9 +65,10 @@ struct SolverState {
   std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
   std::vector<std::vector<IncidentLocal>> obs_incident;
   std::vector<Eigen::Vector3d> obs_t;
-  // Per observation of a textured glossy region: its albedo from the other photos' observations
-  // off the highlights, at the albedo map's texel (solver/held_out_albedo.h); NaN elsewhere.
-  std::vector<Eigen::Vector3d> obs_rho_d_held;
+  // Per observation of a textured glossy region: the other photos' observations off the
+  // highlights at the albedo map's texel (solver/held_out_albedo.h): their πL/E and their lobe
+  // per unit ρs, πT/E (the albedo is the first less ρs times the second); NaN elsewhere.
+  std::vector<Eigen::Vector3d> obs_rho_d_held, obs_held_lobe;
   std::vector<std::unique_ptr<RegionAtlas>> held_atlases;  // per region, built when needed
 
   SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
@@ -83,8 +84,10 @@ struct SolverState {
   void BuildPatchLobes(LightingState* st) const;
   Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
   Eigen::Vector3d PatchAlbedo(int patch) const;
-  Eigen::Vector3d PatchSpecular(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
-  Eigen::Vector3d PatchRadiance(const LightingState& st, int q, const Eigen::Vector3d& toward) const;
+  Eigen::Vector3d PatchSpecular(const LightingState& st, int q,
+                                const Eigen::Vector3d& toward) const;
+  Eigen::Vector3d PatchRadiance(const LightingState& st, int q,
+                                const Eigen::Vector3d& toward) const;
   void UpdatePatchRadiance(LightingState* st);
 
   // solve_stages.cpp

@@ -57,7 +57,9 @@ std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherP
   return inc;
 }
 
-double RelChange(double a, double b, double floor) { return std::abs(a - b) / std::max(std::abs(b), floor); }
+double RelChange(double a, double b, double floor) {
+  return std::abs(a - b) / std::max(std::abs(b), floor);
+}
 
 }  // namespace
 
@@ -97,8 +99,8 @@ void SolverState::IncidentFromPatches() {
             const Eigen::Vector3d l = PatchRadiance(st, s.patch, -s.wi.cast<double>());
             e += s.weight * l;
             if (glossy) {
-              inc.push_back({frame.ToLocal(s.wi.cast<double>()).cast<float>(),
-                             (s.weight * l).cast<float>()});
+              inc.push_back(
+                  {frame.ToLocal(s.wi.cast<double>()).cast<float>(), (s.weight * l).cast<float>()});
             }
           }
           obs_e_direct[i] = gp.e_direct.cast<double>();
@@ -144,7 +146,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           const Eigen::Vector3d li = renderers[l]->ReflectedRadiance(
               q.position + q.n_geo * eps, d.wi, 1, Mix(Mix(options.seed, round), i * 4096 + k++));
           e += d.weight * li;
-          if (glossy) inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
+          if (glossy)
+            inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
         }
         rays += k;
         obs_e_direct[i] = gp.e_direct.cast<double>();
@@ -152,7 +155,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         obs_incident[i] = std::move(inc);
       },
       options.num_threads);
-  summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds_rays +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.rays += rays.load();
 }
 
@@ -219,8 +223,8 @@ void SolverState::ComputeSpecularTerms() {
         const MaterialState& m = materials[obs[i].region];
         Eigen::Vector3d t = Eigen::Vector3d::Zero();
         if (HasSpecularLobe(m.params.model)) {
-          const Eigen::Vector3d wo =
-              LocalFrame(obs[i].region, obs[i].normal.cast<double>()).ToLocal(obs[i].view.cast<double>());
+          const Eigen::Vector3d wo = LocalFrame(obs[i].region, obs[i].normal.cast<double>())
+                                         .ToLocal(obs[i].view.cast<double>());
           for (const IncidentLocal& inc : obs_incident[i]) {
             const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
                                             m.params.ior, wo, inc.wi.cast<double>());
@@ -235,9 +239,12 @@ void SolverState::ComputeSpecularTerms() {
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every observation's
 // albedo as the other photos see it off their highlights (modelled specular part under 10 % of
 // the modelled radiance in every channel, from the current parameters), per texel of the albedo
-// map's size.
+// map's size. Kept as two parts, the held-out πL/E (obs_rho_d_held) and the lobe those samples
+// carry per unit ρs, πT/E (obs_held_lobe): the albedo is their difference at the ρs being fitted,
+// so that the fit takes ρs from both (solver/region_fit.h) instead of from the previous iteration.
 void SolverState::HeldOutAlbedos() {
   obs_rho_d_held.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
+  obs_held_lobe.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   held_atlases.resize(materials.size());
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
@@ -250,22 +257,28 @@ void SolverState::HeldOutAlbedos() {
       ao.texel_size_m = summary.texel_size_m;
       held_atlases[r] = std::make_unique<RegionAtlas>(BuildRegionAtlas(scene.mesh, int(r), ao));
     }
-    HeldOutAlbedo held(*held_atlases[r]);
+    HeldOutAlbedo held(*held_atlases[r]), lobe(*held_atlases[r]);
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
       if (o.region != int(r)) continue;
-      const Eigen::Vector3d l = o.radiance.cast<double>();
       const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
-      // Off the highlight by the model (the patch's albedo), not by the observation: a test on
-      // the observed radiance would let noise that brightens a pixel pass and bias the albedo.
-      const Eigen::Vector3d diffuse = PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi;
+      // Off the highlight by the model, not by the observation: a test on the observed radiance
+      // would let noise that brightens a pixel pass and bias the albedo. The model's diffuse part
+      // takes the region's mean albedo, not the patch's: a patch's albedo follows its texels
+      // (and its own samples' noise), and a bright patch would pass more of its samples closer
+      // to the highlight than a dark one, raising the held-out albedo where the lobe is fitted
+      // (on the true floor texture with exact radiances, the patch's albedo moved rho_s by
+      // several per cent, the region's mean by 0.2 %).
+      const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(obs_e[i]) / kPi;
       if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
-      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * (l - spec), obs_e[i]);
+      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), obs_e[i]);
+      lobe.Add(o.photo, o.triangle, o.b1, o.b2, kPi * obs_t[i], obs_e[i]);
     }
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
       if (o.region != int(r) || !in_fit[i]) continue;
       obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
+      obs_held_lobe[i] = lobe.At(o.photo, o.triangle, o.b1, o.b2);
     }
   }
 }
@@ -316,7 +329,9 @@ double SolverState::FitAll(int stage, int iteration) {
     s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : KnownAlbedo(o);
     s.slot = patch_slot[o.patch];
     s.rho_d_held = obs_rho_d_held[i];
-    s.wo = LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+    s.held_lobe = obs_held_lobe[i];
+    s.wo =
+        LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.incident_begin = static_cast<int>(in.incident.size());
     in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
     s.incident_end = static_cast<int>(in.incident.size());
@@ -326,13 +341,15 @@ double SolverState::FitAll(int stage, int iteration) {
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), l = e;
     for (const FitSample& fs : inputs[k].samples) e += fs.irradiance, l += fs.observed;
     const double n = std::max<size_t>(1, inputs[k].samples.size());
-    spdlog::debug("  {}: {} samples, mean irradiance ({:.4g}, {:.4g}, {:.4g}), mean radiance "
-                  "({:.4g}, {:.4g}, {:.4g})",
-                  inputs[k].name, inputs[k].samples.size(), e[0] / n, e[1] / n, e[2] / n,
-                  l[0] / n, l[1] / n, l[2] / n);
+    spdlog::debug(
+        "  {}: {} samples, mean irradiance ({:.4g}, {:.4g}, {:.4g}), mean radiance "
+        "({:.4g}, {:.4g}, {:.4g})",
+        inputs[k].name, inputs[k].samples.size(), e[0] / n, e[1] / n, e[2] / n, l[0] / n, l[1] / n,
+        l[2] / n);
   }
-  ParallelFor(0, int64_t(regions.size()), [&](int64_t k) { results[k] = FitRegion(inputs[k], {}); },
-              options.num_threads, 1);
+  ParallelFor(
+      0, int64_t(regions.size()), [&](int64_t k) { results[k] = FitRegion(inputs[k], {}); },
+      options.num_threads, 1);
   double change = 0, num = 0, den = 0;
   SolveIteration record;
   record.stage = stage;
@@ -370,7 +387,8 @@ double SolverState::FitAll(int stage, int iteration) {
   record.relative_rms = den > 0 ? std::sqrt(num / den) : 0.0;
   record.max_change = change;
   summary.history.push_back(record);
-  summary.seconds_fit += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds_fit +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("stage {} iteration {}: relative rms {:.4f}, largest change {:.2e}", stage,
                iteration, record.relative_rms, change);
   return change;
@@ -390,16 +408,16 @@ void SolverState::RunStage1() {
     summary.stage1_iterations = it;
     if (it > 1 && change < options.tolerance) {
       summary.converged = true;
-      summary.message = fmt::format("converged: largest relative change {:.2e} < {}", change,
-                                    options.tolerance);
+      summary.message =
+          fmt::format("converged: largest relative change {:.2e} < {}", change, options.tolerance);
       break;
     }
   }
   if (!summary.converged) {
-    summary.message = fmt::format("not converged after {} iterations (largest relative change "
-                                  "{:.2e}, tolerance {})",
-                                  options.max_iterations, summary.history.back().max_change,
-                                  options.tolerance);
+    summary.message = fmt::format(
+        "not converged after {} iterations (largest relative change "
+        "{:.2e}, tolerance {})",
+        options.max_iterations, summary.history.back().max_change, options.tolerance);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
   for (size_t r = 0; r < materials.size(); ++r) {

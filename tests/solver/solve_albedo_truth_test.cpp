@@ -88,7 +88,9 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
               100 * (floor.stage1.rho_s.mean() / truth["floor"]["rho_s"].get<double>() - 1),
               100 * (floor.stage1.alpha / truth["floor"]["alpha"].get<double>() - 1));
   // The floor's lobe, fitted with each sample's albedo from the other photos (held-out, texel
-  // scale): measured rho_s -1.0 %, alpha -0.3 %; guarded at issue 7's bar, 5 %.
+  // scale): measured rho_s -1.5 %, alpha -0.6 % (-1.0 %, -0.3 % before rho_s was fitted
+  // through the held-out samples' own lobe and the off-highlight test took the region's mean
+  // albedo); guarded at issue 7's bar, 5 %.
   EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
   EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
 }

@@ -125,39 +125,58 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       ASSERT_TRUE(r.albedo_map_seen.has_value());
       const Eigen::Vector3d seen_mean =
           SeenMean(ReadImage(so.out / t["rho_d_map"].get<std::string>(), 3), *r.albedo_map_seen);
-      std::printf("floor: rho_d %+.2f %+.2f %+.2f %% (of the seen texels' true mean), rho_s "
-                  "%+.2f %%, alpha %+.2f %%\n",
-                  100 * (f.rho_d[0] / seen_mean[0] - 1), 100 * (f.rho_d[1] / seen_mean[1] - 1),
-                  100 * (f.rho_d[2] / seen_mean[2] - 1),
-                  100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
-                  100 * (f.alpha / t["alpha"].get<double>() - 1));
-      // Measured (paper stage): rho_d +0.1..+0.7 % (clean), +0.3..+0.8 % (noisy), an area mean
+      std::printf(
+          "floor: rho_d %+.2f %+.2f %+.2f %% (of the seen texels' true mean), rho_s "
+          "%+.2f %%, alpha %+.2f %%\n",
+          100 * (f.rho_d[0] / seen_mean[0] - 1), 100 * (f.rho_d[1] / seen_mean[1] - 1),
+          100 * (f.rho_d[2] / seen_mean[2] - 1),
+          100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
+          100 * (f.alpha / t["alpha"].get<double>() - 1));
+      // Measured (paper stage): rho_d -0.0..+0.6 % (clean), +0.2..+0.7 % (noisy), an area mean
       // over the patches; issue 7 asks 1 %, guarded at 2 %. The lobe is fitted with each
       // highlight sample's albedo as the other photos see its texel off their highlights
-      // (solver/held_out_albedo.h): alpha +0.4 % (clean), +5.7 % (noisy), guarded at 10 %;
-      // rho_s -14.7 % (clean), -13.3 % (noisy), guarded at 20 %. Before (each sample with its
-      // patch's off-highlight albedo) these 64-spp sphere-lamp photos gave rho_s -9 %, alpha
-      // -9 %, and photos with less Monte Carlo noise +11 %/-9 % (64 spp, point lamp, now
-      // +0.2 %/+0.5 %) up to +32 %/+20 % (1024 spp, 8 cameras). What still pulls rho_s low
-      // with these photos' noise (14 % per pixel, fireflies off the small lamp) is open: it is
-      // not the gathering's noise (4x the rays: -13 %).
+      // (solver/held_out_albedo.h), rho_s fitted through that albedo's own lobe too: rho_s
+      // -11.9 % (clean), -10.2 % (noisy), guarded at 15 %; alpha -0.0 % (clean), +5.2 % (noisy),
+      // guarded at 10 %. History: each sample with its patch's off-highlight albedo gave -9 % /
+      // -9 %; the held-out albedo with the previous iteration's lobe subtracted and the
+      // off-highlight test on the patch's albedo -14.7 % / +0.4 % (clean), -13.3 % / +5.7 %
+      // (noisy). bench/solver/floor_probe takes this apart (bench/RESULTS.md): with the true
+      // texture's albedo the same samples give rho_s +0.0 %; with exact radiances the held-out
+      // albedo gives -0.2 %; with these photos and the true lobe -7.0 % (-4.0 %, -3.4 % on
+      // synth seeds 2 and 3; -3.1 % at 512 spp): what remains comes from the photos' Monte Carlo
+      // noise (the lobe is 14 % of the highlight samples' radiance, so 0.07 % of albedo error is
+      // 1 % of rho_s) and is open.
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
-      EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.20);
+      EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.15);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.10);
       EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
       continue;
     }
+    std::printf("%s: rho_d %+.2f %+.2f %+.2f %%", r.name.c_str(),
+                100 * (f.rho_d[0] / t["rho_d"][0].get<double>() - 1),
+                100 * (f.rho_d[1] / t["rho_d"][1].get<double>() - 1),
+                100 * (f.rho_d[2] / t["rho_d"][2].get<double>() - 1));
+    if (t.contains("rho_s")) {
+      std::printf(", rho_s %+.2f %%, alpha %+.2f %%",
+                  100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
+                  100 * (f.alpha / t["alpha"].get<double>() - 1));
+    }
+    std::printf("\n");
     for (int c = 0; c < 3; ++c) {
-      // Issue 7 asks 1 %; measured at most 1.2 % (wall_y0) and 2.4 % (glossy_sphere's blue,
-      // a small region seen by few pixels; 3.0 % with sensor noise); 4 % guards those.
-      EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.04)
+      // Issue 7 asks 1 %. Measured (clean): matte_box +1.5..+1.8 %, wall_y0 +1.0..+1.5 %,
+      // wall_x4 +1.0..+1.1 %, the others within 1 % (glossy_sphere -0.9 / -0.4 / +0.1 %; the
+      // 2.4 % on its blue recorded earlier does not recur, with held_out_albedo on or off).
+      // With sensor noise: matte_box +1.3..+1.6 %, wall_y0 +1.0..+1.4 %, wall_x4 +1.0..+1.1 %,
+      // glossy_sphere -0.8 / -0.3 / -0.0 %. 3 % guards those.
+      EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.03)
           << r.name << " rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Issue 7: within 5 %; measured glossy_box -0.6 %/-0.2 %, wall_y4 -4 %/-3.1 %,
-      // glossy_sphere -7 %/-0.4 % (rho_s/alpha). 10 % guards them.
-      EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.10) << r.name;
-      EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.10) << r.name;
+      // Issue 7: within 5 %; measured (clean) glossy_box -0.2 % / -0.0 %, wall_y4 -2.9 % /
+      // +0.5 %, glossy_sphere +1.7 % / +0.0 % (rho_s / alpha); with sensor noise -1.7 % / +0.8 %,
+      // -2.1 % / +2.2 %, +1.3 % / +2.0 %. 5 % (the issue's bar) guards them.
+      EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05) << r.name;
+      EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05) << r.name;
     }
   }
   // The floor's albedo map against the true texture (both on the floor's UVs): the estimate is
@@ -243,8 +262,11 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
   // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here). Measured
-  // 3.4 % beyond the floor (clean photos: model 0.0442, floor 0.0283) and 3.6 % (with sensor
-  // noise: 0.0459); 4 % guards both.
+  // 3.4 % beyond the floor (clean photos: model 0.0439, floor 0.0283) and 3.6 % (with sensor
+  // noise: 0.0456); 4 % guards both. Not from held_out_albedo (off: 3.35 % clean): 77 % of the
+  // squared error sits on the floor's blocks with a mean signed error of -0.5 %, i.e. the floor's
+  // albedo map (1-2 observations of 14 % noise per texel, 18 dB), not its rho_s or mean albedo
+  // (bench/solver/relight_probe, bench/RESULTS.md).
   EXPECT_LT(err, std::sqrt(floor * floor + 0.04 * 0.04));
 }
 

@@ -1,0 +1,87 @@
+// Experiment (run by hand; figures in bench/RESULTS.md): where the relit (L1) error of the solved
+// igi-synth room sits, as solve_truth_test measures it (cam0, 8x8-pixel blocks), per region.
+//   build/bench/relight_probe CAPTURE_DIR OUT_DIR   env: PROBE_HELD=0/1 (held_out_albedo),
+//   PROBE_REUSE=1 (render OUT_DIR/scene.json without solving again)
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+#include "recon/scene.h"
+#include "solver/render.h"
+#include "solver/render_internal.h"
+#include "solver/solve.h"
+#include "solver/surface_hit.h"
+#include "tools/common/json.h"
+#include "tools/common/parallel.h"
+
+using namespace igi;
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+  const fs::path dir = argv[1];
+  const fs::path out = argv[2];
+  SetDefaultThreads(2);
+  const Scene scene = LoadScene(dir / "scene.json");
+  SolveOptions o;
+  o.refine_iterations = 1;
+  o.num_threads = 2;
+  o.show_progress = false;
+  if (const char* e = std::getenv("PROBE_HELD")) o.held_out_albedo = std::string(e) == "1";
+  const bool reuse = std::getenv("PROBE_REUSE") != nullptr && fs::exists(out / "scene.json");
+  if (!reuse) {
+    const SolveSummary s = Solve(scene, o, out);
+    WriteSolveOutputs(s, o, out);
+    for (const RegionSolution& r : s.regions) {
+      std::printf(
+          "%-14s stage1 rho_d %.4f %.4f %.4f rho_s %.4f alpha %.4f | stage2 rho_s %.4f alpha "
+          "%.4f\n",
+          r.name.c_str(), r.stage1.rho_d[0], r.stage1.rho_d[1], r.stage1.rho_d[2],
+          r.stage1.rho_s.mean(), r.stage1.alpha, r.stage2.rho_s.mean(), r.stage2.alpha);
+    }
+  }
+  const Scene solved = LoadScene(out / "scene.json");
+  const Scene true_scene = LoadScene(dir / "truth" / "scene.json");
+  Renderer model(solved, solved.FindLighting("L1"));
+  Renderer reference(true_scene, true_scene.FindLighting("L1"));
+  RenderOptions ro;
+  ro.spp = 64;
+  ro.show_progress = false;
+  ro.seed = 101;
+  const Camera& cam = solved.cameras[solved.FindCamera("cam0")];
+  const Image validation = ReadImage(dir / "validation" / "cam0_L1.exr", 3);
+  const Image mine = model.Render(cam, ro);
+  const Image again = reference.Render(true_scene.cameras[true_scene.FindCamera("cam0")], ro);
+  // Region of each block's centre pixel.
+  const std::unique_ptr<Renderer::Impl> geo = BuildRenderScene(true_scene, 0);
+  std::map<std::string, std::array<double, 5>> per;  // err², floor², signed err, want, count
+  double num = 0, num_f = 0, den = 0;
+  for (int by = 0; by + 8 <= validation.height; by += 8) {
+    for (int bx = 0; bx + 8 <= validation.width; bx += 8) {
+      const std::optional<SurfaceHit> hit = TraceSurface(
+          *geo, cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(bx + 4, by + 4)));
+      const std::string name = hit ? true_scene.materials[hit->region].name : "none";
+      for (int c = 0; c < 3; ++c) {
+        double w = 0, g = 0, a = 0;
+        for (int y = by; y < by + 8; ++y) {
+          for (int x = bx; x < bx + 8; ++x) {
+            w += validation.at(x, y, c) / 64.0;
+            g += mine.at(x, y, c) / 64.0;
+            a += again.at(x, y, c) / 64.0;
+          }
+        }
+        auto& v = per[name];
+        v[0] += (g - w) * (g - w), v[1] += (a - w) * (a - w), v[2] += g - w, v[3] += w, v[4] += 1;
+        num += (g - w) * (g - w), num_f += (a - w) * (a - w), den += w * w;
+      }
+    }
+  }
+  std::printf("relit cam0/L1: model %.4f floor %.4f beyond %.4f\n", std::sqrt(num / den),
+              std::sqrt(num_f / den), std::sqrt(std::max(0.0, num - num_f) / den));
+  for (const auto& [name, v] : per) {
+    std::printf(
+        "  %-14s blocks %4.0f  share of err² %5.1f %% (floor's %5.1f %%)  mean signed err %+.2f "
+        "%%\n",
+        name.c_str(), v[4] / 3, 100 * v[0] / num, 100 * v[1] / num_f, 100 * v[2] / v[3]);
+  }
+  return 0;
+}
