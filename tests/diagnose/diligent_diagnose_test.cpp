@@ -26,10 +26,10 @@
 // these 12 photos the baseline residual is 0.137 (held out 0.110), pose_error is kept (held-out
 // residual² −34 %, the ball's projection moved toward the ground-truth normals' centre, checked
 // below), light_intensity and albedo_texture are tried and rejected, final 0.103 (held out 0.089)
-// against a noise-floor estimate of 0.053; about 6 min. On all 48 photos the baseline is 0.089
-// (held out 0.083); what remains sits in the highlight (a sharper peak and broader shoulders than
-// Ward's Gaussian lobe) and at the terminator (the photos fall below Lambert's cosine:
-// photo/model 0.58 at cos θi < 0.1, 0.91 at 0.5).
+// against a noise-floor estimate of 0.053; 9-12 min at load average 6-10 (2 min of CPU). On all 48
+// photos the baseline is 0.089 (held out 0.083); what remains sits in the highlight (a sharper peak
+// and broader shoulders than Ward's Gaussian lobe) and at the terminator (the photos fall below
+// Lambert's cosine: photo/model 0.58 at cos θi < 0.1, 0.91 at 0.5).
 #include <gtest/gtest.h>
 
 #include <cmath>
