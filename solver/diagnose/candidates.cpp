@@ -351,6 +351,7 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
   const std::vector<PixelRecord>& recs = f.records();
   std::vector<float> share(recs.size(), 0.0f);
   bool any = false;
+  float share_min = 1, share_max = 0;
   for (size_t i = 0; i < share.size(); ++i) {
     float mine = 0, all = 0;
     for (const RecordLightSample& s : recs[i].lights) {
@@ -359,20 +360,26 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
     }
     share[i] = all > 0 ? mine / all : 0;
     any |= mine > 0;
+    if (all > 0 && !recs[i].outlier) {  // records in shadow scale with the light's bounces
+      share_min = std::min(share_min, share[i]);
+      share_max = std::max(share_max, share[i]);
+    }
   }
   if (!any) return out;
-  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-    b[0] = r.sim[c] * share[size_t(&r - recs.data())];
-  });
-  if (fit.coef.size() == 0) return out;
-  // With the albedos free, a light that is the only one of every photographed lighting scales
-  // like the albedos: nothing is left of its basis after the nuisance.
-  if (f.nuisance() && !(fit.train_before - fit.train_after > 1e-6 * fit.train_before)) {
+  // With the albedos free, a light that brings all the direct light of every lit sample (the
+  // only one of every photographed lighting) scales like the albedos: nothing is left of its basis
+  // after the nuisance. (A light alone in its own lighting among others — one directional light per
+  // photo, as in DiLiGenT — is a scale of its photos and can be told apart.)
+  if (f.nuisance() && share_max - share_min < 1e-4f) {
     out.note = "light '" + l.name +
                "' is alone in every photographed lighting: its intensity cannot be told from "
                "the albedos";
     return out;
   }
+  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    b[0] = r.sim[c] * share[size_t(&r - recs.data())];
+  });
+  if (fit.coef.size() == 0) return out;
   FillScores(fit, &out);
   const double factor = 1 + fit.coef[0];
   if (!(factor > 0)) return out;

@@ -7,6 +7,7 @@
 // step, re-render the camera's photos, rebuild the records, refit — because one step recovers
 // only part of a pose error of a few pixels (the linearisation holds below a pixel).
 
+#include <string>
 #include <vector>
 
 #include "recon/scene.h"
@@ -19,10 +20,33 @@
 
 namespace igi {
 
-// One Gauss–Newton step for `camera` (six amplitudes); its apply() composes the step with the
+// One damped Gauss–Newton (Levenberg–Marquardt) step for `camera` (six amplitudes: the damped
+// direction, its length fitted); its apply() composes the step with the
 // camera's qvec/tvec in the declared document.
 CandidateResult FitPoseError(const CandidateContext& context, const ResidualFitter& fitter,
                              int camera);
+
+// A gradient fit is a pose error when its rotation stays below kMaxPoseErrorDeg and its shift
+// below kMaxPoseShiftOfDepth times the median depth of the camera's samples (scene units are
+// arbitrary: metres in a room, sphere radii in DiLiGenT).
+constexpr double kMaxPoseErrorDeg = 5;
+constexpr double kMaxPoseShiftOfDepth = 0.1;
+
+// Levenberg–Marquardt damping of a pose step's normal equations (relative to their diagonal,
+// rotation in radians and shift in units of the median depth): motions the image tells apart
+// less well than this are left out of the step (see FitPoseError).
+constexpr double kPoseDamping = 0.01;
+
+// A pose step that raises the fitted residual is retried at half its length this many times.
+constexpr int kPoseHalvings = 2;
+
+// Composes a small rotation ω (camera frame, radians) and shift δ (scene units) with the pose of
+// camera entry `camera` in *doc: R ← exp(ω) R, t ← exp(ω) t + δ.
+void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
+                     const Eigen::Vector3d& delta, Json* doc);
+
+// The median depth (camera z, scene units) of `camera`'s records; 0 when it has none.
+double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, int camera);
 
 // Blocks whose model-image gradient energy reaches this many times the median block's are the
 // edges where a pose error is scored.
@@ -44,8 +68,9 @@ struct PoseRefinement {
 
 // Iterates the pose of `camera` in *doc from the model's pose: re-renders the camera's photos
 // with the moved pose, rebuilds the records (the camera's outliers included: its sharpest edges
-// are the signal) and applies the next step, until a step is below 0.005° and 0.1 mm, a step
-// raises the fitted residual (taken back), or max_iterations were made.
+// are the signal) and applies the next step, until a step is below 0.005° and 3e-5 of the
+// median depth (0.1 mm at 3 m), a step raises the fitted residual even at a quarter of its
+// length (taken back), or max_iterations (halvings included) were made.
 PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& options,
                           bool materials_solved, double cell_m, int max_iterations, Json* doc);
