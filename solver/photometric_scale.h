@@ -13,9 +13,10 @@
 // comes from the photos, in the photos' units, and only the direct light is absolute. At a
 // reference observation the photo therefore reads
 //     P = k·ρd/π·E_direct + ρd/π·G        (G: the gathered indirect irradiance, photo units)
-// which is linear in k: k is the least-squares solution over every reference observation and
-// channel (samples whose residual exceeds 4 robust standard deviations are left out, then it is
-// solved again). The estimate is taken after the paper's stage has converged, so that the
+// which is linear in k: k = Σ(P − ρd/π·G)/Σ(ρd/π·E_direct) over every reference observation and
+// channel (a ratio of sums, which a noisy albedo lookup on a textured reference does not bias as
+// it does least squares; samples whose residual exceeds 4 robust standard deviations are left
+// out, then it is solved again). The estimate is taken after the paper's stage has converged, so that the
 // patches no photo sees radiate with their region's fitted albedo (which follows the photos'
 // units) rather than a placeholder; the photos are divided by k and the stage is run again, until
 // k changes by less than 0.1 %. What stays outside the photos' units is the light from regions
