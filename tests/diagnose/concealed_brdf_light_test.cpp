@@ -14,58 +14,14 @@
 #include <string>
 #include <vector>
 
-#include "tests/e2e/run.h"
-#include "tests/temp_dir.h"
-#include "tools/common/json.h"
+#include "tests/diagnose/concealed_fixture.h"
 
 namespace igi {
 namespace {
 
-namespace fs = std::filesystem;
-using test::Quote;
-using test::RunTool;
-
-const std::string kDiagnose = " --spp 128 --holdout-block-px 8 --threads 2 --quiet";
-
-struct Outcome {
-  Json diagnosis;
-  double floor = 0;
-};
-
-Outcome Diagnose(const std::string& effect, int seed) {
-  const fs::path dir = test::UniqueTempDir("igi_concealed_" + effect);
-  const fs::path capture = dir / "capture";
-  auto r = RunTool("igi-synth", "--out " + Quote(capture.string()) +
-                                    " --cameras 4 --width 160 --height 120 --spp 64 --lamp point"
-                                    " --unknowns none --threads 2 --quiet --seed " +
-                                    std::to_string(seed) + " --effect " + effect);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  Outcome o;
-  r = RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
-                                  Quote((dir / "diag").string()) + kDiagnose);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  o.diagnosis = ReadJsonFile(dir / "diag" / "diagnosis.json");
-  // The true model: truth/scene.json (true materials and lights) with the capture's photos.
-  Json true_model = ReadJsonFile(capture / "truth" / "scene.json");
-  Json photos = ReadJsonFile(capture / "scene.json")["photos"];
-  for (Json& p : photos) p["file"] = "../" + p["file"].get<std::string>();
-  true_model["photos"] = photos;
-  WriteJsonFile(capture / "truth" / "true_model.json", true_model);
-  r = RunTool("igi-diagnose", Quote((capture / "truth" / "true_model.json").string()) + " --out " +
-                                  Quote((dir / "floor").string()) + kDiagnose + " --max-steps 0");
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  o.floor = ReadJsonFile(dir / "floor" / "diagnosis.json")["baseline"]["residual"].get<double>();
-  fs::remove_all(dir);
-  return o;
-}
-
-void ExpectReachesTheFloor(const Outcome& o) {
-  const Json& d = o.diagnosis;
-  const double final_residual = d["final"]["residual"];
-  EXPECT_LE(final_residual, 1.2 * o.floor)
-      << "baseline " << d["baseline"]["residual"] << ", floor " << o.floor;
-  EXPECT_LT(final_residual, d["baseline"]["residual"].get<double>());
-}
+using test::ConcealedOutcome;
+using test::DiagnoseConcealed;
+using test::ExpectReachesTheFloor;
 
 // Disabled: the candidate finds glossy_box's stretch (seed 11: tangent (0.911, 0.413, 0) against
 // the true (0.906, 0.423, 0), alpha 0.029 / 0.147 against 0.03 / 0.15) and its refit lowers the
@@ -77,7 +33,7 @@ void ExpectReachesTheFloor(const Outcome& o) {
 // face normal of the box: --effect anisotropic_reflection:tangent=0.5736/0.8192/0): 76 % down,
 // 2.3 standard errors.
 TEST(ConcealedBrdfLightTest, DISABLED_AnisotropicReflection) {
-  const Outcome o = Diagnose("anisotropic_reflection", 11);
+  const ConcealedOutcome o = DiagnoseConcealed("anisotropic_reflection", 11);
   const Json& d = o.diagnosis;
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   const Json& step = d["steps"][0];
@@ -97,7 +53,7 @@ TEST(ConcealedBrdfLightTest, DISABLED_AnisotropicReflection) {
 }
 
 TEST(ConcealedBrdfLightTest, LightSourceExtent) {
-  const Outcome o = Diagnose("light_source_extent", 11);
+  const ConcealedOutcome o = DiagnoseConcealed("light_source_extent", 11);
   const Json& d = o.diagnosis;
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   const Json& step = d["steps"][0];
