@@ -42,9 +42,9 @@ inline std::filesystem::path SynthesizeConcealed(const std::filesystem::path& di
 // diagnosis.json (an empty object when it failed).
 inline Json RunDiagnose(const std::filesystem::path& scene, const std::filesystem::path& out,
                         const std::string& extra = "") {
-  const RunResult r = RunTool("igi-diagnose", Quote(scene.string()) + " --out " +
-                                                  Quote(out.string()) + kConcealedDiagnoseFlags +
-                                                  extra);
+  const RunResult r =
+      RunTool("igi-diagnose", Quote(scene.string()) + " --out " + Quote(out.string()) +
+                                  kConcealedDiagnoseFlags + extra);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   if (r.exit_code != 0) return Json::object();
   return ReadJsonFile(out / "diagnosis.json");

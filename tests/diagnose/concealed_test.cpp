@@ -1,9 +1,9 @@
 // igi-diagnose on concealed data (issue 8, CI size): igi-synth captures each hiding one effect
-// that scene.json does not declare, and a control hiding none. For each: the first step igi-diagnose
-// keeps names the hidden effect (CONTRACT.md §6 names), and its final residual comes within 1.2×
-// the noise floor — the residual of the TRUE model (truth/scene.json plus the photo effects of
-// truth.json) rendered at the same samples per pixel, over the same pixels. The control reports no
-// effect.
+// that scene.json does not declare, and a control hiding none. For each: the first step
+// igi-diagnose keeps names the hidden effect (CONTRACT.md §6 names), and its final residual comes
+// within 1.2× the noise floor — the residual of the TRUE model (truth/scene.json plus the photo
+// effects of truth.json) rendered at the same samples per pixel, over the same pixels. The control
+// reports no effect.
 //
 // Size: 4 cameras of 160×120, photos at 64 paths per pixel, a point lamp (its glossy reflections
 // are sampled by next-event estimation only, so the photos carry no fireflies), materials given
@@ -35,9 +35,9 @@ TEST_P(ConcealedEffectTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
   test::ExpectReachesTheFloor(o);
 }
 
-// light_emission_profile is left out here: with known materials the hidden cos² spot darkens the
-// room fourfold and a per-photo exposure scale explains more of it first (the profile's axis is
-// found, its power is not); see the issue note and bench/RESULTS.md.
+// light_emission_profile, anisotropic_reflection and light_source_extent:
+// concealed_brdf_light_test.cpp (slow); missing_geometry and pose_error:
+// concealed_geometry_test.cpp.
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedEffectTest,
                          testing::Values("vignetting", "exposure_scale", "camera_response",
                                          "specular_lobe_shape"));
@@ -68,8 +68,8 @@ namespace {
 TEST(DiagnoseBadInputTest, ExitsTwoWithOneLineAndWritesNothing) {
   const fs::path dir = test::UniqueTempDir("igi_diagnose_bad");
   const fs::path out = dir / "out";
-  auto r = RunTool("igi-diagnose", Quote((dir / "missing.json").string()) + " --out " +
-                                       Quote(out.string()));
+  auto r = RunTool("igi-diagnose",
+                   Quote((dir / "missing.json").string()) + " --out " + Quote(out.string()));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
