@@ -114,48 +114,6 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
   return st;
 }
 
-// One-sided p-value of a normal z, and back.
-double UpperTail(double z) { return 0.5 * std::erfc(z / std::sqrt(2.0)); }
-double UpperQuantile(double p) {
-  double lo = -40, hi = 40;
-  for (int k = 0; k < 100; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (UpperTail(mid) > p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-// The significance of a held-out gain over blocks (b: gain g_b, error before e_b; the n blocks the
-// step changed), two ways, Bonferroni-combined (the z whose p-value is twice the smaller one's):
-// - each block alike: the mean of g_b / e_b over its standard error (an effect spread over many
-//   blocks, e.g. a lens fall-off, whose blocks differ in brightness);
-// - each block by its error: R = Σ g_b / Σ e_b (the reported gain's form) over the ratio
-//   estimator's standard error, sqrt(n/(n−1) Σ (g_b − R e_b)²) / Σ e_b: an effect seen in a few
-//   blocks (a highlight) counts by what it explains there, not diluted by the blocks whose
-//   change is only the path tracer's noise.
-// With no effect both are z's of noise, and the combination keeps the gate's false-alarm rate at
-// most that of one test at the same threshold.
-double BlockGainZ(const std::vector<std::pair<double, double>>& blocks) {
-  const double n = double(blocks.size());
-  if (n < 2) return 0;
-  double mean = 0, sum_g = 0, sum_e = 0;
-  for (const auto& [g, e] : blocks) mean += g / e, sum_g += g, sum_e += e;
-  mean /= n;
-  const double ratio = sum_g / sum_e;
-  double sq_rel = 0, sq_ratio = 0;
-  for (const auto& [g, e] : blocks) {
-    sq_rel += (g / e - mean) * (g / e - mean);
-    sq_ratio += (g - ratio * e) * (g - ratio * e);
-  }
-  const double se_rel = std::sqrt(sq_rel / (n - 1) / n);
-  const double se_ratio = std::sqrt(sq_ratio * n / (n - 1)) / sum_e;
-  const double z_rel = se_rel > 0 ? mean / se_rel : 0;
-  const double z_ratio = se_ratio > 0 ? ratio / se_ratio : 0;
-  const double best = std::max(z_rel, z_ratio);
-  const double p = UpperTail(best);
-  return best > 0 && p > 0 ? UpperQuantile(2 * p) : best;  // no evidence: the larger z as it is
-}
-
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
 // with the held-out blocks as independent units (BlockGainZ; blocks the step left exactly as they
 // were — same seed, same model there — do not count).
