@@ -27,10 +27,11 @@ using test::ExpectReachesTheFloor;
 // The candidate finds glossy_box's stretch (seed 11: tangent (0.911, 0.413, 0) against the true
 // (0.906, 0.423, 0), alpha 0.029 / 0.147 against 0.03 / 0.15) and its refit lowers the held-out
 // residual² by 75.2 %, nearly all of it in the 4 held-out blocks of cam0 that show the highlight
-// (each 90–99 % down). The step gate's mean relative gain per block puts that at 2.2 standard
-// errors (changing a lobe's sampling changes the path tracer's random paths in every block whose
-// paths meet the box, and those blocks score noise); the error-weighted gain (HeldOutGain in
-// diagnose.cpp) at 6.3, 6.2 after the Bonferroni combination: kept (measured 2026-11-22).
+// (each 90–99 % down). Measured 2026-11-22: the step gate's mean relative gain per block puts that
+// at 2.2 standard errors (changing a lobe's sampling changes the path tracer's random paths in
+// every block whose paths meet the box, and those blocks score noise), the error-weighted gain at
+// 6.3, the gate's combination (BlockGainZ) at 6.2: kept, the only step; final residual 0.1484
+// against the true model's 0.1481 (1.00×).
 TEST(ConcealedBrdfLightTest, AnisotropicReflection) {
   const ConcealedOutcome o = DiagnoseConcealed("anisotropic_reflection", 11);
   const Json& d = o.diagnosis;
