@@ -11,9 +11,11 @@
 #include <set>
 #include <unordered_map>
 
+#include "solver/brdf.h"
 #include "solver/diagnose/candidates_brdf_light.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
+#include "solver/sampling.h"
 
 namespace igi {
 namespace {
@@ -223,19 +225,34 @@ CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
   return out;
 }
 
-// Diffuse direct light of one light at a record (ρd/π · Σ irradiance), and the mean direction
-// from the light to the point.
+// The direct light of one light at a record toward the camera, Σ f(wi, view)·irradiance with the
+// region's BRDF (ρd from the record; an anisotropic lobe, whose tangent the records lack, counts
+// as its diffuse part only), and the mean direction from the light to the point.
 struct LightTerm {
-  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();
+  Eigen::Vector3f direct = Eigen::Vector3f::Zero();
   Eigen::Vector3f from_light = Eigen::Vector3f::Zero();
   bool lit = false;
 };
 
-LightTerm TermOf(const PixelRecord& r, int light) {
+LightTerm TermOf(const Scene& model, const PixelRecord& r, int light) {
   LightTerm t;
+  BrdfParams p;
+  if (r.region >= 0 && r.region < int(model.materials.size())) {
+    const Material& m = model.materials[r.region];
+    if (IsReflective(m.brdf) && !IsAnisotropic(m.brdf) && m.rho_s && m.alpha) {
+      p.model = m.brdf;
+      p.rho_s = *m.rho_s;
+      p.alpha = *m.alpha;
+      p.ior = m.ior.value_or(Material::kDefaultIor);
+    }
+  }
+  p.rho_d = r.albedo.cast<double>();
+  const Frame frame = Frame::FromNormal(r.normal.cast<double>());
+  const Eigen::Vector3d wo = frame.ToLocal(r.view.cast<double>());
   for (const RecordLightSample& s : r.lights) {
     if (s.light != light) continue;
-    t.diffuse += r.albedo.cwiseProduct(s.irradiance) / float(kPi);
+    const Eigen::Vector3d f = EvalBrdf(p, wo, frame.ToLocal(s.wi.cast<double>()));
+    t.direct += f.cast<float>().cwiseProduct(s.irradiance);
     t.from_light -= s.wi;
     t.lit = true;
   }
@@ -262,27 +279,31 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   std::vector<LightTerm> terms(recs.size());
   int lit = 0;
   for (size_t i = 0; i < terms.size(); ++i) {
-    terms[i] = TermOf(recs[i], light);
+    terms[i] = TermOf(cx.model, recs[i], light);
     lit += terms[i].lit;
   }
   if (lit < 100) return out;
-  // The direct light of `light` becomes D·cos^n(angle from the axis).
-  // The direct light becomes D·cos^n (a fixed change of amplitude 1, searched over the axis and
-  // n). The light this light sends after a bounce changes too: what is not its direct diffuse term
-  // gets a free scale (the albedos' nuisance covers it per region when they are solved).
+  // The direct light of `light` (diffuse and specular) becomes D·cos^n(angle from the axis): a
+  // fixed change of amplitude 1, searched over the axis and n. The light it sends after a bounce
+  // changes too, by a share that differs between surfaces (the ceiling, lit only by bounces from
+  // what the spot lights, loses more than the floor): what is not its direct term gets a free
+  // scale per region (the albedos' nuisance covers that when they are solved).
+  const int num_regions = int(cx.model.materials.size());
   auto fit_at = [&](const Eigen::Vector3d& axis, double n) {
     const Eigen::Vector3f ax = axis.cast<float>();
     return f.Fit(
-        1,
+        f.nuisance() ? 1 : num_regions,
         [&](const PixelRecord& r, int c, double* b) {
           const LightTerm& t = terms[size_t(&r - recs.data())];
-          b[0] = f.nuisance() ? 0.0 : double(r.sim[c]) - double(t.diffuse[c]);
+          if (!f.nuisance() && r.region >= 0 && r.region < num_regions) {
+            b[r.region] = double(r.sim[c]) - double(t.direct[c]);
+          }
         },
         [&](const PixelRecord& r, int c) {
           const LightTerm& t = terms[size_t(&r - recs.data())];
           if (!t.lit) return 0.0;
           const double cs = std::max(0.0f, t.from_light.dot(ax));
-          return double(t.diffuse[c]) * (std::pow(cs, n) - 1);
+          return double(t.direct[c]) * (std::pow(cs, n) - 1);
         });
   };
   ResidualFit best;
@@ -310,7 +331,8 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
         axis[d / 2] += (d % 2 ? -step : step);
         moved |= consider(axis.normalized(), best_n);
       }
-      for (double factor : {0.8, 1.25}) moved |= consider(best_axis, best_n * factor);
+      for (double factor : {1 - step, 1 / (1 - step)})
+        moved |= consider(best_axis, best_n * factor);
       if (!moved) break;
     }
   }

@@ -115,14 +115,15 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
 }
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
-// with the held-out blocks as independent units.
+// with the held-out blocks as independent units (BlockGainZ; blocks the step left exactly as they
+// were — same seed, same model there — do not count).
 // `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
 // the signed-rank z of their pixels' gains (see EdgeBlocks).
 using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
                                       const std::vector<Image>& after, const PixelHoldout& h,
                                       const BlockFilter& only = nullptr) {
-  // Per block: gain and error before; the significance uses the relative gain per block.
+  // Per block: gain and error before.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
   std::vector<double> pixel_gains;
@@ -151,19 +152,12 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
   if (only) {  // edge blocks: the signed-rank z of their pixels' gains
     return {total_before > 0 ? total_gain / total_before : 0, SignedRankZ(pixel_gains)};
   }
-  std::vector<double> relative;
+  std::vector<std::pair<double, double>> changed;
   for (const auto& [k, ge] : gain) {
-    // Blocks the step left exactly as they were (same seed, same model there) do not count.
-    if (ge.second > 0 && ge.first != 0) relative.push_back(ge.first / ge.second);
+    if (ge.second > 0 && ge.first != 0) changed.push_back(ge);
   }
-  const double n = double(relative.size());
-  if (n < 2 || !(total_before > 0)) return {0, 0};
-  double mean = 0, sq = 0;
-  for (double r : relative) mean += r;
-  mean /= n;
-  for (double r : relative) sq += (r - mean) * (r - mean);
-  const double se = std::sqrt(sq / (n - 1) / n);
-  return {total_gain / total_before, se > 0 ? mean / se : 0};
+  if (changed.size() < 2 || !(total_before > 0)) return {0, 0};
+  return {total_gain / total_before, BlockGainZ(changed)};
 }
 
 // The held-out blocks of `camera`'s photos whose model image's gradient energy is at least

@@ -1,6 +1,7 @@
 #include "solver/diagnose/residual_fit.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -102,6 +103,42 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const
     }
   }
   return fit;
+}
+
+namespace {
+
+// One-sided p-value of a normal z, and back (bisection: p underflows only beyond z ≈ 37).
+double UpperTail(double z) { return 0.5 * std::erfc(z / std::sqrt(2.0)); }
+double UpperQuantile(double p) {
+  double lo = -40, hi = 40;
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (UpperTail(mid) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+double BlockGainZ(const std::vector<std::pair<double, double>>& blocks) {
+  const double n = double(blocks.size());
+  if (n < 2) return 0;
+  double mean = 0, sum_g = 0, sum_e = 0;
+  for (const auto& [g, e] : blocks) mean += g / e, sum_g += g, sum_e += e;
+  mean /= n;
+  const double ratio = sum_g / sum_e;
+  double sq_rel = 0, sq_ratio = 0;
+  for (const auto& [g, e] : blocks) {
+    sq_rel += (g / e - mean) * (g / e - mean);
+    sq_ratio += (g - ratio * e) * (g - ratio * e);
+  }
+  const double se_rel = std::sqrt(sq_rel / (n - 1) / n);
+  const double se_ratio = std::sqrt(sq_ratio * n / (n - 1)) / sum_e;
+  const double z_rel = se_rel > 0 ? mean / se_rel : 0;
+  const double z_ratio = se_ratio > 0 ? ratio / se_ratio : 0;
+  const double best = std::max(z_rel, z_ratio);
+  const double p = UpperTail(best);
+  return best > 0 && p > 0 ? UpperQuantile(2 * p) : best;
 }
 
 std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,

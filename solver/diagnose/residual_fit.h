@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "solver/diagnose/pixel_records.h"
@@ -21,7 +22,7 @@
 namespace igi {
 
 struct ResidualFit {
-  Eigen::VectorXd coef;  // empty: singular
+  Eigen::VectorXd coef;                      // empty: singular
   double train_before = 0, train_after = 0;  // squared-error sums after the nuisance
   double held_before = 0, held_after = 0;
   double z = 0;  // held-out gain / its standard error over cells
@@ -62,6 +63,20 @@ class ResidualFitter {
   bool nuisance_;
   int block_px_;
 };
+
+// The significance (a normal z) of a held-out gain summed over blocks, from each block's
+// (gain g_b, error before e_b), over the n blocks the change touched; two ways, Bonferroni-combined
+// (the z whose one-sided p-value is twice the smaller one's):
+// - each block alike: the mean of g_b / e_b over its standard error (an effect spread over many
+//   blocks, e.g. a lens fall-off, whose blocks differ in brightness);
+// - each block by its error: R = Σ g_b / Σ e_b (the form of the reported gain) over the ratio
+//   estimator's standard error, sqrt(n/(n−1) Σ (g_b − R e_b)²) / Σ e_b: an effect seen in a few
+//   blocks (a highlight) counts by what it explains there, not diluted by the blocks whose change
+//   is only the path tracer's noise.
+// With no effect both are z's of noise, and the combination's false-alarm rate is at most the
+// nominal rate of one test at the same threshold. When neither z is positive, the larger is
+// returned as it is.
+double BlockGainZ(const std::vector<std::pair<double, double>>& blocks);
 
 // Cells for `model`'s records: per region, or per (region, voxel of `cell_m`) where the region
 // has an albedo map.
@@ -120,7 +135,8 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
       e += (y0 - a0 * s) * (y0 - a0 * s);
     }
     if (!support) continue;
-    auto& acc = gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_];
+    auto& acc =
+        gains[(int64_t(r.photo) << 40) + (int64_t(r.y / block_px_) << 20) + r.x / block_px_];
     acc.first += g;
     acc.second += e;
   }

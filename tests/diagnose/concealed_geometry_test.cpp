@@ -16,56 +16,22 @@
 #include <cmath>
 #include <string>
 
-#include "tests/e2e/run.h"
-#include "tests/temp_dir.h"
-#include "tools/common/json.h"
+#include "tests/diagnose/concealed_fixture.h"
 
 namespace igi {
 namespace {
 
 namespace fs = std::filesystem;
-using test::Quote;
-using test::RunTool;
-
-const std::string kDiagnose = " --spp 128 --holdout-block-px 8 --threads 2 --quiet";
-
-fs::path Synthesize(const fs::path& dir, const std::string& effect, int seed) {
-  const fs::path scene = dir / "capture";
-  const auto r = RunTool("igi-synth", "--out " + Quote(scene.string()) +
-                                          " --cameras 4 --width 160 --height 120 --spp 64"
-                                          " --lamp point --unknowns none --threads 2 --quiet"
-                                          " --seed " +
-                                          std::to_string(seed) + " --effect " + effect);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return scene;
-}
-
-// The true model (truth/scene.json: the object included) with the photos and masks of `photos_of`
-// (a scene document whose paths are relative to its folder).
-fs::path TrueModel(const fs::path& capture, const fs::path& photos_of) {
-  Json truth_scene = ReadJsonFile(capture / "truth" / "scene.json");
-  Json photos = ReadJsonFile(photos_of)["photos"];
-  for (Json& p : photos) {
-    for (const char* key : {"file", "mask"}) {
-      if (p.contains(key) && p[key].is_string()) {
-        const fs::path path = photos_of.parent_path() / p[key].get<std::string>();
-        p[key] = fs::absolute(path).lexically_normal().string();
-      }
-    }
-  }
-  truth_scene["photos"] = photos;
-  const fs::path out = capture / "truth" / "true_model.json";
-  WriteJsonFile(out, truth_scene);
-  return out;
-}
+using test::FloorResidual;
+using test::RunDiagnose;
+using test::SynthesizeConcealed;
+using test::WriteTrueModel;
 
 TEST(ConcealedGeometryTest, MissingGeometryIsLocatedAndExcluded) {
   const fs::path dir = test::UniqueTempDir("igi_concealed_missing_geometry");
-  const fs::path capture = Synthesize(dir, "missing_geometry:x=1.9,y=2.0", 11);
-  auto r = RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
-                                       Quote((dir / "diag").string()) + kDiagnose);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const Json d = ReadJsonFile(dir / "diag" / "diagnosis.json");
+  const fs::path capture = SynthesizeConcealed(dir, "missing_geometry:x=1.9,y=2.0", 11);
+  const Json d = RunDiagnose(capture / "scene.json", dir / "diag");
+  ASSERT_TRUE(d.contains("steps"));
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   const Json& step = d["steps"][0];
   ASSERT_EQ(step["effect"], "missing_geometry") << d.dump(1);
@@ -83,23 +49,16 @@ TEST(ConcealedGeometryTest, MissingGeometryIsLocatedAndExcluded) {
   // true model's (measured 0.145 against 0.143).
   const fs::path improved = dir / "diag" / "scene.json";
   for (const Json& p : ReadJsonFile(improved)["photos"]) EXPECT_TRUE(p["mask"].is_string());
-  r = RunTool("igi-diagnose", Quote(TrueModel(capture, improved).string()) + " --out " +
-                                  Quote((dir / "floor").string()) + kDiagnose + " --max-steps 0");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const double floor =
-      ReadJsonFile(dir / "floor" / "diagnosis.json")["baseline"]["residual"].get<double>();
+  const double floor = FloorResidual(WriteTrueModel(capture, improved), dir / "floor");
   EXPECT_LE(d["final"]["residual"].get<double>(), 1.2 * floor) << "floor " << floor;
   fs::remove_all(dir);
 }
 
 TEST(ConcealedGeometryTest, PoseErrorIsNamedFirst) {
   const fs::path dir = test::UniqueTempDir("igi_concealed_pose_error");
-  const fs::path capture = Synthesize(dir, "pose_error", 11);
-  const auto r =
-      RunTool("igi-diagnose", Quote((capture / "scene.json").string()) + " --out " +
-                                  Quote((dir / "diag").string()) + kDiagnose + " --max-steps 1");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const Json d = ReadJsonFile(dir / "diag" / "diagnosis.json");
+  const fs::path capture = SynthesizeConcealed(dir, "pose_error", 11);
+  const Json d = RunDiagnose(capture / "scene.json", dir / "diag", " --max-steps 1");
+  ASSERT_TRUE(d.contains("steps"));
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   EXPECT_EQ(d["steps"][0]["effect"], "pose_error") << d.dump(1);
   EXPECT_EQ(d["steps"][0]["params"]["camera"], "cam0");

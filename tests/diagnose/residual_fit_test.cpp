@@ -1,6 +1,7 @@
 // ResidualFitter: an effect's amplitude is recovered from noisy residual samples, also when each
 // cell's albedo is wrong by a factor (the nuisance the solver would refit); pure noise earns no
-// significant held-out gain; and the photo model of scene.json inverts exactly.
+// significant held-out gain; the step gate's block z (BlockGainZ); and the photo model of
+// scene.json inverts exactly.
 #include "solver/diagnose/residual_fit.h"
 
 #include <gtest/gtest.h>
@@ -26,8 +27,8 @@ std::vector<PixelRecord> Records(double k, double albedo_spread, double noise, i
   std::vector<double> error(cells), center(cells);
   for (int c = 0; c < cells; ++c) {
     center[c] = 0.15 + 0.7 * u(rng);
-    error[c] = confounded ? 1 + albedo_spread * center[c] * 4
-                          : 1 + albedo_spread * (2 * u(rng) - 1);
+    error[c] =
+        confounded ? 1 + albedo_spread * center[c] * 4 : 1 + albedo_spread * (2 * u(rng) - 1);
   }
   std::vector<PixelRecord> out;
   for (int i = 0; i < 20000; ++i) {
@@ -87,6 +88,46 @@ TEST(ResidualFitTest, NoiseAloneEarnsNothing) {
   ASSERT_EQ(fit.coef.size(), 2);
   EXPECT_LT(fit.Gain(), 0.01);
   EXPECT_LT(fit.z, 3);
+}
+
+// BlockGainZ (igi-diagnose's step gate): blocks of error e ~ 1..10 whose change is noise
+// (gain ~ N(0, 0.3 e)) rarely reach 2.5 (one-sided rate 0.6 % per test; 400 draws expect ≤ 2.5,
+// ≤ 8 allowed for the tails of a t statistic); an effect explained in 4 bright blocks among 300
+// noise blocks (a highlight) reaches it although the per-block-alike mean alone stays under 2;
+// an effect spread thinly over every block reaches it too.
+std::vector<std::pair<double, double>> NoiseBlocks(std::mt19937_64* rng, int n) {
+  std::uniform_real_distribution<double> u(1, 10);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<std::pair<double, double>> blocks;
+  for (int b = 0; b < n; ++b) {
+    const double e = u(*rng);
+    blocks.emplace_back(0.3 * e * g(*rng), e);
+  }
+  return blocks;
+}
+
+TEST(BlockGainZTest, NoiseRarelyPasses) {
+  std::mt19937_64 rng(7);
+  int passed = 0;
+  for (int draw = 0; draw < 400; ++draw) passed += BlockGainZ(NoiseBlocks(&rng, 300)) >= 2.5;
+  EXPECT_LE(passed, 8);
+}
+
+TEST(BlockGainZTest, AFewWellExplainedBlocksPass) {
+  std::mt19937_64 rng(8);
+  std::vector<std::pair<double, double>> blocks = NoiseBlocks(&rng, 300);
+  double mean_relative = 0;
+  for (const double e : {4600.0, 1800.0, 1200.0, 140.0}) blocks.emplace_back(0.95 * e, e);
+  for (const auto& [g, e] : blocks) mean_relative += g / e / double(blocks.size());
+  EXPECT_LT(mean_relative, 0.05);  // the per-block-alike mean barely moves
+  EXPECT_GT(BlockGainZ(blocks), 4);
+}
+
+TEST(BlockGainZTest, AThinEffectEverywherePasses) {
+  std::mt19937_64 rng(9);
+  std::vector<std::pair<double, double>> blocks = NoiseBlocks(&rng, 300);
+  for (auto& [g, e] : blocks) g += 0.15 * e;  // 15 % of every block: about 8.7 standard errors
+  EXPECT_GT(BlockGainZ(blocks), 4);
 }
 
 TEST(PhotoModelTest, LinearRadianceInvertsTheForwardModel) {
