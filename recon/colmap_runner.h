@@ -1,6 +1,8 @@
 #pragma once
 // Runs COLMAP 3.8's command line headless (CPU SIFT, exhaustive matching, incremental mapping) on
-// a folder of photos and reads the largest reconstruction back.
+// a folder of photos and reads the largest reconstruction back. Without known intrinsics COLMAP
+// self-calibrates `camera_model` (focal length and distortion refined in its bundle
+// adjustments, principal point held at the image centre).
 //
 // Failures are reported, not hidden: a missing `colmap` executable or a version other than 3.8
 // (igi::Error, exit 1, naming what was found), a step that fails (its log file is named), and a
@@ -30,6 +32,19 @@ struct ColmapRunOptions {
   bool single_camera = true;          // one camera shared by every photo
   int max_image_size = 3200;          // SIFT extraction downscales larger photos (COLMAP default)
   std::optional<KnownIntrinsics> intrinsics;
+  // The COLMAP camera model self-calibrated when `intrinsics` is not given (ignored with it):
+  // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. Measured on the Sceaux photos
+  // (downscaled 4x, focal error against K.txt; bench/RESULTS.md "Registration"): SIMPLE_RADIAL
+  // +1.6 %, RADIAL +2.1 %, OPENCV +2.2 to +2.8 %, SIMPLE_PINHOLE +5.8 % (the lens has barrel
+  // distortion). The extra distortion terms trade off against the focal length (11 photos of
+  // one facade do not separate them), so the one-parameter model is the default.
+  std::string camera_model = "SIMPLE_RADIAL";
+  // COLMAP's --SiftMatching.guided_matching: after the two-view geometry is estimated, match
+  // again along it, which keeps more of the correct matches (Sceaux 4x: 44274 verified matches
+  // instead of 30437, +30 % observations per photo) at about twice the matching time. More
+  // observations near the image borders constrain focal length and distortion better (Sceaux:
+  // focal +1.6 % instead of +2.2 % with SIMPLE_RADIAL).
+  bool guided_matching = true;
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share
@@ -41,6 +56,9 @@ struct ColmapRunOptions {
 
   void Validate() const;
 };
+
+// The COLMAP camera models ColmapRunOptions::camera_model accepts (those recon/camera.h reads).
+extern const std::vector<std::string> kSelfCalibratedModels;
 
 struct ColmapRunSummary {
   std::string version;                    // e.g. "3.8"

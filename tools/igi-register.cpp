@@ -230,6 +230,10 @@ igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
   report["unregistered"] = run.unregistered;
   report["models_reconstructed"] = run.num_models;
   report["known_intrinsics"] = !args.camera.empty();
+  if (args.colmap_model.empty()) {
+    report["colmap_guided_matching"] = args.colmap.guided_matching;
+    if (args.camera.empty()) report["self_calibrated_model"] = args.colmap.camera_model;
+  }
   igi::Json cameras = igi::Json::array();
   for (const auto& [id, cam] : run.model.cameras) {
     cameras.push_back({{"camera_id", id}, {"model", cam.model}, {"params", cam.params}});
@@ -443,6 +447,7 @@ int main(int argc, char** argv) {
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
   Args args;
+  bool no_guided_matching = false;
   app.add_option("--images", args.images, "Folder of photos")->required();
   app.add_option("--out", args.out, "Output folder")->required();
   app.add_option("--scene", args.scene, "scene.json whose frame the poses are brought into");
@@ -454,6 +459,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(6, 1000000));
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
+  app.add_option("--camera-model", args.colmap.camera_model,
+                 "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
+                 "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE");
+  app.add_flag("--no-guided-matching", no_guided_matching,
+               "Match once per photo pair (COLMAP's default; igi re-matches along each pair's "
+               "epipolar geometry, which keeps more correct matches at about twice the time)");
   app.add_flag(
       "--no-mesh-fit", args.no_mesh_fit,
       "With --scene: align by --markers only, without fitting the sparse points to the mesh");
@@ -476,5 +487,8 @@ int main(int argc, char** argv) {
   app.add_flag("--multi-camera", args.multi_camera, "One camera per photo (default: one shared)");
   app.add_flag("--allow-other-colmap", args.colmap.allow_other_version,
                "Accept a COLMAP other than 3.8");
-  return igi::RunMain(app, flags, argc, argv, [&]() -> int { return Run(args, flags); });
+  return igi::RunMain(app, flags, argc, argv, [&]() -> int {
+    args.colmap.guided_matching = !no_guided_matching;
+    return Run(args, flags);
+  });
 }
