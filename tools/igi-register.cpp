@@ -461,7 +461,8 @@ int main(int argc, char** argv) {
                  "SIFT extraction downscales larger photos to this size");
   app.add_option("--camera-model", args.colmap.camera_model,
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
-                 "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE");
+                 "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
+      ->check(CLI::IsMember(igi::kSelfCalibratedModels));
   app.add_flag("--no-guided-matching", no_guided_matching,
                "Match once per photo pair (COLMAP's default; igi re-matches along each pair's "
                "epipolar geometry, which keeps more correct matches at about twice the time)");

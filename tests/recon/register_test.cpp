@@ -14,6 +14,7 @@
 #include "recon/registration.h"
 #include "tests/e2e/run.h"
 #include "tests/temp_dir.h"
+#include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
@@ -63,6 +64,36 @@ TEST(ColmapRunnerTest, MissingOrWrongColmapIsReported) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("3.6"), std::string::npos) << e.what();
   }
+  fs::remove_all(dir);
+}
+
+// The self-calibrated camera model and guided matching reach COLMAP's command line (a fake
+// COLMAP that logs its arguments and reconstructs nothing); a model igi cannot read is refused
+// before anything runs.
+TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
+  const fs::path dir = test::UniqueTempDir("igi_colmap_runner_args");
+  const fs::path fake = dir / "fake-colmap";
+  std::ofstream(fake) << "#!/bin/sh\necho 'COLMAP 3.8 -- Structure-from-Motion'\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  fs::create_directories(dir / "images");
+  ColmapRunOptions options;
+  options.executable = fake.string();
+  EXPECT_EQ(options.camera_model, "SIMPLE_RADIAL");
+  EXPECT_TRUE(options.guided_matching);
+  options.camera_model = "RADIAL";
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);  // nothing mapped
+  const std::string log = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(log.find("--ImageReader.camera_model RADIAL"), std::string::npos) << log;
+  EXPECT_NE(log.find("--SiftMatching.guided_matching 1"), std::string::npos) << log;
+  options.guided_matching = false;
+  options.intrinsics = KnownIntrinsics{"PINHOLE", 640, 480, {500, 500, 320, 240}};
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
+  const std::string known = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(known.find("--ImageReader.camera_model PINHOLE"), std::string::npos) << known;
+  EXPECT_EQ(known.find("--ImageReader.camera_model RADIAL"), std::string::npos) << known;
+  EXPECT_NE(known.find("--SiftMatching.guided_matching 0"), std::string::npos) << known;
+  options.camera_model = "FULL_OPENCV";
+  EXPECT_THROW(options.Validate(), InputError);
   fs::remove_all(dir);
 }
 
