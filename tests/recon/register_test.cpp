@@ -97,9 +97,9 @@ TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
   fs::remove_all(dir);
 }
 
-// Every Sceaux photo registers, and the focal length COLMAP estimates (not given the
-// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) is
-// close to K.txt.
+// Every Sceaux photo registers, and the focal length COLMAP self-calibrates (not given the
+// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) with
+// igi's defaults (SIMPLE_RADIAL, guided matching) is within issue 6's 2 % of K.txt.
 TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   const fs::path dir = test::UniqueTempDir("igi_colmap_sceaux");
   WriteDownscaledSceaux(dir / "images");
@@ -113,10 +113,11 @@ TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   const double expected = kFocalFullPx / kDownscale;
   std::printf("Sceaux: %s focal %.2f px, K.txt %.2f px (%.2f %%)\n", camera.model.c_str(),
               camera.params[0], expected, 100 * (camera.params[0] / expected - 1));
-  // Issue 6 asks for 2 %; COLMAP 3.8's SIMPLE_RADIAL self-calibration measures +2.06 % here
-  // (+2.21 % at half size), so the requirement is NOT met yet and this checks 3 % to catch
-  // regressions. See the issue for what is left (a fuller camera model or the full-size photos).
-  EXPECT_NEAR(camera.params[0], expected, 0.03 * expected);
+  // Issue 6 asks for 2 %. Measured with the defaults: +1.75 %, +1.65 % (this test, two runs:
+  // COLMAP's matching is randomized) and +1.59 % (the same steps from the shell). Without guided
+  // matching COLMAP 3.8 measured +1.9..+2.2 % here, and RADIAL / OPENCV +2.1..+2.8 % (the extra
+  // distortion terms trade off against the focal length); bench/RESULTS.md "Registration".
+  EXPECT_NEAR(camera.params[0], expected, 0.02 * expected);
   for (const ImageReprojection& r : ReprojectionErrors(run.model)) {
     EXPECT_GT(r.observations, 50) << r.name;
     EXPECT_LT(r.rms_px, 1.5) << r.name;  // COLMAP's default filter keeps errors under 4 px
