@@ -34,16 +34,16 @@ struct ColmapRunOptions {
   std::optional<KnownIntrinsics> intrinsics;
   // The COLMAP camera model self-calibrated when `intrinsics` is not given (ignored with it):
   // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. Measured on the Sceaux photos
-  // (downscaled 4x, focal error against K.txt; bench/RESULTS.md "Registration"): SIMPLE_RADIAL
-  // +1.6 %, RADIAL +2.1 %, OPENCV +2.2 to +2.8 %, SIMPLE_PINHOLE +5.8 % (the lens has barrel
-  // distortion). The extra distortion terms trade off against the focal length (11 photos of
-  // one facade do not separate them), so the one-parameter model is the default.
+  // (downscaled 4x, one database, focal error against K.txt; bench/RESULTS.md "Registration"):
+  // SIMPLE_RADIAL +2.16 %, RADIAL +2.77 %, OPENCV +2.65/+2.83 %, SIMPLE_PINHOLE +5.85 % (the lens
+  // has barrel distortion). Each extra distortion term trades off against the focal length (11
+  // photos of one facade do not separate them), so the one-parameter model is the default.
   std::string camera_model = "SIMPLE_RADIAL";
-  // COLMAP's --SiftMatching.guided_matching: after the two-view geometry is estimated, match
-  // again along it, which keeps more of the correct matches (Sceaux 4x: 44274 verified matches
-  // instead of 30437, +30 % observations per photo) at about twice the matching time. More
-  // observations near the image borders constrain focal length and distortion better (Sceaux:
-  // focal +1.6 % instead of +2.2 % with SIMPLE_RADIAL).
+  // COLMAP's --SiftMatching.guided_matching: once a pair's two-view geometry is estimated, match
+  // again along it, which keeps more correct matches (Sceaux 4x: 44274 verified matches instead
+  // of 30437, 1972 observations per photo instead of 1524) at about twice the matching time. The
+  // extra observations constrain focal length and distortion better: Sceaux's focal +1.59 %
+  // instead of +2.16 % (SIMPLE_RADIAL, same features), +2.12 % instead of +2.77 % (RADIAL).
   bool guided_matching = true;
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's

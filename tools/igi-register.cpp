@@ -13,9 +13,10 @@
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
 // COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
-// instead). Exit 3 when some photos did not register (listed in report.json); exit 1 when COLMAP
-// is missing, of another version than 3.8, or reconstructs nothing; exit 2 for bad input
-// (nothing written).
+// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL), with
+// guided matching unless --no-guided-matching (recon/colmap_runner.h says why). Exit 3 when some
+// photos did not register (listed in report.json); exit 1 when COLMAP is missing, of another
+// version than 3.8, or reconstructs nothing; exit 2 for bad input (nothing written).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
