@@ -44,7 +44,12 @@ struct ColmapRunOptions {
   // of 30437, 1972 observations per photo instead of 1524) at about twice the matching time. The
   // extra observations constrain focal length and distortion better: Sceaux's focal +1.59 %
   // instead of +2.16 % (SIMPLE_RADIAL, same features), +2.12 % instead of +2.77 % (RADIAL).
-  bool guided_matching = true;
+  // nullopt (the default): on when self-calibrating, off with known `intrinsics` (where it was
+  // not shown to help: the synthetic room's registration test, one run with it on, took
+  // igi-register 413 s (on the loaded shared machine; 160-275 s measured without it) and left the
+  // worst pose at 0.042 degrees / 2.8 mm instead of 0.015-0.022 degrees / 0.8-1.5 mm).
+  std::optional<bool> guided_matching;
+  bool UseGuidedMatching() const { return guided_matching.value_or(!intrinsics.has_value()); }
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share

@@ -79,19 +79,22 @@ TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
   ColmapRunOptions options;
   options.executable = fake.string();
   EXPECT_EQ(options.camera_model, "SIMPLE_RADIAL");
-  EXPECT_TRUE(options.guided_matching);
+  EXPECT_TRUE(options.UseGuidedMatching());  // self-calibrating
   options.camera_model = "RADIAL";
   EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);  // nothing mapped
   const std::string log = ReadFileToString(dir / "work" / "colmap.log");
   EXPECT_NE(log.find("--ImageReader.camera_model RADIAL"), std::string::npos) << log;
   EXPECT_NE(log.find("--SiftMatching.guided_matching 1"), std::string::npos) << log;
-  options.guided_matching = false;
   options.intrinsics = KnownIntrinsics{"PINHOLE", 640, 480, {500, 500, 320, 240}};
   EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
   const std::string known = ReadFileToString(dir / "work" / "colmap.log");
   EXPECT_NE(known.find("--ImageReader.camera_model PINHOLE"), std::string::npos) << known;
   EXPECT_EQ(known.find("--ImageReader.camera_model RADIAL"), std::string::npos) << known;
   EXPECT_NE(known.find("--SiftMatching.guided_matching 0"), std::string::npos) << known;
+  options.guided_matching = true;  // asked for with known intrinsics
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
+  const std::string asked = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(asked.find("--SiftMatching.guided_matching 1"), std::string::npos) << asked;
   options.camera_model = "FULL_OPENCV";
   EXPECT_THROW(options.Validate(), InputError);
   fs::remove_all(dir);
