@@ -106,7 +106,7 @@ std::vector<std::string> MatcherArgs(const std::filesystem::path& db, const Colm
           "--SiftMatching.num_threads",
           Threads(o.threads),
           "--SiftMatching.guided_matching",
-          o.UseGuidedMatching() ? "1" : "0"};
+          o.guided_matching ? "1" : "0"};
 }
 
 std::vector<std::string> MapperArgs(const std::filesystem::path& images_dir,

@@ -41,15 +41,13 @@ struct ColmapRunOptions {
   std::string camera_model = "SIMPLE_RADIAL";
   // COLMAP's --SiftMatching.guided_matching: once a pair's two-view geometry is estimated, match
   // again along it, which keeps more correct matches (Sceaux 4x: 44274 verified matches instead
-  // of 30437, 1972 observations per photo instead of 1524) at about twice the matching time. The
-  // extra observations constrain focal length and distortion better: Sceaux's focal +1.59 %
-  // instead of +2.16 % (SIMPLE_RADIAL, same features), +2.12 % instead of +2.77 % (RADIAL).
-  // nullopt (the default): on when self-calibrating, off with known `intrinsics` (where it was
-  // not shown to help: the synthetic room's registration test, one run with it on, took
-  // igi-register 413 s (on the loaded shared machine; 160-275 s measured without it) and left the
-  // worst pose at 0.042 degrees / 2.8 mm instead of 0.015-0.022 degrees / 0.8-1.5 mm).
-  std::optional<bool> guided_matching;
-  bool UseGuidedMatching() const { return guided_matching.value_or(!intrinsics.has_value()); }
+  // of 30437). On the Sceaux photos downscaled 4x the self-calibrated focal came closer to K.txt
+  // (+1.59 % instead of +2.16 % with SIMPLE_RADIAL, +2.12 % instead of +2.77 % with RADIAL), but
+  // at full size hardly (+2.21 % instead of +2.30 %) for 2.4x the matching time (1447 s instead
+  // of 600 s on 2 loaded cores), and with known intrinsics it was not better (the synthetic room:
+  // worst pose 0.042 degrees / 2.8 mm instead of 0.015-0.022 / 0.8-1.5 mm, one run). Off by
+  // default (COLMAP's default); bench/RESULTS.md "Registration".
+  bool guided_matching = false;
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share

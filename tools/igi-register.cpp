@@ -13,11 +13,10 @@
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
 // COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
-// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL), with
-// guided matching (--guided-matching auto|on|off; auto = on without --camera; recon/
-// colmap_runner.h says why). Exit 3 when some
-// photos did not register (listed in report.json); exit 1 when COLMAP is missing, of another
-// version than 3.8, or reconstructs nothing; exit 2 for bad input (nothing written).
+// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL);
+// --guided-matching turns on COLMAP's guided matching (recon/colmap_runner.h: what it does). Exit 3
+// when some photos did not register (listed in report.json); exit 1 when COLMAP is missing, of
+// another version than 3.8, or reconstructs nothing; exit 2 for bad input (nothing written).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -233,7 +232,7 @@ igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
   report["models_reconstructed"] = run.num_models;
   report["known_intrinsics"] = !args.camera.empty();
   if (args.colmap_model.empty()) {
-    report["colmap_guided_matching"] = args.colmap.UseGuidedMatching();
+    report["colmap_guided_matching"] = args.colmap.guided_matching;
     if (args.camera.empty()) report["self_calibrated_model"] = args.colmap.camera_model;
   }
   igi::Json cameras = igi::Json::array();
@@ -449,7 +448,6 @@ int main(int argc, char** argv) {
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
   Args args;
-  std::string guided_matching = "auto";
   app.add_option("--images", args.images, "Folder of photos")->required();
   app.add_option("--out", args.out, "Output folder")->required();
   app.add_option("--scene", args.scene, "scene.json whose frame the poses are brought into");
@@ -465,10 +463,9 @@ int main(int argc, char** argv) {
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
                  "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
       ->check(CLI::IsMember(igi::kSelfCalibratedModels));
-  app.add_option("--guided-matching", guided_matching,
-                 "Match each photo pair again along its epipolar geometry (more correct matches, "
-                 "about twice the matching time): auto (default: on without --camera), on, off")
-      ->check(CLI::IsMember({"auto", "on", "off"}));
+  app.add_flag("--guided-matching", args.colmap.guided_matching,
+               "COLMAP matches each photo pair again along its epipolar geometry (more correct "
+               "matches, 2-2.4x the matching time)");
   app.add_flag(
       "--no-mesh-fit", args.no_mesh_fit,
       "With --scene: align by --markers only, without fitting the sparse points to the mesh");
@@ -491,8 +488,5 @@ int main(int argc, char** argv) {
   app.add_flag("--multi-camera", args.multi_camera, "One camera per photo (default: one shared)");
   app.add_flag("--allow-other-colmap", args.colmap.allow_other_version,
                "Accept a COLMAP other than 3.8");
-  return igi::RunMain(app, flags, argc, argv, [&]() -> int {
-    if (guided_matching != "auto") args.colmap.guided_matching = guided_matching == "on";
-    return Run(args, flags);
-  });
+  return igi::RunMain(app, flags, argc, argv, [&]() -> int { return Run(args, flags); });
 }

@@ -105,7 +105,7 @@ TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--colmap-model"), std::string::npos) << r.err;
   for (const std::string flag : {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3",
-                                 "--camera-model FULL_OPENCV", "--guided-matching yes"}) {
+                                 "--camera-model FULL_OPENCV"}) {
     r = RunTool("igi-register", base + " " + flag);
     EXPECT_EQ(r.exit_code, 2) << flag << ": " << r.err;
   }
