@@ -90,8 +90,23 @@ std::vector<std::string> ExtractorArgs(const std::filesystem::path& images_dir,
   if (o.intrinsics) {
     a.insert(a.end(), {"--ImageReader.camera_model", o.intrinsics->model,
                        "--ImageReader.camera_params", ParamsList(o.intrinsics->params)});
+  } else {
+    a.insert(a.end(), {"--ImageReader.camera_model", o.camera_model});
   }
   return a;
+}
+
+std::vector<std::string> MatcherArgs(const std::filesystem::path& db, const ColmapRunOptions& o) {
+  return {o.executable,
+          "exhaustive_matcher",
+          "--database_path",
+          db.string(),
+          "--SiftMatching.use_gpu",
+          "0",
+          "--SiftMatching.num_threads",
+          Threads(o.threads),
+          "--SiftMatching.guided_matching",
+          o.guided_matching ? "1" : "0"};
 }
 
 std::vector<std::string> MapperArgs(const std::filesystem::path& images_dir,
@@ -133,12 +148,20 @@ std::pair<ColmapModel, int> LargestModel(const std::filesystem::path& models) {
 
 }  // namespace
 
+const std::vector<std::string> kSelfCalibratedModels = {"SIMPLE_PINHOLE", "PINHOLE",
+                                                        "SIMPLE_RADIAL", "RADIAL", "OPENCV"};
+
 void ColmapRunOptions::Validate() const {
   ProblemList problems;
   if (executable.empty()) problems.Add("", "--colmap", "", "must name the colmap executable");
   if (threads < 0) problems.Add("", "--threads", std::to_string(threads), "must be >= 0");
   if (min_pose_inliers < 6) {
     problems.Add("", "--min-pose-inliers", std::to_string(min_pose_inliers), "must be >= 6");
+  }
+  if (std::find(kSelfCalibratedModels.begin(), kSelfCalibratedModels.end(), camera_model) ==
+      kSelfCalibratedModels.end()) {
+    problems.Add("", "--camera-model", camera_model,
+                 "must be one of " + Join(kSelfCalibratedModels, ", "));
   }
   if (max_image_size < 100) {
     problems.Add("", "--max-image-size", std::to_string(max_image_size), "must be >= 100");
@@ -206,10 +229,7 @@ ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
   summary.log = work_dir / "colmap.log";
   std::filesystem::remove(summary.log);
   RunStep("feature_extractor", ExtractorArgs(images_dir, db, options), summary.log);
-  RunStep("exhaustive_matcher",
-          {options.executable, "exhaustive_matcher", "--database_path", db.string(),
-           "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", Threads(options.threads)},
-          summary.log);
+  RunStep("exhaustive_matcher", MatcherArgs(db, options), summary.log);
   // COLMAP 3.8's mapper exits 1 when no image pair has enough matches: that, like an empty
   // output, is "reconstructed nothing".
   spdlog::info("colmap mapper …");

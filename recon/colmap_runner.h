@@ -1,6 +1,8 @@
 #pragma once
 // Runs COLMAP 3.8's command line headless (CPU SIFT, exhaustive matching, incremental mapping) on
-// a folder of photos and reads the largest reconstruction back.
+// a folder of photos and reads the largest reconstruction back. Without known intrinsics COLMAP
+// self-calibrates `camera_model` (focal length and distortion refined in its bundle
+// adjustments, principal point held at the image centre).
 //
 // Failures are reported, not hidden: a missing `colmap` executable or a version other than 3.8
 // (igi::Error, exit 1, naming what was found), a step that fails (its log file is named), and a
@@ -30,6 +32,22 @@ struct ColmapRunOptions {
   bool single_camera = true;          // one camera shared by every photo
   int max_image_size = 3200;          // SIFT extraction downscales larger photos (COLMAP default)
   std::optional<KnownIntrinsics> intrinsics;
+  // The COLMAP camera model self-calibrated when `intrinsics` is not given (ignored with it):
+  // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. Measured on the Sceaux photos
+  // (downscaled 4x, one database, focal error against K.txt; bench/RESULTS.md "Registration"):
+  // SIMPLE_RADIAL +2.16 %, RADIAL +2.77 %, OPENCV +2.65/+2.83 %, SIMPLE_PINHOLE +5.85 % (the lens
+  // has barrel distortion). Each extra distortion term trades off against the focal length (11
+  // photos of one facade do not separate them), so the one-parameter model is the default.
+  std::string camera_model = "SIMPLE_RADIAL";
+  // COLMAP's --SiftMatching.guided_matching: once a pair's two-view geometry is estimated, match
+  // again along it, which keeps more correct matches (Sceaux 4x: 44274 verified matches instead
+  // of 30437). On the Sceaux photos downscaled 4x the self-calibrated focal came closer to K.txt
+  // (+1.59 % instead of +2.16 % with SIMPLE_RADIAL, +2.12 % instead of +2.77 % with RADIAL), but
+  // at full size hardly (+2.21 % instead of +2.30 %) for 2.4x the matching time (1447 s instead
+  // of 600 s on 2 loaded cores), and with known intrinsics it was not better (the synthetic room:
+  // worst pose 0.042 degrees / 2.8 mm instead of 0.015-0.022 / 0.8-1.5 mm, one run). Off by
+  // default (COLMAP's default); bench/RESULTS.md "Registration".
+  bool guided_matching = false;
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share
@@ -41,6 +59,9 @@ struct ColmapRunOptions {
 
   void Validate() const;
 };
+
+// The COLMAP camera models ColmapRunOptions::camera_model accepts (those recon/camera.h reads).
+extern const std::vector<std::string> kSelfCalibratedModels;
 
 struct ColmapRunSummary {
   std::string version;                    // e.g. "3.8"

@@ -13,9 +13,10 @@
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
 // COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
-// instead). Exit 3 when some photos did not register (listed in report.json); exit 1 when COLMAP
-// is missing, of another version than 3.8, or reconstructs nothing; exit 2 for bad input
-// (nothing written).
+// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL);
+// --guided-matching turns on COLMAP's guided matching (recon/colmap_runner.h: what it does). Exit 3
+// when some photos did not register (listed in report.json); exit 1 when COLMAP is missing, of
+// another version than 3.8, or reconstructs nothing; exit 2 for bad input (nothing written).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -230,6 +231,10 @@ igi::Json BaseReport(const igi::ColmapRunSummary& run, const Args& args) {
   report["unregistered"] = run.unregistered;
   report["models_reconstructed"] = run.num_models;
   report["known_intrinsics"] = !args.camera.empty();
+  if (args.colmap_model.empty()) {
+    report["colmap_guided_matching"] = args.colmap.guided_matching;
+    if (args.camera.empty()) report["self_calibrated_model"] = args.colmap.camera_model;
+  }
   igi::Json cameras = igi::Json::array();
   for (const auto& [id, cam] : run.model.cameras) {
     cameras.push_back({{"camera_id", id}, {"model", cam.model}, {"params", cam.params}});
@@ -454,6 +459,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(6, 1000000));
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
+  app.add_option("--camera-model", args.colmap.camera_model,
+                 "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
+                 "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
+      ->check(CLI::IsMember(igi::kSelfCalibratedModels));
+  app.add_flag("--guided-matching", args.colmap.guided_matching,
+               "COLMAP matches each photo pair again along its epipolar geometry (more correct "
+               "matches, 2-2.4x the matching time)");
   app.add_flag(
       "--no-mesh-fit", args.no_mesh_fit,
       "With --scene: align by --markers only, without fitting the sparse points to the mesh");

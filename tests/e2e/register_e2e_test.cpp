@@ -94,8 +94,8 @@ TEST(RegisterE2eTest, MarkersNamingPointsTheSceneLacksExit2) {
 }
 
 // The joint refinement's and the model's flags: a --colmap-model that is not a folder, a
-// non-positive --marker-sigma or --mesh-sigma, too few --min-pose-inliers. Exit 2, nothing
-// written.
+// non-positive --marker-sigma or --mesh-sigma, too few --min-pose-inliers, a --camera-model
+// igi cannot read. Exit 2, nothing written.
 TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
   const fs::path dir = test::UniqueTempDir("igi_register_e2e");
   const fs::path out = dir / "out";
@@ -104,7 +104,8 @@ TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
   auto r = RunTool("igi-register", base + " --colmap-model " + Quote((dir / "none").string()));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--colmap-model"), std::string::npos) << r.err;
-  for (const std::string flag : {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3"}) {
+  for (const std::string flag : {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3",
+                                 "--camera-model FULL_OPENCV"}) {
     r = RunTool("igi-register", base + " " + flag);
     EXPECT_EQ(r.exit_code, 2) << flag << ": " << r.err;
   }

@@ -14,6 +14,7 @@
 #include "recon/registration.h"
 #include "tests/e2e/run.h"
 #include "tests/temp_dir.h"
+#include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
@@ -66,9 +67,44 @@ TEST(ColmapRunnerTest, MissingOrWrongColmapIsReported) {
   fs::remove_all(dir);
 }
 
-// Every Sceaux photo registers, and the focal length COLMAP estimates (not given the
-// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) is
-// close to K.txt.
+// The self-calibrated camera model and guided matching reach COLMAP's command line (a fake
+// COLMAP that logs its arguments and reconstructs nothing); a model igi cannot read is refused
+// before anything runs.
+TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
+  const fs::path dir = test::UniqueTempDir("igi_colmap_runner_args");
+  const fs::path fake = dir / "fake-colmap";
+  std::ofstream(fake) << "#!/bin/sh\necho 'COLMAP 3.8 -- Structure-from-Motion'\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  fs::create_directories(dir / "images");
+  ColmapRunOptions options;
+  options.executable = fake.string();
+  EXPECT_EQ(options.camera_model, "SIMPLE_RADIAL");
+  EXPECT_FALSE(options.guided_matching);
+  options.guided_matching = true;
+  options.camera_model = "RADIAL";
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);  // nothing mapped
+  const std::string log = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(log.find("--ImageReader.camera_model RADIAL"), std::string::npos) << log;
+  EXPECT_NE(log.find("--SiftMatching.guided_matching 1"), std::string::npos) << log;
+  options.guided_matching = false;
+  options.intrinsics = KnownIntrinsics{"PINHOLE", 640, 480, {500, 500, 320, 240}};
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
+  const std::string known = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(known.find("--ImageReader.camera_model PINHOLE"), std::string::npos) << known;
+  EXPECT_EQ(known.find("--ImageReader.camera_model RADIAL"), std::string::npos) << known;
+  EXPECT_NE(known.find("--SiftMatching.guided_matching 0"), std::string::npos) << known;
+  options.guided_matching = true;  // with known intrinsics too
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
+  const std::string asked = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(asked.find("--SiftMatching.guided_matching 1"), std::string::npos) << asked;
+  options.camera_model = "FULL_OPENCV";
+  EXPECT_THROW(options.Validate(), InputError);
+  fs::remove_all(dir);
+}
+
+// Every Sceaux photo registers, and the focal length COLMAP self-calibrates (not given the
+// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) with
+// igi's defaults (SIMPLE_RADIAL, no guided matching) is close to K.txt.
 TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   const fs::path dir = test::UniqueTempDir("igi_colmap_sceaux");
   WriteDownscaledSceaux(dir / "images");
@@ -82,9 +118,11 @@ TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   const double expected = kFocalFullPx / kDownscale;
   std::printf("Sceaux: %s focal %.2f px, K.txt %.2f px (%.2f %%)\n", camera.model.c_str(),
               camera.params[0], expected, 100 * (camera.params[0] / expected - 1));
-  // Issue 6 asks for 2 %; COLMAP 3.8's SIMPLE_RADIAL self-calibration measures +2.06 % here
-  // (+2.21 % at half size), so the requirement is NOT met yet and this checks 3 % to catch
-  // regressions. See the issue for what is left (a fuller camera model or the full-size photos).
+  // Issue 6 asks for 2 %, which igi does NOT reach on the full-size photos, so this checks 3 % to
+  // catch regressions. Measured (bench/RESULTS.md "Registration"): here with the defaults
+  // +1.9..+2.2 %; with guided matching +1.65, +1.75, +1.86 % (three runs of this test) but at
+  // full size +2.21 % (+2.30 % without); RADIAL / OPENCV +2.1..+2.8 % (the extra distortion terms
+  // trade off against the focal length). K.txt itself may be good to no better than 1-2 %.
   EXPECT_NEAR(camera.params[0], expected, 0.03 * expected);
   for (const ImageReprojection& r : ReprojectionErrors(run.model)) {
     EXPECT_GT(r.observations, 50) << r.name;
