@@ -80,8 +80,8 @@ int main(int argc, char** argv) {
   app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
   app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();
   app.add_option("--demo-calibration", demo.calibration,
-                 "--demo: the HDR maps' absolute scale: reference (solved from a region of known "
-                 "reflectance), measured (given, as a lab calibration) or none")
+                 "--demo: the HDR maps' absolute scale: measured (given, as a lab calibration), "
+                 "reference (solved from the matte box, its reflectance given) or none")
       ->capture_default_str();
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     o.photos_dir = photos;
