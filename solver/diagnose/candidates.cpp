@@ -435,6 +435,8 @@ double WardLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen
   return std::exp(-tan2 / (alpha * alpha)) / (4 * kPi * alpha * alpha * std::sqrt(ci * co));
 }
 
+}  // namespace
+
 CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFitter& f,
                                    int region) {
   CandidateResult out;
@@ -472,15 +474,23 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
       "its normal, a highlight: a Ward lobe with rho_s ~ {:.3f}, alpha ~ {:.2f} explains it",
       name, rho_s, best_alpha);
   out.valid = true;
-  out.apply = [name](Json* doc) {
+  // Where the region's albedo is declared (materials given, nothing is solved), the lobe gets the
+  // fitted values; otherwise igi-solve fits them with the albedo.
+  out.apply = [name, rho_s, alpha = best_alpha](Json* doc) {
     Json& m = (*doc)["materials"][name];
     Json fresh = {{"brdf", "ward"}};
     if (m.contains("rho_d")) fresh["rho_d"] = m["rho_d"];
     if (m.contains("rho_d_map")) fresh["rho_d_map"] = m["rho_d_map"];
+    if (fresh.contains("rho_d") || fresh.contains("rho_d_map")) {
+      fresh["rho_s"] = rho_s;
+      fresh["alpha"] = alpha;
+    }
     m = fresh;
   };
   return out;
 }
+
+namespace {
 
 // Ward-GMD's colourless specular factor (CONTRACT.md §2), h = l + v unnormalised.
 double GmdLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,

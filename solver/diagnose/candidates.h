@@ -51,6 +51,13 @@ struct ResidualFit;
 // Copies a fit's predicted squared-error sums and significance into a candidate.
 void FillScores(const ResidualFit& fit, CandidateResult* out);
 
+class ResidualFitter;
+// specular_reflection for `region` (declared diffuse): a Ward lobe whose ρs and α best explain
+// the residual. Its apply() writes brdf "ward", with the fitted ρs and α where the region's
+// albedo is declared (nothing is solved then), without them otherwise (igi-solve fits them).
+CandidateResult SpecularReflection(const CandidateContext& context, const ResidualFitter& fitter,
+                                   int region);
+
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).
 std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
