@@ -35,6 +35,26 @@ constexpr int kMaxFitSamples = 6000;  // per region and stage (highlight pixels 
 // ---------------------------------------------------------------------------------------------
 // Set-up: materials, photos, observations, patches, gathering.
 
+// Everything before the rays: patches, materials, photos, observations, fit samples, texel size
+// and highlight coverage.
+void SolverState::Prepare() {
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
+  for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  summary.scene_diagonal_m = (hi - lo).norm();
+  summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
+  patches = BuildPatches(scene.mesh, summary.patch_size_m);
+  summary.patches = patches.size();
+  InitMaterials();
+  summary.regions.resize(scene.materials.size());
+  BuildLightingScenes();
+  LoadPhotos();
+  CollectAllObservations();
+  SummariseRegions();
+  SelectFitSamples();
+  ChooseTexelSize();
+  AnalyseCoverage();
+}
+
 void SolverState::InitMaterials() {
   const size_t n = scene.materials.size();
   materials.resize(n);

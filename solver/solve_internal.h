@@ -74,6 +74,7 @@ struct SolverState {
   SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
 
   // solve.cpp
+  void Prepare();  // everything before the rays (Solve() then gathers and fits)
   void InitMaterials();
   void LoadPhotos();
   void ApplyPhotoModelAndHoldout(int photo);

@@ -277,21 +277,7 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
     throw InputError(DescribeProblem(scene.file.string(), "photos", "[]",
                                      "the solver needs at least one photo"));
   }
-  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
-  for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  s.summary.scene_diagonal_m = (hi - lo).norm();
-  s.summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
-  s.patches = BuildPatches(scene.mesh, s.summary.patch_size_m);
-  s.summary.patches = s.patches.size();
-  s.InitMaterials();
-  s.summary.regions.resize(scene.materials.size());
-  s.BuildLightingScenes();
-  s.LoadPhotos();
-  s.CollectAllObservations();
-  s.SummariseRegions();
-  s.SelectFitSamples();
-  s.ChooseTexelSize();
-  s.AnalyseCoverage();
+  s.Prepare();
   if (options.photo_scale == "solve") PhotoScaleReferenceRegions(s);  // before the rays
   s.GatherAll();
   if (options.photo_scale == "solve") {
