@@ -17,7 +17,6 @@
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
 #include "solver/solve_internal.h"
-#include "solver/photo_model.h"
 #include "solver/surface_hit.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
@@ -26,7 +25,9 @@ namespace igi {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 constexpr int kMaxFitSamples = 6000;  // per region and stage (highlight pixels always kept)
 
@@ -184,19 +185,18 @@ void SolverState::CollectAllObservations() {
   summary.photos.resize(scene.photos.size());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
     const Image* mask = mask_images[i] ? &*mask_images[i] : nullptr;
-    std::vector<Observation> o =
-        CollectObservations(scene, int(i), photo_images[i], mask,
-                            *lighting_scenes[scene.photos[i].lighting], patches, oo,
-                            &summary.photos[i]);
+    std::vector<Observation> o = CollectObservations(scene, int(i), photo_images[i], mask,
+                                                     *lighting_scenes[scene.photos[i].lighting],
+                                                     patches, oo, &summary.photos[i]);
     const PhotoObservationStats& st = summary.photos[i];
     if (o.empty()) {
       problems.Add(scene.file.string(), "photos[" + std::to_string(i) + "]",
                    scene.photos[i].file.string(),
-                   "no valid pixel (" + std::to_string(st.pixels) + " looked at: " +
-                       std::to_string(st.masked) + " masked, " + std::to_string(st.clipped) +
-                       " clipped, " + std::to_string(st.invalid) + " non-finite or negative, " +
-                       std::to_string(st.background) + " see no reflective surface, " +
-                       std::to_string(st.edge) + " on edges)");
+                   "no valid pixel (" + std::to_string(st.pixels) +
+                       " looked at: " + std::to_string(st.masked) + " masked, " +
+                       std::to_string(st.clipped) + " clipped, " + std::to_string(st.invalid) +
+                       " non-finite or negative, " + std::to_string(st.background) +
+                       " see no reflective surface, " + std::to_string(st.edge) + " on edges)");
     }
     obs.insert(obs.end(), o.begin(), o.end());
   }
@@ -233,7 +233,8 @@ void SolverState::SelectFitSamples() {
       in_fit[near[r][k * std::max<size_t>(1, near[r].size() / (kMaxFitSamples * 2 / 3))]] = 1;
     }
     const size_t budget = kMaxFitSamples - std::min<size_t>(near[r].size(), kMaxFitSamples * 2 / 3);
-    const size_t step = std::max<size_t>(1, (rest[r].size() + budget - 1) / std::max<size_t>(1, budget));
+    const size_t step =
+        std::max<size_t>(1, (rest[r].size() + budget - 1) / std::max<size_t>(1, budget));
     for (size_t k = 0; k < rest[r].size(); k += step) in_fit[rest[r][k]] = 1;
   }
 }
@@ -301,7 +302,8 @@ void SolverState::BuildPatchLobes(LightingState* st) const {
         DirectSample rep;
         rep.value.setZero();
         Eigen::Vector3f dir = Eigen::Vector3f::Zero();
-        for (int k = gp.direct_begin + g * n / groups; k < gp.direct_begin + (g + 1) * n / groups; ++k) {
+        for (int k = gp.direct_begin + g * n / groups; k < gp.direct_begin + (g + 1) * n / groups;
+             ++k) {
           const DirectSample& d = st->gather.direct[k];
           rep.value += d.value;
           dir += d.wi * d.value.sum();
@@ -359,7 +361,8 @@ void SolverState::UpdatePatchRadiance(LightingState* st) {
       if (count[q] > 0) {
         st->patch_d[q] = (sum[q] / count[q]).cast<float>();
       } else if (IsReflective(materials[patches.patch_region[q]].params.model)) {
-        st->patch_d[q] = (PatchAlbedo(q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi).cast<float>();
+        st->patch_d[q] =
+            (PatchAlbedo(q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi).cast<float>();
       } else {
         st->patch_d[q].setZero();
       }
@@ -427,7 +430,8 @@ void SolverState::ChooseTexelSize() {
     summary.texel_size_m = 0.01;
     return;
   }
-  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
+  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
+                   footprints.end());
   summary.texel_size_m = std::max(1e-4, footprints[footprints.size() / 2]);
 }
 
@@ -441,9 +445,10 @@ void SolverState::AnalyseCoverage() {
     m.no_highlight = true;
     m.params.rho_s.setZero();
     summary.regions[c.region].status = "no_highlight";
-    spdlog::warn("region {}: no photo shows its highlight; rho_s and alpha cannot be recovered "
-                 "(rho_s held at 0)",
-                 c.name);
+    spdlog::warn(
+        "region {}: no photo shows its highlight; rho_s and alpha cannot be recovered "
+        "(rho_s held at 0)",
+        c.name);
   }
 }
 
@@ -457,7 +462,8 @@ void SolverState::FinishRegions() {
       for (const MaterialState& m : materials) {
         if (m.reflective && m.observations > 0) mean += m.params.rho_d, ++n;
       }
-      materials[r].params.rho_d = n > 0 ? Eigen::Vector3d(mean / n) : Eigen::Vector3d::Constant(0.5);
+      materials[r].params.rho_d =
+          n > 0 ? Eigen::Vector3d(mean / n) : Eigen::Vector3d::Constant(0.5);
       if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
     }
     rs.final_params = materials[r].params;

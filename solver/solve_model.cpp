@@ -161,13 +161,15 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
   for (size_t i = 0; i < obs.size(); ++i) {
     const Observation& o = obs[i];
     PhotoResidual& pr = summary.residuals[o.photo];
-    const int x = std::min(o.x / stride, pr.photo.width - 1), y = std::min(o.y / stride, pr.photo.height - 1);
+    const int x = std::min(o.x / stride, pr.photo.width - 1),
+              y = std::min(o.y / stride, pr.photo.height - 1);
     for (int c = 0; c < 3; ++c) {
       pr.photo.at(x, y, c) = o.radiance[c];
       pr.render.at(x, y, c) = float(pred[i][c]);
       pr.residual.at(x, y, c) = float(pred[i][c] - o.radiance[c]);
     }
-    const double d = (pred1[i] - o.radiance.cast<double>()).dot(pred2[i] - o.radiance.cast<double>());
+    const double d =
+        (pred1[i] - o.radiance.cast<double>()).dot(pred2[i] - o.radiance.cast<double>());
     const double p2 = o.radiance.cast<double>().squaredNorm();
     num[o.photo] += d, den[o.photo] += p2, all_num += d, all_den += p2;
   }
@@ -180,17 +182,20 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
   // Standard error of the squared residual, from the spread of the per-pixel terms.
   double mean = all_num / std::max<size_t>(1, obs.size()), var = 0;
   for (size_t i = 0; i < obs.size(); ++i) {
-    const double d = (pred1[i] - obs[i].radiance.cast<double>()).dot(pred2[i] - obs[i].radiance.cast<double>());
+    const double d =
+        (pred1[i] - obs[i].radiance.cast<double>()).dot(pred2[i] - obs[i].radiance.cast<double>());
     var += (d - mean) * (d - mean);
   }
   const double se_sq = all_den > 0 ? std::sqrt(var) / all_den : 0.0;  // of residual²
   (stage == 1 ? summary.stage1_render_residual : summary.stage2_render_residual) = total;
-  (stage == 1 ? summary.stage1_render_residual_sq_se : summary.stage2_render_residual_sq_se) = se_sq;
+  (stage == 1 ? summary.stage1_render_residual_sq_se : summary.stage2_render_residual_sq_se) =
+      se_sq;
   if (stage == 1) {
     summary.stage2_render_residual = total;
     summary.stage2_render_residual_sq_se = se_sq;
   }
-  summary.seconds_rays += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds_rays +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("stage {} model rendered at the observed pixels: relative rms {:.4f}", stage, total);
 }
 
@@ -230,7 +235,8 @@ void SolverState::RunStage2() {
     // The refinement's parameters are kept only if the photos are not explained worse than by
     // the paper's (beyond twice the standard error of the comparison).
     const double r1 = summary.stage1_render_residual, r2 = summary.stage2_render_residual;
-    const double se = std::hypot(summary.stage1_render_residual_sq_se, summary.stage2_render_residual_sq_se);
+    const double se =
+        std::hypot(summary.stage1_render_residual_sq_se, summary.stage2_render_residual_sq_se);
     summary.refinement_accepted = r2 * r2 <= r1 * r1 + 2 * se;
     if (!summary.refinement_accepted) {
       for (size_t r = 0; r < materials.size(); ++r) {
@@ -239,9 +245,10 @@ void SolverState::RunStage2() {
         materials[r].last_fit = stage1[r].last_fit;
       }
       ComputeSpecularTerms();
-      spdlog::warn("the refinement explains the photos worse ({:.4f} vs {:.4f}): the paper stage's "
-                   "parameters are kept",
-                   r2, r1);
+      spdlog::warn(
+          "the refinement explains the photos worse ({:.4f} vs {:.4f}): the paper stage's "
+          "parameters are kept",
+          r2, r1);
     }
   }
 }
@@ -253,8 +260,8 @@ void SolverState::BuildAlbedoMaps() {
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
-    const bool want = options.albedo_maps == "all" ||
-                      (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
+    const bool want =
+        options.albedo_maps == "all" || (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
     if (!want) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];

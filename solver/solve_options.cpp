@@ -26,8 +26,8 @@ void SolveOptions::Validate() const {
         std::to_string(max_iterations), "must be in [1, 100]");
   check(tolerance > 0 && tolerance < 1, "--tolerance", fmt::format("{}", tolerance),
         "must be in (0, 1)");
-  check(specular_colour == "grey" || specular_colour == "rgb", "--specular-colour",
-        specular_colour, "must be grey or rgb");
+  check(specular_colour == "grey" || specular_colour == "rgb", "--specular-colour", specular_colour,
+        "must be grey or rgb");
   check(albedo_maps == "auto" || albedo_maps == "all" || albedo_maps == "none", "--albedo-maps",
         albedo_maps, "must be auto, all or none");
   check(texel_size_m >= 0, "--texel-size-m", fmt::format("{}", texel_size_m),
@@ -36,6 +36,8 @@ void SolveOptions::Validate() const {
         std::to_string(refine_iterations), "must be in [0, 20]");
   check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),
         "must be in [1, 4096]");
+  check(refine_albedo_step > 0 && refine_albedo_step <= 1, "--refine-albedo-step",
+        std::to_string(refine_albedo_step), "must be in (0, 1]");
   check(photo_scale == "given" || photo_scale == "solve", "--photo-scale", photo_scale,
         "must be given or solve");
   check(holdout_fraction >= 0 && holdout_fraction < 1, "--holdout-fraction",

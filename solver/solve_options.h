@@ -39,6 +39,11 @@ struct SolveOptions {
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
+  // Share of each refinement round's albedo change that is applied. The rounds gather all
+  // indirect light from the model, whose albedos light the next fit, so full steps (1) swing
+  // about the answer; 0.5 steadies them on igi-synth's room (bench/RESULTS.md) but corrects a
+  // stage-1 bias more slowly, so it is an option, not the default.
+  double refine_albedo_step = 1.0;
   // The photos' absolute scale. "given": their values are radiance in the scene's units (after
   // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance
   // maps from a recovered response are known up to a constant) is estimated from the observed

@@ -360,10 +360,20 @@ double SolverState::FitAll(int stage, int iteration) {
     if (!f.fitted) continue;
     const BrdfParams old = m.params;
     if (m.unknown_rho_d) {
-      m.params.rho_d = f.rho_d;
+      // The refinement gathers all indirect light from the model, whose albedos then feed back
+      // on themselves: a full step can overshoot (too bright a model darkens the next albedos);
+      // --refine-albedo-step moves them only part of the way.
+      const double step = stage == 2 ? options.refine_albedo_step : 1.0;
+      auto blend = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+        return step < 1.0 && from.allFinite() && to.allFinite()
+                   ? Eigen::Vector3d(from + step * (to - from))
+                   : to;
+      };
+      m.params.rho_d = blend(old.rho_d, f.rho_d);
       for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
+        const Eigen::Vector3d before = m.patch_rho_d[s].allFinite() ? m.patch_rho_d[s] : old.rho_d;
         m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
-                               ? f.slot_rho_d[s]
+                               ? blend(before, f.slot_rho_d[s])
                                : Eigen::Vector3d::Constant(NAN);
       }
       change = std::max(change, RelChange(m.params.rho_d.mean(), old.rho_d.mean(), 0.01));
@@ -380,6 +390,12 @@ double SolverState::FitAll(int stage, int iteration) {
       change = std::max(change, RelChange(m.params.AlphaY(), old.AlphaY(), 0.005));
     }
     m.last_fit = f;
+    if (m.unknown_rho_d) {
+      m.last_fit.rho_d = m.params.rho_d;
+      for (size_t s = 0; s < m.patch_rho_d.size() && s < m.last_fit.slot_rho_d.size(); ++s) {
+        if (m.patch_rho_d[s].allFinite()) m.last_fit.slot_rho_d[s] = m.patch_rho_d[s];
+      }
+    }
     record.params[scene.materials[regions[k]].name] = ParamsJson(m);
     num += f.relative_rms * f.relative_rms * f.samples;
     den += f.samples;

@@ -12,9 +12,10 @@
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  CLI::App app{"igi-solve: recover per-region Ward parameters and albedo maps from calibrated "
-               "photos (Yu et al. 1999, then a joint refinement with the path tracer)",
-               "igi-solve"};
+  CLI::App app{
+      "igi-solve: recover per-region Ward parameters and albedo maps from calibrated "
+      "photos (Yu et al. 1999, then a joint refinement with the path tracer)",
+      "igi-solve"};
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
@@ -50,6 +51,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--refine-rays", o.refine_rays, "path-traced directions per observation")
       ->capture_default_str();
+  app.add_option("--refine-albedo-step", o.refine_albedo_step,
+                 "share of each refinement round's albedo change applied (1 = full step)")
+      ->capture_default_str();
   app.add_option("--photo-scale", o.photo_scale,
                  "given (photos in the scene's radiance units) or solve (one factor for all "
                  "photos, from the regions of known diffuse reflectance)")
@@ -73,10 +77,10 @@ int main(int argc, char** argv) {
       }
     }
     if (!common.quiet) {
-      std::cout << "solved " << summary.regions.size() << " regions from "
-                << summary.observations << " observations in " << summary.seconds_total
-                << " s: paper " << summary.stage1_render_residual << ", refined "
-                << summary.stage2_render_residual << " relative RMS; wrote " << out_dir << "\n";
+      std::cout << "solved " << summary.regions.size() << " regions from " << summary.observations
+                << " observations in " << summary.seconds_total << " s: paper "
+                << summary.stage1_render_residual << ", refined " << summary.stage2_render_residual
+                << " relative RMS; wrote " << out_dir << "\n";
     }
     if (!failed.empty()) throw igi::PartialError(failed);
     return 0;

@@ -75,6 +75,8 @@ int main(int argc, char** argv) {
       o.indirect_rays = int(v);
     else if (key == "dump")
       dump = v != 0;
+    else if (key == "step")
+      o.refine_albedo_step = v;
     else if (key == "smooth")
       o.smoothing_radius_m = v;
     else {
