@@ -30,11 +30,13 @@ struct DemoOptions {
   double stops = 2;
   bool skip_diagnose = false;
   int num_threads = 0;
-  // Overview cameras that look up at the ceiling (igi-synth --ceiling-cameras). A ceiling no
-  // photo sees keeps placeholder values (its light missing, the walls' rho_d come out +4..+14 %),
-  // but 0 here: with 2, neither registered (COLMAP matched none of their features, and they
-  // see one control point each, too few to pose them from the markers).
-  int ceiling_cameras = 0;
+  // Cameras that look up at the ceiling, on top of `cameras` (igi-synth gets cameras +
+  // ceiling_cameras, --ceiling-cameras ceiling_cameras: its last overview cameras look up). A
+  // ceiling no photo sees keeps a placeholder albedo, which removes light the rest of the room
+  // receives (measured without them: the walls' rho_d -7.5..+14.4 %). COLMAP matches no feature
+  // of theirs with the downward views; igi-register poses them from the surveyed targets on the
+  // ceiling and upper walls (markers.json, see demo.cpp SurveyedTargets).
+  int ceiling_cameras = 2;
   // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
   // which weakens every bounce; measured: rho_s/k -27..-29 %):
   //  - "reference": the capture holds a reference of known reflectance (the matte box, its
@@ -79,5 +81,13 @@ double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
 Json CompareWithTruth(const std::filesystem::path& solved_scene,
                       const std::filesystem::path& truth_json,
                       const std::vector<std::string>& given = {});
+
+// Compares the registered cameras (03-register/scene.json: one camera per photo, named after it)
+// with the true ones (truth/scene.json: camN for photo camN_LIGHTING): per photo the rotation
+// error (degrees) and the position error (metres), whether the true camera looks up (at the
+// ceiling), and how many photos were registered ("registered"; RunDemo adds "photos", the
+// capture's count).
+Json ComparePoses(const std::filesystem::path& registered_scene,
+                  const std::filesystem::path& truth_scene);
 
 }  // namespace igi
