@@ -4,6 +4,8 @@
 // solves and writes the report. Checked:
 // - the recovered parameters against truth.json, after the photometric scale k (the HDR maps'
 //   free constant, see pipeline/demo.h), within stated tolerances;
+// - the ceiling seen (2 cameras look up, posed from the surveyed targets) and solved; every photo
+//   registered, its pose near the true camera;
 // - resuming: with 04-solve deleted, a rerun keeps 00-03 (markers byte-identical, "kept") and
 //   redoes 04 onwards;
 // - report.html in headless Chromium: no console errors, every <img> decoded, a screenshot
@@ -35,15 +37,23 @@ using test::RunTool;
 // true radiance): the demo's photos are 8 spp renders, 3 brackets of 8 bits merged with a
 // recovered response (about 1 % in radiance), COLMAP poses refined with the control points, and
 // the camera's absolute calibration measured after 02-hdr (--radiance-scale). Measured
-// 2026-11-21: without the calibration ρd −4..+15 %, ρs −26..−31 %, α −14..+1 % (the HDR maps'
-// arbitrary scale weakened every bounce); with it (absolute, before k): ρd −7.5..+14 %, ρs
-// −0.6 % / −0.3 % / −8.3 %, α +0.2..+4 %. The bounds guard those sizes (the solver issue's
-// 1 %/5 % bars are not met end to end: the ceiling is seen by no photo). Regions no photo sees
-// ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
-// igi-solve and not compared.
-constexpr double kRhoDTolerance = 0.20;   // region-mean albedo after k
-constexpr double kRhoSTolerance = 0.20;   // specular reflectance after k (highlights only)
-constexpr double kAlphaTolerance = 0.15;  // lobe width (scale-free)
+// 2026-11-21 with the ceiling seen by no photo: ρd −7.5..+14 %, ρs −0.6 % / −0.3 % / −8.3 %,
+// α +0.2..+4 %. Measured 2026-11-22 with 2 ceiling cameras posed from the surveyed targets (after
+// k = 1.009): ρd −8.4..+5.6 % (ceiling −1.0 %, wall_x4 −8.4 %, the rest within 5.6 %), ρs
+// −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
+// textured floor): +16.4 %. The bounds guard those sizes (the solver issue's 1 %/5 % bars are
+// not met end to end). Regions no photo sees ("unobserved") and lobes whose highlight no photo
+// shows ("no_highlight") are reported by igi-solve and not compared.
+constexpr double kRhoDTolerance = 0.12;   // region-mean albedo after k
+constexpr double kRhoSTolerance = 0.10;   // specular reflectance after k (highlights only)
+constexpr double kAlphaTolerance = 0.20;  // lobe width (scale-free); the floor's is +16.4 %
+// The ceiling, seen by the 2 cameras that look up (measured −1.0 % after k, −0.1 % absolute;
+// 40 % low when no photo saw it and it kept a placeholder).
+constexpr double kCeilingRhoDTolerance = 0.05;
+// Registration against the true cameras (measured: COLMAP's poses within 0.011° and 0.6 mm; the
+// ceiling cameras, posed from the exact pixels of 13 markers, within 1e-4° and 0.01 mm).
+constexpr double kRotationToleranceDeg = 0.1;
+constexpr double kPositionToleranceM = 0.005;
 
 double Seconds(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -122,6 +132,30 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
     check("alpha", kAlphaTolerance);
   }
   EXPECT_GE(checked, 10);
+
+  // The ceiling seen and solved (not a placeholder): a region with its own observations, its
+  // albedo near the truth.
+  EXPECT_EQ(status["ceiling"], "solved");
+  EXPECT_GE(observations["ceiling"], 0.02 * all_observations);
+  bool ceiling_compared = false;
+  for (const Json& region : summary["regions"]) {
+    if (region["region"] != "ceiling" || !region.contains("rho_d")) continue;
+    ceiling_compared = true;
+    EXPECT_LT(std::abs(region["rho_d"]["relative_error"].get<double>()), kCeilingRhoDTolerance);
+  }
+  EXPECT_TRUE(ceiling_compared);
+
+  // Every photo registered (the cameras that look up included), each pose near the truth.
+  const Json& poses = summary.at("poses");
+  EXPECT_EQ(poses["photos"].get<int>(), 18);  // 16 cameras + 2 looking up, one lighting
+  EXPECT_EQ(poses["registered"], poses["photos"]);
+  int looking_up = 0;
+  for (const Json& c : poses["cameras"]) {
+    looking_up += c["looks_up"].get<bool>();
+    EXPECT_LT(c["rotation_error_deg"].get<double>(), kRotationToleranceDeg) << c["photo"];
+    EXPECT_LT(c["position_error_m"].get<double>(), kPositionToleranceM) << c["photo"];
+  }
+  EXPECT_GE(looking_up, 2);
 
   // Resume: 04-solve deleted; 00-03 kept (markers unchanged), 04-06 redone.
   std::map<std::string, std::string> markers;
