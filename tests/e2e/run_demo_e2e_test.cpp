@@ -6,8 +6,9 @@
 //   free constant, see pipeline/demo.h), within stated tolerances;
 // - the ceiling seen (2 cameras look up, posed from the surveyed targets) and solved; every photo
 //   registered, its pose near the true camera;
-// - resuming: with 04-solve deleted, a rerun keeps 00-03 (markers byte-identical, "kept") and
-//   redoes 04 onwards;
+// - resuming: with 05-diagnose (skipped here) deleted, a rerun keeps 00-04 (markers
+//   byte-identical, "kept") and redoes 05 onwards (06-report after it too; deleting 04-solve
+//   instead would cost another 6 min of CPU for the same check);
 // - report.html in headless Chromium: no console errors, every <img> decoded, a screenshot
 //   that is not blank.
 // Several minutes on 2 shared cores: LABELS slow.
@@ -171,12 +172,12 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   ASSERT_TRUE(summary.contains("solved_radiance_scale_error"));
   EXPECT_LT(std::abs(summary["solved_radiance_scale_error"].get<double>()), kSolvedScaleTolerance);
 
-  // Resume: 04-solve deleted; 00-03 kept (markers unchanged), 04-06 redone.
+  // Resume: 05-diagnose deleted; 00-04 kept (markers unchanged), 05-06 redone.
   std::map<std::string, std::string> markers;
-  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register"}) {
+  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register", "04-solve"}) {
     markers[s] = ReadFileToString(out / s / "stage.json");
   }
-  fs::remove_all(out / "04-solve");
+  fs::remove_all(out / "05-diagnose");
   t0 = std::chrono::steady_clock::now();
   r = RunTool("igi-run", args);
   std::printf("resumed run: %.0f s\n%s", Seconds(t0), r.out.c_str());
@@ -184,11 +185,12 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   for (const auto& [s, text] : markers) {
     EXPECT_EQ(ReadFileToString(out / s / "stage.json"), text) << s << " was redone";
   }
-  for (const char* s : {"01-response", "02-hdr", "03-register"}) {
+  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register", "04-solve"}) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string(s) + " +kept"))) << s << r.out;
   }
-  EXPECT_TRUE(std::regex_search(r.out, std::regex("04-solve +(done|partial)"))) << r.out;
-  EXPECT_TRUE(fs::exists(out / "04-solve" / "stage.json"));
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("05-diagnose +skipped"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("06-report +(done|partial)"))) << r.out;
+  EXPECT_TRUE(fs::exists(out / "05-diagnose" / "stage.json"));
 
   // The report in headless Chromium.
   const test::PageCheck page = test::CheckPageInChromium(out / "report.html", dir / "chromium");
