@@ -406,8 +406,10 @@ DemoSummary RunDemo(const DemoOptions& o) {
                       {"cpu_seconds", s.cpu_seconds}});
   }
   d.summary["stages"] = stages;
-  d.summary["capture"] = {{"cameras", o.cameras}, {"ceiling_cameras", o.ceiling_cameras}, {"width", o.width},       {"height", o.height},
-                          {"spp", o.spp},         {"brackets", o.brackets}, {"stops", o.stops}};
+  d.summary["capture"] = {{"cameras", o.cameras}, {"ceiling_cameras", o.ceiling_cameras},
+                          {"width", o.width},     {"height", o.height},
+                          {"spp", o.spp},         {"brackets", o.brackets},
+                          {"stops", o.stops}};
   WriteJsonFile(o.out / "demo_summary.json", d.summary);
   d.table.push_back(fmt::format("{:<14} {:<6} {:>9} {:>9} {:>8}", "region", "param", "truth",
                                 "solved/k", "error"));
@@ -429,7 +431,8 @@ DemoSummary RunDemo(const DemoOptions& o) {
   if (d.summary.contains("poses")) {
     const Json& p = d.summary["poses"];
     d.table.push_back(fmt::format(
-        "registered {} of {} photos; pose errors up to {:.3f} deg, {:.1f} mm (see demo_summary.json)",
+        "registered {} of {} photos; pose errors up to {:.3f} deg, {:.1f} mm (see "
+        "demo_summary.json)",
         p["registered"].get<int>(), p["photos"].get<int>(),
         p["max_rotation_error_deg"].get<double>(), 1000 * p["max_position_error_m"].get<double>()));
   }

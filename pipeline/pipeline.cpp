@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-
 #include <sys/resource.h>
 
 #include <chrono>
@@ -213,8 +212,7 @@ RunSummary RunPipeline(const RunOptions& options) {
         Since(t0),  UtcNow(), run.commands,
         run.details};
     WriteStageMarker(dir, m);
-    spdlog::info("{}: {} in {:.1f} s ({:.1f} s CPU)", stage.name, m.status, m.seconds,
-                 cpu_seconds);
+    spdlog::info("{}: {} in {:.1f} s ({:.1f} s CPU)", stage.name, m.status, m.seconds, cpu_seconds);
     summary.stages.push_back({stage.name, m.status, m.seconds, cpu_seconds});
     summary.partial = summary.partial || run.partial();
     for (const std::string& l : run.partial_lines) summary.partial_lines.push_back(l);

@@ -49,7 +49,7 @@ using test::RunTool;
 // sizes (the solver issue's 1 %/5 % bars are not met end to end). Regions no photo sees
 // ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
 // igi-solve and not compared.
-constexpr double kRhoDTolerance = 0.12;   // region-mean albedo after k
+constexpr double kRhoDTolerance = 0.12;  // region-mean albedo after k
 // Specular reflectance after k (highlights only): the floor's faint lobe came out −6.3 % and
 // −10.1 % in two "reference" runs of the same capture (COLMAP's poses differ slightly run to run).
 constexpr double kRhoSTolerance = 0.20;
