@@ -4,7 +4,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "pipeline/stage_marker.h"
 #include "pipeline/subprocess.h"
@@ -30,8 +32,69 @@ double Mean(const std::vector<double>& v) {
   return v.empty() ? 0 : s / double(v.size());
 }
 
-// Control points: the mesh's vertices outside the sphere (room and box corners) at their exact
-// pixels in each true camera (as a user would mark them), for igi-register --markers.
+// Whether the segment from `eye` to `p` (a point on the mesh) is blocked by a triangle before
+// it reaches p (Moller-Trumbore; p's own triangle is not hit before 1 - kEnd).
+bool Occluded(const TriangleMesh& mesh, const Eigen::Vector3d& eye, const Eigen::Vector3d& p) {
+  constexpr double kEnd = 1e-4;
+  const Eigen::Vector3d d = p - eye;
+  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
+    const Eigen::Vector3d a = mesh.positions[mesh.triangles[t][0]].cast<double>();
+    const Eigen::Vector3d e1 = mesh.positions[mesh.triangles[t][1]].cast<double>() - a;
+    const Eigen::Vector3d e2 = mesh.positions[mesh.triangles[t][2]].cast<double>() - a;
+    const Eigen::Vector3d q = d.cross(e2);
+    const double det = e1.dot(q);
+    if (std::abs(det) < 1e-12) continue;
+    const Eigen::Vector3d s = eye - a;
+    const double u = s.dot(q) / det;
+    if (u < 0 || u > 1) continue;
+    const Eigen::Vector3d r = s.cross(e1);
+    const double v = d.dot(r) / det;
+    if (v < 0 || u + v > 1) continue;
+    const double hit = e2.dot(r) / det;
+    if (hit > kEnd && hit < 1 - kEnd) return true;
+  }
+  return false;
+}
+
+// Surveyed targets: stickers on the ceiling (a grid every kTargetSpacingM) and on the walls
+// kUpperWallM below the ceiling, at known 3D positions (a user sticks them and measures them
+// with a tape or a total station), so that cameras looking up see enough control points to be
+// posed from them (PnP needs >= 4; COLMAP does not match such views with the downward ones).
+std::vector<Eigen::Vector3d> SurveyedTargets(const TriangleMesh& mesh) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
+  for (const auto& p : mesh.positions) {
+    lo = lo.cwiseMin(p.cast<double>());
+    hi = hi.cwiseMax(p.cast<double>());
+  }
+  constexpr double kTargetSpacingM = 1.0, kUpperWallM = 0.4;
+  std::vector<Eigen::Vector3d> targets;
+  const Eigen::Vector3d size = hi - lo;
+  const int nx = std::max(1, int(std::floor(size.x() / kTargetSpacingM)));
+  const int ny = std::max(1, int(std::floor(size.y() / kTargetSpacingM)));
+  auto along = [](double from, double length, int n, int i) {
+    return from + length * (i + 0.5) / n;
+  };
+  for (int i = 0; i < nx; ++i) {
+    for (int j = 0; j < ny; ++j) {
+      targets.emplace_back(along(lo.x(), size.x(), nx, i), along(lo.y(), size.y(), ny, j), hi.z());
+    }
+  }
+  const double z = hi.z() - kUpperWallM;
+  for (int i = 0; i < nx; ++i) {
+    targets.emplace_back(along(lo.x(), size.x(), nx, i), lo.y(), z);
+    targets.emplace_back(along(lo.x(), size.x(), nx, i), hi.y(), z);
+  }
+  for (int j = 0; j < ny; ++j) {
+    targets.emplace_back(lo.x(), along(lo.y(), size.y(), ny, j), z);
+    targets.emplace_back(hi.x(), along(lo.y(), size.y(), ny, j), z);
+  }
+  return targets;
+}
+
+// Control points for igi-register --markers, at their exact pixels in each true camera (as a
+// user would mark them): the mesh's vertices outside the sphere (room and box corners; every
+// photo whose frame holds them, as before) and the surveyed targets (SurveyedTargets; only where
+// the camera sees them unoccluded).
 Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_names) {
   Json points = Json::object(), pixels = Json::object();
   const int sphere = truth.FindMaterial("glossy_sphere");
@@ -46,8 +109,12 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
       }
     }
   }
+  const size_t num_corners = corners.size();
+  for (const Eigen::Vector3d& t : SurveyedTargets(truth.mesh)) corners.push_back(t);
   for (size_t i = 0; i < corners.size(); ++i) {
-    const std::string name = "corner" + std::to_string(i);
+    const bool target = i >= num_corners;
+    const std::string name =
+        target ? "target" + std::to_string(i - num_corners) : "corner" + std::to_string(i);
     points[name] = {corners[i].x(), corners[i].y(), corners[i].z()};
     for (const std::string& photo : photo_names) {
       const std::string cam_name = photo.substr(0, photo.rfind('_'));
@@ -58,6 +125,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
       if (!px || px->x() < 0 || px->y() < 0 || px->x() > camera.width || px->y() > camera.height) {
         continue;
       }
+      if (target && Occluded(truth.mesh, camera.CenterInWorld(), corners[i])) continue;
       pixels[photo + ".png"][name] = {px->x(), px->y()};
     }
   }
@@ -71,7 +139,7 @@ std::vector<std::string> SynthArgs(const DemoOptions& o, const fs::path& synth) 
           "--unposed",
           "--textured-walls",
           "--cameras",
-          std::to_string(o.cameras),
+          std::to_string(o.cameras + o.ceiling_cameras),
           "--ceiling-cameras",
           std::to_string(o.ceiling_cameras),
           "--width",
@@ -111,7 +179,7 @@ void GiveReference(const fs::path& synth, const std::string& region) {
 
 // DIR/00-capture: igi-synth's capture plus camera.json and markers.json in its PHOTOS_DIR.
 // Kept when its marker matches the options.
-fs::path Capture(const DemoOptions& o, const fs::path& bin) {
+fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
   const fs::path dir = o.out / "00-capture";
   const fs::path synth = dir / "synth";
   const std::vector<std::string> args = SynthArgs(o, synth);
@@ -119,7 +187,8 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin) {
   for (const std::string& a : args) fp.AddText(a);
   if (o.calibration == "reference") fp.AddText("reference " + o.reference_region);
   const auto marker = ReadStageMarker(dir);
-  if (marker && marker->fingerprint == fp.Hex()) return synth;
+  *kept = marker && marker->fingerprint == fp.Hex();
+  if (*kept) return synth;
   fs::remove_all(dir);
   fs::create_directories(dir);
   const auto r = RunProcess(bin / "igi-synth", args, dir / "log.txt");
@@ -175,6 +244,37 @@ double MeasureRadianceScale(const fs::path& hdr_dir, const fs::path& synth_dir) 
   return ratios[ratios.size() / 2];
 }
 
+Json ComparePoses(const fs::path& registered_scene, const fs::path& truth_scene) {
+  SceneLoadOptions load;
+  load.check_images = false;
+  load.load_geometry = false;
+  const Scene truth = LoadScene(truth_scene, load);
+  const Scene solved = LoadScene(registered_scene, load);
+  Json cameras = Json::array();
+  double max_rotation_deg = 0, max_position_m = 0;
+  for (const Camera& got : solved.cameras) {
+    const int c = truth.FindCamera(got.name.substr(0, got.name.rfind('_')));
+    if (c < 0) continue;
+    const Camera& want = truth.cameras[c];
+    const double rotation_deg =
+        want.cam_from_world.rotation.angularDistance(got.cam_from_world.rotation) * 180 /
+        std::numbers::pi;
+    const double position_m = (want.CenterInWorld() - got.CenterInWorld()).norm();
+    const Eigen::Vector3d forward =
+        want.cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
+    max_rotation_deg = std::max(max_rotation_deg, rotation_deg);
+    max_position_m = std::max(max_position_m, position_m);
+    cameras.push_back({{"photo", got.name},
+                       {"looks_up", forward.z() > 0},
+                       {"rotation_error_deg", rotation_deg},
+                       {"position_error_m", position_m}});
+  }
+  return {{"registered", cameras.size()},
+          {"max_rotation_error_deg", max_rotation_deg},
+          {"max_position_error_m", max_position_m},
+          {"cameras", cameras}};
+}
+
 void DemoOptions::Validate() const {
   ProblemList p;
   if (calibration != "reference" && calibration != "measured" && calibration != "none") {
@@ -182,6 +282,9 @@ void DemoOptions::Validate() const {
   }
   if (out.empty()) p.Add("", "--out", "", "is required");
   if (cameras < 3) p.Add("", "--demo-cameras", std::to_string(cameras), "must be >= 3");
+  if (ceiling_cameras < 0) {
+    p.Add("", "--demo-ceiling-cameras", std::to_string(ceiling_cameras), "must be >= 0");
+  }
   if (width < 64 || height < 48) {
     p.Add("", "--demo-size", fmt::format("{}x{}", width, height), "must be at least 64x48");
   }
@@ -232,7 +335,14 @@ DemoSummary RunDemo(const DemoOptions& o) {
   o.Validate();
   const fs::path bin = o.bin_dir.empty() ? ExecutableDir() : o.bin_dir;
   fs::create_directories(o.out);
-  const fs::path synth = Capture(o, bin);
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = ProcessCpuSeconds();
+  bool kept = false;
+  const fs::path synth = Capture(o, bin, &kept);
+  const StageOutcome capture{
+      "00-capture", kept ? "kept" : "done",
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+      ProcessCpuSeconds() - cpu0};
   RunOptions run;
   run.photos_dir = synth / "brackets";
   run.scene = synth / "scene.json";
@@ -257,7 +367,14 @@ DemoSummary RunDemo(const DemoOptions& o) {
   }
   DemoSummary d;
   d.run = RunPipeline(run);
-  d.run.seconds += first.seconds;
+  d.run.seconds += first.seconds + capture.seconds;
+  // The stages the first call ran (response, HDR) replace their "kept" entries of the second.
+  for (StageOutcome& s : d.run.stages) {
+    for (const StageOutcome& f : first.stages) {
+      if (f.stage == s.stage && s.status == "kept") s = f;
+    }
+  }
+  d.run.stages.insert(d.run.stages.begin(), capture);
   d.summary = CompareWithTruth(
       d.run.solved_scene, synth / "truth.json",
       o.calibration == "reference" ? std::vector<std::string>{o.reference_region}
@@ -273,9 +390,26 @@ DemoSummary RunDemo(const DemoOptions& o) {
       d.summary["solved_radiance_scale_error"] = k["scale"].get<double>() / true_scale - 1;
     }
   }
+  const fs::path registered = o.out / "03-register" / "scene.json";
+  if (fs::exists(registered)) {
+    d.summary["poses"] = ComparePoses(registered, synth / "truth" / "scene.json");
+    int photos = 0;
+    for (const auto& e : fs::directory_iterator(synth / "brackets")) photos += e.is_directory();
+    d.summary["poses"]["photos"] = photos;
+  }
   d.summary["seconds"] = d.run.seconds;
-  d.summary["capture"] = {{"cameras", o.cameras}, {"width", o.width},       {"height", o.height},
-                          {"spp", o.spp},         {"brackets", o.brackets}, {"stops", o.stops}};
+  Json stages = Json::array();
+  for (const StageOutcome& s : d.run.stages) {
+    stages.push_back({{"stage", s.stage},
+                      {"status", s.status},
+                      {"seconds", s.seconds},
+                      {"cpu_seconds", s.cpu_seconds}});
+  }
+  d.summary["stages"] = stages;
+  d.summary["capture"] = {{"cameras", o.cameras}, {"ceiling_cameras", o.ceiling_cameras},
+                          {"width", o.width},     {"height", o.height},
+                          {"spp", o.spp},         {"brackets", o.brackets},
+                          {"stops", o.stops}};
   WriteJsonFile(o.out / "demo_summary.json", d.summary);
   d.table.push_back(fmt::format("{:<14} {:<6} {:>9} {:>9} {:>8}", "region", "param", "truth",
                                 "solved/k", "error"));
@@ -293,6 +427,14 @@ DemoSummary RunDemo(const DemoOptions& o) {
         "HDR scale solved from the reference {}: {:.4f} (true {:.4f}, {:+.1f}%)",
         o.reference_region, d.summary["solved_radiance_scale"]["scale"].get<double>(), true_scale,
         100 * d.summary["solved_radiance_scale_error"].get<double>()));
+  }
+  if (d.summary.contains("poses")) {
+    const Json& p = d.summary["poses"];
+    d.table.push_back(fmt::format(
+        "registered {} of {} photos; pose errors up to {:.3f} deg, {:.1f} mm (see "
+        "demo_summary.json)",
+        p["registered"].get<int>(), p["photos"].get<int>(),
+        p["max_rotation_error_deg"].get<double>(), 1000 * p["max_position_error_m"].get<double>()));
   }
   d.table.push_back(fmt::format("photometric scale k = {:.4f} (see demo_summary.json)",
                                 d.summary["photometric_scale_k"].get<double>()));

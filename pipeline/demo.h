@@ -30,11 +30,13 @@ struct DemoOptions {
   double stops = 2;
   bool skip_diagnose = false;
   int num_threads = 0;
-  // Overview cameras that look up at the ceiling (igi-synth --ceiling-cameras). A ceiling no
-  // photo sees keeps placeholder values (its light missing, the walls' rho_d come out +4..+14 %),
-  // but 0 here: with 2, neither registered (COLMAP matched none of their features, and they
-  // see one control point each, too few to pose them from the markers).
-  int ceiling_cameras = 0;
+  // Cameras that look up at the ceiling, on top of `cameras` (igi-synth gets cameras +
+  // ceiling_cameras, --ceiling-cameras ceiling_cameras: its last overview cameras look up). A
+  // ceiling no photo sees keeps a placeholder albedo, which removes light the rest of the room
+  // receives (measured without them: the walls' rho_d -7.5..+14.4 %). COLMAP matches no feature
+  // of theirs with the downward views; igi-register poses them from the surveyed targets on the
+  // ceiling and upper walls (markers.json, see demo.cpp SurveyedTargets).
+  int ceiling_cameras = 2;
   // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
   // which weakens every bounce; measured: rho_s/k -27..-29 %):
   //  - "reference": the capture holds a reference of known reflectance (the matte box, its
@@ -43,11 +45,13 @@ struct DemoOptions {
   //  - "measured": the camera calibrated absolutely (igi-run --radiance-scale), as a lab camera
   //    measured against a radiance standard (simulated with igi-synth's noise-free radiance);
   //  - "none".
-  // "measured" by default: the demo's photos never see the ceiling, whose light is 59 % of what
-  // reaches the matte box, so "reference" measures the scale -13.5 % (-4.3 % with the ceiling's
-  // albedo given too; 2026-11-22, true cameras and radiance: the bias is the scene's, not the
-  // HDR merge's or the registration's).
-  std::string calibration = "measured";
+  // "reference" by default: it is what a user without a lab does (a grey card, a measured
+  // wall) and needs no truth. Measured 2026-11-22 with the ceiling seen (2 cameras looking up):
+  // the scale solved -3.1 % (0.2208 against 0.2278), the regions' absolute errors as with
+  // "measured" (rho_d -6.7..+7.8 % against -7.6..+6.6 %). Before the ceiling was seen it was
+  // -13.3 %: the ceiling's placeholder albedo removed light that reaches the matte box (54 %
+  // of its light is indirect).
+  std::string calibration = "reference";
   std::string reference_region = "matte_box";
   // The demo's control points are exact projections: weighted like sub-pixel targets
   // (igi-register's default, 1 px, is for hand-clicked points).
@@ -79,5 +83,13 @@ double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
 Json CompareWithTruth(const std::filesystem::path& solved_scene,
                       const std::filesystem::path& truth_json,
                       const std::vector<std::string>& given = {});
+
+// Compares the registered cameras (03-register/scene.json: one camera per photo, named after it)
+// with the true ones (truth/scene.json: camN for photo camN_LIGHTING): per photo the rotation
+// error (degrees) and the position error (metres), whether the true camera looks up (at the
+// ceiling), and how many photos were registered ("registered"; RunDemo adds "photos", the
+// capture's count).
+Json ComparePoses(const std::filesystem::path& registered_scene,
+                  const std::filesystem::path& truth_scene);
 
 }  // namespace igi

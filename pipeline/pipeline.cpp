@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <functional>
@@ -154,6 +155,16 @@ double Since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
+double ProcessCpuSeconds() {
+  auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  double total = 0;
+  for (const int who : {RUSAGE_SELF, RUSAGE_CHILDREN}) {
+    rusage u{};
+    if (::getrusage(who, &u) == 0) total += seconds(u.ru_utime) + seconds(u.ru_stime);
+  }
+  return total;
+}
+
 const std::vector<std::string>& StageNames() {
   static const std::vector<std::string> names = {"01-response", "02-hdr",      "03-register",
                                                  "04-solve",    "05-diagnose", "06-report"};
@@ -191,15 +202,18 @@ RunSummary RunPipeline(const RunOptions& options) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = ProcessCpuSeconds();
     StageRun run(ctx, stage.name);
     if (stage.applies) stage.body(ctx, &run);
+    const double cpu_seconds = ProcessCpuSeconds() - cpu0;
+    run.details["cpu_seconds"] = cpu_seconds;
     StageMarker m{
         stage.name, hex,      !stage.applies ? "skipped" : run.partial() ? "partial" : "done",
         Since(t0),  UtcNow(), run.commands,
         run.details};
     WriteStageMarker(dir, m);
-    spdlog::info("{}: {} in {:.1f} s", stage.name, m.status, m.seconds);
-    summary.stages.push_back({stage.name, m.status, m.seconds});
+    spdlog::info("{}: {} in {:.1f} s ({:.1f} s CPU)", stage.name, m.status, m.seconds, cpu_seconds);
+    summary.stages.push_back({stage.name, m.status, m.seconds, cpu_seconds});
     summary.partial = summary.partial || run.partial();
     for (const std::string& l : run.partial_lines) summary.partial_lines.push_back(l);
     if (stage.name == options.stop_after) break;

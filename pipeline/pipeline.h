@@ -25,6 +25,9 @@ struct StageOutcome {
   std::string stage;   // "04-solve"
   std::string status;  // "done", "partial", "skipped" (does not apply) or "kept" (resumed)
   double seconds = 0;  // this run's time (0 for kept stages)
+  // CPU time (user + sys) of igi-run and the tools it ran during the stage (0 for kept stages):
+  // what the stage costs on a shared machine, where wall time is only an upper bound.
+  double cpu_seconds = 0;
 };
 
 struct RunSummary {
@@ -35,6 +38,9 @@ struct RunSummary {
   std::filesystem::path solved_scene;
   double seconds = 0;
 };
+
+// User + sys CPU seconds of this process and of its children it has waited for (getrusage).
+double ProcessCpuSeconds();
 
 // The stage folders, in order.
 const std::vector<std::string>& StageNames();

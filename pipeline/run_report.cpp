@@ -47,10 +47,13 @@ void StagesSection(const fs::path& out, HtmlReport* page) {
   std::vector<std::vector<std::string>> rows;
   for (const std::string& s : StageNames()) {
     const auto m = ReadStageMarker(out / s);
+    const bool cpu =
+        m && m->details.contains("cpu_seconds") && m->details["cpu_seconds"].is_number();
     rows.push_back({s, m ? m->status : "not finished", m ? fmt::format("{:.1f}", m->seconds) : "",
+                    cpu ? fmt::format("{:.1f}", m->details["cpu_seconds"].get<double>()) : "",
                     m ? m->finished_utc : ""});
   }
-  page->Table({"stage", "status", "seconds", "finished (UTC)"}, rows);
+  page->Table({"stage", "status", "seconds", "CPU seconds", "finished (UTC)"}, rows);
 }
 
 void ResponseSection(const fs::path& out, HtmlReport* page) {

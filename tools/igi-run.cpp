@@ -30,7 +30,8 @@ written), 3 partial (e.g. photos that did not register).)";
 
 void PrintSummary(const igi::RunSummary& s) {
   for (const auto& st : s.stages) {
-    std::printf("  %-12s %-8s %6.1f s\n", st.stage.c_str(), st.status.c_str(), st.seconds);
+    std::printf("  %-12s %-8s %6.1f s  %6.1f s CPU\n", st.stage.c_str(), st.status.c_str(),
+                st.seconds, st.cpu_seconds);
   }
   std::printf("report: %s\nsolved scene: %s\n%.1f s\n", s.report.c_str(), s.solved_scene.c_str(),
               s.seconds);
@@ -76,6 +77,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
   app.add_option("--demo-cameras", demo.cameras, "--demo: cameras")->capture_default_str();
+  app.add_option("--demo-ceiling-cameras", demo.ceiling_cameras,
+                 "--demo: cameras looking up at the ceiling, besides --demo-cameras (posed from "
+                 "surveyed targets)")
+      ->capture_default_str();
   app.add_option("--demo-width", demo.width, "--demo: photo width")->capture_default_str();
   app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
   app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();

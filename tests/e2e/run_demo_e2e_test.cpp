@@ -4,8 +4,11 @@
 // solves and writes the report. Checked:
 // - the recovered parameters against truth.json, after the photometric scale k (the HDR maps'
 //   free constant, see pipeline/demo.h), within stated tolerances;
-// - resuming: with 04-solve deleted, a rerun keeps 00-03 (markers byte-identical, "kept") and
-//   redoes 04 onwards;
+// - the ceiling seen (2 cameras look up, posed from the surveyed targets) and solved; every photo
+//   registered, its pose near the true camera;
+// - resuming: with 05-diagnose (skipped here) deleted, a rerun keeps 00-04 (markers
+//   byte-identical, "kept") and redoes 05 onwards (06-report after it too; deleting 04-solve
+//   instead would cost another 6 min of CPU for the same check);
 // - report.html in headless Chromium: no console errors, every <img> decoded, a screenshot
 //   that is not blank.
 // Several minutes on 2 shared cores: LABELS slow.
@@ -34,16 +37,33 @@ using test::RunTool;
 // Tolerances on top of the solver's own (README: 1-7 % on igi-synth rooms from true poses and
 // true radiance): the demo's photos are 8 spp renders, 3 brackets of 8 bits merged with a
 // recovered response (about 1 % in radiance), COLMAP poses refined with the control points, and
-// the camera's absolute calibration measured after 02-hdr (--radiance-scale). Measured
-// 2026-11-21: without the calibration ρd −4..+15 %, ρs −26..−31 %, α −14..+1 % (the HDR maps'
-// arbitrary scale weakened every bounce); with it (absolute, before k): ρd −7.5..+14 %, ρs
-// −0.6 % / −0.3 % / −8.3 %, α +0.2..+4 %. The bounds guard those sizes (the solver issue's
-// 1 %/5 % bars are not met end to end: the ceiling is seen by no photo). Regions no photo sees
+// the HDR maps' absolute scale solved from the matte box (the demo's default
+// --demo-calibration reference; the matte box's material is given and left out of the
+// comparison). Measured 2026-11-21 with the ceiling seen by no photo (calibration "measured"):
+// ρd −7.5..+14 %, ρs −0.6 % / −0.3 % / −8.3 %, α +0.2..+4 %; "reference" solved the scale
+// −13.3 %. Measured 2026-11-22 with 2 ceiling cameras posed from the surveyed targets, after k:
+// "reference" (k = 1.030, the scale solved −3.1 %): ρd −9.4..+4.7 % (wall_x4 −9.4 %, the ceiling
+// −0.9 %), ρs −6.3..+1.6 %, α −1.5..+1.6 %; "measured" (k = 1.009): ρd −8.4..+5.6 %, ρs
+// −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
+// textured floor): +16.4 % (+1.6 % with "reference": weakly determined). The bounds guard those
+// sizes (the solver issue's 1 %/5 % bars are not met end to end). Regions no photo sees
 // ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
 // igi-solve and not compared.
-constexpr double kRhoDTolerance = 0.20;   // region-mean albedo after k
-constexpr double kRhoSTolerance = 0.20;   // specular reflectance after k (highlights only)
-constexpr double kAlphaTolerance = 0.15;  // lobe width (scale-free)
+constexpr double kRhoDTolerance = 0.12;  // region-mean albedo after k
+// Specular reflectance after k (highlights only): the floor's faint lobe came out −6.3 % and
+// −10.1 % in two "reference" runs of the same capture (COLMAP's poses differ slightly run to run).
+constexpr double kRhoSTolerance = 0.20;
+constexpr double kAlphaTolerance = 0.20;  // lobe width (scale-free); the floor's up to +16.4 %
+// The ceiling, seen by the 2 cameras that look up (measured −0.9 % after k with "reference",
+// −1.0 % with "measured"; 40 % low when no photo saw it and it kept a placeholder).
+constexpr double kCeilingRhoDTolerance = 0.05;
+// Registration against the true cameras (measured: COLMAP's poses within 0.011° and 0.6 mm; the
+// ceiling cameras, posed from the exact pixels of 13 markers, within 1e-4° and 0.01 mm).
+constexpr double kRotationToleranceDeg = 0.1;
+constexpr double kPositionToleranceM = 0.005;
+// The HDR maps' scale solved from the matte box against the true one (measured −3.1 %; −13.3 %
+// when the ceiling was unseen).
+constexpr double kSolvedScaleTolerance = 0.06;
 
 double Seconds(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -123,12 +143,41 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   }
   EXPECT_GE(checked, 10);
 
-  // Resume: 04-solve deleted; 00-03 kept (markers unchanged), 04-06 redone.
+  // The ceiling seen and solved (not a placeholder): a region with its own observations, its
+  // albedo near the truth.
+  EXPECT_EQ(status["ceiling"], "solved");
+  EXPECT_GE(observations["ceiling"], 0.02 * all_observations);
+  bool ceiling_compared = false;
+  for (const Json& region : summary["regions"]) {
+    if (region["region"] != "ceiling" || !region.contains("rho_d")) continue;
+    ceiling_compared = true;
+    EXPECT_LT(std::abs(region["rho_d"]["relative_error"].get<double>()), kCeilingRhoDTolerance);
+  }
+  EXPECT_TRUE(ceiling_compared);
+
+  // Every photo registered (the cameras that look up included), each pose near the truth.
+  const Json& poses = summary.at("poses");
+  EXPECT_EQ(poses["photos"].get<int>(), 18);  // 16 cameras + 2 looking up, one lighting
+  EXPECT_EQ(poses["registered"], poses["photos"]);
+  int looking_up = 0;
+  for (const Json& c : poses["cameras"]) {
+    looking_up += c["looks_up"].get<bool>();
+    EXPECT_LT(c["rotation_error_deg"].get<double>(), kRotationToleranceDeg) << c["photo"];
+    EXPECT_LT(c["position_error_m"].get<double>(), kPositionToleranceM) << c["photo"];
+  }
+  EXPECT_GE(looking_up, 2);
+
+  // The photos' scale solved from the reference (the default calibration).
+  ASSERT_EQ(summary["calibration"], "reference");
+  ASSERT_TRUE(summary.contains("solved_radiance_scale_error"));
+  EXPECT_LT(std::abs(summary["solved_radiance_scale_error"].get<double>()), kSolvedScaleTolerance);
+
+  // Resume: 05-diagnose deleted; 00-04 kept (markers unchanged), 05-06 redone.
   std::map<std::string, std::string> markers;
-  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register"}) {
+  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register", "04-solve"}) {
     markers[s] = ReadFileToString(out / s / "stage.json");
   }
-  fs::remove_all(out / "04-solve");
+  fs::remove_all(out / "05-diagnose");
   t0 = std::chrono::steady_clock::now();
   r = RunTool("igi-run", args);
   std::printf("resumed run: %.0f s\n%s", Seconds(t0), r.out.c_str());
@@ -136,11 +185,12 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
   for (const auto& [s, text] : markers) {
     EXPECT_EQ(ReadFileToString(out / s / "stage.json"), text) << s << " was redone";
   }
-  for (const char* s : {"01-response", "02-hdr", "03-register"}) {
+  for (const char* s : {"00-capture", "01-response", "02-hdr", "03-register", "04-solve"}) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string(s) + " +kept"))) << s << r.out;
   }
-  EXPECT_TRUE(std::regex_search(r.out, std::regex("04-solve +(done|partial)"))) << r.out;
-  EXPECT_TRUE(fs::exists(out / "04-solve" / "stage.json"));
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("05-diagnose +skipped"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("06-report +(done|partial)"))) << r.out;
+  EXPECT_TRUE(fs::exists(out / "05-diagnose" / "stage.json"));
 
   // The report in headless Chromium.
   const test::PageCheck page = test::CheckPageInChromium(out / "report.html", dir / "chromium");

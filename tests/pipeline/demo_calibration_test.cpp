@@ -1,11 +1,16 @@
 // igi-run --demo's absolute calibration (pipeline/demo.h MeasureRadianceScale): the median ratio
-// of the HDR maps to igi-synth's noise-free radiance, whatever a few outliers do.
+// of the HDR maps to igi-synth's noise-free radiance, whatever a few outliers do; the comparison
+// with the truth (CompareWithTruth) and of the registered cameras with the true ones
+// (ComparePoses).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include "pipeline/demo.h"
 #include "tests/temp_dir.h"
+#include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
@@ -80,6 +85,60 @@ TEST(DemoCalibrationTest, ComparisonLeavesOutTheGivenReference) {
   EXPECT_NO_THROW(o.Validate());
   o.calibration = "guess";
   EXPECT_THROW(o.Validate(), InputError);
+}
+
+// A scene with the given cameras (name -> {qvec, tvec}) and nothing to load.
+Json SceneWithCameras(const Json& poses) {
+  Json cameras = Json::object();
+  for (const auto& [name, pose] : poses.items()) {
+    cameras[name] = {{"model", "PINHOLE"},     {"width", 40},          {"height", 30},
+                     {"params", {30, 30, 20, 15}}, {"qvec", pose["qvec"]}, {"tvec", pose["tvec"]}};
+  }
+  return {{"format", "igi-scene"},
+          {"version", 1},
+          {"geometry", Json::array({Json{{"file", "room.obj"}}})},
+          {"materials", {{"m", {{"brdf", "lambert"}, {"rho_d", 0.5}}}}},
+          {"lights", {{"p", {{"type", "point"}, {"position", {0, 0, 1}}, {"intensity", 1}}}}},
+          {"lightings", {{"L0", {"p"}}}},
+          {"cameras", cameras}};
+}
+
+// Registered cameras are named after their photo (camN_L0), the true ones camN. Exact values:
+// camera a rotated by 2 degrees about z (its centre kept), camera b (looking up) moved 3 cm.
+TEST(DemoCalibrationTest, ComparesRegisteredPosesWithTruth) {
+  const fs::path dir = test::UniqueTempDir("demo_poses");
+  fs::create_directories(dir);
+  WriteFileAtomic(dir / "room.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");  // not loaded
+  const double half = 0.5 * 2.0 * std::numbers::pi / 180;  // half of 2 degrees
+  // b looks up: world +z is its optical axis (camera z); rotation of pi about x maps z -> -z,
+  // so b's cam_from_world is the identity (camera z = world z).
+  WriteJsonFile(dir / "truth.json",
+                SceneWithCameras({{"a", {{"qvec", {0, 1, 0, 0}}, {"tvec", {0, 0, 0}}}},
+                                  {"b", {{"qvec", {1, 0, 0, 0}}, {"tvec", {0, 0, 0}}}}}));
+  WriteJsonFile(
+      dir / "registered.json",
+      SceneWithCameras(
+          {{"a_L0",
+            {{"qvec", {0, std::cos(half), std::sin(half), 0}},  // (0,1,0,0) then 2 deg about z
+             {"tvec", {0, 0, 0}}}},
+           {"b_L0", {{"qvec", {1, 0, 0, 0}}, {"tvec", {0.03, 0, 0}}}}}));
+  const Json poses = ComparePoses(dir / "registered.json", dir / "truth.json");
+  EXPECT_EQ(poses["registered"], 2);
+  ASSERT_EQ(poses["cameras"].size(), 2u);
+  for (const Json& c : poses["cameras"]) {
+    if (c["photo"] == "a_L0") {
+      EXPECT_NEAR(c["rotation_error_deg"].get<double>(), 2.0, 1e-9);
+      EXPECT_NEAR(c["position_error_m"].get<double>(), 0.0, 1e-12);
+      EXPECT_FALSE(c["looks_up"].get<bool>());
+    } else {
+      EXPECT_NEAR(c["rotation_error_deg"].get<double>(), 0.0, 1e-9);
+      EXPECT_NEAR(c["position_error_m"].get<double>(), 0.03, 1e-12);
+      EXPECT_TRUE(c["looks_up"].get<bool>());
+    }
+  }
+  EXPECT_NEAR(poses["max_rotation_error_deg"].get<double>(), 2.0, 1e-9);
+  EXPECT_NEAR(poses["max_position_error_m"].get<double>(), 0.03, 1e-12);
+  fs::remove_all(dir);
 }
 
 }  // namespace
