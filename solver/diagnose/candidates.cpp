@@ -229,8 +229,15 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
 CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
   out.effect = "ambient_light";
+  // An ambient light of radiance L adds ρd·L where it lands, and then what the lit room reflects
+  // of it: each bounce multiplies it by about the room's mean albedo ρ̄, so the offset is about
+  // ρd·L/(1 − ρ̄) (ρ̄ over the records, i.e. over what the photos see).
+  double mean_albedo = 0;
+  for (const PixelRecord& r : f.records()) mean_albedo += r.albedo.mean();
+  mean_albedo = f.records().empty() ? 0 : mean_albedo / double(f.records().size());
+  const double bounces = 1 / (1 - std::clamp(mean_albedo, 0.0, 0.9));
   const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = r.albedo[c] * cx.model.photos[r.photo].exposure_scale;
+    b[c] = r.albedo[c] * bounces * cx.model.photos[r.photo].exposure_scale;
   });
   if (fit.coef.size() == 0) return out;
   const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
@@ -494,14 +501,20 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   if (count < 50) return out;
   ResidualFit best;
   double best_alpha = 0.1;
-  for (double alpha : {0.03, 0.05, 0.08, 0.12, 0.18, 0.25, 0.35}) {
-    const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+  // The records carry the direct light only; the lobe also reflects the lit room around the
+  // region (a broad brightening of the whole region). With the albedos given (no nuisance), a
+  // free scale of the region's prediction takes that part, so that the lobe's width follows the
+  // highlight (the refit renders the reflected room itself).
+  const int k = f.nuisance() ? 1 : 2;
+  for (double alpha : {0.03, 0.04, 0.05, 0.065, 0.08, 0.1, 0.12, 0.15, 0.18, 0.25, 0.35}) {
+    const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
       for (const RecordLightSample& ls : r.lights) {
         s += WardLobe(r.normal, ls.wi, r.view, alpha) * ls.irradiance[c];
       }
       b[0] = s;
+      if (k == 2) b[1] = r.sim[c];
     });
     // A physical lobe only (0 < ρs < 1): a region no highlight reaches leaves the amplitude free.
     if (fit.coef.size() == 0 || !(fit.coef[0] > 0) || !(fit.coef[0] < 1)) continue;
