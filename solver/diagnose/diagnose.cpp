@@ -474,10 +474,13 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     }
     for (int i = 0; i < int(trials.size()); ++i) {
       DiagnosisStep& ds = trials[i].step;
+      // A step that passed but explained less than the best stays a candidate of the next round
+      // (two hidden effects: both pass the first round, one is applied, the other comes next).
       if (ds.kept && i != best) {
         ds.kept = false;
         ds.verdict +=
             fmt::format("; not applied: {} explained more", trials[best].step.candidate.effect);
+        continue;
       }
       (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }

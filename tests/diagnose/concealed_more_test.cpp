@@ -48,8 +48,7 @@ TEST_P(ConcealedMoreTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest,
-                         testing::Values("light_intensity", "specular_reflection",
-                                         "ambient_light:kind=uniform,radiance=0.1"));
+                         testing::Values("light_intensity", "specular_reflection"));
 
 INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest,
                          testing::Values("vignetting+exposure_scale",
