@@ -10,7 +10,7 @@
 # MATERIALS=unknown (default): scene.json leaves ρd, ρs and α out and igi-diagnose solves them at
 # every step (4-18 min per case on the shared 2-core machine); given: igi-synth --unknowns none,
 # nothing is solved (1-4 min per case).
-# A CASE is an effect name, several joined by '+', or "none" (a control). Default: every effect
+# A CASE is an effect (NAME or NAME:k=v,...), several joined by '+', or "none" (a control). Default: every effect
 # igi-synth can hide, two pairs and two controls. Output: a Markdown table on stdout; the work
 # folders stay under ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
@@ -29,7 +29,8 @@ case "$MATERIALS" in
 esac
 CASES=("$@")
 if [ ${#CASES[@]} -eq 0 ]; then
-  CASES=(vignetting exposure_scale camera_response ambient_light light_emission_profile
+  CASES=(vignetting exposure_scale camera_response ambient_light
+         ambient_light:kind=uniform,radiance=0.1 light_emission_profile
          light_intensity specular_reflection specular_lobe_shape fresnel anisotropic_reflection
          light_source_extent pose_error missing_geometry
          vignetting+exposure_scale light_emission_profile+camera_response none none)
