@@ -10,9 +10,10 @@
 # MATERIALS=unknown (default): scene.json leaves ρd, ρs and α out and igi-diagnose solves them at
 # every step (4-18 min per case on the shared 2-core machine); given: igi-synth --unknowns none,
 # nothing is solved (1-4 min per case).
-# A CASE is an effect (NAME or NAME:k=v,...), several joined by '+', or "none" (a control). Default: every effect
-# igi-synth can hide, two pairs and two controls. Output: a Markdown table on stdout; the work
-# folders stay under ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
+# A CASE is an effect (NAME or NAME:k=v,...), several joined by '+', or "none" (a control).
+# Default: every effect igi-synth can hide (ambient_light both ways), two pairs and two controls.
+# Output: a Markdown table on stdout; the work folders stay under
+# ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
 BUILD="${1:-build}"
 shift || true
