@@ -80,7 +80,8 @@ for case in "${CASES[@]}"; do
     for n in "${names[@]}"; do effects+=(--effect "$n"); done
   fi
   "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 --spp 64 \
-      --lamp point --seed $((100 + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" "${effects[@]}"
+      --lamp point --seed $((100 + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
+      "${effects[@]}" > /dev/null
   start=$(date +%s)
   /usr/bin/time -f "%U %S" -o "$dir/cpu.txt" \
     "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \
