@@ -1,23 +1,37 @@
 #!/usr/bin/env bash
 # igi-diagnose on concealed data, full size (issue 8): one igi-synth capture per hidden effect (and
-# pairs, and controls), materials UNKNOWN (igi-diagnose solves them at every step), then a table
-# of what the first kept step named, the final residual against the noise floor (the true model's
-# residual at the same samples per pixel over the same pixels), and the time.
+# pairs, and controls), then a table of what the first kept step named, the final residual against
+# the noise floor (the true model's residual at the same samples per pixel over the same pixels),
+# and the time.
 #
-#   bench/diagnose/run_concealed_suite.sh [BUILD_DIR] [CASE...]
+#   [MATERIALS=unknown|given] [SPP=256] [THREADS=2] [CAMERAS=6] \
+#     bench/diagnose/run_concealed_suite.sh [BUILD_DIR] [CASE...]
 #
-# A CASE is an effect name, several joined by '+', or "none" (a control). Default: every effect
-# igi-synth can hide, two pairs and two controls. Output: a Markdown table on stdout; the work
-# folders stay under ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
+# MATERIALS=unknown (default): scene.json leaves ρd, ρs and α out and igi-diagnose solves them at
+# every step (4-18 min per case on the shared 2-core machine); given: igi-synth --unknowns none,
+# nothing is solved (1-4 min per case).
+# A CASE is an effect (NAME or NAME:k=v,...), several joined by '+', or "none" (a control).
+# Default: every effect igi-synth can hide (ambient_light both ways), two pairs and two controls.
+# Output: a Markdown table on stdout; the work folders stay under
+# ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
 BUILD="${1:-build}"
 shift || true
 BIN="$(cd "$BUILD/bin" && pwd)"
 WORK="${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}"
 SPP="${SPP:-256}"
+MATERIALS="${MATERIALS:-unknown}"
+THREADS="${THREADS:-2}"
+CAMERAS="${CAMERAS:-6}"
+case "$MATERIALS" in
+  unknown) UNKNOWNS=() ;;
+  given) UNKNOWNS=(--unknowns none) ;;
+  *) echo "MATERIALS must be unknown or given" >&2; exit 2 ;;
+esac
 CASES=("$@")
 if [ ${#CASES[@]} -eq 0 ]; then
-  CASES=(vignetting exposure_scale camera_response ambient_light light_emission_profile
+  CASES=(vignetting exposure_scale camera_response ambient_light
+         ambient_light:kind=uniform,radiance=0.1 light_emission_profile
          light_intensity specular_reflection specular_lobe_shape fresnel anisotropic_reflection
          light_source_extent pose_error missing_geometry
          vignetting+exposure_scale light_emission_profile+camera_response none none)
@@ -53,8 +67,8 @@ json.dump(t, open(os.path.join(cap, "truth", "true_model.json"), "w"), indent=1)
 PY
 }
 
-echo "| hidden | first kept step | all kept steps | baseline | final | floor | final/floor | seconds |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| hidden | first kept step | all kept steps | baseline | final | floor | final/floor | wall s | CPU s |"
+echo "|---|---|---|---|---|---|---|---|---|"
 i=0
 for case in "${CASES[@]}"; do
   i=$((i + 1))
@@ -65,26 +79,29 @@ for case in "${CASES[@]}"; do
     IFS='+' read -ra names <<< "$case"
     for n in "${names[@]}"; do effects+=(--effect "$n"); done
   fi
-  "$BIN/igi-synth" --out "$dir/capture" --cameras 6 --width 160 --height 120 --spp 64 \
-      --lamp point --seed $((100 + i)) --quiet "${effects[@]}"
+  "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 --spp 64 \
+      --lamp point --seed $((100 + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
+      "${effects[@]}" > /dev/null
   start=$(date +%s)
-  "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \
-      --holdout-block-px 8 --refine-iterations 0 --quiet || true
+  /usr/bin/time -f "%U %S" -o "$dir/cpu.txt" \
+    "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \
+      --holdout-block-px 8 --refine-iterations 0 --threads "$THREADS" --quiet || true
   end=$(date +%s)
+  cpu=$(awk '{printf "%.0f", $1 + $2}' "$dir/cpu.txt" 2>/dev/null || echo "?")
   floor_model "$dir/capture"
   "$BIN/igi-diagnose" "$dir/capture/truth/true_model.json" --out "$dir/floor" --spp "$SPP" \
-      --holdout-block-px 8 --max-steps 0 --quiet || true
-  python3 - "$dir" "$case" $((end - start)) <<'PY'
+      --holdout-block-px 8 --max-steps 0 --threads "$THREADS" --quiet || true
+  python3 - "$dir" "$case" $((end - start)) "$cpu" <<'PY'
 import json, sys, os
-d, case, secs = sys.argv[1], sys.argv[2], sys.argv[3]
+d, case, secs, cpu = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
 try:
     g = json.load(open(os.path.join(d, "diag", "diagnosis.json")))
     f = json.load(open(os.path.join(d, "floor", "diagnosis.json")))["baseline"]["residual"]
 except Exception as e:
-    print(f"| {case} | (failed: {e}) | | | | | | {secs} |"); sys.exit(0)
+    print(f"| {case} | (failed: {e}) | | | | | | {secs} | {cpu} |"); sys.exit(0)
 kept = [s["effect"] for s in g["steps"]]
 first = kept[0] if kept else "(none)"
 b, fin = g["baseline"]["residual"], g["final"]["residual"]
-print(f"| {case} | {first} | {', '.join(kept) or '-'} | {b:.4f} | {fin:.4f} | {f:.4f} | {fin / f:.2f} | {secs} |")
+print(f"| {case} | {first} | {', '.join(kept) or '-'} | {b:.4f} | {fin:.4f} | {f:.4f} | {fin / f:.2f} | {secs} | {cpu} |")
 PY
 done

@@ -30,6 +30,25 @@ std::vector<std::string> PhotoFiles(const Scene& model) {
   return out;
 }
 
+// Whether `light` is the only light of every photographed lighting: then everything the photos
+// record comes from it (bounces too), and a scale common to all photos is its intensity.
+bool AloneInEveryPhoto(const Scene& model, int light) {
+  for (const Photo& p : model.photos) {
+    if (p.lighting < 0 || p.lighting >= int(model.lightings.size())) return false;
+    const std::vector<int>& lights = model.lightings[p.lighting].lights;
+    if (lights.size() != 1 || lights[0] != light) return false;
+  }
+  return !model.photos.empty();
+}
+
+// The light that is alone in every photographed lighting, or -1.
+int LoneLight(const Scene& model) {
+  for (int l = 0; l < int(model.lights.size()); ++l) {
+    if (AloneInEveryPhoto(model, l)) return l;
+  }
+  return -1;
+}
+
 // ---------------------------------------------------------------- exposure_scale
 CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
@@ -39,15 +58,32 @@ CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& 
     out.note = "one photo: a scale of its own cannot be told from the model's";
     return out;
   }
-  const ResidualFit fit =
+  ResidualFit fit =
       f.Fit(n, [&](const PixelRecord& r, int c, double* b) { b[r.photo] = r.sim[c]; });
   if (fit.coef.size() == 0) return out;
-  FillScores(fit, &out);
   std::vector<double> scale(n);
   for (int j = 0; j < n; ++j) scale[j] = 1 + fit.coef[j];
   std::vector<double> sorted = scale;
   std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  const double ref = cx.materials_solved ? sorted[n / 2] : 1.0;
+  double ref = cx.materials_solved ? sorted[n / 2] : 1.0;
+  // Materials given and one light alone in every photo: a scale common to all photos is that
+  // light's intensity (light_intensity, one parameter), so the photos' scales are fitted relative
+  // to the photo at the median (n − 1 parameters) and credited with what they explain beyond it.
+  const int lone = cx.materials_solved ? -1 : LoneLight(cx.model);
+  if (lone >= 0) {
+    int ref_photo = 0;
+    for (int j = 0; j < n; ++j) {
+      if (scale[j] == sorted[n / 2]) ref_photo = j;
+    }
+    auto slot = [ref_photo](int photo) { return photo < ref_photo ? photo : photo - 1; };
+    fit = f.Fit(n - 1, [&](const PixelRecord& r, int c, double* b) {
+      if (r.photo != ref_photo) b[slot(r.photo)] = r.sim[c];
+    });
+    if (fit.coef.size() == 0) return out;
+    for (int j = 0; j < n; ++j) scale[j] = j == ref_photo ? 1.0 : 1 + fit.coef[slot(j)];
+    ref = 1.0;
+  }
+  FillScores(fit, &out);
   const std::vector<std::string> files = PhotoFiles(cx.model);
   Json scales = Json::object();
   Json photos = Json::array();
@@ -61,7 +97,7 @@ CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& 
   }
   out.params = {{"scale", scales}};
   out.where = {{"photos", photos}, {"frame", "photo"}};
-  out.num_params = n;
+  out.num_params = lone >= 0 ? n - 1 : n;
   out.evidence = fmt::format(
       "per-photo level: {} is {:.3f}x the model where the other photos agree with it, on every "
       "surface alike: a scale of the whole photo",
@@ -193,8 +229,15 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
 CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
   out.effect = "ambient_light";
+  // An ambient light of radiance L adds ρd·L where it lands, and then what the lit room reflects
+  // of it: each bounce multiplies it by about the room's mean albedo ρ̄, so the offset is about
+  // ρd·L/(1 − ρ̄) (ρ̄ over the records, i.e. over what the photos see).
+  double mean_albedo = 0;
+  for (const PixelRecord& r : f.records()) mean_albedo += r.albedo.mean();
+  mean_albedo = f.records().empty() ? 0 : mean_albedo / double(f.records().size());
+  const double bounces = 1 / (1 - std::clamp(mean_albedo, 0.0, 0.9));
   const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = r.albedo[c] * cx.model.photos[r.photo].exposure_scale;
+    b[c] = r.albedo[c] * bounces * cx.model.photos[r.photo].exposure_scale;
   });
   if (fit.coef.size() == 0) return out;
   const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
@@ -374,6 +417,14 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
   std::vector<float> share(recs.size(), 0.0f);
   bool any = false;
   float share_min = 1, share_max = 0;
+  // Photos whose lighting is this light alone: all they record comes from it, the light it sends
+  // after bounces (shadows too) included.
+  std::vector<bool> alone(cx.model.photos.size(), false);
+  for (size_t j = 0; j < alone.size(); ++j) {
+    const int g = cx.model.photos[j].lighting;
+    alone[j] = g >= 0 && g < int(cx.model.lightings.size()) &&
+               cx.model.lightings[g].lights == std::vector<int>{light};
+  }
   for (size_t i = 0; i < share.size(); ++i) {
     float mine = 0, all = 0;
     for (const RecordLightSample& s : recs[i].lights) {
@@ -381,6 +432,9 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
       if (s.light == light) mine += s.irradiance.sum();
     }
     share[i] = all > 0 ? mine / all : 0;
+    if (recs[i].photo >= 0 && recs[i].photo < int(alone.size()) && alone[recs[i].photo]) {
+      share[i] = 1;
+    }
     any |= mine > 0;
     if (all > 0 && !recs[i].outlier) {  // records in shadow scale with the light's bounces
       share_min = std::min(share_min, share[i]);
@@ -447,14 +501,20 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   if (count < 50) return out;
   ResidualFit best;
   double best_alpha = 0.1;
-  for (double alpha : {0.03, 0.05, 0.08, 0.12, 0.18, 0.25, 0.35}) {
-    const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+  // The records carry the direct light only; the lobe also reflects the lit room around the
+  // region (a broad brightening of the whole region). With the albedos given (no nuisance), a
+  // free scale of the region's prediction takes that part, so that the lobe's width follows the
+  // highlight (the refit renders the reflected room itself).
+  const int k = f.nuisance() ? 1 : 2;
+  for (double alpha : {0.03, 0.04, 0.05, 0.065, 0.08, 0.1, 0.12, 0.15, 0.18, 0.25, 0.35}) {
+    const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
       for (const RecordLightSample& ls : r.lights) {
         s += WardLobe(r.normal, ls.wi, r.view, alpha) * ls.irradiance[c];
       }
       b[0] = s;
+      if (k == 2) b[1] = r.sim[c];
     });
     // A physical lobe only (0 < ρs < 1): a region no highlight reaches leaves the amplitude free.
     if (fit.coef.size() == 0 || !(fit.coef[0] > 0) || !(fit.coef[0] < 1)) continue;
@@ -503,11 +563,16 @@ double GmdLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen:
   return hh / (kPi * alpha * alpha * hn * hn * hn * hn) * std::exp(-tan2 / (alpha * alpha));
 }
 
-// Schlick's weight of the *_fresnel models over their plain ones at ior 1.5.
-double FresnelWeight(const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {
-  const double c = std::min(1.0, double((wi + wo).norm()) / 2), f0 = 0.04;
+// Schlick's weight of the *_fresnel models over their plain ones, F(c)/F0 (solver/brdf.h).
+double FresnelWeight(const Eigen::Vector3f& wi, const Eigen::Vector3f& wo, double ior) {
+  const double c = std::min(1.0, double((wi + wo).norm()) / 2);
+  const double f0 = std::pow((ior - 1) / (ior + 1), 2);
   return 1 + (1 / f0 - 1) * std::pow(1 - c, 5);
 }
+
+// The indices of refraction the fresnel candidate tries (F0 from 0.0006 to 0.11): the weight's
+// growth toward grazing angles is steeper the lower the index.
+constexpr double kFresnelIors[] = {1.05, 1.1, 1.2, 1.33, 1.5, 2.0};
 
 // specular_lobe_shape (ward <-> ward_gmd) and fresnel (plain -> *_fresnel) on a glossy region:
 // the change of its specular term, ρs·(S_alt − S)·E, fitted with a free amplitude.
@@ -520,21 +585,40 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   if (!(m.brdf == BrdfModel::kWard || gmd) || !m.rho_s || !m.alpha) return out;
   const double rho_s = m.rho_s->mean(), alpha = *m.alpha;
   if (!(rho_s > 0)) return out;
-  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-    if (r.region != region) return;
-    double d = 0;
-    for (const RecordLightSample& ls : r.lights) {
-      const double plain =
-          gmd ? GmdLobe(r.normal, ls.wi, r.view, alpha) : WardLobe(r.normal, ls.wi, r.view, alpha);
-      const double alt = fresnel ? plain * FresnelWeight(ls.wi, r.view)
-                                 : (gmd ? WardLobe(r.normal, ls.wi, r.view, alpha)
-                                        : GmdLobe(r.normal, ls.wi, r.view, alpha));
-      d += rho_s * (alt - plain) * ls.irradiance[c];
+  auto fit_at = [&](double ior) {
+    return f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+      if (r.region != region) return;
+      double d = 0;
+      for (const RecordLightSample& ls : r.lights) {
+        const double plain = gmd ? GmdLobe(r.normal, ls.wi, r.view, alpha)
+                                 : WardLobe(r.normal, ls.wi, r.view, alpha);
+        const double alt = fresnel ? plain * FresnelWeight(ls.wi, r.view, ior)
+                                   : (gmd ? WardLobe(r.normal, ls.wi, r.view, alpha)
+                                          : GmdLobe(r.normal, ls.wi, r.view, alpha));
+        d += rho_s * (alt - plain) * ls.irradiance[c];
+      }
+      b[0] = d;
+    });
+  };
+  // fresnel: the index whose weight, at amplitude 1, explains the most (the amplitude must stay
+  // near 1: the weight is a fixed function of the angles once the index is chosen).
+  ResidualFit fit;
+  double ior = m.ior.value_or(Material::kDefaultIor);
+  double fitted_amplitude = 0;
+  if (fresnel) {
+    for (double candidate_ior : kFresnelIors) {
+      const ResidualFit at = fit_at(candidate_ior);
+      if (at.coef.size()) fitted_amplitude = at.coef[0];
+      if (at.coef.size() == 0 || !(at.coef[0] > 0.3) || !(at.coef[0] < 3)) continue;
+      if (fit.coef.size() == 0 || at.train_after < fit.train_after) fit = at, ior = candidate_ior;
     }
-    b[0] = d;
-  });
+  } else {
+    fit = fit_at(ior);
+    if (fit.coef.size()) fitted_amplitude = fit.coef[0];
+  }
   if (fit.coef.size() == 0 || !(fit.coef[0] > 0.3) || !(fit.coef[0] < 3)) {
-    out.note = "the alternative lobe does not fit region " + m.name;
+    out.note = fmt::format("the alternative lobe does not fit region {} (amplitude {:.2f})",
+                           m.name, fitted_amplitude);
     return out;
   }
   FillScores(fit, &out);
@@ -542,20 +626,25 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
       fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel" : (gmd ? "ward" : "ward_gmd");
   out.params = {
       {"region", m.name}, {"from", BrdfModelName(m.brdf)}, {"to", to}, {"amplitude", fit.coef[0]}};
+  if (fresnel) out.params["ior"] = ior;
   out.where = {{"regions", {m.name}}, {"frame", fresnel ? "grazing angle" : "half-vector angle"}};
-  out.num_params = 0;
+  out.num_params = fresnel ? 1 : 0;  // fresnel: the index
   out.evidence =
       fresnel ? fmt::format(
                     "region '{}': the photos' highlights grow toward grazing angles faster than "
-                    "the {} lobe; Schlick's Fresnel weight explains it (amplitude {:.2f})",
-                    m.name, BrdfModelName(m.brdf), fit.coef[0])
+                    "the {} lobe; Schlick's Fresnel weight at index {:.2f} explains it "
+                    "(amplitude {:.2f})",
+                    m.name, BrdfModelName(m.brdf), ior, fit.coef[0])
               : fmt::format(
                     "region '{}': the highlight's fall-off away from its peak follows {} rather "
                     "than {} (amplitude {:.2f} of the difference)",
                     m.name, to, BrdfModelName(m.brdf), fit.coef[0]);
   out.valid = true;
   const std::string name = m.name;
-  out.apply = [name, to](Json* doc) { (*doc)["materials"][name]["brdf"] = to; };
+  out.apply = [name, to, fresnel, ior](Json* doc) {
+    (*doc)["materials"][name]["brdf"] = to;
+    if (fresnel) (*doc)["materials"][name]["ior"] = ior;
+  };
   return out;
 }
 

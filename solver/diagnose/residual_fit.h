@@ -141,10 +141,15 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
     acc.second += e;
   }
   std::vector<double> list;
+  std::vector<std::pair<double, double>> blocks;
   for (const auto& [key, ge] : gains) {
-    if (ge.second > 0) list.push_back(ge.first / ge.second);
+    if (ge.second > 0) list.push_back(ge.first / ge.second), blocks.push_back(ge);
   }
-  fit.z = Z(list);
+  // The candidate's z only decides which candidates are refitted (the step gate, on the refit,
+  // guards against false alarms): the larger of the mean relative gain's z and the step gate's
+  // BlockGainZ, so that an effect seen in a few blocks (a highlight on one wall: large gains in
+  // its few blocks, the path tracer's noise in the many others its basis touches) is refitted.
+  fit.z = std::max(Z(list), BlockGainZ(blocks));
   return fit;
 }
 

@@ -216,7 +216,15 @@ Json MissingGeometry(Params& p, SynthScenes* s) {
 
 Json Ambient(Params& p, const SynthRoom& room, SynthScenes* s) {
   const double radiance = p.Number("radiance", 0.4, 0.0, 1e6);
+  const std::string kind = p.Name("kind", "panel", {"panel", "uniform"});
   p.Finish();
+  if (kind == "uniform") {  // the contract's ambient light: the same radiance from everywhere
+    s->true_scene["lights"]["ambient"] =
+        Json{{"type", "ambient"}, {"radiance", Vec(Vector3d::Constant(radiance))}};
+    for (auto& [name, list] : s->true_scene["lightings"].items()) list.push_back("ambient");
+    return Json{{"light", s->true_scene["lights"]["ambient"]}, {"lightings", "all"},
+                {"kind", kind}};
+  }
   const double x = room.size.x() - 0.002;
   SynthMesh mesh;
   mesh.AddQuad({x, 1.2, 0.9}, {x, 1.2, 2.1}, {x, 2.8, 2.1}, {x, 2.8, 0.9}, "ambient_panel");

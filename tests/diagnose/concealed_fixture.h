@@ -11,6 +11,8 @@
 // held-out blocks of 8 pixels, on 2 threads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -24,7 +26,8 @@ namespace igi::test {
 inline const std::string kConcealedDiagnoseFlags =
     " --spp 128 --holdout-block-px 8 --threads 2 --quiet";
 
-// Writes an igi-synth capture into dir/capture hiding `effect` ("NAME[:k=v,...]"; empty: none).
+// Writes an igi-synth capture into dir/capture hiding `effect` ("NAME[:k=v,...]", several joined
+// by '+'; empty: none).
 inline std::filesystem::path SynthesizeConcealed(const std::filesystem::path& dir,
                                                  const std::string& effect, int seed) {
   const std::filesystem::path capture = dir / "capture";
@@ -32,7 +35,11 @@ inline std::filesystem::path SynthesizeConcealed(const std::filesystem::path& di
                      " --cameras 4 --width 160 --height 120 --spp 64 --lamp point"
                      " --unknowns none --threads 2 --quiet --seed " +
                      std::to_string(seed);
-  if (!effect.empty()) args += " --effect " + effect;
+  for (size_t begin = 0; begin < effect.size();) {
+    const size_t end = std::min(effect.find('+', begin), effect.size());
+    args += " --effect " + effect.substr(begin, end - begin);
+    begin = end + 1;
+  }
   const RunResult r = RunTool("igi-synth", args);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   return capture;
@@ -106,7 +113,8 @@ struct ConcealedOutcome {
 };
 
 // Synthesizes a capture hiding `effect` (empty: none), diagnoses it, measures the floor, calls
-// `inspect` (when given) with the diagnosis folder, and removes everything.
+// `inspect` (when given) with the diagnosis folder, and removes everything (unless the environment
+// variable IGI_CONCEALED_KEEP names a folder: everything is moved there, for study).
 inline ConcealedOutcome DiagnoseConcealed(
     const std::string& effect, int seed,
     const std::function<void(const std::filesystem::path& diag_dir)>& inspect = nullptr) {
@@ -117,6 +125,11 @@ inline ConcealedOutcome DiagnoseConcealed(
   o.diagnosis = RunDiagnose(capture / "scene.json", dir / "diag");
   if (inspect) inspect(dir / "diag");
   o.floor = FloorResidual(WriteTrueModel(capture), dir / "floor");
+  if (const char* keep = std::getenv("IGI_CONCEALED_KEEP"); keep != nullptr && *keep != 0) {
+    const std::filesystem::path to = std::filesystem::path(keep) / dir.filename();
+    std::filesystem::create_directories(to.parent_path());
+    std::filesystem::copy(dir, to, std::filesystem::copy_options::recursive);
+  }
   std::filesystem::remove_all(dir);
   return o;
 }

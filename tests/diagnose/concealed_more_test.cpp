@@ -1,0 +1,75 @@
+// igi-diagnose on concealed data (issue 8): the effects of the suite not proven elsewhere —
+// light_intensity, specular_reflection — and a capture hiding a PAIR of effects. Same fixture and
+// size as diagnose_concealed_test (4 cameras of 160×120, photos at 64 paths per pixel, a point
+// lamp, materials given, seed 11). For each: the first step igi-diagnose keeps names the hidden
+// effect (for a pair, one of the two, and both are kept), and the final residual comes within
+// 1.2× of the true model's (ExpectReachesTheFloor).
+//
+// Measured 2026-11-22 (load average 5–6, 2–4 min per case):
+// - light_intensity (the lamp 1.25× brighter): light_intensity first, factor 1.241; final
+//   residual 0.1444 against the true model's 0.1446 (1.00×; baseline 0.2410). The lamp is the
+//   only light of every photo, so with the materials given a common scale of all photos IS its
+//   intensity: exposure_scale is fitted relative to the median photo (before, it took the common
+//   scale with 4 parameters and was kept first).
+// - specular_reflection (wall_y4 declared lambert; truly ward ρs 0.05, α 0.07): specular_reflection
+//   first, ρs 0.053, α 0.12, held-out residual² −18.5 %, 3.8 standard errors over the held-out
+//   blocks that see wall_y4; final 0.1548 against 0.1446 (1.07×; baseline 0.1876).
+// - vignetting + exposure_scale: exposure_scale first (cam1 1.148× the median photo; truth
+//   1.3, the rest absorbed by the vignetting's different mean in each photo), then vignetting
+//   (k1 0.113, k2 −0.419; truth −0.25, −0.05), which had passed the first round too but explained
+//   less; final 0.1516 against 0.1436 (1.06×; baseline 0.1858).
+// Not proven here (bench/RESULTS.md): fresnel (invisible at this size: the true model's residual
+// is 0.991× the declared one's), ambient_light (the true model's residual exceeds the declared
+// one's: the ambient light's render noise), light_emission_profile + camera_response (the
+// response is refitted after the profile with held-out residual² −55 % but at −1.6 standard
+// errors, one block's error dominating).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "tests/diagnose/concealed_fixture.h"
+
+namespace igi {
+namespace {
+
+using test::ConcealedOutcome;
+using test::DiagnoseConcealed;
+using test::ExpectReachesTheFloor;
+
+// "a:k=v+b" -> {"a", "b"}.
+std::vector<std::string> EffectNames(const std::string& spec) {
+  std::vector<std::string> out;
+  for (size_t begin = 0; begin < spec.size();) {
+    const size_t end = std::min(spec.find('+', begin), spec.size());
+    const std::string one = spec.substr(begin, end - begin);
+    out.push_back(one.substr(0, one.find(':')));
+    begin = end + 1;
+  }
+  return out;
+}
+
+class ConcealedMoreTest : public testing::TestWithParam<const char*> {};
+
+TEST_P(ConcealedMoreTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
+  const std::vector<std::string> hidden = EffectNames(GetParam());
+  const ConcealedOutcome o = DiagnoseConcealed(GetParam(), 11);
+  const Json& d = o.diagnosis;
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  std::vector<std::string> kept;
+  for (const Json& s : d["steps"]) kept.push_back(s["effect"]);
+  EXPECT_NE(std::find(hidden.begin(), hidden.end(), kept[0]), hidden.end()) << d.dump(1);
+  for (const std::string& h : hidden) {
+    EXPECT_NE(std::find(kept.begin(), kept.end(), h), kept.end()) << h << " not kept";
+  }
+  ExpectReachesTheFloor(o);
+}
+
+INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest,
+                         testing::Values("light_intensity", "specular_reflection"));
+
+INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest, testing::Values("vignetting+exposure_scale"));
+
+}  // namespace
+}  // namespace igi
