@@ -89,6 +89,15 @@ class SolveE2E : public ::testing::Test {
                    Quote(scene.string()) + " --out " + Quote(out.string()) + kFast + extra);
   }
 
+  // Both cameras' photos of the Lambertian room, every albedo stripped from its scene.json.
+  fs::path LambertRoomAlbedosUnknown() const {
+    RenderPhotos(false);
+    Json m = TrueMaterials(false);
+    for (auto& [name, material] : m.items()) material.erase("rho_d");
+    return WriteScene(SceneDoc(m, Json::array({PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"),
+                                               PhotoEntry("photos/cam1_L0.exr", "cam1", "L0")})));
+  }
+
   fs::path dir_;
 };
 
@@ -198,12 +207,7 @@ TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {
 // from the paper stage's albedos in both runs (same seed, same model, same rays), so with
 // S = 0.5 the refined albedo lies exactly halfway between the paper's and the full step's.
 TEST_F(SolveE2E, RefineAlbedoStepMovesPartOfTheWay) {
-  RenderPhotos(false);
-  Json m = TrueMaterials(false);
-  for (auto& [name, material] : m.items()) material.erase("rho_d");
-  const fs::path scene =
-      WriteScene(SceneDoc(m, Json::array({PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"),
-                                          PhotoEntry("photos/cam1_L0.exr", "cam1", "L0")})));
+  const fs::path scene = LambertRoomAlbedosUnknown();
   const fs::path full = dir_ / "full", half = dir_ / "half";
   ASSERT_EQ(Solve(scene, full).exit_code, 0);  // kFast: one refinement round
   ASSERT_EQ(Solve(scene, half, " --refine-albedo-step 0.5").exit_code, 0);
@@ -235,12 +239,7 @@ TEST_F(SolveE2E, RefineAlbedoStepMovesPartOfTheWay) {
 // --indirect-rays 0 --refine-iterations 0 the same test gives +55 % .. +207 %, so the tolerance
 // catches a solver that loses the inter-reflections.
 TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
-  RenderPhotos(false);
-  Json m = TrueMaterials(false);
-  for (auto& [name, material] : m.items()) material.erase("rho_d");
-  const fs::path scene =
-      WriteScene(SceneDoc(m, Json::array({PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"),
-                                          PhotoEntry("photos/cam1_L0.exr", "cam1", "L0")})));
+  const fs::path scene = LambertRoomAlbedosUnknown();
   const auto r = Solve(scene, Out());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Json solved = ReadJsonFile(Out() / "scene.json");
