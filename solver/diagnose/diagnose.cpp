@@ -203,10 +203,7 @@ BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>&
 // entirely), and those blocks would only add noise to the significance.
 BlockFilter RegionBlocks(const Scene& model, const std::vector<PixelRecord>& records,
                          const std::string& region, const PixelHoldout& h) {
-  int index = -1;
-  for (int g = 0; g < int(model.materials.size()); ++g) {
-    if (model.materials[g].name == region) index = g;
-  }
+  const int index = model.FindMaterial(region);  // -1: no such region, no block
   auto blocks = std::make_shared<std::set<std::tuple<size_t, int, int>>>();
   for (const PixelRecord& r : records) {
     if (r.region == index && r.held_out) {
