@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "pipeline/stage_marker.h"
 #include "pipeline/subprocess.h"
@@ -91,11 +92,14 @@ std::vector<Eigen::Vector3d> SurveyedTargets(const TriangleMesh& mesh) {
   return targets;
 }
 
-// Control points for igi-register --markers, at their exact pixels in each true camera (as a
-// user would mark them): the mesh's vertices outside the sphere (room and box corners; every
+// Control points for igi-register --markers, at their pixels in each true camera plus Gaussian
+// noise of `noise_px` (as a user or a target detector would mark them): the mesh's vertices outside the sphere (room and box corners; every
 // photo whose frame holds them, as before) and the surveyed targets (SurveyedTargets; only where
 // the camera sees them unoccluded).
-Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_names) {
+Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_names,
+                    double noise_px) {
+  std::mt19937_64 rng(2026);
+  std::normal_distribution<double> click(0.0, 1.0);
   Json points = Json::object(), pixels = Json::object();
   const int sphere = truth.FindMaterial("glossy_sphere");
   std::vector<Eigen::Vector3d> corners;
@@ -126,7 +130,8 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
         continue;
       }
       if (target && Occluded(truth.mesh, camera.CenterInWorld(), corners[i])) continue;
-      pixels[photo + ".png"][name] = {px->x(), px->y()};
+      const double dx = noise_px * click(rng), dy = noise_px * click(rng);
+      pixels[photo + ".png"][name] = {px->x() + dx, px->y() + dy};
     }
   }
   return {{"format", "igi-markers"}, {"version", 1}, {"points", points}, {"pixels", pixels}};
@@ -186,6 +191,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
   Fingerprint fp;
   for (const std::string& a : args) fp.AddText(a);
   if (o.calibration == "reference") fp.AddText("reference " + o.reference_region);
+  fp.AddText(fmt::format("marker noise {}", o.marker_noise_px));
   const auto marker = ReadStageMarker(dir);
   *kept = marker && marker->fingerprint == fp.Hex();
   if (*kept) return synth;
@@ -203,6 +209,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
   for (const auto& e : fs::directory_iterator(synth / "brackets")) {
     if (e.is_directory()) photos.push_back(e.path().filename().string());
   }
+  std::sort(photos.begin(), photos.end());  // the markers' noise does not depend on the listing
   const Camera& c0 = truth.cameras.at(0);
   WriteJsonFile(synth / "brackets" / "camera.json", Json{{"format", "igi-camera"},
                                                          {"version", 1},
@@ -210,7 +217,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
                                                          {"width", c0.width},
                                                          {"height", c0.height},
                                                          {"params", c0.params}});
-  WriteJsonFile(synth / "brackets" / "markers.json", MarkersOfTruth(truth, photos));
+  WriteJsonFile(synth / "brackets" / "markers.json", MarkersOfTruth(truth, photos, o.marker_noise_px));
   if (o.calibration == "reference") GiveReference(synth, o.reference_region);
   WriteStageMarker(dir, StageMarker{"00-capture",
                                     fp.Hex(),
@@ -289,6 +296,9 @@ void DemoOptions::Validate() const {
     p.Add("", "--demo-size", fmt::format("{}x{}", width, height), "must be at least 64x48");
   }
   if (spp < 1) p.Add("", "--demo-spp", std::to_string(spp), "must be >= 1");
+  if (!(marker_noise_px >= 0 && marker_noise_px <= 10)) {
+    p.Add("", "--demo-marker-noise", fmt::format("{}", marker_noise_px), "must be in [0, 10] px");
+  }
   p.ThrowIfAny();
 }
 

@@ -53,9 +53,13 @@ struct DemoOptions {
   // of its light is indirect).
   std::string calibration = "reference";
   std::string reference_region = "matte_box";
-  // The demo's control points are exact projections: weighted like sub-pixel targets
-  // (igi-register's default, 1 px, is for hand-clicked points).
-  std::vector<std::string> register_args = {"--marker-sigma", "0.1"};
+  // The control points' pixels are their true projections plus Gaussian noise of this standard
+  // deviation (pixels, per axis; fixed seed), as a target detector or a careful user marks
+  // them; 0 = exact projections.
+  double marker_noise_px = 0.3;
+  // igi-register weighs the control points by the same sigma (its default, 1 px, is for
+  // hand-clicked points).
+  std::vector<std::string> register_args = {"--marker-sigma", "0.3"};
   std::vector<std::string> solve_args = {"--refine-iterations", "0"};
   // The demo's diagnosis: coarser samples and at most two steps (it is the slowest stage).
   std::vector<std::string> diagnose_args = {"--pixel-stride", "4",  "--max-steps",         "2",

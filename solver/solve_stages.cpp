@@ -7,10 +7,10 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <unordered_map>
 
 #include "solver/albedo_map.h"
 #include "solver/held_out_albedo.h"
+#include "solver/neighbour_mean.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
@@ -161,45 +161,19 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
 }
 
 // The mean of `values` over each observation's neighbours: same region, normals within 25°,
-// within `radius`, and (same_photo) in the same photo, else any photo of the same lighting.
+// within `radius`, and (same_photo) in the same photo, else any photo of the same lighting
+// (solver/neighbour_mean.h).
 std::vector<Eigen::Vector3d> SolverState::NeighbourMean(const std::vector<Eigen::Vector3d>& values,
                                                         double radius, bool same_photo) const {
   std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
+  std::vector<NeighbourPoint> points(obs.size());
+  for (size_t i = 0; i < obs.size(); ++i) {
+    points[i] = {obs[i].position, obs[i].normal, obs[i].region, obs[i].photo};
+  }
   for (const LightingState& st : lighting_state) {
-    if (!st.active) continue;
-    std::unordered_map<int64_t, std::vector<int>> grid;
-    auto key = [&](const Eigen::Vector3f& p, int dx, int dy, int dz) {
-      const int64_t x = int64_t(std::floor(p.x() / radius)) + dx;
-      const int64_t y = int64_t(std::floor(p.y() / radius)) + dy;
-      const int64_t z = int64_t(std::floor(p.z() / radius)) + dz;
-      return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
-    };
-    for (int i : st.obs) grid[key(obs[i].position, 0, 0, 0)].push_back(i);
-    ParallelFor(
-        0, int64_t(st.obs.size()),
-        [&](int64_t k) {
-          const int i = st.obs[k];
-          const Observation& o = obs[i];
-          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-          int count = 0;
-          for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dz = -1; dz <= 1; ++dz) {
-                auto it = grid.find(key(o.position, dx, dy, dz));
-                if (it == grid.end()) continue;
-                for (int j : it->second) {
-                  const Observation& p = obs[j];
-                  if (p.region != o.region || (p.position - o.position).norm() > radius ||
-                      p.normal.dot(o.normal) < 0.9f || (same_photo && p.photo != o.photo)) {
-                    continue;
-                  }
-                  sum += values[j];
-                  ++count;
-                }
-              }
-          out[i] = count > 0 ? Eigen::Vector3d(sum / count) : values[i];
-        },
-        options.num_threads);
+    if (st.active) {
+      igi::NeighbourMean(points, values, st.obs, radius, same_photo, options.num_threads, &out);
+    }
   }
   return out;
 }

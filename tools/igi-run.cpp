@@ -81,6 +81,9 @@ int main(int argc, char** argv) {
                  "--demo: cameras looking up at the ceiling, besides --demo-cameras (posed from "
                  "surveyed targets)")
       ->capture_default_str();
+  app.add_option("--demo-marker-noise", demo.marker_noise_px,
+                 "--demo: standard deviation (px) of the noise on the control points' pixels")
+      ->capture_default_str();
   app.add_option("--demo-width", demo.width, "--demo: photo width")->capture_default_str();
   app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
   app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();
