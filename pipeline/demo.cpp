@@ -11,6 +11,7 @@
 
 #include "pipeline/stage_marker.h"
 #include "pipeline/subprocess.h"
+#include "recon/mesh_closest_point.h"
 #include "recon/scene.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
@@ -34,27 +35,10 @@ double Mean(const std::vector<double>& v) {
 }
 
 // Whether the segment from `eye` to `p` (a point on the mesh) is blocked by a triangle before
-// it reaches p (Moller-Trumbore; p's own triangle is not hit before 1 - kEnd).
-bool Occluded(const TriangleMesh& mesh, const Eigen::Vector3d& eye, const Eigen::Vector3d& p) {
+// it reaches p (p's own triangle is not hit before 1 - kEnd).
+bool Occluded(const MeshClosestPoint& bvh, const Eigen::Vector3d& eye, const Eigen::Vector3d& p) {
   constexpr double kEnd = 1e-4;
-  const Eigen::Vector3d d = p - eye;
-  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
-    const Eigen::Vector3d a = mesh.positions[mesh.triangles[t][0]].cast<double>();
-    const Eigen::Vector3d e1 = mesh.positions[mesh.triangles[t][1]].cast<double>() - a;
-    const Eigen::Vector3d e2 = mesh.positions[mesh.triangles[t][2]].cast<double>() - a;
-    const Eigen::Vector3d q = d.cross(e2);
-    const double det = e1.dot(q);
-    if (std::abs(det) < 1e-12) continue;
-    const Eigen::Vector3d s = eye - a;
-    const double u = s.dot(q) / det;
-    if (u < 0 || u > 1) continue;
-    const Eigen::Vector3d r = s.cross(e1);
-    const double v = d.dot(r) / det;
-    if (v < 0 || u + v > 1) continue;
-    const double hit = e2.dot(r) / det;
-    if (hit > kEnd && hit < 1 - kEnd) return true;
-  }
-  return false;
+  return bvh.Intersect(eye, p - eye, kEnd, 1 - kEnd).has_value();
 }
 
 // Surveyed targets: stickers on the ceiling (a grid every kTargetSpacingM) and on the walls
@@ -115,6 +99,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
   }
   const size_t num_corners = corners.size();
   for (const Eigen::Vector3d& t : SurveyedTargets(truth.mesh)) corners.push_back(t);
+  const MeshClosestPoint bvh(truth.mesh);
   for (size_t i = 0; i < corners.size(); ++i) {
     const bool target = i >= num_corners;
     const std::string name =
@@ -129,7 +114,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
       if (!px || px->x() < 0 || px->y() < 0 || px->x() > camera.width || px->y() > camera.height) {
         continue;
       }
-      if (target && Occluded(truth.mesh, camera.CenterInWorld(), corners[i])) continue;
+      if (target && Occluded(bvh, camera.CenterInWorld(), corners[i])) continue;
       const double dx = noise_px * click(rng), dy = noise_px * click(rng);
       pixels[photo + ".png"][name] = {px->x() + dx, px->y() + dy};
     }
@@ -302,15 +287,98 @@ void DemoOptions::Validate() const {
   p.ThrowIfAny();
 }
 
+namespace {
+
+// Bilinear lookup of a linear RGB texture at `uv` (u right, v up, clamped at the borders; texel
+// centres at (i + 0.5) / size, as the renderer reads its textures).
+Eigen::Vector3d TextureAt(const Image& texture, const Eigen::Vector2f& uv) {
+  const double x = std::clamp(double(uv.x()), 0.0, 1.0) * texture.width - 0.5;
+  const double y = (1 - std::clamp(double(uv.y()), 0.0, 1.0)) * texture.height - 0.5;
+  const int x0 = std::clamp(int(std::floor(x)), 0, texture.width - 1);
+  const int y0 = std::clamp(int(std::floor(y)), 0, texture.height - 1);
+  const int x1 = std::min(x0 + 1, texture.width - 1), y1 = std::min(y0 + 1, texture.height - 1);
+  const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
+  Eigen::Vector3d out;
+  for (int c = 0; c < 3; ++c) {
+    const int ch = std::min(c, texture.channels - 1);
+    out[c] = (1 - fy) * ((1 - fx) * texture.at(x0, y0, ch) + fx * texture.at(x1, y0, ch)) +
+             fy * ((1 - fx) * texture.at(x0, y1, ch) + fx * texture.at(x1, y1, ch));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scene, int samples,
+                                                      uint64_t seed) {
+  SceneLoadOptions load;
+  load.check_images = false;
+  const Scene truth = LoadScene(truth_scene, load);
+  std::map<std::string, Eigen::Vector3d> out;
+  if (!truth.mesh.has_uvs()) return out;
+  std::vector<std::optional<Image>> textures(truth.materials.size());
+  for (size_t r = 0; r < truth.materials.size(); ++r) {
+    if (truth.materials[r].rho_d_map) textures[r] = ReadImage(*truth.materials[r].rho_d_map, 3);
+  }
+  std::vector<double> cdf;
+  double total = 0;
+  for (size_t t = 0; t < truth.mesh.num_triangles(); ++t) {
+    const int r = truth.mesh.triangle_region[t];
+    cdf.push_back(total += r >= 0 && textures[r] ? truth.mesh.TriangleArea(t) : 0.0);
+  }
+  if (!(total > 0)) return out;
+  const MeshClosestPoint bvh(truth.mesh);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Eigen::Vector3d> sum(truth.materials.size(), Eigen::Vector3d::Zero());
+  std::vector<int> count(truth.materials.size(), 0);
+  for (int i = 0; i < samples; ++i) {
+    const size_t t = std::min(
+        size_t(std::lower_bound(cdf.begin(), cdf.end(), u(rng) * total) - cdf.begin()),
+        cdf.size() - 1);
+    double b1 = u(rng), b2 = u(rng);
+    if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
+    const Eigen::Vector3i& tri = truth.mesh.triangles[t];
+    const Eigen::Vector3d p = (1 - b1 - b2) * truth.mesh.positions[tri[0]].cast<double>() +
+                              b1 * truth.mesh.positions[tri[1]].cast<double>() +
+                              b2 * truth.mesh.positions[tri[2]].cast<double>();
+    const bool seen = std::any_of(truth.cameras.begin(), truth.cameras.end(), [&](const Camera& c) {
+      const auto px = c.ImgFromWorld(p);
+      return px && px->x() >= 0 && px->y() >= 0 && px->x() < c.width && px->y() < c.height &&
+             !Occluded(bvh, c.CenterInWorld(), p);
+    });
+    if (!seen) continue;
+    const Eigen::Vector2f uv = float(1 - b1 - b2) * truth.mesh.uvs[tri[0]] +
+                               float(b1) * truth.mesh.uvs[tri[1]] +
+                               float(b2) * truth.mesh.uvs[tri[2]];
+    const int r = truth.mesh.triangle_region[t];
+    sum[r] += TextureAt(*textures[r], uv);
+    ++count[r];
+  }
+  for (size_t r = 0; r < truth.materials.size(); ++r) {
+    if (count[r] > 0) out[truth.materials[r].name] = sum[r] / count[r];
+  }
+  return out;
+}
+
 Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
                       const std::vector<std::string>& given) {
   const Json solved = ReadJsonFile(solved_scene)["materials"];
   Json truth = ReadJsonFile(truth_json)["materials"];
   for (const std::string& name : given) truth.erase(name);
+  // A textured region's truth is its texture's mean over the surface the photos see (what the
+  // solver can recover), when the true scene is there to say which part that is.
+  const fs::path truth_scene = truth_json.parent_path() / "truth" / "scene.json";
+  const std::map<std::string, Eigen::Vector3d> seen =
+      fs::exists(truth_scene) ? SeenTrueAlbedo(truth_scene) : std::map<std::string, Eigen::Vector3d>{};
+  auto true_rho_d = [&](const std::string& name, const Json& t) {
+    const auto it = seen.find(name);
+    return it != seen.end() ? it->second.mean() : Mean(Rgb(t["rho_d"]));
+  };
   std::vector<double> ratios;
   for (const auto& [name, t] : truth.items()) {
     if (!solved.contains(name) || !t.contains("rho_d") || !solved[name].contains("rho_d")) continue;
-    const double m = Mean(Rgb(t["rho_d"]));
+    const double m = true_rho_d(name, t);
     if (m > 0) ratios.push_back(Mean(Rgb(solved[name]["rho_d"])) / m);
   }
   std::sort(ratios.begin(), ratios.end());
@@ -322,12 +390,17 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
     for (const char* key : {"rho_d", "rho_s", "alpha"}) {
       if (!t.contains(key) || !solved[name].contains(key)) continue;
       const std::vector<double> tv = Rgb(t[key]), sv = Rgb(solved[name][key]);
+      const bool rho_d = std::string(key) == "rho_d";
       const double scale = std::string(key) == "alpha" ? 1.0 : k;
-      const double truth_mean = Mean(tv), got = Mean(sv) / scale;
+      const double truth_mean = rho_d ? true_rho_d(name, t) : Mean(tv), got = Mean(sv) / scale;
       r[key] = {{"truth", truth_mean},
                 {"recovered", Mean(sv)},
                 {"recovered_over_k", got},
                 {"relative_error", truth_mean > 0 ? got / truth_mean - 1 : 0.0}};
+      if (rho_d && seen.count(name)) {
+        r[key]["truth_whole_texture"] = Mean(tv);
+        r[key]["truth_is"] = "the true texture's mean over the surface the photos see";
+      }
     }
     regions.push_back(r);
   }
@@ -337,7 +410,8 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
           {"note",
            "k = median over regions of recovered/true mean rho_d: the HDR maps' free constant "
            "(the response is recovered up to a factor); rho_d and rho_s errors are after "
-           "dividing by k, alpha needs no k"},
+           "dividing by k, alpha needs no k. A textured region's true rho_d is its texture's "
+           "mean over the surface some photo sees (truth_whole_texture: over the whole texture)"},
           {"regions", regions}};
 }
 

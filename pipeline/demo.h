@@ -10,7 +10,10 @@
 // comparison states that constant k (median over regions of recovered/true ρd) and each
 // region's ρd and ρs errors after dividing by k; α does not depend on it.
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -82,8 +85,19 @@ DemoSummary RunDemo(const DemoOptions& options);
 double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
                             const std::filesystem::path& synth_dir);
 
+// The true albedo textures' mean over the surface some photo sees, per region with a texture
+// (truth/scene.json's rho_d_map): `samples` points uniform by area on the textured regions,
+// kept where a true camera sees them (in its frame, unoccluded), each texture read bilinearly
+// at their UVs. The photos show part of each surface and the solver recovers that part: a
+// texture's mean over its whole UV square is not what it can be compared with (measured on the
+// demo, 2026-11-22: wall_x4's photos see 48 % of it, whose mean is 5.2 % below the whole's).
+std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const std::filesystem::path& truth_scene,
+                                                      int samples = 200000, uint64_t seed = 1);
+
 // Compares a solved scene with truth.json: per region and parameter (see demo.h's note on k).
 // Regions in `given` (their material was given to the solver, e.g. the reference) are left out.
+// A textured region's true rho_d is SeenTrueAlbedo's when truth/scene.json lies beside
+// truth.json, else the texture's mean (truth.json's rho_d).
 Json CompareWithTruth(const std::filesystem::path& solved_scene,
                       const std::filesystem::path& truth_json,
                       const std::vector<std::string>& given = {});

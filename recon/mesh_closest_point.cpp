@@ -112,4 +112,29 @@ std::optional<ClosestPoint> MeshClosestPoint::Query(const Eigen::Vector3d& p,
   return state.best;
 }
 
+std::optional<MeshRayHit> MeshClosestPoint::Intersect(const Eigen::Vector3d& origin,
+                                                       const Eigen::Vector3d& direction,
+                                                       double t_min, double t_max) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(origin.x());
+  rh.ray.org_y = static_cast<float>(origin.y());
+  rh.ray.org_z = static_cast<float>(origin.z());
+  rh.ray.dir_x = static_cast<float>(direction.x());
+  rh.ray.dir_y = static_cast<float>(direction.y());
+  rh.ray.dir_z = static_cast<float>(direction.z());
+  rh.ray.tnear = static_cast<float>(t_min);
+  rh.ray.tfar = static_cast<float>(std::min(t_max, 1e30));
+  rh.ray.time = 0;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return MeshRayHit{static_cast<int>(rh.hit.primID), rh.ray.tfar, rh.hit.u, rh.hit.v};
+}
+
 }  // namespace igi

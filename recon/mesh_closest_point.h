@@ -1,6 +1,7 @@
 #pragma once
 // Closest points on a triangle mesh (Embree's BVH point queries; exact point-triangle distance
-// in double precision). Used to fit reconstructed points to a scene mesh.
+// in double precision), and rays against it (Embree's ray queries). Used to fit reconstructed
+// points to a scene mesh, and for visibility on a mesh outside the renderer.
 
 #include <Eigen/Core>
 #include <memory>
@@ -21,6 +22,12 @@ struct ClosestPoint {
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                        const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
+struct MeshRayHit {
+  int triangle = -1;
+  double t = 0;           // origin + t·direction is the hit (direction as given, not normalised)
+  double b1 = 0, b2 = 0;  // barycentrics of the triangle's vertices 1 and 2
+};
+
 // An acceleration structure over a mesh's triangles. Queries are thread-safe. The mesh must
 // outlive the object.
 class MeshClosestPoint {
@@ -32,6 +39,12 @@ class MeshClosestPoint {
 
   // The closest mesh point within `max_distance_m` of `p` (nullopt when none is).
   std::optional<ClosestPoint> Query(const Eigen::Vector3d& p, double max_distance_m = 1e30) const;
+
+  // The first triangle (either side) along origin + t·direction with t_min < t < t_max (nullopt
+  // when none is).
+  std::optional<MeshRayHit> Intersect(const Eigen::Vector3d& origin,
+                                      const Eigen::Vector3d& direction, double t_min = 0,
+                                      double t_max = 1e30) const;
 
  private:
   struct Impl;

@@ -141,5 +141,44 @@ TEST(DemoCalibrationTest, ComparesRegisteredPosesWithTruth) {
   fs::remove_all(dir);
 }
 
+// The seen part of a texture: a 2 x 2 m floor (z = 0, UVs over [0,1]^2) whose texture is 0.2 on
+// its left half (u < 0.5) and 0.8 on its right, under a pinhole camera 1 m above x = 0.45 looking
+// down with a field of view of 1 m at the floor: it sees x < 0.95 (u < 0.475), the left half
+// only (the bilinear lookup mixes in the right half's value only within half a texel of u = 0.5,
+// which it does not reach). The seen mean is 0.2; the whole texture's is 0.5.
+TEST(DemoCalibrationTest, SeenTrueAlbedoAveragesTheSeenSurfaceOnly) {
+  const fs::path dir = test::UniqueTempDir("demo_seen");
+  fs::create_directories(dir / "textures");
+  WriteFileAtomic(dir / "floor.obj",
+                  "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\n"
+                  "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                  "usemtl floor\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  Image texture = Constant(64, 64, 0.2f);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 32; x < 64; ++x) {
+      for (int c = 0; c < 3; ++c) texture.pixels[(size_t(y) * 64 + x) * 3 + c] = 0.8f;
+    }
+  }
+  WriteImage(dir / "textures" / "floor.exr", texture);
+  // Camera looking down (-z): cam_from_world rotates world z to camera -z (pi about x), centre
+  // (0.45, 1, 1): t = -R c = -(0.45, -1, -1). Focal 20 px over 20 px: 1 m wide at 1 m.
+  Json scene = SceneWithCameras({{"down", {{"qvec", {0, 1, 0, 0}}, {"tvec", {-0.45, 1, 1}}}}});
+  scene["cameras"]["down"]["width"] = 20;
+  scene["cameras"]["down"]["height"] = 20;
+  scene["cameras"]["down"]["params"] = {20, 20, 10, 10};
+  scene["geometry"] = Json::array({Json{{"file", "floor.obj"}}});
+  scene["materials"] = {{"floor", {{"brdf", "lambert"}, {"rho_d", 0.5}, {"rho_d_map", "textures/floor.exr"}}}};
+  WriteJsonFile(dir / "scene.json", scene);
+  const auto seen = SeenTrueAlbedo(dir / "scene.json", 20000, 3);
+  ASSERT_EQ(seen.count("floor"), 1u);
+  EXPECT_NEAR(seen.at("floor").x(), 0.2, 1e-6);
+  // Moved to x = 1 the camera sees u in [0.25, 0.75]: half of each value, mean 0.5 within the
+  // sampling noise (20000 points, about half of them seen).
+  scene["cameras"]["down"]["tvec"] = {-1.0, 1, 1};
+  WriteJsonFile(dir / "scene.json", scene);
+  EXPECT_NEAR(SeenTrueAlbedo(dir / "scene.json", 20000, 3).at("floor").x(), 0.5, 0.02);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace igi

@@ -125,6 +125,45 @@ TEST(MeshClosestPointTest, MatchesBruteForce) {
   EXPECT_FALSE(closest.Query({2, 2, 1.5}, 0.1).has_value());  // 1.5 m from every face
 }
 
+// Rays against the BVH: the hit's point (from t and from the barycentrics) lies on the mesh at
+// the first triangle along the ray; t_min and t_max bound it; a ray from outside the closed
+// room pointing away from it misses.
+TEST(MeshClosestPointTest, IntersectFindsTheFirstTriangle) {
+  const TriangleMesh mesh = Room();
+  const MeshClosestPoint bvh(mesh);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0.5, 3.5), d(-1, 1);
+  int hits = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vector3d origin(u(rng), u(rng), 0.5 * u(rng));
+    const Vector3d dir = Vector3d(d(rng), d(rng), d(rng)).normalized();
+    const auto hit = bvh.Intersect(origin, dir);
+    if (!hit) continue;
+    ++hits;
+    const Vector3d p = origin + hit->t * dir;
+    const auto& t = mesh.triangles[hit->triangle];
+    const Vector3d from_bary = (1 - hit->b1 - hit->b2) * mesh.positions[t[0]].cast<double>() +
+                               hit->b1 * mesh.positions[t[1]].cast<double>() +
+                               hit->b2 * mesh.positions[t[2]].cast<double>();
+    EXPECT_LT((p - from_bary).norm(), 1e-4);
+    EXPECT_LT(bvh.Query(p)->distance_m, 1e-4);
+    // Nothing closer: the hit point is the first mesh point along the ray.
+    for (double s = 0.02; s < hit->t - 0.02; s += 0.02) {
+      ASSERT_GT(bvh.Query(origin + s * dir)->distance_m, 1e-5) << "ray " << i << " at " << s;
+    }
+    EXPECT_FALSE(bvh.Intersect(origin, dir, 0, hit->t - 1e-3).has_value());
+    const auto beyond = bvh.Intersect(origin, dir, hit->t + 1e-3);
+    if (beyond) {
+      EXPECT_GT(beyond->t, hit->t);
+    }
+  }
+  EXPECT_EQ(hits, 200);  // the room is closed
+  EXPECT_FALSE(bvh.Intersect({-1, 2, 1}, {-1, 0, 0}).has_value());
+  const auto in = bvh.Intersect({-1, 2, 1}, {1, 0, 0});
+  ASSERT_TRUE(in.has_value());
+  EXPECT_NEAR(in->t, 1.0, 1e-5);  // the wall x = 0
+}
+
 // From a start 5 degrees, 10 % scale and 0.3 m off, with 5 mm noise and 10 % outliers: the
 // recovered similarity is within 0.05 degrees, 0.1 % scale and 5 mm (noise averaged over
 // thousands of points leaves far less).
