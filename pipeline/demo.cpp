@@ -77,9 +77,9 @@ std::vector<Eigen::Vector3d> SurveyedTargets(const TriangleMesh& mesh) {
 }
 
 // Control points for igi-register --markers, at their pixels in each true camera plus Gaussian
-// noise of `noise_px` (as a user or a target detector would mark them): the mesh's vertices outside the sphere (room and box corners; every
-// photo whose frame holds them, as before) and the surveyed targets (SurveyedTargets; only where
-// the camera sees them unoccluded).
+// noise of `noise_px` (as a user or a target detector would mark them): the mesh's vertices outside
+// the sphere (room and box corners; every photo whose frame holds them, as before) and the surveyed
+// targets (SurveyedTargets; only where the camera sees them unoccluded).
 Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_names,
                     double noise_px) {
   std::mt19937_64 rng(2026);
@@ -155,8 +155,8 @@ std::vector<std::string> SynthArgs(const DemoOptions& o, const fs::path& synth) 
 void GiveReference(const fs::path& synth, const std::string& region) {
   const Json truth = ReadJsonFile(synth / "truth" / "scene.json");
   if (!truth["materials"].contains(region)) {
-    throw InputError(DescribeProblem((synth / "truth" / "scene.json").string(), "materials",
-                                     region, "the demo's reference region must exist"));
+    throw InputError(DescribeProblem((synth / "truth" / "scene.json").string(), "materials", region,
+                                     "the demo's reference region must exist"));
   }
   Json material = truth["materials"][region];
   if (material.contains("rho_d_map")) {
@@ -202,7 +202,8 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
                                                          {"width", c0.width},
                                                          {"height", c0.height},
                                                          {"params", c0.params}});
-  WriteJsonFile(synth / "brackets" / "markers.json", MarkersOfTruth(truth, photos, o.marker_noise_px));
+  WriteJsonFile(synth / "brackets" / "markers.json",
+                MarkersOfTruth(truth, photos, o.marker_noise_px));
   if (o.calibration == "reference") GiveReference(synth, o.reference_region);
   WriteStageMarker(dir, StageMarker{"00-capture",
                                     fp.Hex(),
@@ -333,9 +334,9 @@ std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scen
   std::vector<Eigen::Vector3d> sum(truth.materials.size(), Eigen::Vector3d::Zero());
   std::vector<int> count(truth.materials.size(), 0);
   for (int i = 0; i < samples; ++i) {
-    const size_t t = std::min(
-        size_t(std::lower_bound(cdf.begin(), cdf.end(), u(rng) * total) - cdf.begin()),
-        cdf.size() - 1);
+    const size_t t =
+        std::min(size_t(std::lower_bound(cdf.begin(), cdf.end(), u(rng) * total) - cdf.begin()),
+                 cdf.size() - 1);
     double b1 = u(rng), b2 = u(rng);
     if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
     const Eigen::Vector3i& tri = truth.mesh.triangles[t];
@@ -370,7 +371,8 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
   // solver can recover), when the true scene is there to say which part that is.
   const fs::path truth_scene = truth_json.parent_path() / "truth" / "scene.json";
   const std::map<std::string, Eigen::Vector3d> seen =
-      fs::exists(truth_scene) ? SeenTrueAlbedo(truth_scene) : std::map<std::string, Eigen::Vector3d>{};
+      fs::exists(truth_scene) ? SeenTrueAlbedo(truth_scene)
+                              : std::map<std::string, Eigen::Vector3d>{};
   auto true_rho_d = [&](const std::string& name, const Json& t) {
     const auto it = seen.find(name);
     return it != seen.end() ? it->second.mean() : Mean(Rgb(t["rho_d"]));
@@ -459,10 +461,10 @@ DemoSummary RunDemo(const DemoOptions& o) {
     }
   }
   d.run.stages.insert(d.run.stages.begin(), capture);
-  d.summary = CompareWithTruth(
-      d.run.solved_scene, synth / "truth.json",
-      o.calibration == "reference" ? std::vector<std::string>{o.reference_region}
-                                   : std::vector<std::string>{});
+  d.summary =
+      CompareWithTruth(d.run.solved_scene, synth / "truth.json",
+                       o.calibration == "reference" ? std::vector<std::string>{o.reference_region}
+                                                    : std::vector<std::string>{});
   d.summary["calibration"] = o.calibration;
   d.summary["radiance_scale"] = run.radiance_scale;
   d.summary["true_radiance_scale"] = true_scale;
@@ -507,10 +509,10 @@ DemoSummary RunDemo(const DemoOptions& o) {
     }
   }
   if (d.summary.contains("solved_radiance_scale_error")) {
-    d.table.push_back(fmt::format(
-        "HDR scale solved from the reference {}: {:.4f} (true {:.4f}, {:+.1f}%)",
-        o.reference_region, d.summary["solved_radiance_scale"]["scale"].get<double>(), true_scale,
-        100 * d.summary["solved_radiance_scale_error"].get<double>()));
+    d.table.push_back(
+        fmt::format("HDR scale solved from the reference {}: {:.4f} (true {:.4f}, {:+.1f}%)",
+                    o.reference_region, d.summary["solved_radiance_scale"]["scale"].get<double>(),
+                    true_scale, 100 * d.summary["solved_radiance_scale_error"].get<double>()));
   }
   if (d.summary.contains("poses")) {
     const Json& p = d.summary["poses"];

@@ -113,8 +113,8 @@ std::optional<ClosestPoint> MeshClosestPoint::Query(const Eigen::Vector3d& p,
 }
 
 std::optional<MeshRayHit> MeshClosestPoint::Intersect(const Eigen::Vector3d& origin,
-                                                       const Eigen::Vector3d& direction,
-                                                       double t_min, double t_max) const {
+                                                      const Eigen::Vector3d& direction,
+                                                      double t_min, double t_max) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;

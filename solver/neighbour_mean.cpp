@@ -64,9 +64,9 @@ void NeighbourMean(const std::vector<NeighbourPoint>& points,
     return a.first < b.first || (a.first == b.first && a.second < b.second);
   });
   const size_t n = keyed.size();
-  SortedPoints s{std::vector<int>(n), std::vector<Eigen::Vector3f>(n),
-                 std::vector<Eigen::Vector3f>(n), std::vector<int>(n),
-                 std::vector<Eigen::Vector3d>(n), {}};
+  SortedPoints s{
+      std::vector<int>(n), std::vector<Eigen::Vector3f>(n), std::vector<Eigen::Vector3f>(n),
+      std::vector<int>(n), std::vector<Eigen::Vector3d>(n), {}};
   s.cells.reserve(n / 4 + 1);
   for (size_t k = 0; k < n; ++k) {
     const int i = keyed[k].second;

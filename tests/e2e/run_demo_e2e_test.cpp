@@ -45,11 +45,15 @@ using test::RunTool;
 // "reference" (k = 1.030, the scale solved −3.1 %): ρd −9.4..+4.7 % (wall_x4 −9.4 %, the ceiling
 // −0.9 %), ρs −6.3..+1.6 %, α −1.5..+1.6 %; "measured" (k = 1.009): ρd −8.4..+5.6 %, ρs
 // −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
-// textured floor): +16.4 % (+1.6 % with "reference": weakly determined). The bounds guard those
-// sizes (the solver issue's 1 %/5 % bars are not met end to end). Regions no photo sees
-// ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
-// igi-solve and not compared.
-constexpr double kRhoDTolerance = 0.12;  // region-mean albedo after k
+// textured floor): +16.4 % (+1.6 % with "reference": weakly determined). Since 2026-11-22 a
+// textured region's true ρd is its texture's mean over the surface the photos see (pipeline/demo.h
+// SeenTrueAlbedo), not over the whole texture: on the same solve that took wall_x4 from −7.7 % to
+// −5.1 % and the glossy objects from +3.2 / +4.9 % to +1.8 / +0.0 %; every other region within
+// 2.7 % (solve from every third pixel, as the demo now does: the same within 1.5 points). The
+// bounds guard those sizes (the solver issue's 1 %/5 % bars are not met end to end). Regions no
+// photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported
+// by igi-solve and not compared.
+constexpr double kRhoDTolerance = 0.08;  // region-mean albedo after k (seen part)
 // Specular reflectance after k (highlights only): the floor's faint lobe came out −6.3 % and
 // −10.1 % in two "reference" runs of the same capture (COLMAP's poses differ slightly run to run).
 constexpr double kRhoSTolerance = 0.20;

@@ -59,16 +59,14 @@ TEST(DemoCalibrationTest, MedianRatioOfHdrToTrueRadiance) {
 TEST(DemoCalibrationTest, ComparisonLeavesOutTheGivenReference) {
   const fs::path dir = test::UniqueTempDir("demo_compare");
   fs::create_directories(dir);
-  WriteJsonFile(dir / "truth.json",
-                Json{{"materials",
-                      {{"a", {{"rho_d", {0.5, 0.5, 0.5}}}},
-                       {"b", {{"rho_d", {0.2, 0.2, 0.2}}, {"rho_s", 0.1}}},
-                       {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
-  WriteJsonFile(dir / "scene.json",
-                Json{{"materials",
-                      {{"a", {{"rho_d", {1.0, 1.0, 1.0}}}},
-                       {"b", {{"rho_d", {0.4, 0.4, 0.4}}, {"rho_s", 0.2}}},
-                       {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
+  WriteJsonFile(dir / "truth.json", Json{{"materials",
+                                          {{"a", {{"rho_d", {0.5, 0.5, 0.5}}}},
+                                           {"b", {{"rho_d", {0.2, 0.2, 0.2}}, {"rho_s", 0.1}}},
+                                           {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
+  WriteJsonFile(dir / "scene.json", Json{{"materials",
+                                          {{"a", {{"rho_d", {1.0, 1.0, 1.0}}}},
+                                           {"b", {{"rho_d", {0.4, 0.4, 0.4}}, {"rho_s", 0.2}}},
+                                           {"ref", {{"rho_d", {0.7, 0.7, 0.7}}}}}}});
   const Json all = CompareWithTruth(dir / "scene.json", dir / "truth.json");
   EXPECT_EQ(all["regions"].size(), 3u);
   const Json without = CompareWithTruth(dir / "scene.json", dir / "truth.json", {"ref"});
@@ -91,7 +89,7 @@ TEST(DemoCalibrationTest, ComparisonLeavesOutTheGivenReference) {
 Json SceneWithCameras(const Json& poses) {
   Json cameras = Json::object();
   for (const auto& [name, pose] : poses.items()) {
-    cameras[name] = {{"model", "PINHOLE"},     {"width", 40},          {"height", 30},
+    cameras[name] = {{"model", "PINHOLE"},         {"width", 40},          {"height", 30},
                      {"params", {30, 30, 20, 15}}, {"qvec", pose["qvec"]}, {"tvec", pose["tvec"]}};
   }
   return {{"format", "igi-scene"},
@@ -109,7 +107,7 @@ TEST(DemoCalibrationTest, ComparesRegisteredPosesWithTruth) {
   const fs::path dir = test::UniqueTempDir("demo_poses");
   fs::create_directories(dir);
   WriteFileAtomic(dir / "room.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");  // not loaded
-  const double half = 0.5 * 2.0 * std::numbers::pi / 180;  // half of 2 degrees
+  const double half = 0.5 * 2.0 * std::numbers::pi / 180;                     // half of 2 degrees
   // b looks up: world +z is its optical axis (camera z); rotation of pi about x maps z -> -z,
   // so b's cam_from_world is the identity (camera z = world z).
   WriteJsonFile(dir / "truth.json",
@@ -167,7 +165,8 @@ TEST(DemoCalibrationTest, SeenTrueAlbedoAveragesTheSeenSurfaceOnly) {
   scene["cameras"]["down"]["height"] = 20;
   scene["cameras"]["down"]["params"] = {20, 20, 10, 10};
   scene["geometry"] = Json::array({Json{{"file", "floor.obj"}}});
-  scene["materials"] = {{"floor", {{"brdf", "lambert"}, {"rho_d", 0.5}, {"rho_d_map", "textures/floor.exr"}}}};
+  scene["materials"] = {
+      {"floor", {{"brdf", "lambert"}, {"rho_d", 0.5}, {"rho_d_map", "textures/floor.exr"}}}};
   WriteJsonFile(dir / "scene.json", scene);
   const auto seen = SeenTrueAlbedo(dir / "scene.json", 20000, 3);
   ASSERT_EQ(seen.count("floor"), 1u);
