@@ -1,20 +1,27 @@
-// Experiment (run by hand; figures in bench/RESULTS.md, "the ceiling's albedo on converged
-// photos"): where a diffuse region's stage-1 albedo bias comes from, against the true scene.
+// Experiment (run by hand; figures in bench/RESULTS.md, "The ceiling's +1.5 % on converged
+// photos"): where a region's stage-1 albedo bias comes from, against the true scene.
 //   build/bench/ceiling_probe CAPTURE [region=ceiling] [stride=2] [every=4] [ref_rays=1024]
-//                             [paths=8] [pixel_paths=256]
-// Runs stage 1 on an igi-synth capture (2 threads) and, for every `every`-th observation of
-// `region`, compares:
+//       [paths=8] [pixel_paths=256] [spec_rays=32] [smooth=0] [patch=0] [bounce=1]
+//       [stage2=0] [seed2=1]
+// Runs stage 1 on an igi-synth capture (2 threads; smooth, patch: SolveOptions' smoothing radius
+// and patch size, 0 = auto; bounce: SolveOptions::specular_bounces) and, for every `every`-th
+// observation of `region`, compares:
 //  (a) the gathered irradiance (direct; indirect raw and smoothed) with a reference irradiance of
 //      the TRUE scene (truth/scene.json) at the same point: `ref_rays` cosine-weighted rays, each
 //      the true reflected radiance (one path);
 //  (b) on the gather's own indirect rays: the radiance the solver takes for the patch each ray
 //      hits (the photos' mean over the patch's observations, or ρd·E/π where no photo sees it)
 //      against the true reflected radiance along the same ray (`paths` paths), split by the hit
-//      region and by how many observations the hit patch has;
+//      region and by how many observations the hit patch has; "+spec_ind": with the glossy hit's
+//      true specular reflection of the indirect light added (`spec_rays` lobe rays, 0 = off);
+//      and the irradiance at the centres of the unseen patches the rays meet against a reference;
 //  (d) the photo's pixel against ρd_true·E_ref/π at the pixel centre's point and against a
-//      `pixel_paths`-path render of the true scene through the pixel centre.
+//      `pixel_paths`-path render of the true scene through the pixel centre;
+//  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2)
+//      over the true scene and over the stage-1 model, against the same reference.
 // Prints the ratios and the albedo πΣL/ΣE with each irradiance.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -63,7 +70,7 @@ int main(int argc, char** argv) {
   std::map<std::string, std::string> kv = {
       {"region", "ceiling"}, {"stride", "2"},        {"every", "4"},  {"ref_rays", "1024"},
       {"paths", "8"},        {"pixel_paths", "256"}, {"smooth", "0"}, {"patch", "0"},
-      {"spec_rays", "32"},   {"bounce", "1"}};
+      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"}, {"seed2", "1"}};
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     const size_t eq = a.find('=');
@@ -236,6 +243,30 @@ int main(int argc, char** argv) {
         t[4].sum() / (rho_true.cwiseProduct(e_ref) / kPi).sum(),
         100 * (rho_g.mean() / rho_true.mean() - 1), 100 * (rho_r.mean() / rho_true.mean() - 1),
         100 * (rho_pix.mean() / rho_true.mean() - 1));
+  }
+  if (kv["stage2"] != "0") {
+    // (e) stage 2's gathering (the path tracer over a scene, SolverState::IncidentFromRenderer)
+    // at the same points, over the true scene and over the stage-1 model the refinement renders.
+    const fs::path tmp =
+        fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));
+    fs::create_directories(tmp);
+    std::vector<RegionAtlas> atlases;
+    std::vector<Image> maps;
+    const Scene model = s.CompleteScene(&atlases, &maps, tmp);
+    s.options.refine_rays = std::stoi(kv["stage2"]);
+    s.options.seed = std::stoull(kv["seed2"]);
+    for (int variant = 0; variant < 2; ++variant) {
+      s.IncidentFromRenderer(variant == 0 ? truth_scene : model, 1);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
+      for (size_t k = 0; k < rows.size(); ++k) {
+        sum += s.obs_e_indirect[subset[k]];
+        ref_sum += rows[k].e_ind_ref;
+      }
+      std::printf("stage 2's E_ind over the %s / reference (true scene): %.4f\n",
+                  variant == 0 ? "true scene" : "stage-1 model", sum.sum() / ref_sum.sum());
+    }
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
   }
   std::printf("the gather's own rays: model radiance / true radiance (share of the true E_ind)\n");
   const double all_true = rays["all"].b.sum();
