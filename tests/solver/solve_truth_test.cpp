@@ -137,15 +137,15 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // highlight sample's albedo as the other photos see its texel off their highlights
       // (solver/held_out_albedo.h), rho_s fitted through that albedo's own lobe too: rho_s
       // -10.3 % (clean), -8.1 % (noisy), guarded at 15 %; alpha -0.4 % (clean), +4.2 % (noisy),
-      // guarded at 10 % (before the specular bounces: -11.9 % / -0.0 %, -10.2 % / +5.2 %). History: each sample with its patch's off-highlight albedo gave -9 % /
-      // -9 %; the held-out albedo with the previous iteration's lobe subtracted and the
-      // off-highlight test on the patch's albedo -14.7 % / +0.4 % (clean), -13.3 % / +5.7 %
-      // (noisy). bench/solver/floor_probe takes this apart (bench/RESULTS.md): with the true
-      // texture's albedo the same samples give rho_s +0.0 %; with exact radiances the held-out
-      // albedo gives -0.2 %; with these photos and the true lobe -7.0 % (-4.0 %, -3.4 % on
-      // synth seeds 2 and 3; -3.1 % at 512 spp): what remains comes from the photos' Monte Carlo
-      // noise (the lobe is 14 % of the highlight samples' radiance, so 0.07 % of albedo error is
-      // 1 % of rho_s) and is open.
+      // guarded at 10 % (before the specular bounces: -11.9 % / -0.0 %, -10.2 % / +5.2 %). History:
+      // each sample with its patch's off-highlight albedo gave -9 % / -9 %; the held-out albedo
+      // with the previous iteration's lobe subtracted and the off-highlight test on the patch's
+      // albedo -14.7 % / +0.4 % (clean), -13.3 % / +5.7 % (noisy). bench/solver/floor_probe takes
+      // this apart (bench/RESULTS.md): with the true texture's albedo the same samples give rho_s
+      // +0.0 %; with exact radiances the held-out albedo gives -0.2 %; with these photos and the
+      // true lobe -7.0 % (-4.0 %, -3.4 % on synth seeds 2 and 3; -3.1 % at 512 spp): what remains
+      // comes from the photos' Monte Carlo noise (the lobe is 14 % of the highlight samples'
+      // radiance, so 0.07 % of albedo error is 1 % of rho_s) and is open.
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.15);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.10);
