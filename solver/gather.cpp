@@ -16,8 +16,67 @@ struct PointSamples {
   GatherPoint point;
   std::vector<DirectSample> direct;
   std::vector<IndirectSample> indirect;
+  std::vector<SpecularBounce> bounces;
   uint64_t rays = 0;
 };
+
+// The frame in which the solver evaluates a region's lobe (SolverState::LocalFrame).
+Frame ShadingFrame(const Material& m, const Eigen::Vector3d& n) {
+  if (IsAnisotropic(m.brdf) && m.tangent) return Frame::FromNormalTangent(n, *m.tangent);
+  return Frame::FromNormal(n);
+}
+
+// One direction about the mirror of wo (local frame), drawn from a mixture of a cosine lobe and
+// Ward lobes of roughness lobe_alpha and lobe_alpha/4 in equal shares, with the mixture's
+// density: an unbiased one-sample estimate of any lobe's integral (HemisphereDirections' mixture).
+bool SampleBounce(const Eigen::Vector3d& wo, double lobe_alpha, Pcg32& rng, Eigen::Vector3d* wi,
+                  double* weight) {
+  BrdfParams broad, narrow;
+  broad.model = narrow.model = BrdfModel::kWard;
+  broad.rho_s = narrow.rho_s = Eigen::Vector3d::Ones();
+  broad.alpha = lobe_alpha;
+  narrow.alpha = 0.25 * lobe_alpha;
+  const double pick = rng.UniformDouble();
+  const Eigen::Vector2d u = rng.Uniform2D();
+  if (pick < 1.0 / 3) {
+    *wi = SampleCosineHemisphere(u);
+  } else {
+    const BrdfSample bs = SampleBrdf(pick < 2.0 / 3 ? broad : narrow, wo, 0.5, u);
+    if (!bs.Valid()) return false;
+    *wi = bs.wi;
+  }
+  if (!(wi->z() > 0)) return false;
+  const double pdf =
+      (CosineHemispherePdf(wi->z()) + BrdfPdf(broad, wo, *wi) + BrdfPdf(narrow, wo, *wi)) / 3.0;
+  if (!(pdf > 0)) return false;
+  *weight = wi->z() / pdf;
+  return true;
+}
+
+// The specular bounce at `hit` of an indirect ray along `dir`; false where none can be drawn.
+bool TraceBounce(const Renderer::Impl& scene, const PatchSet& patches, const SurfaceHit& hit,
+                 const Eigen::Vector3d& dir, double lobe_alpha, Pcg32& rng, PointSamples* out) {
+  const Frame frame = ShadingFrame(scene.scene->materials[hit.region], hit.n_s);
+  const Eigen::Vector3d wo = frame.ToLocal(-dir);
+  if (!(wo.z() > 0)) return false;
+  Eigen::Vector3d wi;
+  double weight = 0;
+  if (!SampleBounce(wo, lobe_alpha, rng, &wi, &weight)) return false;
+  const Eigen::Vector3d wi_world = frame.ToWorld(wi);
+  if (!(wi_world.dot(hit.n_geo) > 0)) return false;
+  SpecularBounce b;
+  b.wo = wo.cast<float>();
+  b.wi = wi.cast<float>();
+  b.weight = static_cast<float>(weight);
+  ++out->rays;
+  const std::optional<SurfaceHit> next =
+      TraceSurface(scene, hit.position + hit.n_geo * scene.ray_epsilon, wi_world);
+  if (next && IsReflective(scene.scene->materials[next->region].brdf)) {
+    b.patch = patches.PatchOf(next->triangle, next->b1, next->b2);
+  }
+  out->bounces.push_back(b);
+  return true;
+}
 
 void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples,
                   Pcg32& rng, PointSamples* out) {
@@ -65,6 +124,10 @@ void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const 
     const std::optional<SurfaceHit> hit = TraceSurface(scene, q.position + q.n_geo * eps, d.wi);
     if (hit && IsReflective(scene.scene->materials[hit->region].brdf)) {
       is.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
+      if (options.specular_bounces && HasSpecularLobe(scene.scene->materials[hit->region].brdf) &&
+          TraceBounce(scene, patches, *hit, d.wi, options.lobe_alpha, rng, out)) {
+        is.bounce = static_cast<int>(out->bounces.size()) - 1;  // local; rebased in Gather()
+      }
     }
     out->indirect.push_back(is);
   }
@@ -146,6 +209,11 @@ GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
       set.direct.insert(set.direct.end(), ps.direct.begin(), ps.direct.end());
       p.direct_end = static_cast<int>(set.direct.size());
       p.indirect_begin = static_cast<int>(set.indirect.size());
+      const int bounce_base = static_cast<int>(set.bounces.size());
+      for (IndirectSample& is : ps.indirect) {
+        if (is.bounce >= 0) is.bounce += bounce_base;
+      }
+      set.bounces.insert(set.bounces.end(), ps.bounces.begin(), ps.bounces.end());
       set.indirect.insert(set.indirect.end(), ps.indirect.begin(), ps.indirect.end());
       p.indirect_end = static_cast<int>(set.indirect.size());
       set.points.push_back(p);

@@ -246,6 +246,7 @@ void SolverState::GatherAll() {
   GatherOptions go;
   go.light_samples = options.light_samples;
   go.indirect_rays = options.indirect_rays;
+  go.specular_bounces = options.specular_bounces;
   go.seed = options.seed;
   go.num_threads = options.num_threads;
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
@@ -345,6 +346,27 @@ Eigen::Vector3d SolverState::PatchRadiance(const LightingState& st, int q,
   return st.patch_d[q].cast<double>() + PatchSpecular(st, q, toward);
 }
 
+// The specular radiance an indirect sample's glossy hit reflects back along the sample from its
+// bounce (solver/gather.h): ρs·S·W(wo, wi)·weight times the diffuse radiance of the patch the
+// bounce meets (the specular part of that radiance is left out: second order in ρs).
+Eigen::Vector3d SolverState::BounceRadiance(const LightingState& st,
+                                            const IndirectSample& s) const {
+  if (s.bounce < 0 || s.patch < 0) return Eigen::Vector3d::Zero();
+  const SpecularBounce& b = st.gather.bounces[s.bounce];
+  const MaterialState& m = materials[patches.patch_region[s.patch]];
+  if (b.patch < 0 || !(m.params.rho_s.maxCoeff() > 0)) return Eigen::Vector3d::Zero();
+  const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                  m.params.ior, b.wo.cast<double>(), b.wi.cast<double>());
+  if (!(w > 0)) return Eigen::Vector3d::Zero();
+  return (w * b.weight) * m.params.rho_s.cwiseProduct(st.patch_d[b.patch].cast<double>());
+}
+
+Eigen::Vector3d SolverState::IndirectRadiance(const LightingState& st,
+                                              const IndirectSample& s) const {
+  if (s.patch < 0) return Eigen::Vector3d::Zero();
+  return PatchRadiance(st, s.patch, -s.wi.cast<double>()) + BounceRadiance(st, s);
+}
+
 // D_q: the diffuse radiance of each patch: the photos' mean over its observations less their
 // predicted specular part; patches no photo of the lighting sees get ρd·E/π.
 void SolverState::UpdatePatchRadiance(LightingState* st) {
@@ -376,7 +398,7 @@ void SolverState::UpdatePatchRadiance(LightingState* st) {
           for (int k = gp.indirect_begin; k < gp.indirect_end; ++k) {
             const IndirectSample& s = st->gather.indirect[k];
             if (s.patch < 0) continue;
-            e += s.weight * PatchRadiance(*st, s.patch, -s.wi.cast<double>());
+            e += s.weight * IndirectRadiance(*st, s);
           }
           st->patch_e[q] = e.cast<float>();
         },

@@ -89,6 +89,10 @@ struct SolverState {
                                 const Eigen::Vector3d& toward) const;
   Eigen::Vector3d PatchRadiance(const LightingState& st, int q,
                                 const Eigen::Vector3d& toward) const;
+  // The radiance arriving along an indirect sample: its patch's radiance toward the sample's
+  // point plus the specular light its glossy hit reflects from the sample's bounce.
+  Eigen::Vector3d BounceRadiance(const LightingState& st, const IndirectSample& s) const;
+  Eigen::Vector3d IndirectRadiance(const LightingState& st, const IndirectSample& s) const;
   void UpdatePatchRadiance(LightingState* st);
 
   // solve_stages.cpp

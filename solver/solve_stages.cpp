@@ -96,7 +96,7 @@ void SolverState::IncidentFromPatches() {
           for (int d = gp.indirect_begin; d < gp.indirect_end; ++d) {
             const IndirectSample& s = st.gather.indirect[d];
             if (s.patch < 0) continue;
-            const Eigen::Vector3d l = PatchRadiance(st, s.patch, -s.wi.cast<double>());
+            const Eigen::Vector3d l = IndirectRadiance(st, s);
             e += s.weight * l;
             if (glossy) {
               inc.push_back(

@@ -1,6 +1,8 @@
 // Experiment (run by hand; figures in bench/RESULTS.md): where the relit (L1) error of the solved
 // igi-synth room sits, as solve_truth_test measures it (cam0, 8x8-pixel blocks), per region.
 //   build/bench/relight_probe CAPTURE_DIR OUT_DIR   env: PROBE_HELD=0/1 (held_out_albedo),
+//   PROBE_REFINE=N (refinement rounds, default 1), PROBE_BOUNCE=0/1 (specular_bounces),
+//   PROBE_STEP=S (refine_albedo_step),
 //   PROBE_REUSE=1 (render OUT_DIR/scene.json without solving again)
 #include <cstdio>
 #include <filesystem>
@@ -27,6 +29,9 @@ int main(int argc, char** argv) {
   o.num_threads = 2;
   o.show_progress = false;
   if (const char* e = std::getenv("PROBE_HELD")) o.held_out_albedo = std::string(e) == "1";
+  if (const char* e = std::getenv("PROBE_REFINE")) o.refine_iterations = std::atoi(e);
+  if (const char* e = std::getenv("PROBE_BOUNCE")) o.specular_bounces = std::string(e) == "1";
+  if (const char* e = std::getenv("PROBE_STEP")) o.refine_albedo_step = std::atof(e);
   const bool reuse = std::getenv("PROBE_REUSE") != nullptr && fs::exists(out / "scene.json");
   if (!reuse) {
     const SolveSummary s = Solve(scene, o, out);

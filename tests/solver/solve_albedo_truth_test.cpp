@@ -77,22 +77,38 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
       all.psnr_db, seen.psnr_db, 100 * seen.compared, interior.psnr_db, 100 * interior.compared);
   // About three quarters of the floor is seen (the boxes and the sphere hide the rest).
   EXPECT_GT(seen.compared, 0.65);
-  // Issue 7 asks 35 dB (noise-free). Measured 32.9 dB over the seen texels and 34.4 dB two
-  // texels (9 cm) inside them (33.8 and 35.3 dB with 512-spp photos, bench/RESULTS.md): the rest
-  // is the photos' Monte Carlo noise (about 7 % per pixel at 256 spp), the gathered indirect
-  // irradiance's noise, and its bias near the walls and the boxes' and sphere's contacts.
-  // Guarded 1 dB below the measured values.
-  EXPECT_GT(seen.psnr_db, 31.9);
-  EXPECT_GT(interior.psnr_db, 33.4);
+  // Issue 7 asks 35 dB (noise-free). Measured 33.1 dB over the seen texels and 34.9 dB two
+  // texels (9 cm) inside them (32.9 / 34.4 dB before the specular bounces; 33.8 and 35.3 dB with
+  // 512-spp photos then, bench/RESULTS.md): the rest is the photos' Monte Carlo noise (about
+  // 7 % per pixel at 256 spp), the gathered indirect irradiance's noise, and its bias near the
+  // walls and the boxes' and sphere's contacts. Guarded 1 dB below the measured values.
+  EXPECT_GT(seen.psnr_db, 32.0);
+  EXPECT_GT(interior.psnr_db, 33.8);
   std::printf("floor: rho_s %+.2f %%, alpha %+.2f %%\n",
               100 * (floor.stage1.rho_s.mean() / truth["floor"]["rho_s"].get<double>() - 1),
               100 * (floor.stage1.alpha / truth["floor"]["alpha"].get<double>() - 1));
   // The floor's lobe, fitted with each sample's albedo from the other photos (held-out, texel
-  // scale): measured rho_s -1.5 %, alpha -0.6 % (-1.0 %, -0.3 % before rho_s was fitted
-  // through the held-out samples' own lobe and the off-highlight test took the region's mean
-  // albedo); guarded at issue 7's bar, 5 %.
+  // scale): measured rho_s -0.4 %, alpha -0.2 % (-1.5 %, -0.6 % before the specular bounces;
+  // -1.0 %, -0.3 % before rho_s was fitted through the held-out samples' own lobe and the
+  // off-highlight test took the region's mean albedo); guarded at issue 7's bar, 5 %.
   EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
   EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
+  // Issue 7: region-mean albedos within 1 % on (nearly) noise-free photos. The regions of one
+  // albedo (all but the textured floor), paper stage: measured -0.56..+0.83 % (glossy_box's red,
+  // rho_d 0.1, +0.83 %; the ceiling +0.27..+0.60 %). Without the specular bounces
+  // (SolveOptions::specular_bounces, solver/gather.h) the ceiling is +2.0..+2.3 % and this fails.
+  for (const RegionSolution& r : s.regions) {
+    if (r.name == "floor" || !truth.contains(r.name)) continue;
+    const Json& t = truth[r.name];
+    std::printf("%s: rho_d %+.2f %+.2f %+.2f %%\n", r.name.c_str(),
+                100 * (r.stage1.rho_d[0] / t["rho_d"][0].get<double>() - 1),
+                100 * (r.stage1.rho_d[1] / t["rho_d"][1].get<double>() - 1),
+                100 * (r.stage1.rho_d[2] / t["rho_d"][2].get<double>() - 1));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LT(RelErr(r.stage1.rho_d[c], t["rho_d"][c].get<double>()), 0.01)
+          << r.name << " rho_d[" << c << "]";
+    }
+  }
 }
 
 }  // namespace

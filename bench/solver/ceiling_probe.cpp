@@ -1,0 +1,333 @@
+// Experiment (run by hand; figures in bench/RESULTS.md, "The ceiling's +1.5 % on converged
+// photos"): where a region's stage-1 albedo bias comes from, against the true scene.
+//   build/bench/ceiling_probe CAPTURE [region=ceiling] [stride=2] [every=4] [ref_rays=1024]
+//       [paths=8] [pixel_paths=256] [spec_rays=32] [smooth=0] [patch=0] [bounce=1]
+//       [stage2=0] [seed2=1]
+// Runs stage 1 on an igi-synth capture (2 threads; smooth, patch: SolveOptions' smoothing radius
+// and patch size, 0 = auto; bounce: SolveOptions::specular_bounces) and, for every `every`-th
+// observation of `region`, compares:
+//  (a) the gathered irradiance (direct; indirect raw and smoothed) with a reference irradiance of
+//      the TRUE scene (truth/scene.json) at the same point: `ref_rays` cosine-weighted rays, each
+//      the true reflected radiance (one path);
+//  (b) on the gather's own indirect rays: the radiance the solver takes for the patch each ray
+//      hits (the photos' mean over the patch's observations, or ρd·E/π where no photo sees it)
+//      against the true reflected radiance along the same ray (`paths` paths), split by the hit
+//      region and by how many observations the hit patch has; "+spec_ind": with the glossy hit's
+//      true specular reflection of the indirect light added (`spec_rays` lobe rays, 0 = off);
+//      and the irradiance at the centres of the unseen patches the rays meet against a reference;
+//  (d) the photo's pixel against ρd_true·E_ref/π at the pixel centre's point and against a
+//      `pixel_paths`-path render of the true scene through the pixel centre;
+//  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2)
+//      over the true scene and over the stage-1 model, against the same reference.
+// Prints the ratios and the albedo πΣL/ΣE with each irradiance.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "recon/scene.h"
+#include "solver/render.h"
+#include "solver/render_internal.h"
+#include "solver/solve_internal.h"
+#include "solver/surface_hit.h"
+#include "tools/common/json.h"
+#include "tools/common/parallel.h"
+
+using namespace igi;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Sum {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  double n = 0;
+  void Add(const Eigen::Vector3d& x, const Eigen::Vector3d& y) { a += x, b += y, n += 1; }
+  double Ratio() const { return a.sum() / b.sum(); }
+};
+
+struct Row {
+  Eigen::Vector3d e_dir, e_ind_raw, e_ind_smooth, e_ind_ref, l_photo, l_pixel_ref;
+  std::map<std::string, Sum> by;  // key -> (Σ w·L_model, Σ w·L_true) on the gather's own rays
+};
+
+std::string Bucket(int count) {
+  return count == 0 ? "unseen" : count < 4 ? "1-3 obs" : count < 16 ? "4-15 obs" : "16+ obs";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr,
+                 "usage: ceiling_probe CAPTURE [region= stride= every= ref_rays= paths=]\n");
+    return 2;
+  }
+  const fs::path dir = argv[1];
+  std::map<std::string, std::string> kv = {
+      {"region", "ceiling"}, {"stride", "2"},        {"every", "4"},  {"ref_rays", "1024"},
+      {"paths", "8"},        {"pixel_paths", "256"}, {"smooth", "0"}, {"patch", "0"},
+      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"}, {"seed2", "1"}};
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    const size_t eq = a.find('=');
+    if (eq == std::string::npos || !kv.count(a.substr(0, eq))) {
+      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
+      return 2;
+    }
+    kv[a.substr(0, eq)] = a.substr(eq + 1);
+  }
+  SetDefaultThreads(2);
+  const Scene scene = LoadScene(dir / "scene.json");
+  SolveOptions options;
+  options.refine_iterations = 0;
+  options.num_threads = 2;
+  options.show_progress = false;
+  options.pixel_stride = std::stoi(kv["stride"]);
+  options.smoothing_radius_m = std::stod(kv["smooth"]);
+  options.patch_size_m = std::stod(kv["patch"]);
+  options.specular_bounces = kv["bounce"] != "0";
+  SolverState s(scene, options);
+  s.Prepare();
+  s.GatherAll();
+  s.RunStage1();
+  const int region = scene.FindMaterial(kv["region"]);
+  const Json truth = ReadJsonFile(dir / "truth.json")["materials"];
+  const Eigen::Vector3d rho_true(truth[kv["region"]]["rho_d"][0].get<double>(),
+                                 truth[kv["region"]]["rho_d"][1].get<double>(),
+                                 truth[kv["region"]]["rho_d"][2].get<double>());
+  const Eigen::Vector3d rho_fit = s.materials[region].params.rho_d;
+  std::printf("%s: stage-1 rho_d %+.2f %+.2f %+.2f %% (%s), patch %.4f m\n", kv["region"].c_str(),
+              100 * (rho_fit[0] / rho_true[0] - 1), 100 * (rho_fit[1] / rho_true[1] - 1),
+              100 * (rho_fit[2] / rho_true[2] - 1),
+              s.materials[region].last_fit.albedo_model.c_str(), s.summary.patch_size_m);
+  const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
+  const int lighting = 0;
+  const Renderer ref(truth_scene, lighting);
+  const LightingState& st = s.lighting_state[lighting];
+  std::vector<int> count(s.patches.size(), 0);
+  for (int i : st.obs) ++count[s.obs[i].patch];
+  std::vector<int> subset;
+  int seen = 0;
+  for (int i : st.obs) {
+    if (s.obs[i].region == region && seen++ % std::stoi(kv["every"]) == 0) subset.push_back(i);
+  }
+  const int ref_rays = std::stoi(kv["ref_rays"]), paths = std::stoi(kv["paths"]);
+  const int pixel_paths = std::stoi(kv["pixel_paths"]);
+  const int spec_rays = std::stoi(kv["spec_rays"]);
+  std::vector<Row> rows(subset.size());
+  const auto start = std::chrono::steady_clock::now();
+  ParallelFor(
+      0, int64_t(subset.size()),
+      [&](int64_t k) {
+        const int i = subset[k];
+        const Observation& o = s.obs[i];
+        Row& row = rows[k];
+        row.e_dir = s.obs_e_direct[i];
+        row.e_ind_raw = s.obs_e_indirect[i];
+        row.e_ind_smooth = s.obs_e[i] - s.obs_e_direct[i];
+        row.l_photo = o.radiance.cast<double>();
+        const double eps = s.lighting_scenes[lighting]->ray_epsilon;
+        GatherQuery q;
+        q.position = o.position.cast<double>();
+        const Eigen::Vector3d fn = scene.mesh.FaceNormal(o.triangle).cast<double>();
+        q.n_geo = fn.dot(o.view.cast<double>()) >= 0 ? fn : -fn;
+        q.n_s = o.normal.cast<double>();
+        Pcg32 rng(1000 + i, 7);
+        row.e_ind_ref.setZero();
+        int ray = 0;
+        for (const WeightedDirection& d : HemisphereDirections(q, ref_rays, 0.2, rng)) {
+          row.e_ind_ref += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * eps, d.wi, 1,
+                                                            uint64_t(i) * 65536 + ray++);
+        }
+        const GatherPoint& gp = st.gather.points[s.obs_point[i]];
+        for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
+          const IndirectSample& is = st.gather.indirect[j];
+          const Eigen::Vector3d wi = is.wi.cast<double>();
+          const Eigen::Vector3d l_true =
+              ref.ReflectedRadiance(q.position + q.n_geo * eps, wi, paths, uint64_t(j) * 977 + 5);
+          const Eigen::Vector3d l_model =
+              is.patch < 0 ? Eigen::Vector3d::Zero() : s.IndirectRadiance(st, is);
+          const std::string hit =
+              is.patch < 0 ? "none" : scene.materials[s.patches.patch_region[is.patch]].name;
+          const std::string b = is.patch < 0 ? "none" : Bucket(count[is.patch]);
+          // The glossy hit's specular reflection of the indirect light toward the point, which the
+          // model's patch radiance leaves out: Σ over lobe directions of ρs·S·W·L_true.
+          Eigen::Vector3d l_spec_ind = Eigen::Vector3d::Zero();
+          if (is.patch >= 0) {
+            const int hr = s.patches.patch_region[is.patch];
+            const MaterialState& hm = s.materials[hr];
+            const std::optional<SurfaceHit> h =
+                TraceSurface(*s.lighting_scenes[lighting], q.position + q.n_geo * eps, wi);
+            if (h && HasSpecularLobe(hm.params.model) && spec_rays > 0) {
+              GatherQuery hq;
+              hq.position = h->position;
+              hq.n_geo = h->n_geo;
+              hq.n_s = h->n_s;
+              hq.view = -wi;
+              hq.lobe = true;
+              const Frame frame = s.LocalFrame(hr, h->n_s);
+              const Eigen::Vector3d wo = frame.ToLocal(-wi);
+              Pcg32 r2(j * 3 + 1, 11);
+              int m = 0;
+              for (const WeightedDirection& d2 : HemisphereDirections(hq, spec_rays, 0.2, r2)) {
+                const double sw =
+                    SpecularWeight(hm.params.model, hm.params.AlphaX(), hm.params.AlphaY(),
+                                   hm.params.ior, wo, frame.ToLocal(d2.wi));
+                if (!(sw > 0)) continue;
+                l_spec_ind += sw * d2.weight *
+                              ref.ReflectedRadiance(h->position + h->n_geo * eps, d2.wi, 1,
+                                                    uint64_t(j) * 4099 + m++)
+                                  .cwiseProduct(hm.params.rho_s);
+              }
+            }
+          }
+          row.by["+spec_ind all"].Add(is.weight * (l_model + l_spec_ind), is.weight * l_true);
+          if (is.patch >= 0) {
+            row.by["+spec_ind hit " + scene.materials[s.patches.patch_region[is.patch]].name].Add(
+                is.weight * (l_model + l_spec_ind), is.weight * l_true);
+          }
+          row.by["all"].Add(is.weight * l_model, is.weight * l_true);
+          row.by["hit " + hit + " " + b].Add(is.weight * l_model, is.weight * l_true);
+          row.by["hit " + hit].Add(is.weight * l_model, is.weight * l_true);
+          row.by["patch " + b].Add(is.weight * l_model, is.weight * l_true);
+        }
+        const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+        row.l_pixel_ref = ref.Radiance(cam.CenterInWorld(),
+                                       cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5)),
+                                       pixel_paths, uint64_t(i) * 31 + 3);
+      },
+      2, 1);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Totals, per photo and overall.
+  std::map<std::string, std::array<Eigen::Vector3d, 6>> tot;
+  std::map<std::string, Sum> rays;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const Row& r = rows[k];
+    for (const std::string& key :
+         {std::string("all"), fmt::format("photo {}", s.obs[subset[k]].photo)}) {
+      auto it = tot.find(key);
+      if (it == tot.end()) {
+        std::array<Eigen::Vector3d, 6> zero;
+        zero.fill(Eigen::Vector3d::Zero());
+        it = tot.emplace(key, zero).first;
+      }
+      auto& t = it->second;
+      const std::array<Eigen::Vector3d, 6> v = {r.e_dir,     r.e_ind_raw, r.e_ind_smooth,
+                                                r.e_ind_ref, r.l_photo,   r.l_pixel_ref};
+      for (int c = 0; c < 6; ++c) t[c] += v[c];
+    }
+    for (const auto& [key, sum] : r.by) {
+      Sum& a = rays[key];
+      a.a += sum.a, a.b += sum.b, a.n += sum.n;
+    }
+  }
+  std::printf("%zu samples (every %s-th of %d), %.1f s wall for the references\n", rows.size(),
+              kv["every"].c_str(), seen, seconds);
+  for (auto& [key, t] : tot) {
+    const Eigen::Vector3d e_g = t[0] + t[2], e_ref = t[0] + t[3];
+    const Eigen::Vector3d rho_g = kPi * t[4].cwiseQuotient(e_g);
+    const Eigen::Vector3d rho_r = kPi * t[4].cwiseQuotient(e_ref);
+    const Eigen::Vector3d rho_pix = kPi * t[5].cwiseQuotient(e_ref);
+    std::printf(
+        "%-8s E_dir/E %.3f | E_ind smoothed/ref %.4f raw/ref %.4f | E_gathered/E_ref %.4f | "
+        "L_photo/L_pixel_ref %.4f | L_photo/(rho E_ref/pi) %.4f\n"
+        "         rho = pi SumL/SumE: gathered E %+.2f %%, reference E %+.2f %%, pixel-ref L and "
+        "ref E %+.2f %%\n",
+        key.c_str(), t[0].sum() / e_ref.sum(), t[2].sum() / t[3].sum(), t[1].sum() / t[3].sum(),
+        e_g.sum() / e_ref.sum(), t[4].sum() / t[5].sum(),
+        t[4].sum() / (rho_true.cwiseProduct(e_ref) / kPi).sum(),
+        100 * (rho_g.mean() / rho_true.mean() - 1), 100 * (rho_r.mean() / rho_true.mean() - 1),
+        100 * (rho_pix.mean() / rho_true.mean() - 1));
+  }
+  if (kv["stage2"] != "0") {
+    // (e) stage 2's gathering (the path tracer over a scene, SolverState::IncidentFromRenderer)
+    // at the same points, over the true scene and over the stage-1 model the refinement renders.
+    const fs::path tmp =
+        fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));
+    fs::create_directories(tmp);
+    std::vector<RegionAtlas> atlases;
+    std::vector<Image> maps;
+    const Scene model = s.CompleteScene(&atlases, &maps, tmp);
+    s.options.refine_rays = std::stoi(kv["stage2"]);
+    s.options.seed = std::stoull(kv["seed2"]);
+    for (int variant = 0; variant < 2; ++variant) {
+      s.IncidentFromRenderer(variant == 0 ? truth_scene : model, 1);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
+      for (size_t k = 0; k < rows.size(); ++k) {
+        sum += s.obs_e_indirect[subset[k]];
+        ref_sum += rows[k].e_ind_ref;
+      }
+      std::printf("stage 2's E_ind over the %s / reference (true scene): %.4f\n",
+                  variant == 0 ? "true scene" : "stage-1 model", sum.sum() / ref_sum.sum());
+    }
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+  }
+  std::printf("the gather's own rays: model radiance / true radiance (share of the true E_ind)\n");
+  const double all_true = rays["all"].b.sum();
+  for (const auto& [key, a] : rays) {
+    std::printf("  %-22s %.4f  (%5.1f %%, %6.0f rays)\n", key.c_str(), a.Ratio(),
+                100 * a.b.sum() / all_true, a.n);
+  }
+  // (b) the patches no photo sees that the point's rays meet: the solver's irradiance at their
+  // centres (direct and indirect) against a reference of the true scene there.
+  std::map<int, int> hits;
+  for (int i : subset) {
+    const GatherPoint& gp = st.gather.points[s.obs_point[i]];
+    for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
+      const int q = st.gather.indirect[j].patch;
+      if (q >= 0 && count[q] == 0) ++hits[q];
+    }
+  }
+  std::vector<int> unseen;
+  for (const auto& [q, n] : hits) unseen.push_back(q);
+  std::vector<std::array<double, 5>> pe(unseen.size());
+  const Renderer::Impl& ls = *s.lighting_scenes[lighting];
+  ParallelFor(
+      0, int64_t(unseen.size()),
+      [&](int64_t k) {
+        const int q = unseen[k];
+        GatherQuery gq;
+        gq.position = s.patches.center[q].cast<double>();
+        gq.n_geo = scene.mesh.FaceNormal(s.patches.patch_triangle[q]).cast<double>();
+        gq.n_s = s.patches.normal[q].cast<double>();
+        Pcg32 rng(77 + q, 9);
+        Eigen::Vector3d e = Eigen::Vector3d::Zero();
+        int ray = 0;
+        for (const WeightedDirection& d : HemisphereDirections(gq, ref_rays, 0.2, rng)) {
+          e += d.weight * ref.ReflectedRadiance(gq.position + gq.n_geo * ls.ray_epsilon, d.wi, 1,
+                                                uint64_t(q) * 65536 + ray++);
+        }
+        const GatherPoint& gp = st.gather.points[st.first_patch_point + q];
+        const Eigen::Vector3d e_dir = gp.e_direct.cast<double>();
+        pe[k] = {e_dir.sum(), (st.patch_e[q].cast<double>() - e_dir).sum(), e.sum(),
+                 double(hits[q]), s.PatchAlbedo(q).sum()};
+      },
+      2, 1);
+  std::map<std::string, std::array<double, 6>> by_region;
+  for (size_t k = 0; k < unseen.size(); ++k) {
+    const int q = unseen[k];
+    const int r = s.patches.patch_region[q];
+    auto& a = by_region[scene.materials[r].name];
+    const double w = pe[k][3];  // weighted by the rays that meet the patch
+    Eigen::Vector3d rt(truth[scene.materials[r].name]["rho_d"][0].get<double>(),
+                       truth[scene.materials[r].name]["rho_d"][1].get<double>(),
+                       truth[scene.materials[r].name]["rho_d"][2].get<double>());
+    a[0] += w * pe[k][0], a[1] += w * pe[k][1], a[2] += w * pe[k][2], a[3] += w;
+    a[4] += w * pe[k][4], a[5] += w * rt.sum();
+  }
+  std::printf(
+      "unseen patches met by the rays (weighted by rays): E_dir/E_ref, E_ind/E_ind_ref, "
+      "E/E_ref, albedo/true\n");
+  for (const auto& [name, a] : by_region) {
+    std::printf("  %-14s %4.0f rays  E_dir share %.3f  E_ind %.4f  E %.4f  albedo %.4f\n",
+                name.c_str(), a[3], a[0] / (a[0] + a[2]), a[1] / a[2],
+                (a[0] + a[1]) / (a[0] + a[2]), a[4] / a[5]);
+  }
+  return 0;
+}

@@ -1,0 +1,95 @@
+// The paper stage's gathering against the path tracer: a glossy surface sends the points it
+// lights not only its diffuse radiance and the lamp's highlight but also its specular reflection
+// of the rest of the room (solver/gather.h, "specular bounce"). Without that term every point lit
+// by a glossy surface gathers too little light and its albedo comes out too high (igi-synth's
+// ceiling +1.5..+2.3 % on converged photos, bench/RESULTS.md).
+//
+// Scene: tests/e2e/box_room.h's 2 m room with a glossy floor (Ward ρd 0.15, ρs 0.4, α 0.1, all
+// known), known walls and a ceiling whose albedo (0.7) is solved from one photo of the camera
+// looking up, rendered by the path tracer (256 paths per pixel).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "recon/scene.h"
+#include "solver/render.h"
+#include "solver/solve.h"
+#include "tests/e2e/box_room.h"
+#include "tests/temp_dir.h"
+#include "tools/common/image.h"
+#include "tools/common/json.h"
+
+namespace igi {
+namespace {
+namespace fs = std::filesystem;
+namespace room = test::box_room;
+
+Json Materials(bool with_ceiling) {
+  Json m = room::TrueMaterials(false);
+  m["floor"] = {{"brdf", "ward"}, {"rho_d", {0.15, 0.15, 0.15}}, {"rho_s", 0.4}, {"alpha", 0.1}};
+  if (!with_ceiling) m["ceiling"] = {{"brdf", "lambert"}};
+  return m;
+}
+
+class SolveGather : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::UniqueTempDir("solve_gather");
+    fs::create_directories(dir_ / "geometry");
+    fs::create_directories(dir_ / "photos");
+    {
+      std::FILE* f = std::fopen((dir_ / "geometry" / "room.obj").c_str(), "w");
+      ASSERT_NE(f, nullptr);
+      std::fputs(room::RoomObj(false).c_str(), f);
+      std::fclose(f);
+    }
+    const Json photos = Json::array({room::PhotoEntry("photos/cam1.exr", "cam1", "L0")});
+    // The truth has no photos (they are rendered from it).
+    WriteJsonFile(dir_ / "truth.json", room::SceneDoc(Materials(true), Json::array()));
+    WriteJsonFile(dir_ / "scene.json", room::SceneDoc(Materials(false), photos));
+    SceneLoadOptions lo;
+    lo.require_complete_materials = true;
+    lo.check_images = false;
+    const Scene truth = LoadScene(dir_ / "truth.json", lo);
+    const Renderer renderer(truth, truth.FindLighting("L0"));
+    RenderOptions ro;
+    ro.spp = 256;
+    ro.seed = 5;
+    ro.num_threads = 2;
+    ro.show_progress = false;
+    WriteImage(dir_ / "photos" / "cam1.exr",
+               renderer.Render(truth.cameras[truth.FindCamera("cam1")], ro));
+  }
+
+  // The solved ceiling albedo's relative error (paper stage only).
+  double CeilingError(bool specular_bounces) const {
+    const Scene scene = LoadScene(dir_ / "scene.json");
+    SolveOptions o;
+    o.refine_iterations = 0;
+    o.specular_bounces = specular_bounces;
+    o.num_threads = 2;
+    o.show_progress = false;
+    const SolveSummary s = Solve(scene, o, dir_ / "out");
+    const RegionSolution& ceiling = s.regions[scene.FindMaterial("ceiling")];
+    EXPECT_EQ(ceiling.status, "solved");
+    return ceiling.stage1.rho_d.mean() / 0.7 - 1;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(SolveGather, GlossySurfacesPassOnTheirSpecularReflectionOfTheRoom) {
+  const double with = CeilingError(true), without = CeilingError(false);
+  std::printf("ceiling rho_d error: %+.2f %% with specular bounces, %+.2f %% without\n", 100 * with,
+              100 * without);
+  // Measured -0.63 % with, +4.44 % without (the floor's specular reflection of the ceiling
+  // missing from the ceiling's irradiance); with another photo seed and 256 indirect rays
+  // -0.13 % / +4.78 %: the -0.6 % is gathering noise. 1 %: issue 7's bar for region means.
+  EXPECT_LT(std::abs(with), 0.01);
+  // The scene must show the effect, or the check above guards nothing.
+  EXPECT_GT(without, 0.03);
+}
+
+}  // namespace
+}  // namespace igi
