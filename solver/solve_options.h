@@ -22,9 +22,9 @@ struct SolveOptions {
   int indirect_rays = 64;
   // Where an indirect ray meets a glossy surface, trace one more ray about its mirror direction
   // so that the surface's specular reflection of the rest of the room joins the light it sends
-  // (solver/gather.h). Off: glossy patches send only their diffuse radiance and the direct
-  // light's highlight (the ceiling of igi-synth's room gathers 2 % too little). No flag: for
-  // experiments (bench/solver/bench_solve_truth bounce=0).
+  // (solver/gather.h). Off (--specular-bounces false): glossy patches send only their diffuse
+  // radiance and the direct light's highlight (the ceiling of igi-synth's room gathers 2 % too
+  // little; bench/solver/bench_solve_truth bounce=0).
   bool specular_bounces = true;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
   // surface is averaged to remove gathering noise; 0 = auto (the scene diagonal / 96).

@@ -176,9 +176,10 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   Json photos = Json::array();
   for (size_t k = 0; k < s.photos.size(); ++k) {
     const PhotoObservationStats& p = s.photos[k];
-    Json pj = {{"pixels", p.pixels}, {"valid", p.valid},           {"masked", p.masked},
-               {"clipped", p.clipped}, {"invalid", p.invalid},     {"background", p.background},
-               {"edge", p.edge},     {"saturation", Num(p.saturation)}};
+    Json pj = {{"pixels", p.pixels},   {"valid", p.valid},
+               {"masked", p.masked},   {"clipped", p.clipped},
+               {"invalid", p.invalid}, {"background", p.background},
+               {"edge", p.edge},       {"saturation", Num(p.saturation)}};
     if (k < s.residuals.size()) {
       pj["file"] = s.residuals[k].file;
       pj["residual_paper"] = Num(s.residuals[k].stage1);
@@ -197,20 +198,29 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                        {"params", it.params}});
   }
   j["history"] = history;
-  j["timing"] = {{"total_s", s.seconds_total},
-                 {"ray_casting_s", s.seconds_rays},
-                 {"fitting_s", s.seconds_fit},
-                 {"ray_casting_share", s.seconds_total > 0 ? s.seconds_rays / s.seconds_total : 0.0}};
+  j["timing"] = {
+      {"total_s", s.seconds_total},
+      {"ray_casting_s", s.seconds_rays},
+      {"fitting_s", s.seconds_fit},
+      {"ray_casting_share", s.seconds_total > 0 ? s.seconds_rays / s.seconds_total : 0.0}};
   j["rays"] = s.rays;
   j["patches"] = s.patches;
   j["patch_size_m"] = s.patch_size_m;
   j["texel_size_m"] = s.texel_size_m;
   j["observations"] = s.observations;
-  j["options"] = {{"pixel_stride", o.pixel_stride},     {"light_samples", o.light_samples},
-                  {"indirect_rays", o.indirect_rays},   {"max_iterations", o.max_iterations},
-                  {"tolerance", o.tolerance},           {"specular_colour", o.specular_colour},
-                  {"albedo_maps", o.albedo_maps},       {"refine_iterations", o.refine_iterations},
-                  {"refine_rays", o.refine_rays},       {"seed", o.seed}};
+  j["options"] = {{"pixel_stride", o.pixel_stride},
+                  {"light_samples", o.light_samples},
+                  {"indirect_rays", o.indirect_rays},
+                  {"max_iterations", o.max_iterations},
+                  {"tolerance", o.tolerance},
+                  {"specular_colour", o.specular_colour},
+                  {"albedo_maps", o.albedo_maps},
+                  {"refine_iterations", o.refine_iterations},
+                  {"refine_rays", o.refine_rays},
+                  {"seed", o.seed},
+                  {"refine_albedo_step", o.refine_albedo_step},
+                  {"specular_bounces", o.specular_bounces},
+                  {"photo_scale", o.photo_scale}};
   return j;
 }
 

@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   app.add_option("--refine-albedo-step", o.refine_albedo_step,
                  "share of each refinement round's albedo change applied (1 = full step)")
       ->capture_default_str();
+  app.add_option("--specular-bounces", o.specular_bounces,
+                 "gathering follows glossy surfaces' reflection of the room (true) or takes only "
+                 "their diffuse radiance and the lights' highlights (false)")
+      ->capture_default_str();
   app.add_option("--photo-scale", o.photo_scale,
                  "given (photos in the scene's radiance units) or solve (one factor for all "
                  "photos, from the regions of known diffuse reflectance)")

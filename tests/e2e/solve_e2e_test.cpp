@@ -210,7 +210,11 @@ TEST_F(SolveE2E, RefineAlbedoStepMovesPartOfTheWay) {
   const fs::path scene = LambertRoomAlbedosUnknown();
   const fs::path full = dir_ / "full", half = dir_ / "half";
   ASSERT_EQ(Solve(scene, full).exit_code, 0);  // kFast: one refinement round
-  ASSERT_EQ(Solve(scene, half, " --refine-albedo-step 0.5").exit_code, 0);
+  // No glossy region here: --specular-bounces false changes nothing but the report's options.
+  ASSERT_EQ(Solve(scene, half, " --refine-albedo-step 0.5 --specular-bounces false").exit_code, 0);
+  EXPECT_EQ(ReadJsonFile(full / "report.json")["options"]["specular_bounces"], true);
+  EXPECT_EQ(ReadJsonFile(half / "report.json")["options"]["specular_bounces"], false);
+  EXPECT_EQ(ReadJsonFile(half / "report.json")["options"]["refine_albedo_step"], 0.5);
   const Json a = ReadJsonFile(full / "report.json")["regions"];
   const Json b = ReadJsonFile(half / "report.json")["regions"];
   ASSERT_EQ(a.size(), b.size());
