@@ -61,10 +61,13 @@ constexpr double kAlphaTolerance = 0.20;  // lobe width (scale-free); the floor'
 // The ceiling, seen by the 2 cameras that look up (measured −0.9 % after k with "reference",
 // −1.0 % with "measured"; 40 % low when no photo saw it and it kept a placeholder).
 constexpr double kCeilingRhoDTolerance = 0.05;
-// Registration against the true cameras (measured: COLMAP's poses within 0.011° and 0.6 mm; the
-// ceiling cameras, posed from the exact pixels of 13 markers, within 1e-4° and 0.01 mm).
+// Registration against the true cameras: issue 6's bars, 0.1° and 0.5 % of the scene's size (the
+// room's 6.4 m diagonal: 32 mm; held here to 0.2 %, 12.8 mm). Measured with exact control points:
+// COLMAP's poses within 0.011° and 0.6 mm, the ceiling cameras within 1e-4°; with the demo's
+// 0.1 px of noise on them (2026-11-22): every photo within 0.085° and 5.4 mm (cam2; the ceiling
+// cameras, posed from about 13 targets alone, and the markers anchor the joint refinement).
 constexpr double kRotationToleranceDeg = 0.1;
-constexpr double kPositionToleranceM = 0.005;
+constexpr double kPositionToleranceM = 0.002 * 6.4;
 // The HDR maps' scale solved from the matte box against the true one (measured −3.1 %; −13.3 %
 // when the ceiling was unseen).
 constexpr double kSolvedScaleTolerance = 0.06;
