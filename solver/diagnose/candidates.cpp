@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -478,6 +479,10 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
 }
 
 // ---------------------------------------------------------------- specular_reflection
+// The roughnesses specular_reflection tries; its widest value is a bound, not a fit (see there).
+constexpr std::array<double, 11> kSpecularAlphaGrid = {0.03, 0.04, 0.05, 0.065, 0.08, 0.1,
+                                                       0.12, 0.15, 0.18, 0.25, 0.35};
+
 double WardLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,
                 double alpha) {
   const double ci = n.dot(wi), co = n.dot(wo);
@@ -506,7 +511,7 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   // free scale of the region's prediction takes that part, so that the lobe's width follows the
   // highlight (the refit renders the reflected room itself).
   const int k = f.nuisance() ? 1 : 2;
-  for (double alpha : {0.03, 0.04, 0.05, 0.065, 0.08, 0.1, 0.12, 0.15, 0.18, 0.25, 0.35}) {
+  for (double alpha : kSpecularAlphaGrid) {
     const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
@@ -522,6 +527,16 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   }
   if (best.coef.size() == 0) {
     out.note = "no lobe with 0 < rho_s < 1 fits region " + name;
+    return out;
+  }
+  // The widest lobe searched fitting best is no highlight: a broad brightening of the region (what
+  // another effect leaves, e.g. an emission profile's fitted power) that a lobe wider still would
+  // fit better, i.e. a change of the region's overall level, not a specular reflection.
+  if (best_alpha >= kSpecularAlphaGrid.back()) {
+    out.note = fmt::format(
+        "region {}: the widest lobe searched (alpha {:.2f}, rho_s {:.3f}) fits best: a broad "
+        "brightening, not a highlight",
+        name, best_alpha, best.coef[0]);
     return out;
   }
   FillScores(best, &out);

@@ -179,6 +179,15 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
       if (!moved) break;
     }
   }
+  // As for specular_reflection: a lobe whose wide direction reaches the widest roughness of the
+  // grid is a broad brightening of the region, not a highlight stretched along a tangent.
+  if (std::max(bp.ax, bp.ay) >= grid.back()) {
+    out.note = fmt::format(
+        "region {}: the lobe's wide direction reaches the widest roughness searched (alpha {:.3f} "
+        "/ {:.3f}): a broad brightening, not a highlight",
+        m.name, bp.ax, bp.ay);
+    return out;
+  }
   const double explained = best.train_before - best.train_after;
   const double share = iso.coef.size() ? (iso.train_after - best.train_after) / explained : 1.0;
   const double ratio = std::max(bp.ax, bp.ay) / std::min(bp.ax, bp.ay);
