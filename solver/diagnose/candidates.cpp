@@ -16,7 +16,9 @@
 #include "solver/diagnose/candidates_brdf_light.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
+#include "solver/render.h"
 #include "solver/sampling.h"
+#include "tools/common/parallel.h"
 
 namespace igi {
 namespace {
@@ -227,18 +229,49 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
 }
 
 // ---------------------------------------------------------------- ambient_light
+// What an ambient light of unit radiance adds at each record, as the photo sees it: the radiance
+// reflected toward the camera (ρd·1 at the point, plus what the room reflects of it: every bounce,
+// rendered with the model's materials and no other light; emitters made black), times the photo's
+// exposure scale and the camera's vignetting. 16 paths per record: the first vertex is exact for
+// the diffuse term (the renderer evaluates ambient light exactly), the bounces are averaged.
+std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
+                                                 const std::vector<PixelRecord>& records) {
+  Scene unit = model;
+  Light ambient;
+  ambient.name = "unit_ambient";
+  ambient.type = LightType::kAmbient;
+  ambient.radiance = Eigen::Vector3d::Ones();
+  unit.lights = {ambient};
+  unit.lightings = {Lighting{"unit_ambient", {0}}};
+  for (Material& m : unit.materials) {
+    if (m.brdf == BrdfModel::kEmitter) m.brdf = BrdfModel::kBlack;
+  }
+  const Renderer renderer(unit, 0);
+  std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
+  ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
+    const PixelRecord& r = records[i];
+    const Photo& photo = model.photos[r.photo];
+    const Camera& camera = model.cameras[photo.camera];
+    const Eigen::Vector3d center = camera.CenterInWorld();
+    const Eigen::Vector3d dir = r.position.cast<double>() - center;
+    if (!(dir.norm() > 0)) return;
+    const Eigen::Vector3d l = renderer.ReflectedRadiance(center, dir, 16, uint64_t(i) + 1);
+    const double k =
+        photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
+    out[i] = (l * k).cast<float>();
+  });
+  return out;
+}
+
 CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
   out.effect = "ambient_light";
-  // An ambient light of radiance L adds ρd·L where it lands, and then what the lit room reflects
-  // of it: each bounce multiplies it by about the room's mean albedo ρ̄, so the offset is about
-  // ρd·L/(1 − ρ̄) (ρ̄ over the records, i.e. over what the photos see).
-  double mean_albedo = 0;
-  for (const PixelRecord& r : f.records()) mean_albedo += r.albedo.mean();
-  mean_albedo = f.records().empty() ? 0 : mean_albedo / double(f.records().size());
-  const double bounces = 1 / (1 - std::clamp(mean_albedo, 0.0, 0.9));
+  // An ambient light of radiance L adds L times the unit light's response where it lands (the
+  // point's ρd and what the lit room reflects of it), in shadow too.
+  const std::vector<Eigen::Vector3f> response = UnitAmbientResponse(cx.model, f.records());
+  const PixelRecord* first = f.records().data();
   const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = r.albedo[c] * bounces * cx.model.photos[r.photo].exposure_scale;
+    b[c] = response[&r - first][c];
   });
   if (fit.coef.size() == 0) return out;
   const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);

@@ -67,7 +67,8 @@ TEST_P(ConcealedMoreTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest,
-                         testing::Values("light_intensity", "specular_reflection"));
+                         testing::Values("light_intensity", "specular_reflection",
+                                         "ambient_light:kind=uniform"));
 
 INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest, testing::Values("vignetting+exposure_scale"));
 
