@@ -348,6 +348,17 @@ std::vector<Eigen::Vector3d> SphereDirections(int n) {
 }
 
 // ---------------------------------------------------------------- light_emission_profile
+// The median of the records' mean model value (a response's reference level).
+double MedianSim(const std::vector<PixelRecord>& records) {
+  std::vector<float> values;
+  for (const PixelRecord& r : records) {
+    if (!r.held_out && !r.outlier) values.push_back(r.sim.mean());
+  }
+  if (values.empty()) return 1.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return std::max(1e-12, double(values[values.size() / 2]));
+}
+
 CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light) {
   CandidateResult out;
   out.effect = "light_emission_profile";
@@ -366,28 +377,44 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   // what the spot lights, loses more than the floor): what is not its direct term gets a free
   // scale per region (the albedos' nuisance covers that when they are solved).
   const int num_regions = int(cx.model.materials.size());
-  auto fit_at = [&](const Eigen::Vector3d& axis, double n) {
+  // The axis and power are searched with a camera response beside the profile as a nuisance (its
+  // expansion to second order, u·ln(u/ref) and u·ln²(u/ref), u the profiled value; a power
+  // r·(u/r)^e = u·exp((e − 1)·ln(u/r))): a response the photos also hide (a power of
+  // the pixel value) would otherwise bend the profile's fit (an 11° axis error and power 2.38 for
+  // 2 in the light_emission_profile + camera_response capture), and the response could then no
+  // longer be proven. The scores come from the fit without it: the profile must explain on its
+  // own what it is credited with.
+  const double ref = MedianSim(recs);
+  auto fit_at = [&](const Eigen::Vector3d& axis, double n, bool response_nuisance) {
     const Eigen::Vector3f ax = axis.cast<float>();
+    const int k_regions = f.nuisance() ? 1 : num_regions;
+    auto offset = [&](const PixelRecord& r, int c) {
+      const LightTerm& t = terms[size_t(&r - recs.data())];
+      if (!t.lit) return 0.0;
+      const double cs = std::max(0.0f, t.from_light.dot(ax));
+      return double(t.direct[c]) * (std::pow(cs, n) - 1);
+    };
     return f.Fit(
-        f.nuisance() ? 1 : num_regions,
+        k_regions + (response_nuisance ? 2 : 0),
         [&](const PixelRecord& r, int c, double* b) {
           const LightTerm& t = terms[size_t(&r - recs.data())];
           if (!f.nuisance() && r.region >= 0 && r.region < num_regions) {
             b[r.region] = double(r.sim[c]) - double(t.direct[c]);
           }
+          const double u = double(r.sim[c]) + offset(r, c);
+          if (response_nuisance && u > 0) {
+            const double log_u = std::log(u / ref);
+            b[k_regions] = u * log_u;
+            b[k_regions + 1] = u * log_u * log_u;
+          }
         },
-        [&](const PixelRecord& r, int c) {
-          const LightTerm& t = terms[size_t(&r - recs.data())];
-          if (!t.lit) return 0.0;
-          const double cs = std::max(0.0f, t.from_light.dot(ax));
-          return double(t.direct[c]) * (std::pow(cs, n) - 1);
-        });
+        offset);
   };
   ResidualFit best;
   double best_n = 1;
   Eigen::Vector3d best_axis = -Eigen::Vector3d::UnitZ();
   auto consider = [&](const Eigen::Vector3d& axis, double n) {
-    const ResidualFit fit = fit_at(axis, n);
+    const ResidualFit fit = fit_at(axis, n, true);
     if (fit.coef.size() == 0) return false;
     if (best.coef.size() && fit.train_after >= best.train_after) return false;
     best = fit, best_axis = axis, best_n = n;
@@ -412,6 +439,11 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
         moved |= consider(best_axis, best_n * factor);
       if (!moved) break;
     }
+  }
+  best = fit_at(best_axis, best_n, false);
+  if (best.coef.size() == 0) {
+    out.note = "the profile alone does not fit (degenerate)";
+    return out;
   }
   FillScores(best, &out);
   const double n = best_n;
