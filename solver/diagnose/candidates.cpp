@@ -359,6 +359,8 @@ double MedianSim(const std::vector<PixelRecord>& records) {
   return std::max(1e-12, double(values[values.size() / 2]));
 }
 
+}  // namespace
+
 CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light) {
   CandidateResult out;
   out.effect = "light_emission_profile";
@@ -449,7 +451,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity = l.type == LightType::kSphere
-                                        ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))
+                                        ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
                                         : l.intensity;
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
@@ -473,6 +475,8 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   };
   return out;
 }
+
+namespace {
 
 // ---------------------------------------------------------------- light_intensity
 CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter& f, int light) {

@@ -58,6 +58,13 @@ class ResidualFitter;
 CandidateResult SpecularReflection(const CandidateContext& context, const ResidualFitter& fitter,
                                    int region);
 
+// light_emission_profile for light `light` (index into model.lights): the light's direct term
+// becomes cos^n of the angle from an axis (a "spot" with a cos_power profile). The axis and n are
+// searched with a camera response as a nuisance (so that a response the photos also hide does not
+// bend them) and scored without it.
+CandidateResult EmissionProfile(const CandidateContext& context, const ResidualFitter& fitter,
+                                int light);
+
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).
 std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
