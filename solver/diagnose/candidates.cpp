@@ -16,22 +16,21 @@
 #include "solver/diagnose/candidates_brdf_light.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/render.h"
 #include "solver/sampling.h"
-#include "tools/common/parallel.h"
 
 namespace igi {
+std::vector<std::string> PhotoFiles(const Scene& model) {
+  std::vector<std::string> out;
+  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
+  return out;
+}
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
 std::string Pct(double v) { return fmt::format("{:.1f}%", 100 * v); }
 
-std::vector<std::string> PhotoFiles(const Scene& model) {
-  std::vector<std::string> out;
-  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
-  return out;
-}
 
 // Whether `light` is the only light of every photographed lighting: then everything the photos
 // record comes from it (bounces too), and a scale common to all photos is its intensity.
@@ -224,80 +223,6 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
       if (p.contains("response")) old = p["response"].value("exponent", 1.0);
       p["response"] = {{"exponent", old * e}, {"reference", reference}};
     }
-  };
-  return out;
-}
-
-// ---------------------------------------------------------------- ambient_light
-// What an ambient light of unit radiance adds at each record, as the photo sees it: the radiance
-// reflected toward the camera (ρd·1 at the point, plus what the room reflects of it: every bounce,
-// rendered with the model's materials and no other light; emitters made black), times the photo's
-// exposure scale and the camera's vignetting. 16 paths per record: the first vertex is exact for
-// the diffuse term (the renderer evaluates ambient light exactly), the bounces are averaged.
-std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
-                                                 const std::vector<PixelRecord>& records) {
-  Scene unit = model;
-  Light ambient;
-  ambient.name = "unit_ambient";
-  ambient.type = LightType::kAmbient;
-  ambient.radiance = Eigen::Vector3d::Ones();
-  unit.lights = {ambient};
-  unit.lightings = {Lighting{"unit_ambient", {0}}};
-  for (Material& m : unit.materials) {
-    if (m.brdf == BrdfModel::kEmitter) m.brdf = BrdfModel::kBlack;
-  }
-  const Renderer renderer(unit, 0);
-  std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
-  ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
-    const PixelRecord& r = records[i];
-    const Photo& photo = model.photos[r.photo];
-    const Camera& camera = model.cameras[photo.camera];
-    const Eigen::Vector3d center = camera.CenterInWorld();
-    const Eigen::Vector3d dir = r.position.cast<double>() - center;
-    if (!(dir.norm() > 0)) return;
-    const Eigen::Vector3d l = renderer.ReflectedRadiance(center, dir, 16, uint64_t(i) + 1);
-    const double k =
-        photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
-    out[i] = (l * k).cast<float>();
-  });
-  return out;
-}
-
-CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
-  CandidateResult out;
-  out.effect = "ambient_light";
-  // An ambient light of radiance L adds L times the unit light's response where it lands (the
-  // point's ρd and what the lit room reflects of it), in shadow too.
-  const std::vector<Eigen::Vector3f> response = UnitAmbientResponse(cx.model, f.records());
-  const PixelRecord* first = f.records().data();
-  const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = response[&r - first][c];
-  });
-  if (fit.coef.size() == 0) return out;
-  const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
-  if (!(radiance.minCoeff() > 0)) {
-    out.note = "the offset that fits is negative in some channel: not an ambient light";
-    return out;
-  }
-  FillScores(fit, &out);
-  out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
-  out.num_params = 3;
-  double mean_sim = 0;
-  int n = 0;
-  for (const PixelRecord& r : f.records()) mean_sim += r.sim.mean(), ++n;
-  out.evidence = fmt::format(
-      "a smooth offset proportional to the albedo everywhere, in shadow too, that no change of "
-      "the albedos explains: the photos are brighter than the model by albedo x {:.4g} (mean "
-      "model radiance {:.4g}), light from no declared source",
-      radiance.mean(), n ? mean_sim / n : 0.0);
-  out.valid = true;
-  out.apply = [radiance](Json* doc) {
-    std::string name = "ambient";
-    while ((*doc)["lights"].contains(name)) name += "_";
-    (*doc)["lights"][name] = {{"type", "ambient"},
-                              {"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-    for (auto& [lname, list] : (*doc)["lightings"].items()) list.push_back(name);
   };
   return out;
 }
@@ -768,7 +693,7 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   if (allowed("exposure_scale")) out.push_back(ExposureScale(cx, f));
   if (allowed("vignetting")) out.push_back(Vignetting(cx, f));
   if (allowed("camera_response")) out.push_back(Response(cx, f));
-  if (allowed("ambient_light")) out.push_back(Ambient(cx, f));
+  if (allowed("ambient_light")) out.push_back(AmbientLight(cx, f));
   for (int l = 0; l < int(cx.model.lights.size()); ++l) {
     const Light& light = cx.model.lights[l];
     const bool point_like =

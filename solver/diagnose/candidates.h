@@ -47,6 +47,9 @@ struct CandidateResult {
   std::string Key() const;
 };
 
+// The photos' file names (a candidate's "where" for effects of every photo).
+std::vector<std::string> PhotoFiles(const Scene& model);
+
 struct ResidualFit;
 // Copies a fit's predicted squared-error sums and significance into a candidate.
 void FillScores(const ResidualFit& fit, CandidateResult* out);
