@@ -1,12 +1,16 @@
 // The path tracer: next-event estimation with multiple importance sampling (power heuristic)
 // between light sampling and BRDF sampling, unbiased Russian roulette, two-sided surfaces,
-// pixel values as means over the pixel square.
+// pixel values as means over the pixel square. Ambient lights (uniform radiance from every
+// direction, never occluded) are not sampled: each path vertex adds L times the BRDF's
+// hemispherical integral, exactly ρd·L for the diffuse term and one direction drawn from the
+// specular lobe alone for the lobe (AddAmbient).
 #include "solver/render.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "solver/render_internal.h"
 #include "tools/common/parallel.h"
@@ -65,9 +69,16 @@ Eigen::Vector3d LightNumbers(LightType type, Pcg32& rng) {
 class PathTracer {
  public:
   PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
-      : impl_(impl),
-        options_(options),
-        light_select_pdf_(impl.lights.empty() ? 0.0 : 1.0 / double(impl.lights.size())) {}
+      : impl_(impl), options_(options) {
+    for (int l = 0; l < static_cast<int>(impl.lights.size()); ++l) {
+      if (impl.lights[l].type == LightType::kAmbient) {
+        ambient_ += impl.lights[l].light->radiance;
+      } else {
+        sampled_lights_.push_back(l);
+      }
+    }
+    light_select_pdf_ = sampled_lights_.empty() ? 0.0 : 1.0 / double(sampled_lights_.size());
+  }
 
   // Radiance arriving along the ray. reflected_only: leave out the emission of what the ray
   // meets first (lights, emitters), i.e. only light reflected by the first surface.
@@ -92,17 +103,42 @@ class PathTracer {
                          const Frame& frame, const BrdfParams& params,
                          const Eigen::Vector3d& wo_local, Pcg32& rng) const;
 
+  // The ambient lights' radiance reflected toward wo: L·∫ f(wo, wi) cosθi dωi over the
+  // hemisphere, i.e. L·ρd exactly plus the specular lobe's directional albedo estimated with one
+  // direction drawn from the lobe alone (weight f_s·cos/pdf_s, nearly constant for Ward's lobe).
+  // No ray: nothing occludes an ambient light, and no other estimator counts it (light sampling
+  // skips it and a BRDF-sampled ray never reaches it).
+  void AddAmbient(PathState* s, const BrdfParams& params, const Eigen::Vector3d& wo_local,
+                  Pcg32& rng) const;
+
   const Renderer::Impl& impl_;
   const RenderOptions& options_;
-  double light_select_pdf_;
+  std::vector<int> sampled_lights_;  // lights drawn by next-event estimation: all but ambient
+  double light_select_pdf_ = 0;      // 1 / sampled_lights_.size()
+  Eigen::Vector3d ambient_ = Eigen::Vector3d::Zero();  // total radiance of the ambient lights
 };
+
+void PathTracer::AddAmbient(PathState* s, const BrdfParams& params,
+                            const Eigen::Vector3d& wo_local, Pcg32& rng) const {
+  if (!(ambient_.maxCoeff() > 0) || !(wo_local.z() > 0)) return;
+  Eigen::Vector3d albedo = params.rho_d;
+  if (HasSpecularLobe(params.model) && params.rho_s.maxCoeff() > 0) {
+    BrdfParams lobe = params;  // ρd = 0: the draw comes from the specular lobe, pdf its own
+    lobe.rho_d.setZero();
+    const BrdfSample bs = SampleBrdf(lobe, wo_local, 0.0, rng.Uniform2D());
+    if (bs.Valid()) albedo += bs.weight;
+  }
+  s->radiance += s->throughput.cwiseProduct(ambient_).cwiseProduct(albedo);
+}
 
 void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
                                    const Eigen::Vector3d& n_geo, const Frame& frame,
                                    const BrdfParams& params, const Eigen::Vector3d& wo_local,
                                    Pcg32& rng) const {
-  const int n = static_cast<int>(impl_.lights.size());
-  const int light = n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1);
+  const int n = static_cast<int>(sampled_lights_.size());
+  if (n == 0) return;
+  const int light =
+      sampled_lights_[n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1)];
   const LightSample ls = impl_.SampleLight(light, p, LightNumbers(impl_.lights[light].type, rng));
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
@@ -188,6 +224,7 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     }
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
     SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng);
+    AddAmbient(&s, params, wo_local, rng);
 
     // Lambert has one lobe: no number to pick it.
     const double u_lobe = HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;

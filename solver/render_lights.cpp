@@ -79,7 +79,9 @@ LightSample Renderer::Impl::SampleLight(int index, const Eigen::Vector3d& point,
     }
     case LightType::kAmbient: {
       // Uniform directions; no distance: the ambient light is never occluded. Treated as a
-      // delta light for MIS (no BRDF-sampled ray ever reaches it).
+      // delta light for MIS (no BRDF-sampled ray ever reaches it). The path tracer does not
+      // call this (it evaluates ambient light exactly at each vertex, render.cpp AddAmbient);
+      // the solver's gather (gather.cpp) does, an unbiased but noisy estimate.
       s.wi = SampleUniformSphere(Eigen::Vector2d(u[0], u[1]));
       s.distance = 0;
       s.value = light->radiance;

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -18,17 +19,18 @@
 #include "solver/sampling.h"
 
 namespace igi {
+std::vector<std::string> PhotoFiles(const Scene& model) {
+  std::vector<std::string> out;
+  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
+  return out;
+}
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
 std::string Pct(double v) { return fmt::format("{:.1f}%", 100 * v); }
 
-std::vector<std::string> PhotoFiles(const Scene& model) {
-  std::vector<std::string> out;
-  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
-  return out;
-}
 
 // Whether `light` is the only light of every photographed lighting: then everything the photos
 // record comes from it (bounces too), and a scale common to all photos is its intensity.
@@ -225,49 +227,6 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   return out;
 }
 
-// ---------------------------------------------------------------- ambient_light
-CandidateResult Ambient(const CandidateContext& cx, const ResidualFitter& f) {
-  CandidateResult out;
-  out.effect = "ambient_light";
-  // An ambient light of radiance L adds ρd·L where it lands, and then what the lit room reflects
-  // of it: each bounce multiplies it by about the room's mean albedo ρ̄, so the offset is about
-  // ρd·L/(1 − ρ̄) (ρ̄ over the records, i.e. over what the photos see).
-  double mean_albedo = 0;
-  for (const PixelRecord& r : f.records()) mean_albedo += r.albedo.mean();
-  mean_albedo = f.records().empty() ? 0 : mean_albedo / double(f.records().size());
-  const double bounces = 1 / (1 - std::clamp(mean_albedo, 0.0, 0.9));
-  const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = r.albedo[c] * bounces * cx.model.photos[r.photo].exposure_scale;
-  });
-  if (fit.coef.size() == 0) return out;
-  const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
-  if (!(radiance.minCoeff() > 0)) {
-    out.note = "the offset that fits is negative in some channel: not an ambient light";
-    return out;
-  }
-  FillScores(fit, &out);
-  out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
-  out.num_params = 3;
-  double mean_sim = 0;
-  int n = 0;
-  for (const PixelRecord& r : f.records()) mean_sim += r.sim.mean(), ++n;
-  out.evidence = fmt::format(
-      "a smooth offset proportional to the albedo everywhere, in shadow too, that no change of "
-      "the albedos explains: the photos are brighter than the model by albedo x {:.4g} (mean "
-      "model radiance {:.4g}), light from no declared source",
-      radiance.mean(), n ? mean_sim / n : 0.0);
-  out.valid = true;
-  out.apply = [radiance](Json* doc) {
-    std::string name = "ambient";
-    while ((*doc)["lights"].contains(name)) name += "_";
-    (*doc)["lights"][name] = {{"type", "ambient"},
-                              {"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-    for (auto& [lname, list] : (*doc)["lightings"].items()) list.push_back(name);
-  };
-  return out;
-}
-
 // The direct light of one light at a record toward the camera, Σ f(wi, view)·irradiance with the
 // region's BRDF (ρd from the record; an anisotropic lobe, whose tangent the records lack, counts
 // as its diffuse part only), and the mean direction from the light to the point.
@@ -314,6 +273,19 @@ std::vector<Eigen::Vector3d> SphereDirections(int n) {
 }
 
 // ---------------------------------------------------------------- light_emission_profile
+// The median of the records' mean model value (a response's reference level).
+double MedianSim(const std::vector<PixelRecord>& records) {
+  std::vector<float> values;
+  for (const PixelRecord& r : records) {
+    if (!r.held_out && !r.outlier) values.push_back(r.sim.mean());
+  }
+  if (values.empty()) return 1.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return std::max(1e-12, double(values[values.size() / 2]));
+}
+
+}  // namespace
+
 CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light) {
   CandidateResult out;
   out.effect = "light_emission_profile";
@@ -332,28 +304,44 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   // what the spot lights, loses more than the floor): what is not its direct term gets a free
   // scale per region (the albedos' nuisance covers that when they are solved).
   const int num_regions = int(cx.model.materials.size());
-  auto fit_at = [&](const Eigen::Vector3d& axis, double n) {
+  // The axis and power are searched with a camera response beside the profile as a nuisance (its
+  // expansion to second order, u·ln(u/ref) and u·ln²(u/ref), u the profiled value; a power
+  // r·(u/r)^e = u·exp((e − 1)·ln(u/r))): a response the photos also hide (a power of
+  // the pixel value) would otherwise bend the profile's fit (an 11° axis error and power 2.38 for
+  // 2 in the light_emission_profile + camera_response capture), and the response could then no
+  // longer be proven. The scores come from the fit without it: the profile must explain on its
+  // own what it is credited with.
+  const double ref = MedianSim(recs);
+  auto fit_at = [&](const Eigen::Vector3d& axis, double n, bool response_nuisance) {
     const Eigen::Vector3f ax = axis.cast<float>();
+    const int k_regions = f.nuisance() ? 1 : num_regions;
+    auto offset = [&](const PixelRecord& r, int c) {
+      const LightTerm& t = terms[size_t(&r - recs.data())];
+      if (!t.lit) return 0.0;
+      const double cs = std::max(0.0f, t.from_light.dot(ax));
+      return double(t.direct[c]) * (std::pow(cs, n) - 1);
+    };
     return f.Fit(
-        f.nuisance() ? 1 : num_regions,
+        k_regions + (response_nuisance ? 2 : 0),
         [&](const PixelRecord& r, int c, double* b) {
           const LightTerm& t = terms[size_t(&r - recs.data())];
           if (!f.nuisance() && r.region >= 0 && r.region < num_regions) {
             b[r.region] = double(r.sim[c]) - double(t.direct[c]);
           }
+          const double u = double(r.sim[c]) + offset(r, c);
+          if (response_nuisance && u > 0) {
+            const double log_u = std::log(u / ref);
+            b[k_regions] = u * log_u;
+            b[k_regions + 1] = u * log_u * log_u;
+          }
         },
-        [&](const PixelRecord& r, int c) {
-          const LightTerm& t = terms[size_t(&r - recs.data())];
-          if (!t.lit) return 0.0;
-          const double cs = std::max(0.0f, t.from_light.dot(ax));
-          return double(t.direct[c]) * (std::pow(cs, n) - 1);
-        });
+        offset);
   };
   ResidualFit best;
   double best_n = 1;
   Eigen::Vector3d best_axis = -Eigen::Vector3d::UnitZ();
   auto consider = [&](const Eigen::Vector3d& axis, double n) {
-    const ResidualFit fit = fit_at(axis, n);
+    const ResidualFit fit = fit_at(axis, n, true);
     if (fit.coef.size() == 0) return false;
     if (best.coef.size() && fit.train_after >= best.train_after) return false;
     best = fit, best_axis = axis, best_n = n;
@@ -379,11 +367,16 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
       if (!moved) break;
     }
   }
+  best = fit_at(best_axis, best_n, false);
+  if (best.coef.size() == 0) {
+    out.note = "the profile alone does not fit (degenerate)";
+    return out;
+  }
   FillScores(best, &out);
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity = l.type == LightType::kSphere
-                                        ? Eigen::Vector3d(l.radiance * (kPi * l.radius * l.radius))
+                                        ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
                                         : l.intensity;
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
@@ -407,6 +400,8 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   };
   return out;
 }
+
+namespace {
 
 // ---------------------------------------------------------------- light_intensity
 CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter& f, int light) {
@@ -478,6 +473,10 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
 }
 
 // ---------------------------------------------------------------- specular_reflection
+// The roughnesses specular_reflection tries; its widest value is a bound, not a fit (see there).
+constexpr std::array<double, 11> kSpecularAlphaGrid = {0.03, 0.04, 0.05, 0.065, 0.08, 0.1,
+                                                       0.12, 0.15, 0.18, 0.25, 0.35};
+
 double WardLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,
                 double alpha) {
   const double ci = n.dot(wi), co = n.dot(wo);
@@ -506,7 +505,7 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   // free scale of the region's prediction takes that part, so that the lobe's width follows the
   // highlight (the refit renders the reflected room itself).
   const int k = f.nuisance() ? 1 : 2;
-  for (double alpha : {0.03, 0.04, 0.05, 0.065, 0.08, 0.1, 0.12, 0.15, 0.18, 0.25, 0.35}) {
+  for (double alpha : kSpecularAlphaGrid) {
     const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
@@ -522,6 +521,16 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
   }
   if (best.coef.size() == 0) {
     out.note = "no lobe with 0 < rho_s < 1 fits region " + name;
+    return out;
+  }
+  // The widest lobe searched fitting best is no highlight: a broad brightening of the region (what
+  // another effect leaves, e.g. an emission profile's fitted power) that a lobe wider still would
+  // fit better, i.e. a change of the region's overall level, not a specular reflection.
+  if (best_alpha >= kSpecularAlphaGrid.back()) {
+    out.note = fmt::format(
+        "region {}: the widest lobe searched (alpha {:.2f}, rho_s {:.3f}) fits best: a broad "
+        "brightening, not a highlight",
+        name, best_alpha, best.coef[0]);
     return out;
   }
   FillScores(best, &out);
@@ -684,7 +693,7 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   if (allowed("exposure_scale")) out.push_back(ExposureScale(cx, f));
   if (allowed("vignetting")) out.push_back(Vignetting(cx, f));
   if (allowed("camera_response")) out.push_back(Response(cx, f));
-  if (allowed("ambient_light")) out.push_back(Ambient(cx, f));
+  if (allowed("ambient_light")) out.push_back(AmbientLight(cx, f));
   for (int l = 0; l < int(cx.model.lights.size()); ++l) {
     const Light& light = cx.model.lights[l];
     const bool point_like =

@@ -47,6 +47,9 @@ struct CandidateResult {
   std::string Key() const;
 };
 
+// The photos' file names (a candidate's "where" for effects of every photo).
+std::vector<std::string> PhotoFiles(const Scene& model);
+
 struct ResidualFit;
 // Copies a fit's predicted squared-error sums and significance into a candidate.
 void FillScores(const ResidualFit& fit, CandidateResult* out);
@@ -57,6 +60,13 @@ class ResidualFitter;
 // albedo is declared (nothing is solved then), without them otherwise (igi-solve fits them).
 CandidateResult SpecularReflection(const CandidateContext& context, const ResidualFitter& fitter,
                                    int region);
+
+// light_emission_profile for light `light` (index into model.lights): the light's direct term
+// becomes cos^n of the angle from an axis (a "spot" with a cos_power profile). The axis and n are
+// searched with a camera response as a nuisance (so that a response the photos also hide does not
+// bend them) and scored without it.
+CandidateResult EmissionProfile(const CandidateContext& context, const ResidualFitter& fitter,
+                                int light);
 
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).

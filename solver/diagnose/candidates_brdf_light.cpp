@@ -179,6 +179,15 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
       if (!moved) break;
     }
   }
+  // As for specular_reflection: a lobe whose wide direction reaches the widest roughness of the
+  // grid is a broad brightening of the region, not a highlight stretched along a tangent.
+  if (std::max(bp.ax, bp.ay) >= grid.back()) {
+    out.note = fmt::format(
+        "region {}: the lobe's wide direction reaches the widest roughness searched (alpha {:.3f} "
+        "/ {:.3f}): a broad brightening, not a highlight",
+        m.name, bp.ax, bp.ay);
+    return out;
+  }
   const double explained = best.train_before - best.train_after;
   const double share = iso.coef.size() ? (iso.train_after - best.train_after) / explained : 1.0;
   const double ratio = std::max(bp.ax, bp.ay) / std::min(bp.ax, bp.ay);
@@ -564,6 +573,85 @@ CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitt
     return out;
   }
   return ExtentFit(cx, f, light);
+}
+
+namespace {
+
+// ---------------------------------------------------------------- ambient_light
+// What an ambient light of unit radiance adds at each record, as the photo sees it: the radiance
+// reflected toward the camera (ρd·1 at the point, plus what the room reflects of it: every bounce,
+// rendered with the model's materials and no other light; emitters made black), times the photo's
+// exposure scale and the camera's vignetting. 16 paths per record: the first vertex is exact for
+// the diffuse term (the renderer evaluates ambient light exactly), the bounces are averaged.
+std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
+                                                 const std::vector<PixelRecord>& records) {
+  Scene unit = model;
+  Light ambient;
+  ambient.name = "unit_ambient";
+  ambient.type = LightType::kAmbient;
+  ambient.radiance = Eigen::Vector3d::Ones();
+  unit.lights = {ambient};
+  unit.lightings = {Lighting{"unit_ambient", {0}}};
+  for (Material& m : unit.materials) {
+    if (m.brdf == BrdfModel::kEmitter) m.brdf = BrdfModel::kBlack;
+  }
+  const Renderer renderer(unit, 0);
+  std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
+  ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
+    const PixelRecord& r = records[i];
+    const Photo& photo = model.photos[r.photo];
+    const Camera& camera = model.cameras[photo.camera];
+    const Eigen::Vector3d center = camera.CenterInWorld();
+    const Eigen::Vector3d dir = r.position.cast<double>() - center;
+    if (!(dir.norm() > 0)) return;
+    const Eigen::Vector3d l = renderer.ReflectedRadiance(center, dir, 16, uint64_t(i) + 1);
+    const double k =
+        photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
+    out[i] = (l * k).cast<float>();
+  });
+  return out;
+}
+
+}  // namespace
+
+CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f) {
+  CandidateResult out;
+  out.effect = "ambient_light";
+  // An ambient light of radiance L adds L times the unit light's response where it lands (the
+  // point's ρd and what the lit room reflects of it), in shadow too.
+  const std::vector<Eigen::Vector3f> response = UnitAmbientResponse(cx.model, f.records());
+  const PixelRecord* first = f.records().data();
+  const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
+    b[c] = response[&r - first][c];
+  });
+  if (fit.coef.size() == 0) return out;
+  const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
+  if (!(radiance.minCoeff() > 0)) {
+    out.note = "the offset that fits is negative in some channel: not an ambient light";
+    return out;
+  }
+  FillScores(fit, &out);
+  out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
+  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
+  out.num_params = 3;
+  double mean_sim = 0;
+  int n = 0;
+  for (const PixelRecord& r : f.records()) mean_sim += r.sim.mean(), ++n;
+  out.evidence = fmt::format(
+      "a smooth offset proportional to the albedo everywhere, in shadow too, that no change of "
+      "the albedos explains: the photos are brighter than the model by what an ambient light of "
+      "radiance {:.4g} adds (on each surface and through the room's bounces; mean model "
+      "radiance {:.4g}), light from no declared source",
+      radiance.mean(), n ? mean_sim / n : 0.0);
+  out.valid = true;
+  out.apply = [radiance](Json* doc) {
+    std::string name = "ambient";
+    while ((*doc)["lights"].contains(name)) name += "_";
+    (*doc)["lights"][name] = {{"type", "ambient"},
+                              {"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
+    for (auto& [lname, list] : (*doc)["lightings"].items()) list.push_back(name);
+  };
+  return out;
 }
 
 }  // namespace igi

@@ -1,5 +1,5 @@
 #pragma once
-// The candidates of two effects of CONTRACT.md §6 that change the shape of reflected light:
+// The candidates of three effects of CONTRACT.md §6 that change reflected or received light:
 //
 // anisotropic_reflection — a glossy region whose highlight is stretched along a surface
 //   direction. Studied in the region's tangent frame (the azimuth of the half vector around the
@@ -14,7 +14,11 @@
 //   samples for every r) minus the current one is the change, with a free amplitude; r is
 //   searched on a grid and refined.
 //
-// Both follow candidates.h: fitted by a ResidualFitter on the fitted records, scored on the
+// ambient_light — light from no declared source, the same from every direction: what a unit
+//   "ambient" light adds at each record (rendered: the point's ρd and the room's bounces of it)
+//   with a free RGB radiance.
+//
+// All follow candidates.h: fitted by a ResidualFitter on the fitted records, scored on the
 // held-out ones, with apply() writing the fitted model into the declared scene document.
 
 #include "solver/diagnose/candidates.h"
@@ -33,5 +37,8 @@ CandidateResult AnisotropicReflection(const CandidateContext& cx, const Residual
 // "sphere" light at its position with the fitted radius and the same intensity
 // (radiance = intensity / (π r²)).
 CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light);
+
+// ambient_light: apply() adds an "ambient" light of the fitted radiance to every lighting.
+CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f);
 
 }  // namespace igi

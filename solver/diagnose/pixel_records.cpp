@@ -104,6 +104,27 @@ Eigen::Vector3f AlbedoAt(const Scene& model, const Renderer::Impl& impl, const S
   return rho.cast<float>();
 }
 
+// An ambient light (radiance L from every direction, never occluded) as k cosine-weighted
+// directions about the shading normal, stratified on a grid, each bringing irradiance π·L/k: the
+// diffuse term Σ ρd/π·irradiance is ρd·L exactly, as the renderer computes it, and a lobe is
+// estimated without bias. No shadow rays.
+void GatherAmbient(const Light& light, const SurfaceHit& hit, int k, Pcg32& rng, int id,
+                   PixelRecord* r) {
+  const Frame frame = Frame::FromNormal(hit.n_s);
+  const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
+  const Eigen::Vector3f irradiance = (light.radiance * (kPi / k)).cast<float>();
+  for (int s = 0; s < k; ++s) {
+    Eigen::Vector2d u = rng.Uniform2D();
+    if (s < side * side) u = Eigen::Vector2d((s % side + u.x()) / side, (s / side + u.y()) / side);
+    RecordLightSample rs;
+    rs.light = id;
+    rs.wi = frame.ToWorld(SampleCosineHemisphere(u)).cast<float>();
+    rs.irradiance = irradiance;
+    rs.distance = 1e30f;
+    r->lights.push_back(rs);
+  }
+}
+
 void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceHit& hit,
                   int samples, Pcg32& rng, PixelRecord* r) {
   const double eps = impl.ray_epsilon;
@@ -112,7 +133,12 @@ void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceH
     const LightType type = impl.lights[l].type;
     const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
                        type == LightType::kDirectional;
-    const int k = delta ? 1 : type == LightType::kAmbient ? 4 * samples : samples;
+    if (type == LightType::kAmbient) {
+      GatherAmbient(*impl.lights[l].light, hit, 4 * samples, rng, l < int(ids.size()) ? ids[l] : -1,
+                    r);
+      continue;
+    }
+    const int k = delta ? 1 : samples;
     for (int s = 0; s < k; ++s) {
       const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
       const LightSample ls = impl.SampleLight(l, hit.position, u);

@@ -1,6 +1,7 @@
-// The anisotropic_reflection and light_source_extent candidates on synthetic records with known
-// truth: the first recovers a stretched lobe's tangent and roughnesses and refuses a lobe that is
-// merely wider; the second recovers a sphere light's radius from soft shadow edges rendered by
+// The anisotropic_reflection, specular_reflection and light_source_extent candidates on synthetic
+// records with known truth: the first recovers a stretched lobe's tangent and roughnesses and
+// refuses a lobe that is merely wider; both lobe candidates refuse a lobe at the widest roughness
+// they search; the last recovers a sphere light's radius from soft shadow edges rendered by
 // the renderer (an independent estimator of the sphere's direct light) and finds nothing in
 // photos of a point light.
 #include "solver/diagnose/candidates_brdf_light.h"
@@ -58,7 +59,10 @@ double Lobe(BrdfModel model, double ax, double ay, double angle, const Vector3d&
 // Records of a plate under a point light, seen with half vectors spread around the normal (as
 // several cameras around a highlight would see it). The photo has the true lobe (anisotropic
 // with tangent at 25°, or isotropic with another alpha); the model the declared ward lobe.
-std::vector<PixelRecord> PlateRecords(bool anisotropic, uint64_t seed) {
+// true_ax/true_ay (when > 0) replace the true lobe's roughnesses (anisotropic: along the 25°
+// tangent and across it; isotropic: true_ax).
+std::vector<PixelRecord> PlateRecords(bool anisotropic, uint64_t seed, double true_ax = 0,
+                                      double true_ay = 0) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> g(0, 1);
@@ -90,8 +94,10 @@ std::vector<PixelRecord> PlateRecords(bool anisotropic, uint64_t seed) {
     ls.distance = float(d);
     r.lights.push_back(ls);
     const double s_model = Lobe(BrdfModel::kWard, kAlpha, kAlpha, 0, wo, wi);
-    const double s_true = anisotropic ? Lobe(BrdfModel::kWardAniso, 0.03, 0.15, angle, wo, wi)
-                                      : Lobe(BrdfModel::kWard, 0.08, 0.08, 0, wo, wi);
+    const double ax = true_ax > 0 ? true_ax : anisotropic ? 0.03 : 0.08;
+    const double ay = anisotropic ? (true_ay > 0 ? true_ay : 0.15) : ax;
+    const double s_true = anisotropic ? Lobe(BrdfModel::kWardAniso, ax, ay, angle, wo, wi)
+                                      : Lobe(BrdfModel::kWard, ax, ax, 0, wo, wi);
     for (int c = 0; c < 3; ++c) {
       const double diffuse = kRhoD[c] / kPi * e;
       r.sim[c] = float(diffuse + kRhoS * s_model * e);
@@ -165,6 +171,39 @@ TEST(SpecularReflectionTest, ADeclaredAlbedoGetsTheFittedLobe) {
   Json unknown = {{"materials", {{"plate", {{"brdf", "lambert"}}}}}};
   c.apply(&unknown);
   EXPECT_EQ(unknown["materials"]["plate"], Json({{"brdf", "ward"}}));
+}
+
+// A lobe wider than any the candidate searches (true α 0.8 against the grid's widest 0.35) is a
+// broad brightening of the region: the widest value fitting best is a bound, not a fit, and the
+// candidate refuses it (in the light_emission_profile concealed capture such a "lobe" on wall_y0,
+// α 0.35, absorbed what the profile's fitted power left).
+TEST(SpecularReflectionTest, ALobeAtTheWidestAlphaSearchedIsRefused) {
+  Scene model = PlateScene();
+  model.materials[0].brdf = BrdfModel::kLambert;
+  model.materials[0].rho_s.reset();
+  model.materials[0].alpha.reset();
+  std::vector<PixelRecord> records = PlateRecords(false, 4, 0.8);
+  for (PixelRecord& r : records) {
+    for (int c = 0; c < 3; ++c) r.sim[c] = float(kRhoD[c] / kPi * r.lights[0].irradiance[c]);
+  }
+  const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
+  const Json given = {
+      {"materials", {{"plate", {{"brdf", "lambert"}, {"rho_d", {0.1, 0.2, 0.5}}}}}}};
+  const CandidateResult c = SpecularReflection({model, given, false}, f, 0);
+  EXPECT_FALSE(c.valid) << c.evidence;
+  EXPECT_NE(c.note.find("widest lobe searched (alpha 0.35"), std::string::npos) << c.note;
+}
+
+// The same for anisotropic_reflection: a lobe stretched to α 0.8 across its tangent (the grid
+// goes to 0.3) is refused, where 0.03 / 0.15 is found (RecoversTheTangentAndRoughnesses).
+TEST(AnisotropicReflectionTest, ALobeReachingTheWidestAlphaIsRefused) {
+  const Scene model = PlateScene();
+  const Json declared = PlateDocument();
+  const std::vector<PixelRecord> records = PlateRecords(true, 5, 0.03, 0.8);
+  const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
+  const CandidateResult c = AnisotropicReflection({model, declared, false}, f, 0);
+  EXPECT_FALSE(c.valid) << c.evidence;
+  EXPECT_NE(c.note.find("widest roughness searched"), std::string::npos) << c.note;
 }
 
 TEST(AnisotropicReflectionTest, AWiderIsotropicLobeIsNotNamedAnisotropic) {

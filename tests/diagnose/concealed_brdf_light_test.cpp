@@ -66,17 +66,20 @@ TEST(ConcealedBrdfLightTest, LightSourceExtent) {
 
 // The lamp is a spot, I·cos²(angle from −z): the room is 4× darker than the model, its ceiling lit
 // only by bounces. The candidate fits the lamp's whole direct term (diffuse and specular) as
-// cos^n with a free scale per region for what the light sends after a bounce; seed 11 measured
-// (2026-11-22): axis 0.7° from −z, cos power 2.14, held-out residual² down 99.9 %, final
-// residual 0.0505 against the true model's 0.0482 (1.05×). A per-photo exposure_scale of
-// 1.5–5 % is kept after it (what the power's error leaves), which this test allows.
+// cos^n with a free scale per region for what the light sends after a bounce (and, in the search
+// of the axis and n only, a camera response as a nuisance); seed 11 measured (2026-11-22, session
+// 7): axis 1.1° from −z, cos power 1.92, held-out residual² down 99.9 %, then a small vignetting
+// step (k1 −0.07, k2 0.05: what the power's error leaves), which this test allows; final residual
+// 0.0502 against the true model's 0.0482 (1.04×). (Session 6: axis 0.7°, power 2.14, then
+// light_intensity and a spurious broad lobe on wall_y0, α 0.35, that specular_reflection now
+// refuses.)
 TEST(ConcealedBrdfLightTest, LightEmissionProfile) {
   const ConcealedOutcome o = DiagnoseConcealed("light_emission_profile", 11);
   const Json& d = o.diagnosis;
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   const Json& step = d["steps"][0];
   EXPECT_EQ(step["effect"], "light_emission_profile") << d.dump(1);
-  // The axis within 5° of −z and the power within 20 % of 2 (measured 0.7°, 2.14: the power
+  // The axis within 5° of −z and the power within 20 % of 2 (measured 1.1°, 1.92: the power
   // trades against the bounce light's free scales).
   const std::vector<double> axis = step["params"]["direction"].get<std::vector<double>>();
   EXPECT_GT(-axis[2], std::cos(5 * std::numbers::pi / 180)) << step["params"].dump();

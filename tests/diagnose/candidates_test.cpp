@@ -1,0 +1,127 @@
+// The light_emission_profile candidate (solver/diagnose/candidates.cpp) on synthetic records with
+// known truth: a point lamp that truly is a cos² spot pointing down, seen on a floor and a wall,
+// in photos that also hide a camera response (a power 0.8 of the pixel value). The candidate
+// searches the profile's axis and power with the response as a nuisance, so the response does
+// not bend them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "solver/diagnose/candidates.h"
+#include "solver/diagnose/residual_fit.h"
+#include "solver/photo_model.h"
+#include "solver/sampling.h"
+
+namespace igi {
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+constexpr double kRho = 0.5;        // every surface's ρd (Lambert)
+constexpr double kIntensity = 8.0;  // the lamp's peak intensity, W/sr
+constexpr double kBounce = 0.03;    // light after a bounce (the same in the model and photos)
+const Vector3d kLamp(0, 0, 2.5);
+
+Scene RoomModel() {
+  Scene s;
+  for (const char* name : {"floor", "wall"}) {
+    Material m;
+    m.name = name;
+    m.brdf = BrdfModel::kLambert;
+    m.rho_d = Vector3d::Constant(kRho);
+    s.materials.push_back(m);
+  }
+  Light lamp;
+  lamp.name = "lamp";
+  lamp.type = LightType::kPoint;
+  lamp.position = kLamp;
+  lamp.intensity = Vector3d::Constant(kIntensity);
+  s.lights.push_back(lamp);
+  s.lightings.push_back(Lighting{"L0", {0}});
+  return s;
+}
+
+// Records on the floor (z = 0, |x|, |y| < 3) and a wall (x = 3, |y| < 3, 0 < z < 2.5), the view
+// straight along the normal. The photo: the lamp's direct light times cos^power of the angle from
+// −z, plus the bounce term, through the response v = (u/ref)^exponent·ref (ref 0.05), 1 % noise.
+std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  const double ref = 0.05;
+  std::vector<PixelRecord> out;
+  for (int i = 0; i < 8000; ++i) {
+    const bool wall = i % 2 == 1;
+    const Vector3d p = wall ? Vector3d(3, 6 * u(rng) - 3, 2.5 * u(rng))
+                            : Vector3d(6 * u(rng) - 3, 6 * u(rng) - 3, 0);
+    const Vector3d n = wall ? Vector3d(-1, 0, 0) : Vector3d(0, 0, 1);
+    const double d = (kLamp - p).norm();
+    const Vector3d wi = (kLamp - p) / d;
+    const double e = kIntensity * std::max(0.0, wi.dot(n)) / (d * d);
+    const double direct = kRho / kPi * e;
+    const double cos_axis = wi.z();  // cos of the angle from −z of the direction lamp → point
+    PixelRecord r;
+    r.photo = i % 4;
+    r.x = (i / 4) % 160;
+    r.y = (i / 640) % 120;
+    r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(r.photo, r.x, r.y);
+    r.region = wall ? 1 : 0;
+    r.position = p.cast<float>();
+    r.normal = n.cast<float>();
+    r.view = n.cast<float>();
+    r.albedo = Vector3f::Constant(float(kRho));
+    RecordLightSample ls;
+    ls.light = 0;
+    ls.wi = wi.cast<float>();
+    ls.irradiance = Vector3f::Constant(float(e));
+    ls.distance = float(d);
+    r.lights.push_back(ls);
+    const double truth = direct * std::pow(std::max(0.0, cos_axis), power) + kBounce;
+    const double recorded = ref * std::pow(truth / ref, exponent);
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(direct + kBounce);
+      r.recorded[c] = float(recorded * (1 + 0.01 * g(rng)));
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+// Measured (seed 1): axis 0.3° from −z, power 2.12. Searched without the response nuisance the
+// same records gave axis 1.8°, power 1.60 (the response's power of the pixel value reads as a
+// weaker profile), which fails here. Allowed: 3° and 15 %.
+TEST(EmissionProfileTest, AHiddenResponseDoesNotBendTheProfile) {
+  const Scene model = RoomModel();
+  const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
+  const std::vector<PixelRecord> records = RoomRecords(2.0, 0.8, 1);
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, false, 8);
+  const CandidateResult c = EmissionProfile({model, declared, false}, f, 0);
+  ASSERT_TRUE(c.valid) << c.note;
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.5);
+}
+
+// Without a response the profile is found as well (measured: axis 0.3°, power 2.01).
+TEST(EmissionProfileTest, FindsTheProfileAlone) {
+  const Scene model = RoomModel();
+  const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
+  const std::vector<PixelRecord> records = RoomRecords(2.0, 1.0, 2);
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, false, 8);
+  const CandidateResult c = EmissionProfile({model, declared, false}, f, 0);
+  ASSERT_TRUE(c.valid) << c.note;
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.9);
+}
+
+}  // namespace
+}  // namespace igi
