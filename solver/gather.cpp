@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "solver/brdf.h"
 #include "solver/sampling.h"
@@ -78,15 +79,38 @@ bool TraceBounce(const Renderer::Impl& scene, const PatchSet& patches, const Sur
   return true;
 }
 
-void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples,
-                  Pcg32& rng, PointSamples* out) {
+// The contract's ambient light (uniform radiance L from every direction, never occluded): its
+// irradiance is exactly πL. It is kept as k stratified cosine-weighted directions about the
+// shading normal, each carrying πL/k, so that the irradiance is exact (no light samples, no
+// rays) and the glossy fits still see the directions it arrives from.
+void GatherAmbient(const Eigen::Vector3d& radiance, const GatherQuery& q, int k, Pcg32& rng,
+                   PointSamples* out) {
+  const Frame frame = Frame::FromNormal(q.n_s);
+  const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
+  k = side * side;
+  for (int s = 0; s < k; ++s) {
+    const Eigen::Vector2d u(((s % side) + rng.UniformDouble()) / side,
+                            ((s / side) + rng.UniformDouble()) / side);
+    DirectSample d;
+    d.wi = frame.ToWorld(SampleCosineHemisphere(u)).cast<float>();
+    d.value = (radiance * (std::numbers::pi / k)).cast<float>();
+    out->point.e_direct += d.value;
+    out->direct.push_back(d);
+  }
+}
+
+void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples, Pcg32& rng,
+                  PointSamples* out) {
   const double eps = scene.ray_epsilon;
   for (int l = 0; l < static_cast<int>(scene.lights.size()); ++l) {
     const LightType type = scene.lights[l].type;
-    const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
-                       type == LightType::kDirectional;
-    // Ambient light: uniform directions, so more samples than an extended light.
-    const int k = delta ? 1 : type == LightType::kAmbient ? 4 * light_samples : light_samples;
+    if (type == LightType::kAmbient) {
+      GatherAmbient(scene.lights[l].light->radiance, q, 4 * light_samples, rng, out);
+      continue;
+    }
+    const bool delta =
+        type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
+    const int k = delta ? 1 : light_samples;
     const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
     for (int s = 0; s < k; ++s) {
       // Stratified over a side×side grid for the first side² samples, random after.
@@ -116,7 +140,8 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
 void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const GatherQuery& q,
                     const GatherOptions& options, Pcg32& rng, PointSamples* out) {
   const double eps = scene.ray_epsilon;
-  for (const WeightedDirection& d : HemisphereDirections(q, options.indirect_rays, options.lobe_alpha, rng)) {
+  for (const WeightedDirection& d :
+       HemisphereDirections(q, options.indirect_rays, options.lobe_alpha, rng)) {
     IndirectSample is;
     is.wi = d.wi.cast<float>();
     is.weight = static_cast<float>(d.weight);
@@ -172,7 +197,8 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
     }
     if (!(wi_local.z() > 0)) continue;
     double pdf = p_cos * CosineHemispherePdf(wi_local.z());
-    if (lobe) pdf += p_broad * BrdfPdf(broad, wo, wi_local) + p_narrow * BrdfPdf(narrow, wo, wi_local);
+    if (lobe)
+      pdf += p_broad * BrdfPdf(broad, wo, wi_local) + p_narrow * BrdfPdf(narrow, wo, wi_local);
     const Eigen::Vector3d wi = frame.ToWorld(wi_local);
     if (!(wi.dot(q.n_geo) > 0) || !(pdf > 0)) continue;
     out.push_back({wi, wi_local.z() / (pdf * n)});

@@ -9,11 +9,16 @@
 // looking up, rendered by the path tracer (256 paths per pixel).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 
 #include "recon/scene.h"
+#include "solver/gather.h"
+#include "solver/patches.h"
 #include "solver/render.h"
+#include "solver/render_internal.h"
 #include "solver/solve.h"
 #include "tests/e2e/box_room.h"
 #include "tests/temp_dir.h"
@@ -89,6 +94,42 @@ TEST_F(SolveGather, GlossySurfacesPassOnTheirSpecularReflectionOfTheRoom) {
   EXPECT_LT(std::abs(with), 0.01);
   // The scene must show the effect, or the check above guards nothing.
   EXPECT_GT(without, 0.03);
+}
+
+// The contract's ambient light (uniform radiance, never occluded) in the solver's gathering: its
+// irradiance is exactly πL wherever the point is, in the open or in a corner (the renderer adds
+// ρd·L exactly too, solver/render.cpp), and its samples keep the directions it arrives from. It
+// was estimated from uniform-sphere light samples (noise of several percent per point).
+TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {
+  Json doc = ReadJsonFile(dir_ / "truth.json");
+  doc["lights"]["amb"] = {{"type", "ambient"}, {"radiance", {0.3, 0.2, 0.1}}};
+  doc["lightings"]["L0"] = Json::array({"amb"});
+  WriteJsonFile(dir_ / "ambient.json", doc);
+  SceneLoadOptions lo;
+  lo.require_complete_materials = true;
+  lo.check_images = false;
+  const Scene scene = LoadScene(dir_ / "ambient.json", lo);
+  const auto rs = BuildRenderScene(scene, scene.FindLighting("L0"));
+  const PatchSet patches = BuildPatches(scene.mesh, 0.2);
+  std::vector<GatherQuery> queries(3);
+  queries[0].position = {1, 1, 0};        // mid-floor, facing up
+  queries[1].position = {0.01, 1, 0.01};  // in the floor's corner with the wall x = 0
+  queries[2].position = {1, 1, 2};        // mid-ceiling, facing down
+  queries[2].n_geo = queries[2].n_s = -Eigen::Vector3d::UnitZ();
+  GatherOptions go;
+  go.light_samples = 4;
+  go.indirect_rays = 4;
+  go.num_threads = 1;
+  const GatherSet g = Gather(*rs, patches, queries, go);
+  const Eigen::Vector3d expected = std::numbers::pi * Eigen::Vector3d(0.3, 0.2, 0.1);
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const GatherPoint& p = g.points[i];
+    EXPECT_LT((p.e_direct.cast<double>() - expected).norm(), 1e-5) << "point " << i;
+    ASSERT_EQ(p.direct_end - p.direct_begin, 16) << "point " << i;  // 4 × light_samples
+    for (int k = p.direct_begin; k < p.direct_end; ++k) {
+      EXPECT_GT(g.direct[k].wi.cast<double>().dot(queries[i].n_s), 0.0);
+    }
+  }
 }
 
 }  // namespace
