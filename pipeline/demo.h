@@ -5,7 +5,8 @@
 //
 // The capture's PHOTOS_DIR is DIR/00-capture/synth/brackets (one NAME_L0 folder per photo), with
 // camera.json (the true intrinsics, as igi-calib intrinsics would give) and markers.json (the
-// room's corners at their exact pixels, as a user would click them). HDR maps from a recovered
+// room's corners and surveyed targets at their pixels plus marker_noise_px of noise, as a target
+// detector finds them). HDR maps from a recovered
 // response are radiance up to one constant (Debevec–Malik's g has a free offset), so the
 // comparison states that constant k (median over regions of recovered/true ρd) and each
 // region's ρd and ρs errors after dividing by k; α does not depend on it.
