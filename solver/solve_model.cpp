@@ -262,7 +262,11 @@ void SolverState::BuildAlbedoMaps() {
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
     const bool want =
         options.albedo_maps == "all" || (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
-    if (!want) continue;
+    const std::vector<std::string>& only = options.albedo_map_regions;
+    if (!want || (!only.empty() && std::find(only.begin(), only.end(), scene.materials[r].name) ==
+                                       only.end())) {
+      continue;
+    }
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
     Image seen;

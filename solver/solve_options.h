@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace igi {
 
@@ -37,6 +38,9 @@ struct SolveOptions {
   // Albedo maps: "auto" for regions whose albedo varies significantly across patches (or that
   // declare UVs and vary), "all" for every region with an unknown albedo, "none".
   std::string albedo_maps = "auto";
+  // With "auto" or "all": only these regions (by name) get a map; empty: every region. (A
+  // library option, used by igi-diagnose to give maps to the regions it found textured first.)
+  std::vector<std::string> albedo_map_regions;
   double texel_size_m = 0;  // albedo map texel, metres; 0 = auto (the median pixel footprint)
   // A textured glossy region's ρs and α are fitted with each sample's albedo as the other photos
   // see that texel off their highlights (false: its patch's off-highlight albedo).

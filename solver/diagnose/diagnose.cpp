@@ -16,6 +16,7 @@
 
 #include "solver/diagnose/missing_geometry.h"
 #include "solver/diagnose/pose_error.h"
+#include "solver/diagnose/texture_evidence.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -80,12 +81,21 @@ struct ModelState {
   fs::path dir;
   Scene model;
   std::vector<Image> sims;
+  std::vector<Image> sim_var;  // Monte Carlo variance of sims (SimulatePhotos)
   std::vector<PixelRecord> records;
   ResidualSums train, held;
 };
 
+// The solver's albedo maps for a fit: "none", or "auto" (where the albedo varies), optionally
+// only for the regions in `only`.
+struct MapMode {
+  std::string maps = "none";
+  std::vector<std::string> only;  // empty: every region
+  bool Full() const { return maps == "auto" && only.empty(); }
+};
+
 // Fits (solves, when materials are unknown) the declared document into `dir` and simulates it.
-ModelState FitModel(const Json& declared, bool solve, const std::string& maps, const fs::path& dir,
+ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const fs::path& dir,
                     const DiagnoseOptions& o, const PhotoSet& photos) {
   ModelState st;
   st.dir = dir;
@@ -99,7 +109,8 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
     so.holdout_block_px = o.holdout_block_px;
     so.num_threads = o.num_threads;
     so.show_progress = false;
-    so.albedo_maps = maps;
+    so.albedo_maps = maps.maps;
+    so.albedo_map_regions = maps.only;
     const SolveSummary summary = Solve(declared_scene, so, dir);
     WriteSolveOutputs(summary, so, dir);
     model_path = dir / "scene.json";
@@ -107,7 +118,7 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
   SceneLoadOptions lo;
   lo.require_complete_materials = true;
   st.model = LoadScene(model_path, lo);
-  st.sims = SimulatePhotos(st.model, o, o.seed);
+  st.sims = SimulatePhotos(st.model, o, o.seed, &st.sim_var);
   st.records = BuildRecords(st.model, photos, st.sims, o);
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st.train = ResidualOverPhotos(photos, st.sims, holdout, false);
@@ -116,15 +127,24 @@ ModelState FitModel(const Json& declared, bool solve, const std::string& maps, c
 }
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
-// with the held-out blocks as independent units (BlockGainZ; blocks the step left exactly as they
+// with the held-out blocks as independent units. Each pixel's squared error is counted less its
+// simulation's Monte Carlo variance (`*_var`, SimulatePhotos), so that a model whose render is
+// merely less noisy earns nothing (the demo's false ambient_light step: an exact ambient term and
+// lower albedos cut the 16-spp renders' variance by a third, which read as a 2–6 % gain) (BlockGainZ; blocks the step left exactly as they
 // were — same seed, same model there — do not count).
 // `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
 // the signed-rank z of their pixels' gains (see EdgeBlocks).
 // With `pixel_units` false, `only` just selects the blocks and the z is BlockGainZ over them.
 using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
-std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<Image>& before,
-                                      const std::vector<Image>& after, const PixelHoldout& h,
+std::pair<double, double> HeldOutGain(const PhotoSet& photos, const ModelState& before_state,
+                                      const ModelState& after_state, const PixelHoldout& h,
                                       const BlockFilter& only = nullptr, bool pixel_units = true) {
+  const std::vector<Image>& before = before_state.sims;
+  const std::vector<Image>& after = after_state.sims;
+  auto var = [](const ModelState& s, size_t i, size_t k) {
+    return i < s.sim_var.size() && k < s.sim_var[i].pixels.size() ? double(s.sim_var[i].pixels[k])
+                                                                   : 0.0;
+  };
   // Per block: gain and error before.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
   double total_before = 0, total_gain = 0;
@@ -139,8 +159,10 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const std::vector<
         for (int c = 0; c < 3; ++c) {
           const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
           if (!std::isfinite(a) || !std::isfinite(b)) continue;
-          e += (b - p) * (b - p);
-          g += (b - p) * (b - p) - (a - p) * (a - p);
+          const size_t k = (size_t(y) * before[i].width + x) * before[i].channels + c;
+          const double eb = (b - p) * (b - p) - var(before_state, i, k);
+          e += eb;
+          g += eb - ((a - p) * (a - p) - var(after_state, i, k));
         }
         if (only) pixel_gains.push_back(g);
         auto& acc = gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px];
@@ -297,6 +319,49 @@ double CellSize(const Scene& model) {
   return box.isEmpty() ? 0.05 : std::max(1e-3, double(box.diagonal().norm()) / 96);
 }
 
+// The albedo_texture step for the solved regions whose records show a texture
+// (FindTexturedRegions), before any other candidate; invalid when none does.
+CandidateResult TextureFirst(const Scene& declared, const ModelState& st, double cell_m) {
+  std::vector<bool> solved(st.model.materials.size(), false);
+  for (size_t r = 0; r < solved.size(); ++r) {
+    const int d = declared.FindMaterial(st.model.materials[r].name);
+    solved[r] = d >= 0 && !declared.materials[size_t(d)].rho_d.has_value();
+  }
+  TextureEvidenceOptions to;
+  to.cell_m = cell_m;
+  CandidateResult c;
+  c.effect = "albedo_texture";
+  c.num_params = -1;
+  Json regions = Json::array(), tests = Json::array();
+  std::string shown;
+  for (const TextureEvidence& e : FindTexturedRegions(st.model, st.records, solved, to)) {
+    tests.push_back({{"region", e.region},
+                     {"cells", e.cells},
+                     {"sign_agreement", e.agreement},
+                     {"z", e.z},
+                     {"amplitude", e.amplitude},
+                     {"textured", e.textured}});
+    spdlog::info("igi-diagnose: texture test of {}: {} cells, signs agree in {:.0f}% (z {:.1f}), "
+                 "amplitude {:.1f}%{}",
+                 e.region, e.cells, 100 * e.agreement, e.z, 100 * e.amplitude,
+                 e.textured ? ": textured" : "");
+    if (!e.textured) continue;
+    regions.push_back(e.region);
+    shown += fmt::format("{}{} ({:.0f}% of {} cells, {:.0f}%)", shown.empty() ? "" : ", ", e.region,
+                         100 * e.agreement, e.cells, 100 * e.amplitude);
+  }
+  c.valid = !regions.empty();
+  c.params = {{"regions", regions}};
+  c.where = {{"regions", regions}, {"frame", "position on the surfaces"}, {"texture_tests", tests}};
+  c.evidence = fmt::format(
+      "the photos' ratio to the constant-albedo model changes from one {:.0f} cm surface cell to "
+      "the next, alike in the even and the odd photos (region: share of cells whose high-pass "
+      "signs agree, cells, reproducible amplitude): {}. A texture: fitted before any other "
+      "candidate is judged, so that no smooth effect can pass for it",
+      100 * cell_m, shown);
+  return c;
+}
+
 // The photo whose held-out residual the step reduced most (for the report's images).
 size_t MostImprovedPhoto(const PhotoSet& photos, const std::vector<Image>& before,
                          const std::vector<Image>& after) {
@@ -331,7 +396,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   // Albedo maps are themselves a model to earn: the baseline (when solving) has constant
   // albedos per region, so that a map cannot absorb an effect of the image or the lights before
   // it is found; "albedo_texture" is the step that adds them.
-  std::string maps = solve ? "none" : "auto";
+  MapMode maps{solve ? "none" : "auto", {}};
   spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
   ModelState st = FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos);
   sum.baseline_residual = st.train.Relative();
@@ -350,7 +415,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::optional<PhotoSet> photos;  // the photos' valid pixels after the step (masks)
   };
   MissingGeometryResult missing;  // the located object of this round, if any
-  auto try_step = [&](CandidateResult c, const std::string& next_maps) {
+  auto try_step = [&](CandidateResult c, const MapMode& next_maps) {
     spdlog::info("igi-diagnose: trying {} (predicted held-out gain {:.1f}%, z {:.1f})", c.effect,
                  100 * c.Gain(), c.z);
     Trial t;
@@ -410,11 +475,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
         ChangesRegionMaterial(c)
             ? RegionBlocks(st.model, st.records, c.params["region"].get<std::string>(), holdout)
             : nullptr;
-    const auto [gain_all, z_all] = HeldOutGain(ph, st.sims, t.state.sims, holdout);
+    const auto [gain_all, z_all] = HeldOutGain(ph, st, t.state, holdout);
     const double gain = gain_all;
-    double z = only ? HeldOutGain(ph, st.sims, t.state.sims, holdout, only).second : z_all;
+    double z = only ? HeldOutGain(ph, st, t.state, holdout, only).second : z_all;
     if (region_only) {
-      z = HeldOutGain(ph, st.sims, t.state.sims, holdout, region_only, false).second;
+      z = HeldOutGain(ph, st, t.state, holdout, region_only, false).second;
     }
     t.gain = gain;
     ds.z = z;
@@ -450,7 +515,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     ds.residual_before_image = ResidualImage(photos, st.sims, img);
     ds.residual_after_image = ResidualImage(ph, t.state.sims, img);
     spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
-    if (c.effect == "albedo_texture" && ds.kept) {
+    if (c.effect == "albedo_texture" && ds.kept && !c.params.contains("regions")) {
       Json regions = Json::array();
       for (const Material& m : t.state.model.materials) {
         if (m.rho_d_map) regions.push_back(m.name);
@@ -464,7 +529,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     return t;
   };
   // Applies the best of `trials` that passed; records the others. Returns whether one was kept.
-  auto settle = [&](std::vector<Trial>& trials, const std::string& next_maps) {
+  auto settle = [&](std::vector<Trial>& trials, const MapMode& next_maps) {
     int best = -1;
     for (int i = 0; i < int(trials.size()); ++i) {
       if (trials[i].step.kept && (best < 0 || trials[i].gain > trials[best].gain)) best = i;
@@ -490,6 +555,18 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     for (Trial& t : trials) sum.steps.push_back(std::move(t.step));
     return best >= 0;
   };
+  // Textured regions first: on them the texture is most of a constant-albedo model's residual,
+  // and a smooth candidate correlated with it by chance would earn a false gain
+  // (texture_evidence.h).
+  if (solve && o.max_steps > 0) {
+    CandidateResult texture = TextureFirst(scene, st, CellSize(st.model));
+    if (texture.valid) {
+      const MapMode next{"auto", texture.params["regions"].get<std::vector<std::string>>()};
+      std::vector<Trial> one;
+      one.push_back(try_step(std::move(texture), next));
+      settle(one, next);
+    }
+  }
   for (int step = 0; step < o.max_steps; ++step) {
     std::vector<std::string> excluded = kept_effects;
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
@@ -520,15 +597,15 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       if (trials.size() >= 2 && any) break;
     }
     bool kept = settle(trials, maps);
-    if (!kept && maps == "none") {
+    if (!kept && !maps.Full()) {
       CandidateResult texture;
       texture.effect = "albedo_texture";
       texture.valid = true;
       texture.num_params = -1;  // one albedo per texel of the regions that get a map
       texture.evidence = "albedo maps where the solver finds the albedo varies";
       std::vector<Trial> one;
-      one.push_back(try_step(texture, "auto"));
-      kept = settle(one, "auto");
+      one.push_back(try_step(texture, MapMode{"auto", {}}));
+      kept = settle(one, MapMode{"auto", {}});
       if (kept) rejected.clear();  // with free albedos the earlier verdicts may change
     }
     if (!kept) break;

@@ -70,20 +70,45 @@ PhotoSet LoadPhotoSet(const Scene& scene) {
   return set;
 }
 
-std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options,
-                                  uint64_t seed) {
+std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+                                  std::vector<Image>* variance) {
   std::vector<Image> sims(model.photos.size());
+  if (variance) variance->assign(model.photos.size(), Image());
   std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
+  const bool split = variance && options.spp >= 2;
+  const int spp1 = split ? options.spp / 2 : options.spp, spp2 = options.spp - spp1;
   for (size_t i = 0; i < model.photos.size(); ++i) {
     const Photo& p = model.photos[i];
     if (!renderers[p.lighting]) renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
     RenderOptions ro;
-    ro.spp = options.spp;
+    ro.spp = spp1;
     ro.seed = seed + 7919 * i;
     ro.num_threads = options.num_threads;
     ro.show_progress = false;
     sims[i] = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
+    if (!split) {
+      ApplyExposureAndResponse(p, &sims[i]);
+      if (variance) (*variance)[i] = Image(sims[i].width, sims[i].height, sims[i].channels);
+      continue;
+    }
+    ro.spp = spp2;
+    ro.seed = seed + 7919 * i + 0x5bd1e995ULL;
+    Image h2 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
+    Image h1 = sims[i];
+    for (size_t k = 0; k < sims[i].pixels.size(); ++k) {
+      sims[i].pixels[k] = float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) /
+                                options.spp);
+    }
     ApplyExposureAndResponse(p, &sims[i]);
+    ApplyExposureAndResponse(p, &h1);
+    ApplyExposureAndResponse(p, &h2);
+    const double k_var = 1.0 / (options.spp * (1.0 / spp1 + 1.0 / spp2));
+    Image& v = (*variance)[i];
+    v = Image(h1.width, h1.height, h1.channels);
+    for (size_t k = 0; k < v.pixels.size(); ++k) {
+      const double d = double(h1.pixels[k]) - double(h2.pixels[k]);
+      v.pixels[k] = std::isfinite(d) ? float(k_var * d * d) : 0.0f;
+    }
   }
   return sims;
 }

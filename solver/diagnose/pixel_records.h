@@ -54,7 +54,13 @@ struct PhotoSet {
 PhotoSet LoadPhotoSet(const Scene& scene);
 
 // Renders every photo's camera under its lighting and applies the photo model (scale, response).
-std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed);
+// With `variance`: each render is the mean of two independent renders of half the paths, and
+// (*variance)[i] holds, per pixel and channel, an unbiased estimate of the Monte Carlo variance of
+// sims[i] from their difference: (h1 − h2)² / (spp (1/spp1 + 1/spp2)), zero when spp is 1.
+// A model whose render is less noisy (an exact ambient term, lower albedos) has a lower residual²
+// against the photos for that reason alone; the held-out gains subtract this variance.
+std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+                                  std::vector<Image>* variance = nullptr);
 
 // The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel.
 std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,

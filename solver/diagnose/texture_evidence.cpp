@@ -1,0 +1,124 @@
+#include "solver/diagnose/texture_evidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+namespace igi {
+namespace {
+
+using CellKey = int64_t;
+
+CellKey KeyOf(int ix, int iy, int iz) {
+  constexpr int64_t kOffset = int64_t(1) << 20;  // cells within ±2^20 of the origin
+  return ((int64_t(ix) + kOffset) << 42) | ((int64_t(iy) + kOffset) << 21) | (int64_t(iz) + kOffset);
+}
+
+struct CellSum {
+  double sum = 0;
+  int n = 0;
+  double Mean() const { return sum / n; }
+};
+
+// The cells' ratio sums of one photo set (photo parity `parity`) for region `region`.
+struct CellGrid {
+  std::unordered_map<CellKey, CellSum> cells;
+  std::unordered_map<CellKey, Eigen::Vector3i> coords;
+};
+
+double Ratio(const PixelRecord& r) {
+  const double sim = r.sim.sum(), rec = r.recorded.sum();
+  if (!(sim > 1e-9) || !std::isfinite(rec)) return NAN;
+  return std::clamp(rec / sim, 0.0, 4.0);
+}
+
+// The mean of the neighbours (26-neighbourhood) that have at least `min_n` records, or NaN when
+// fewer than 3 do.
+double NeighbourMean(const CellGrid& g, const Eigen::Vector3i& c, int min_n) {
+  double sum = 0;
+  int count = 0;
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const auto it = g.cells.find(KeyOf(c.x() + dx, c.y() + dy, c.z() + dz));
+        if (it == g.cells.end() || it->second.n < min_n) continue;
+        sum += it->second.Mean();
+        ++count;
+      }
+    }
+  }
+  return count >= 3 ? sum / count : NAN;
+}
+
+TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellGrid& b,
+                         const TextureEvidenceOptions& o) {
+  TextureEvidence e;
+  e.region = name;
+  std::vector<double> products;
+  double mean_sum = 0;
+  int agree = 0;
+  for (const auto& [key, ca] : a.cells) {
+    const auto it = b.cells.find(key);
+    if (ca.n < o.min_records_per_cell || it == b.cells.end() ||
+        it->second.n < o.min_records_per_cell) {
+      continue;
+    }
+    const Eigen::Vector3i& c = a.coords.at(key);
+    const double na = NeighbourMean(a, c, o.min_records_per_cell);
+    const double nb = NeighbourMean(b, c, o.min_records_per_cell);
+    if (!std::isfinite(na) || !std::isfinite(nb)) continue;
+    const double ha = ca.Mean() - na, hb = it->second.Mean() - nb;
+    products.push_back(ha * hb);
+    agree += ha * hb > 0;
+    mean_sum += 0.5 * (ca.Mean() + it->second.Mean());
+  }
+  e.cells = int(products.size());
+  if (e.cells == 0) return e;
+  e.agreement = double(agree) / e.cells;
+  e.z = (e.agreement - 0.5) * 2 * std::sqrt(double(e.cells));
+  // Trimmed: the largest tenth of the products (sharp edges: a shadow, a highlight) left out.
+  std::sort(products.begin(), products.end());
+  const size_t keep = products.size() - products.size() / 10;
+  double sum = 0;
+  for (size_t i = 0; i < keep; ++i) sum += products[i];
+  const double mean_ratio = mean_sum / e.cells;
+  e.amplitude = mean_ratio > 0 ? std::sqrt(std::max(0.0, sum / double(keep))) / mean_ratio : 0;
+  e.textured = e.cells >= o.min_cells && e.agreement >= o.min_agreement && e.z >= o.min_z &&
+               e.amplitude >= o.min_amplitude;
+  return e;
+}
+
+}  // namespace
+
+std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
+                                                 const std::vector<PixelRecord>& records,
+                                                 const std::vector<bool>& solved,
+                                                 const TextureEvidenceOptions& options) {
+  const int regions = int(model.materials.size());
+  std::vector<CellGrid> grids(2 * size_t(regions));  // [region * 2 + photo parity]
+  for (const PixelRecord& r : records) {
+    if (r.held_out || r.outlier || r.region < 0 || r.region >= regions) continue;
+    if (r.region >= int(solved.size()) || !solved[r.region]) continue;
+    const double q = Ratio(r);
+    if (!std::isfinite(q)) continue;
+    const Eigen::Vector3i c = (r.position.cast<double>() / options.cell_m).array().floor().cast<int>();
+    CellGrid& g = grids[size_t(r.region) * 2 + (r.photo & 1)];
+    const CellKey key = KeyOf(c.x(), c.y(), c.z());
+    CellSum& s = g.cells[key];
+    s.sum += q;
+    ++s.n;
+    g.coords[key] = c;
+  }
+  std::vector<TextureEvidence> out;
+  for (int r = 0; r < regions; ++r) {
+    const CellGrid& a = grids[size_t(r) * 2];
+    const CellGrid& b = grids[size_t(r) * 2 + 1];
+    if (a.cells.empty() || b.cells.empty()) continue;
+    out.push_back(Evaluate(model.materials[r].name, a, b, options));
+  }
+  return out;
+}
+
+}  // namespace igi

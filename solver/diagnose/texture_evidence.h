@@ -1,0 +1,50 @@
+#pragma once
+// Which solved regions are textured: their photos' ratio to a constant-albedo model varies from
+// one surface cell to the next in the same way in two disjoint sets of photos.
+//
+// Why igi-diagnose needs it: it judges its candidates on a model whose solved regions have one
+// albedo each (an albedo map could absorb any effect of the lights), but on a textured region
+// the texture is then most of the residual, and a smooth candidate that happens to correlate
+// with it earns a false gain. igi-run's demo showed it: its textured ceiling is darker than its
+// mean under the lamp's hot spot, and an ambient light (which flattens the lit/unlit contrast)
+// was kept with 23 standard errors. A texture differs from every effect of the lights or the
+// camera in scale: those are smooth on a surface (or sharp along a few edges), a texture changes
+// from cell to cell everywhere. So the test looks at the high-pass part of the ratio over surface
+// cells (each cell's mean ratio minus its neighbours' mean) and asks that it be (a) reproducible
+// between even and odd photos — photo noise is not; (b) of the same sign in most cells — a few
+// shadow or highlight edges are not most cells; (c) at least `min_amplitude` of the ratio.
+
+#include <string>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/diagnose/pixel_records.h"
+
+namespace igi {
+
+struct TextureEvidenceOptions {
+  double cell_m = 0.05;          // surface cell, metres
+  int min_cells = 30;            // cells seen by both photo sets with enough neighbours
+  double min_agreement = 0.6;    // share of those cells whose high-pass signs agree
+  double min_z = 5;              // the agreement's z against coin flips
+  double min_amplitude = 0.015;  // reproducible high-pass RMS, relative to the mean ratio
+  int min_records_per_cell = 2;  // per photo set
+};
+
+struct TextureEvidence {
+  std::string region;
+  int cells = 0;           // cells compared
+  double agreement = 0;    // share of cells whose high-pass signs agree between the photo sets
+  double z = 0;            // (agreement − ½)·2·√cells
+  double amplitude = 0;    // √(trimmed mean of hA·hB) / mean ratio
+  bool textured = false;
+};
+
+// One entry per region whose ρd the model solved (`solved[r]` true) and that has records; the
+// training records (not held out, not outliers) are used.
+std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
+                                                 const std::vector<PixelRecord>& records,
+                                                 const std::vector<bool>& solved,
+                                                 const TextureEvidenceOptions& options);
+
+}  // namespace igi
