@@ -263,8 +263,8 @@ void SolverState::BuildAlbedoMaps() {
     const bool want =
         options.albedo_maps == "all" || (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
     const std::vector<std::string>& only = options.albedo_map_regions;
-    if (!want || (!only.empty() && std::find(only.begin(), only.end(), scene.materials[r].name) ==
-                                       only.end())) {
+    if (!want || (!only.empty() &&
+                  std::find(only.begin(), only.end(), scene.materials[r].name) == only.end())) {
       continue;
     }
     const RegionAtlas atlas = AtlasOf(*this, int(r));

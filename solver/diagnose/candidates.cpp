@@ -1,11 +1,13 @@
 #include "solver/diagnose/candidates.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -30,7 +32,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 std::string Pct(double v) { return fmt::format("{:.1f}%", 100 * v); }
-
 
 // Whether `light` is the only light of every photographed lighting: then everything the photos
 // record comes from it (bounces too), and a scale common to all photos is its intensity.
@@ -375,9 +376,10 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   FillScores(best, &out);
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
-  const Eigen::Vector3d intensity = l.type == LightType::kSphere
-                                        ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
-                                        : l.intensity;
+  const Eigen::Vector3d intensity =
+      l.type == LightType::kSphere
+          ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
+          : l.intensity;
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
                 {"cos_power", n}};
@@ -475,7 +477,7 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
 // ---------------------------------------------------------------- specular_reflection
 // The roughnesses specular_reflection tries; its widest value is a bound, not a fit (see there).
 constexpr std::array<double, 11> kSpecularAlphaGrid = {0.03, 0.04, 0.05, 0.065, 0.08, 0.1,
-                                                       0.12, 0.15, 0.18, 0.25, 0.35};
+                                                       0.12, 0.15, 0.18, 0.25,  0.35};
 
 double WardLobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo,
                 double alpha) {
@@ -626,8 +628,8 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     if (fit.coef.size()) fitted_amplitude = fit.coef[0];
   }
   if (fit.coef.size() == 0 || !(fit.coef[0] > 0.3) || !(fit.coef[0] < 3)) {
-    out.note = fmt::format("the alternative lobe does not fit region {} (amplitude {:.2f})",
-                           m.name, fitted_amplitude);
+    out.note = fmt::format("the alternative lobe does not fit region {} (amplitude {:.2f})", m.name,
+                           fitted_amplitude);
     return out;
   }
   FillScores(fit, &out);
@@ -690,47 +692,104 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   auto allowed = [&](const std::string& e) {
     return std::find(excluded.begin(), excluded.end(), e) == excluded.end();
   };
-  if (allowed("exposure_scale")) out.push_back(ExposureScale(cx, f));
-  if (allowed("vignetting")) out.push_back(Vignetting(cx, f));
-  if (allowed("camera_response")) out.push_back(Response(cx, f));
-  if (allowed("ambient_light")) out.push_back(AmbientLight(cx, f));
+  // Logs (debug) each candidate's CPU-heavy evaluation time.
+  auto start = std::chrono::steady_clock::now();
+  auto timed = [&](size_t before) {
+    const auto now = std::chrono::steady_clock::now();
+    for (size_t i = before; i < out.size(); ++i) {
+      spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s", out[i].Key(),
+                    std::chrono::duration<double>(now - start).count());
+    }
+    start = now;
+  };
+  if (allowed("exposure_scale")) {
+    const size_t n = out.size();
+    out.push_back(ExposureScale(cx, f));
+    timed(n);
+  }
+  if (allowed("vignetting")) {
+    const size_t n = out.size();
+    out.push_back(Vignetting(cx, f));
+    timed(n);
+  }
+  if (allowed("camera_response")) {
+    const size_t n = out.size();
+    out.push_back(Response(cx, f));
+    timed(n);
+  }
+  if (allowed("ambient_light")) {
+    const size_t n = out.size();
+    out.push_back(AmbientLight(cx, f));
+    timed(n);
+  }
   for (int l = 0; l < int(cx.model.lights.size()); ++l) {
     const Light& light = cx.model.lights[l];
     const bool point_like =
         light.type == LightType::kPoint || light.type == LightType::kSphere ||
         (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
-    if (point_like && allowed("light_emission_profile:" + light.name))
+    if (point_like && allowed("light_emission_profile:" + light.name)) {
+      const size_t n = out.size();
       out.push_back(EmissionProfile(cx, f, l));
+      timed(n);
+    }
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
-      out.push_back(LightIntensity(cx, f, l));
+      {
+        const size_t n = out.size();
+        out.push_back(LightIntensity(cx, f, l));
+        timed(n);
+      }
     }
     if ((light.type == LightType::kPoint || light.type == LightType::kSphere) &&
         allowed("light_source_extent:" + light.name)) {
-      out.push_back(LightSourceExtent(cx, f, l));
+      {
+        const size_t n = out.size();
+        out.push_back(LightSourceExtent(cx, f, l));
+        timed(n);
+      }
     }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
     const std::string& region = cx.model.materials[g].name;
     if (allowed("specular_lobe_shape:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, false);
-      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
+      if (c.valid || !c.note.empty()) {
+        const size_t n = out.size();
+        out.push_back(std::move(c));
+        timed(n);
+      }
     }
     if (allowed("fresnel:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, true);
-      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
+      if (c.valid || !c.note.empty()) {
+        const size_t n = out.size();
+        out.push_back(std::move(c));
+        timed(n);
+      }
     }
     if (allowed("anisotropic_reflection:" + region)) {
       CandidateResult c = AnisotropicReflection(cx, f, g);
-      if (c.valid || !c.note.empty()) out.push_back(std::move(c));
+      if (c.valid || !c.note.empty()) {
+        const size_t n = out.size();
+        out.push_back(std::move(c));
+        timed(n);
+      }
     }
   }
   for (int c = 0; c < int(cx.model.cameras.size()); ++c) {
-    if (allowed("pose_error:" + cx.model.cameras[c].name)) out.push_back(PoseError(cx, f, c));
+    if (allowed("pose_error:" + cx.model.cameras[c].name)) {
+      const size_t n = out.size();
+      out.push_back(PoseError(cx, f, c));
+      timed(n);
+    }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
     if (allowed("specular_reflection:" + cx.model.materials[g].name)) {
       if (cx.model.materials[g].brdf == BrdfModel::kLambert) {
-        out.push_back(SpecularReflection(cx, f, g));
+        {
+          const size_t n = out.size();
+          out.push_back(SpecularReflection(cx, f, g));
+          timed(n);
+        }
       }
     }
   }

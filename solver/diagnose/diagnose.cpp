@@ -94,9 +94,11 @@ struct MapMode {
   bool Full() const { return maps == "auto" && only.empty(); }
 };
 
-// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it.
+// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it;
+// with `with_records`, also builds its residual samples (only the kept model's are ever used).
 ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const fs::path& dir,
-                    const DiagnoseOptions& o, const PhotoSet& photos) {
+                    const DiagnoseOptions& o, const PhotoSet& photos, bool with_records) {
+  const auto t0 = std::chrono::steady_clock::now();
   ModelState st;
   st.dir = dir;
   fs::create_directories(dir);
@@ -118,8 +120,16 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   SceneLoadOptions lo;
   lo.require_complete_materials = true;
   st.model = LoadScene(model_path, lo);
+  const auto t1 = std::chrono::steady_clock::now();
   st.sims = SimulatePhotos(st.model, o, o.seed, &st.sim_var);
-  st.records = BuildRecords(st.model, photos, st.sims, o);
+  const auto t2 = std::chrono::steady_clock::now();
+  if (with_records) st.records = BuildRecords(st.model, photos, st.sims, o);
+  const auto t3 = std::chrono::steady_clock::now();
+  using Seconds = std::chrono::duration<double>;
+  spdlog::info("igi-diagnose: {}: {}{:.1f} s simulating the photos, {:.1f} s building records",
+               dir.filename().string(),
+               solve ? fmt::format("{:.1f} s solving, ", Seconds(t1 - t0).count()) : "",
+               Seconds(t2 - t1).count(), Seconds(t3 - t2).count());
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st.train = ResidualOverPhotos(photos, st.sims, holdout, false);
   st.held = ResidualOverPhotos(photos, st.sims, holdout, true);
@@ -127,11 +137,11 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
 }
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
-// with the held-out blocks as independent units. Each pixel's squared error is counted less its
-// simulation's Monte Carlo variance (`*_var`, SimulatePhotos), so that a model whose render is
+// with the held-out blocks as independent units (BlockGainZ; blocks the step left exactly as they
+// were — same seed, same model there — do not count). Each pixel's squared error is counted less
+// its simulation's Monte Carlo variance (ModelState::sim_var), so that a model whose render is
 // merely less noisy earns nothing (the demo's false ambient_light step: an exact ambient term and
-// lower albedos cut the 16-spp renders' variance by a third, which read as a 2–6 % gain) (BlockGainZ; blocks the step left exactly as they
-// were — same seed, same model there — do not count).
+// lower albedos cut its 16-spp renders' variance by a third, which read as a 2–6 % gain).
 // `only` (when given) selects the blocks (photo, block x, block y) that count, and the z is then
 // the signed-rank z of their pixels' gains (see EdgeBlocks).
 // With `pixel_units` false, `only` just selects the blocks and the z is BlockGainZ over them.
@@ -143,7 +153,7 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const ModelState& 
   const std::vector<Image>& after = after_state.sims;
   auto var = [](const ModelState& s, size_t i, size_t k) {
     return i < s.sim_var.size() && k < s.sim_var[i].pixels.size() ? double(s.sim_var[i].pixels[k])
-                                                                   : 0.0;
+                                                                  : 0.0;
   };
   // Per block: gain and error before.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
@@ -160,9 +170,11 @@ std::pair<double, double> HeldOutGain(const PhotoSet& photos, const ModelState& 
           const double p = rec.at(x, y, c), b = before[i].at(x, y, c), a = after[i].at(x, y, c);
           if (!std::isfinite(a) || !std::isfinite(b)) continue;
           const size_t k = (size_t(y) * before[i].width + x) * before[i].channels + c;
-          const double eb = (b - p) * (b - p) - var(before_state, i, k);
+          // The error before stays raw (the gain's scale and the blocks' weights); the gain is
+          // the change of squared error less the change of the renders' variance.
+          const double eb = (b - p) * (b - p), ea = (a - p) * (a - p);
           e += eb;
-          g += eb - ((a - p) * (a - p) - var(after_state, i, k));
+          g += eb - ea - (var(before_state, i, k) - var(after_state, i, k));
         }
         if (only) pixel_gains.push_back(g);
         auto& acc = gain[(int64_t(i) << 40) + (int64_t(y / h.block_px) << 20) + x / h.block_px];
@@ -341,10 +353,11 @@ CandidateResult TextureFirst(const Scene& declared, const ModelState& st, double
                      {"z", e.z},
                      {"amplitude", e.amplitude},
                      {"textured", e.textured}});
-    spdlog::info("igi-diagnose: texture test of {}: {} cells, signs agree in {:.0f}% (z {:.1f}), "
-                 "amplitude {:.1f}%{}",
-                 e.region, e.cells, 100 * e.agreement, e.z, 100 * e.amplitude,
-                 e.textured ? ": textured" : "");
+    spdlog::info(
+        "igi-diagnose: texture test of {}: {} cells, signs agree in {:.0f}% (z {:.1f}), "
+        "amplitude {:.1f}%{}",
+        e.region, e.cells, 100 * e.agreement, e.z, 100 * e.amplitude,
+        e.textured ? ": textured" : "");
     if (!e.textured) continue;
     regions.push_back(e.region);
     shown += fmt::format("{}{} ({:.0f}% of {} cells, {:.0f}%)", shown.empty() ? "" : ", ", e.region,
@@ -398,7 +411,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   // it is found; "albedo_texture" is the step that adds them.
   MapMode maps{solve ? "none" : "auto", {}};
   spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
-  ModelState st = FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos);
+  ModelState st =
+      FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos, true);
   sum.baseline_residual = st.train.Relative();
   sum.baseline_held_out = st.held.Relative();
   spdlog::info("igi-diagnose: baseline residual {:.4f} (held out {:.4f})", sum.baseline_residual,
@@ -458,7 +472,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     if (masks) t.photos = MaskedPhotoSet(photos, missing.excluded);
     const PhotoSet& ph = masks ? *t.photos : photos;
     try {
-      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph);
+      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph, false);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
@@ -547,9 +561,14 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       (i == best ? kept_effects : rejected).push_back(ds.candidate.Key());
     }
     if (best >= 0) {
+      // A verdict is on a model: once a step changes it, the candidates rejected so far are
+      // judged again (an effect fitted while a bigger one was unmodelled — vignetting beside a
+      // photo's exposure — can earn its place once that one is in the model).
+      rejected.clear();
       if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
+      st.records = BuildRecords(st.model, photos, st.sims, o);
       maps = next_maps;
     }
     for (Trial& t : trials) sum.steps.push_back(std::move(t.step));
@@ -571,6 +590,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::vector<std::string> excluded = kept_effects;
     excluded.insert(excluded.end(), rejected.begin(), rejected.end());
     const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
+    const auto t0 = std::chrono::steady_clock::now();
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
     if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
       missing =
@@ -578,6 +598,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       cands.push_back(missing.candidate);
     }
     sum.last_candidates = cands;
+    spdlog::info("igi-diagnose: {} candidates evaluated in {:.1f} s", cands.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     std::vector<CandidateResult*> ranked;
     for (CandidateResult& c : cands) {
       if (c.valid && c.Gain() >= o.candidate_min_gain && c.z >= o.candidate_min_z) {
@@ -606,7 +628,6 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       std::vector<Trial> one;
       one.push_back(try_step(texture, MapMode{"auto", {}}));
       kept = settle(one, MapMode{"auto", {}});
-      if (kept) rejected.clear();  // with free albedos the earlier verdicts may change
     }
     if (!kept) break;
   }

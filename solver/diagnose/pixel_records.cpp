@@ -70,6 +70,31 @@ PhotoSet LoadPhotoSet(const Scene& scene) {
   return set;
 }
 
+namespace {
+
+// The mean over the (2r+1)² window about each pixel (clipped at the image's edges), per channel.
+Image BoxMean(const Image& in, int r) {
+  Image out(in.width, in.height, in.channels);
+  for (int y = 0; y < in.height; ++y) {
+    for (int x = 0; x < in.width; ++x) {
+      for (int c = 0; c < in.channels; ++c) {
+        double sum = 0;
+        int n = 0;
+        for (int v = std::max(0, y - r); v <= std::min(in.height - 1, y + r); ++v) {
+          for (int u = std::max(0, x - r); u <= std::min(in.width - 1, x + r); ++u) {
+            sum += in.at(u, v, c);
+            ++n;
+          }
+        }
+        out.at(x, y, c) = float(sum / n);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
                                   std::vector<Image>* variance) {
   std::vector<Image> sims(model.photos.size());
@@ -79,7 +104,8 @@ std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& opt
   const int spp1 = split ? options.spp / 2 : options.spp, spp2 = options.spp - spp1;
   for (size_t i = 0; i < model.photos.size(); ++i) {
     const Photo& p = model.photos[i];
-    if (!renderers[p.lighting]) renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+    if (!renderers[p.lighting])
+      renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
     RenderOptions ro;
     ro.spp = spp1;
     ro.seed = seed + 7919 * i;
@@ -96,19 +122,21 @@ std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& opt
     Image h2 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
     Image h1 = sims[i];
     for (size_t k = 0; k < sims[i].pixels.size(); ++k) {
-      sims[i].pixels[k] = float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) /
-                                options.spp);
+      sims[i].pixels[k] =
+          float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) / options.spp);
     }
     ApplyExposureAndResponse(p, &sims[i]);
     ApplyExposureAndResponse(p, &h1);
     ApplyExposureAndResponse(p, &h2);
     const double k_var = 1.0 / (options.spp * (1.0 / spp1 + 1.0 / spp2));
-    Image& v = (*variance)[i];
-    v = Image(h1.width, h1.height, h1.channels);
-    for (size_t k = 0; k < v.pixels.size(); ++k) {
+    Image raw(h1.width, h1.height, h1.channels);
+    for (size_t k = 0; k < raw.pixels.size(); ++k) {
       const double d = double(h1.pixels[k]) - double(h2.pixels[k]);
-      v.pixels[k] = std::isfinite(d) ? float(k_var * d * d) : 0.0f;
+      raw.pixels[k] = std::isfinite(d) ? float(k_var * d * d) : 0.0f;
     }
+    // One pixel's estimate has one degree of freedom (its noise is as large as itself): averaged
+    // over a 5 × 5 window, where the variance changes slowly, it adds little noise to the gains.
+    (*variance)[i] = BoxMean(raw, 2);
   }
   return sims;
 }
@@ -156,8 +184,8 @@ void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceH
   const std::vector<int>& ids = model.lightings[model.photos[r->photo].lighting].lights;
   for (int l = 0; l < int(impl.lights.size()); ++l) {
     const LightType type = impl.lights[l].type;
-    const bool delta = type == LightType::kPoint || type == LightType::kSpot ||
-                       type == LightType::kDirectional;
+    const bool delta =
+        type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
     if (type == LightType::kAmbient) {
       GatherAmbient(*impl.lights[l].light, hit, 4 * samples, rng, l < int(ids.size()) ? ids[l] : -1,
                     r);
@@ -200,55 +228,59 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
     }
   }
   rows.resize(row_of.size());
-  ParallelFor(0, int64_t(row_of.size()), [&](int64_t k) {
-    const auto [i, y] = row_of[k];
-    const Photo& p = model.photos[i];
-    const Camera& cam = model.cameras[p.camera];
-    const Renderer::Impl& impl = *scenes[p.lighting];
-    const Image& rec = photos.recorded[i];
-    const double half_diag2 = 0.25 * (double(cam.width) * cam.width + double(cam.height) * cam.height);
-    Pcg32 rng = PixelSampleRng(options.seed + 17, uint64_t(k), 0);
-    for (int x = 0; x < rec.width; x += options.pixel_stride) {
-      if (photos.valid[i].at(x, y, 0) < 0.5f) continue;
-      const Eigen::Vector3d center = cam.CenterInWorld();
-      const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-      const std::optional<SurfaceHit> hit = TraceSurface(impl, center, dir);
-      if (!hit) continue;
-      PixelRecord r;
-      r.photo = i;
-      r.x = x;
-      r.y = y;
-      r.held_out = holdout.HeldOut(i, x, y);
-      for (int c = 0; c < 3; ++c) {
-        r.recorded[c] = rec.at(x, y, c);
-        r.sim[c] = sims[i].at(x, y, c);
-      }
-      if (!r.sim.allFinite()) continue;
-      r.region = hit->region;
-      r.position = hit->position.cast<float>();
-      r.normal = hit->n_s.cast<float>();
-      r.view = (-dir).cast<float>();
-      const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
-      r.r2 = float((dx * dx + dy * dy) / half_diag2);
-      r.albedo = AlbedoAt(model, impl, *hit);
-      r.point_cam = (cam.cam_from_world * hit->position).cast<float>();
-      const Image& sim = sims[i];
-      auto at = [&](int xx, int yy, int c) {
-        return sim.at(std::clamp(xx, 0, sim.width - 1), std::clamp(yy, 0, sim.height - 1), c);
-      };
-      for (int c = 0; c < 3; ++c) {
-        float gx = 0, gy = 0;
-        for (int d = -1; d <= 1; ++d) {
-          gx += at(x + 1, y + d, c) - at(x - 1, y + d, c);
-          gy += at(x + d, y + 1, c) - at(x + d, y - 1, c);
+  ParallelFor(
+      0, int64_t(row_of.size()),
+      [&](int64_t k) {
+        const auto [i, y] = row_of[k];
+        const Photo& p = model.photos[i];
+        const Camera& cam = model.cameras[p.camera];
+        const Renderer::Impl& impl = *scenes[p.lighting];
+        const Image& rec = photos.recorded[i];
+        const double half_diag2 =
+            0.25 * (double(cam.width) * cam.width + double(cam.height) * cam.height);
+        Pcg32 rng = PixelSampleRng(options.seed + 17, uint64_t(k), 0);
+        for (int x = 0; x < rec.width; x += options.pixel_stride) {
+          if (photos.valid[i].at(x, y, 0) < 0.5f) continue;
+          const Eigen::Vector3d center = cam.CenterInWorld();
+          const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+          const std::optional<SurfaceHit> hit = TraceSurface(impl, center, dir);
+          if (!hit) continue;
+          PixelRecord r;
+          r.photo = i;
+          r.x = x;
+          r.y = y;
+          r.held_out = holdout.HeldOut(i, x, y);
+          for (int c = 0; c < 3; ++c) {
+            r.recorded[c] = rec.at(x, y, c);
+            r.sim[c] = sims[i].at(x, y, c);
+          }
+          if (!r.sim.allFinite()) continue;
+          r.region = hit->region;
+          r.position = hit->position.cast<float>();
+          r.normal = hit->n_s.cast<float>();
+          r.view = (-dir).cast<float>();
+          const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
+          r.r2 = float((dx * dx + dy * dy) / half_diag2);
+          r.albedo = AlbedoAt(model, impl, *hit);
+          r.point_cam = (cam.cam_from_world * hit->position).cast<float>();
+          const Image& sim = sims[i];
+          auto at = [&](int xx, int yy, int c) {
+            return sim.at(std::clamp(xx, 0, sim.width - 1), std::clamp(yy, 0, sim.height - 1), c);
+          };
+          for (int c = 0; c < 3; ++c) {
+            float gx = 0, gy = 0;
+            for (int d = -1; d <= 1; ++d) {
+              gx += at(x + 1, y + d, c) - at(x - 1, y + d, c);
+              gy += at(x + d, y + 1, c) - at(x + d, y - 1, c);
+            }
+            r.sim_gradient(c, 0) = gx / 6;
+            r.sim_gradient(c, 1) = gy / 6;
+          }
+          GatherLights(model, impl, *hit, options.light_samples, rng, &r);
+          rows[k].push_back(std::move(r));
         }
-        r.sim_gradient(c, 0) = gx / 6;
-        r.sim_gradient(c, 1) = gy / 6;
-      }
-      GatherLights(model, impl, *hit, options.light_samples, rng, &r);
-      rows[k].push_back(std::move(r));
-    }
-  }, options.num_threads);
+      },
+      options.num_threads);
   std::vector<PixelRecord> out;
   for (auto& row : rows) {
     for (PixelRecord& r : row) out.push_back(std::move(r));
@@ -284,7 +316,7 @@ ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out) {
 }
 
 ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
-                           const PixelHoldout& holdout, bool held_out) {
+                                const PixelHoldout& holdout, bool held_out) {
   ResidualSums s;
   for (size_t i = 0; i < sims.size(); ++i) {
     const Image& rec = photos.recorded[i];

@@ -35,12 +35,12 @@ struct PixelRecord {
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // shading normal, toward the camera
   Eigen::Vector3f view = Eigen::Vector3f::Zero();    // unit, toward the camera
   float r2 = 0;  // (distance to the principal point / half the image diagonal)²
-  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // the model's ρd at the point
+  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();     // the model's ρd at the point
   Eigen::Vector3f point_cam = Eigen::Vector3f::Zero();  // the point in the camera frame
   // The model image's gradient at the pixel (Prewitt: a 3×3-smoothed central difference), per
   // channel: d sim / dx, d sim / dy.
   Eigen::Matrix<float, 3, 2> sim_gradient = Eigen::Matrix<float, 3, 2>::Zero();
-  std::vector<RecordLightSample> lights;             // direct light at the point
+  std::vector<RecordLightSample> lights;  // direct light at the point
 };
 
 // Recorded photos of a scene (loaded once) and their valid-pixel masks.
@@ -79,6 +79,6 @@ ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out);
 
 // Residual over every valid pixel of the photos (not only the records' stride).
 ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
-                           const PixelHoldout& holdout, bool held_out);
+                                const PixelHoldout& holdout, bool held_out);
 
 }  // namespace igi

@@ -12,7 +12,8 @@ using CellKey = int64_t;
 
 CellKey KeyOf(int ix, int iy, int iz) {
   constexpr int64_t kOffset = int64_t(1) << 20;  // cells within ±2^20 of the origin
-  return ((int64_t(ix) + kOffset) << 42) | ((int64_t(iy) + kOffset) << 21) | (int64_t(iz) + kOffset);
+  return ((int64_t(ix) + kOffset) << 42) | ((int64_t(iy) + kOffset) << 21) |
+         (int64_t(iz) + kOffset);
 }
 
 struct CellSum {
@@ -103,7 +104,8 @@ std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
     if (r.region >= int(solved.size()) || !solved[r.region]) continue;
     const double q = Ratio(r);
     if (!std::isfinite(q)) continue;
-    const Eigen::Vector3i c = (r.position.cast<double>() / options.cell_m).array().floor().cast<int>();
+    const Eigen::Vector3i c =
+        (r.position.cast<double>() / options.cell_m).array().floor().cast<int>();
     CellGrid& g = grids[size_t(r.region) * 2 + (r.photo & 1)];
     const CellKey key = KeyOf(c.x(), c.y(), c.z());
     CellSum& s = g.cells[key];

@@ -33,10 +33,10 @@ struct TextureEvidenceOptions {
 
 struct TextureEvidence {
   std::string region;
-  int cells = 0;           // cells compared
-  double agreement = 0;    // share of cells whose high-pass signs agree between the photo sets
-  double z = 0;            // (agreement − ½)·2·√cells
-  double amplitude = 0;    // √(trimmed mean of hA·hB) / mean ratio
+  int cells = 0;         // cells compared
+  double agreement = 0;  // share of cells whose high-pass signs agree between the photo sets
+  double z = 0;          // (agreement − ½)·2·√cells
+  double amplitude = 0;  // √(trimmed mean of hA·hB) / mean ratio
   bool textured = false;
 };
 
