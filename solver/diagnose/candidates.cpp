@@ -692,104 +692,57 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   auto allowed = [&](const std::string& e) {
     return std::find(excluded.begin(), excluded.end(), e) == excluded.end();
   };
-  // Logs (debug) each candidate's CPU-heavy evaluation time.
+  // Adds a candidate and logs (debug) the time since the previous one was added.
   auto start = std::chrono::steady_clock::now();
-  auto timed = [&](size_t before) {
+  auto add = [&](CandidateResult c) {
     const auto now = std::chrono::steady_clock::now();
-    for (size_t i = before; i < out.size(); ++i) {
-      spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s", out[i].Key(),
-                    std::chrono::duration<double>(now - start).count());
-    }
+    spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s", c.Key(),
+                  std::chrono::duration<double>(now - start).count());
     start = now;
+    out.push_back(std::move(c));
   };
-  if (allowed("exposure_scale")) {
-    const size_t n = out.size();
-    out.push_back(ExposureScale(cx, f));
-    timed(n);
-  }
-  if (allowed("vignetting")) {
-    const size_t n = out.size();
-    out.push_back(Vignetting(cx, f));
-    timed(n);
-  }
-  if (allowed("camera_response")) {
-    const size_t n = out.size();
-    out.push_back(Response(cx, f));
-    timed(n);
-  }
-  if (allowed("ambient_light")) {
-    const size_t n = out.size();
-    out.push_back(AmbientLight(cx, f));
-    timed(n);
-  }
+
+  if (allowed("exposure_scale")) add(ExposureScale(cx, f));
+  if (allowed("vignetting")) add(Vignetting(cx, f));
+  if (allowed("camera_response")) add(Response(cx, f));
+  if (allowed("ambient_light")) add(AmbientLight(cx, f));
   for (int l = 0; l < int(cx.model.lights.size()); ++l) {
     const Light& light = cx.model.lights[l];
     const bool point_like =
         light.type == LightType::kPoint || light.type == LightType::kSphere ||
         (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
-    if (point_like && allowed("light_emission_profile:" + light.name)) {
-      const size_t n = out.size();
-      out.push_back(EmissionProfile(cx, f, l));
-      timed(n);
-    }
+    if (point_like && allowed("light_emission_profile:" + light.name))
+      add(EmissionProfile(cx, f, l));
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
-      {
-        const size_t n = out.size();
-        out.push_back(LightIntensity(cx, f, l));
-        timed(n);
-      }
+      add(LightIntensity(cx, f, l));
     }
     if ((light.type == LightType::kPoint || light.type == LightType::kSphere) &&
         allowed("light_source_extent:" + light.name)) {
-      {
-        const size_t n = out.size();
-        out.push_back(LightSourceExtent(cx, f, l));
-        timed(n);
-      }
+      add(LightSourceExtent(cx, f, l));
     }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
     const std::string& region = cx.model.materials[g].name;
     if (allowed("specular_lobe_shape:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, false);
-      if (c.valid || !c.note.empty()) {
-        const size_t n = out.size();
-        out.push_back(std::move(c));
-        timed(n);
-      }
+      if (c.valid || !c.note.empty()) add(std::move(c));
     }
     if (allowed("fresnel:" + region)) {
       CandidateResult c = LobeChange(cx, f, g, true);
-      if (c.valid || !c.note.empty()) {
-        const size_t n = out.size();
-        out.push_back(std::move(c));
-        timed(n);
-      }
+      if (c.valid || !c.note.empty()) add(std::move(c));
     }
     if (allowed("anisotropic_reflection:" + region)) {
       CandidateResult c = AnisotropicReflection(cx, f, g);
-      if (c.valid || !c.note.empty()) {
-        const size_t n = out.size();
-        out.push_back(std::move(c));
-        timed(n);
-      }
+      if (c.valid || !c.note.empty()) add(std::move(c));
     }
   }
   for (int c = 0; c < int(cx.model.cameras.size()); ++c) {
-    if (allowed("pose_error:" + cx.model.cameras[c].name)) {
-      const size_t n = out.size();
-      out.push_back(PoseError(cx, f, c));
-      timed(n);
-    }
+    if (allowed("pose_error:" + cx.model.cameras[c].name)) add(PoseError(cx, f, c));
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {
     if (allowed("specular_reflection:" + cx.model.materials[g].name)) {
       if (cx.model.materials[g].brdf == BrdfModel::kLambert) {
-        {
-          const size_t n = out.size();
-          out.push_back(SpecularReflection(cx, f, g));
-          timed(n);
-        }
+        add(SpecularReflection(cx, f, g));
       }
     }
   }

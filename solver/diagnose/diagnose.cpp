@@ -126,10 +126,11 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   if (with_records) st.records = BuildRecords(st.model, photos, st.sims, o);
   const auto t3 = std::chrono::steady_clock::now();
   using Seconds = std::chrono::duration<double>;
-  spdlog::info("igi-diagnose: {}: {}{:.1f} s simulating the photos, {:.1f} s building records",
-               dir.filename().string(),
-               solve ? fmt::format("{:.1f} s solving, ", Seconds(t1 - t0).count()) : "",
-               Seconds(t2 - t1).count(), Seconds(t3 - t2).count());
+  spdlog::info(
+      "igi-diagnose: {}: {}{:.1f} s simulating the photos{}", dir.filename().string(),
+      solve ? fmt::format("{:.1f} s solving, ", Seconds(t1 - t0).count()) : "",
+      Seconds(t2 - t1).count(),
+      with_records ? fmt::format(", {:.1f} s building records", Seconds(t3 - t2).count()) : "");
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st.train = ResidualOverPhotos(photos, st.sims, holdout, false);
   st.held = ResidualOverPhotos(photos, st.sims, holdout, true);
