@@ -111,16 +111,17 @@ std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& opt
     ro.seed = seed + 7919 * i;
     ro.num_threads = options.num_threads;
     ro.show_progress = false;
-    sims[i] = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
+    Image h1 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
     if (!split) {
-      ApplyExposureAndResponse(p, &sims[i]);
-      if (variance) (*variance)[i] = Image(sims[i].width, sims[i].height, sims[i].channels);
+      ApplyExposureAndResponse(p, &h1);
+      if (variance) (*variance)[i] = Image(h1.width, h1.height, h1.channels);
+      sims[i] = std::move(h1);
       continue;
     }
     ro.spp = spp2;
     ro.seed = seed + 7919 * i + 0x5bd1e995ULL;
     Image h2 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
-    Image h1 = sims[i];
+    sims[i] = Image(h1.width, h1.height, h1.channels);
     for (size_t k = 0; k < sims[i].pixels.size(); ++k) {
       sims[i].pixels[k] =
           float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) / options.spp);

@@ -17,6 +17,7 @@ CellKey KeyOf(int ix, int iy, int iz) {
 }
 
 struct CellSum {
+  Eigen::Vector3i cell = Eigen::Vector3i::Zero();  // integer cell coordinates
   double sum = 0;
   int n = 0;
   double Mean() const { return sum / n; }
@@ -25,7 +26,6 @@ struct CellSum {
 // The cells' ratio sums of one photo set (photo parity `parity`) for region `region`.
 struct CellGrid {
   std::unordered_map<CellKey, CellSum> cells;
-  std::unordered_map<CellKey, Eigen::Vector3i> coords;
 };
 
 double Ratio(const PixelRecord& r) {
@@ -66,7 +66,7 @@ TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellG
         it->second.n < o.min_records_per_cell) {
       continue;
     }
-    const Eigen::Vector3i& c = a.coords.at(key);
+    const Eigen::Vector3i& c = ca.cell;
     const double na = NeighbourMean(a, c, o.min_records_per_cell);
     const double nb = NeighbourMean(b, c, o.min_records_per_cell);
     if (!std::isfinite(na) || !std::isfinite(nb)) continue;
@@ -109,9 +109,9 @@ std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
     CellGrid& g = grids[size_t(r.region) * 2 + (r.photo & 1)];
     const CellKey key = KeyOf(c.x(), c.y(), c.z());
     CellSum& s = g.cells[key];
+    s.cell = c;
     s.sum += q;
     ++s.n;
-    g.coords[key] = c;
   }
   std::vector<TextureEvidence> out;
   for (int r = 0; r < regions; ++r) {
