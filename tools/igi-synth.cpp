@@ -2,6 +2,7 @@
 // (scene.json, geometry, photos, optional LDR brackets) plus truth.json, with optional effects
 // that the photos show and scene.json does not declare.
 #include <cstdio>
+#include <optional>
 
 #include "solver/synth/synthesize.h"
 #include "tools/common/cli.h"
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
   igi::SynthOptions o;
   std::string noise = "none", response = "gamma", unknowns = "rho_d,rho_s,alpha";
-  std::string photo_lightings = "L0", validation_lightings = "L1";
+  std::string photo_lightings = "L0", validation_lightings = "L1", lamp_position;
   std::vector<std::string> effects;
   app.add_option("--out", o.out, "Scene folder to write (empty or absent)")->required();
   app.add_flag("--overwrite", o.overwrite, "Allow a non-empty --out folder");
@@ -42,6 +43,11 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "Random seed (same seed, same files)");
   app.add_option("--glossy-brdf", o.glossy_brdf, "True model of the glossy regions: ward|ward_gmd");
   app.add_option("--lamp", o.lamp, "Lamp type: sphere (r = 4 cm) or point");
+  app.add_option("--lamp-position", lamp_position,
+                 "Centre of the photographed lamp, x,y,z in metres (default 2.3,1.7,2.4)");
+  app.add_option("--grazing-cameras", o.grazing_cameras,
+                 "Extra cameras seeing the floor's highlight at 60-80 deg incidence (Fresnel; "
+                 "needs a low lamp, e.g. --lamp-position 2,2,0.6)");
   app.add_option("--floor-texture", o.floor_texture,
                  "Floor albedo: tiles (grout lines and grain finer than a pixel) or smooth (the "
                  "tiles low-pass filtered, sigma 6 cm, resolved by the photos)");
@@ -89,6 +95,18 @@ int main(int argc, char** argv) {
       o.brackets.response = igi::ResponseKind::kFile;
     else
       problems.Add("--response", "", response, "must be gamma, sigmoid or file");
+    if (!lamp_position.empty()) {
+      const std::vector<std::string> parts = igi::SplitTokens(lamp_position, ",");
+      std::vector<double> v;
+      for (const std::string& s : parts) {
+        if (const std::optional<double> d = igi::ParseDouble(s)) v.push_back(*d);
+      }
+      if (v.size() == 3 && parts.size() == 3) {
+        o.lamp_position = Eigen::Vector3d(v[0], v[1], v[2]);
+      } else {
+        problems.Add("--lamp-position", "", lamp_position, "must be three numbers x,y,z");
+      }
+    }
     o.unknowns = List(unknowns);
     o.photo_lightings = List(photo_lightings);
     o.validation_lightings = List(validation_lightings);

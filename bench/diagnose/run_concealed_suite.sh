@@ -31,7 +31,7 @@ esac
 CASES=("$@")
 if [ ${#CASES[@]} -eq 0 ]; then
   CASES=(vignetting exposure_scale camera_response ambient_light
-         ambient_light:kind=uniform,radiance=0.1 light_emission_profile
+         ambient_light:radiance=0.1 ambient_light:kind=panel light_emission_profile
          light_intensity specular_reflection specular_lobe_shape fresnel anisotropic_reflection
          light_source_extent pose_error missing_geometry
          vignetting+exposure_scale light_emission_profile+camera_response none none)

@@ -10,7 +10,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <unordered_map>
 
@@ -285,59 +287,82 @@ double MedianSim(const std::vector<PixelRecord>& records) {
   return std::max(1e-12, double(values[values.size() / 2]));
 }
 
-}  // namespace
-
-CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light) {
-  CandidateResult out;
-  out.effect = "light_emission_profile";
-  const Light& l = cx.model.lights[light];
-  const std::vector<PixelRecord>& recs = f.records();
-  std::vector<LightTerm> terms(recs.size());
-  int lit = 0;
-  for (size_t i = 0; i < terms.size(); ++i) {
-    terms[i] = TermOf(cx.model, recs[i], light);
-    lit += terms[i].lit;
+// The fit of light `light`'s emission profile on one fitter's records: its direct terms once,
+// then a fit per (axis, power).
+class ProfileFit {
+ public:
+  ProfileFit(const CandidateContext& cx, const ResidualFitter& f, int light)
+      : f_(f), num_regions_(int(cx.model.materials.size())), terms_(f.records().size()) {
+    const std::vector<PixelRecord>& recs = f.records();
+    for (size_t i = 0; i < terms_.size(); ++i) {
+      terms_[i] = TermOf(cx.model, recs[i], light);
+      lit_ += terms_[i].lit;
+    }
+    ref_ = MedianSim(recs);
   }
-  if (lit < 100) return out;
+  int lit() const { return lit_; }
+
   // The direct light of `light` (diffuse and specular) becomes D·cos^n(angle from the axis): a
-  // fixed change of amplitude 1, searched over the axis and n. The light it sends after a bounce
-  // changes too, by a share that differs between surfaces (the ceiling, lit only by bounces from
-  // what the spot lights, loses more than the floor): what is not its direct term gets a free
-  // scale per region (the albedos' nuisance covers that when they are solved).
-  const int num_regions = int(cx.model.materials.size());
-  // The axis and power are searched with a camera response beside the profile as a nuisance (its
-  // expansion to second order, u·ln(u/ref) and u·ln²(u/ref), u the profiled value; a power
-  // r·(u/r)^e = u·exp((e − 1)·ln(u/r))): a response the photos also hide (a power of
-  // the pixel value) would otherwise bend the profile's fit (an 11° axis error and power 2.38 for
-  // 2 in the light_emission_profile + camera_response capture), and the response could then no
-  // longer be proven. The scores come from the fit without it: the profile must explain on its
-  // own what it is credited with.
-  const double ref = MedianSim(recs);
-  auto fit_at = [&](const Eigen::Vector3d& axis, double n, bool response_nuisance) {
+  // fixed change of amplitude 1. The light it sends after a bounce changes too, by a share that
+  // differs between surfaces (the ceiling, lit only by bounces from what the spot lights, loses
+  // more than the floor): what is not its direct term gets a free scale per region (the albedos'
+  // nuisance covers that when they are solved). With `response_nuisance`, a camera response
+  // beside the profile (its expansion to second order, u·ln(u/ref) and u·ln²(u/ref), u the
+  // profiled value; a power r·(u/r)^e = u·exp((e − 1)·ln(u/r))).
+  ResidualFit operator()(const Eigen::Vector3d& axis, double n, bool response_nuisance) const {
     const Eigen::Vector3f ax = axis.cast<float>();
-    const int k_regions = f.nuisance() ? 1 : num_regions;
+    const PixelRecord* base = f_.records().data();
+    const int k_regions = f_.nuisance() ? 1 : num_regions_;
     auto offset = [&](const PixelRecord& r, int c) {
-      const LightTerm& t = terms[size_t(&r - recs.data())];
+      const LightTerm& t = terms_[size_t(&r - base)];
       if (!t.lit) return 0.0;
       const double cs = std::max(0.0f, t.from_light.dot(ax));
       return double(t.direct[c]) * (std::pow(cs, n) - 1);
     };
-    return f.Fit(
+    return f_.Fit(
         k_regions + (response_nuisance ? 2 : 0),
         [&](const PixelRecord& r, int c, double* b) {
-          const LightTerm& t = terms[size_t(&r - recs.data())];
-          if (!f.nuisance() && r.region >= 0 && r.region < num_regions) {
+          const LightTerm& t = terms_[size_t(&r - base)];
+          if (!f_.nuisance() && r.region >= 0 && r.region < num_regions_) {
             b[r.region] = double(r.sim[c]) - double(t.direct[c]);
           }
           const double u = double(r.sim[c]) + offset(r, c);
           if (response_nuisance && u > 0) {
-            const double log_u = std::log(u / ref);
+            const double log_u = std::log(u / ref_);
             b[k_regions] = u * log_u;
             b[k_regions + 1] = u * log_u * log_u;
           }
         },
         offset);
-  };
+  }
+
+ private:
+  const ResidualFitter& f_;
+  int num_regions_;
+  std::vector<LightTerm> terms_;
+  int lit_ = 0;
+  double ref_ = 1;
+};
+
+}  // namespace
+
+CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter& f, int light,
+                                const RecordSubset* search) {
+  CandidateResult out;
+  out.effect = "light_emission_profile";
+  const Light& l = cx.model.lights[light];
+  const ProfileFit all(cx, f, light);
+  if (all.lit() < 100) return out;
+  // The axis and power are searched with a camera response beside the profile as a nuisance: a
+  // response the photos also hide (a power of the pixel value) would otherwise bend the
+  // profile's fit (an 11° axis error and power 2.38 for 2 in the light_emission_profile +
+  // camera_response capture), and the response could then no longer be proven. The search runs
+  // on `search`'s records when given (a subsample), the final fit on every record; the scores
+  // come from the fit without the response: the profile must explain on its own what it is
+  // credited with.
+  std::optional<ProfileFit> subset;
+  if (search) subset.emplace(cx, search->fitter(), light);
+  const ProfileFit& fit_at = subset ? *subset : all;
   ResidualFit best;
   double best_n = 1;
   Eigen::Vector3d best_axis = -Eigen::Vector3d::UnitZ();
@@ -368,7 +393,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
       if (!moved) break;
     }
   }
-  best = fit_at(best_axis, best_n, false);
+  best = all(best_axis, best_n, false);
   if (best.coef.size() == 0) {
     out.note = "the profile alone does not fit (degenerate)";
     return out;
@@ -688,6 +713,12 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   int num_cells = 0;
   std::vector<int> cells = RecordCells(cx.model, records, cx.cell_m, &num_cells);
   const ResidualFitter f(records, std::move(cells), num_cells, cx.materials_solved, cx.block_px);
+  // The searches' subsample (none when the records are few).
+  std::unique_ptr<RecordSubset> search;
+  if (const int stride = SearchStride(records, cx.search_records); stride > 1) {
+    search = std::make_unique<RecordSubset>(cx.model, records, cx.cell_m, cx.materials_solved,
+                                            cx.block_px, stride);
+  }
   std::vector<CandidateResult> out;
   auto allowed = [&](const std::string& e) {
     return std::find(excluded.begin(), excluded.end(), e) == excluded.end();
@@ -712,13 +743,13 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
         light.type == LightType::kPoint || light.type == LightType::kSphere ||
         (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
     if (point_like && allowed("light_emission_profile:" + light.name))
-      add(EmissionProfile(cx, f, l));
+      add(EmissionProfile(cx, f, l, search.get()));
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
       add(LightIntensity(cx, f, l));
     }
     if ((light.type == LightType::kPoint || light.type == LightType::kSphere) &&
         allowed("light_source_extent:" + light.name)) {
-      add(LightSourceExtent(cx, f, l));
+      add(LightSourceExtent(cx, f, l, search.get()));
     }
   }
   for (int g = 0; g < int(cx.model.materials.size()); ++g) {

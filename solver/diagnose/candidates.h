@@ -24,6 +24,10 @@ struct CandidateContext {
   bool materials_solved;  // unknown materials are re-solved after each step
   double cell_m = 0.05;   // surface cell of regions with albedo maps (their free albedo)
   int block_px = 16;      // held-out block: the unit of the gain's standard error
+  // The searches over a candidate's nonlinear parameters (an emission profile's axis, a source's
+  // radius, an anisotropic lobe) run on a subsample of about this many fitted records; the
+  // parameters they find are then fitted and scored on every record.
+  int search_records = 30000;
 };
 
 struct CandidateResult {
@@ -55,6 +59,7 @@ struct ResidualFit;
 void FillScores(const ResidualFit& fit, CandidateResult* out);
 
 class ResidualFitter;
+class RecordSubset;
 // specular_reflection for `region` (declared diffuse): a Ward lobe whose ρs and α best explain
 // the residual. Its apply() writes brdf "ward", with the fitted ρs and α where the region's
 // albedo is declared (nothing is solved then), without them otherwise (igi-solve fits them).
@@ -64,9 +69,10 @@ CandidateResult SpecularReflection(const CandidateContext& context, const Residu
 // light_emission_profile for light `light` (index into model.lights): the light's direct term
 // becomes cos^n of the angle from an axis (a "spot" with a cos_power profile). The axis and n are
 // searched with a camera response as a nuisance (so that a response the photos also hide does not
-// bend them) and scored without it.
+// bend them) and scored without it. The search runs on `search`'s records when given (a subsample
+// of the fitter's), the final fit and its scores on the fitter's.
 CandidateResult EmissionProfile(const CandidateContext& context, const ResidualFitter& fitter,
-                                int light);
+                                int light, const RecordSubset* search = nullptr);
 
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 
 #include "solver/brdf.h"
@@ -119,27 +120,45 @@ struct LobeParams {
   double phi = 0, ax = 0.1, ay = 0.1;  // tangent angle (radians) in the highlight plane
 };
 
-CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter& f, int region) {
+// The region's current lobe and an anisotropic one on one fitter's records.
+class LobeFit {
+ public:
+  LobeFit(const ResidualFitter& f, int region, const Material& m)
+      : f_(f), lobe_(f.records(), region, m), to_(AnisotropicOf(m.brdf)) {
+    const double alpha = *m.alpha;
+    current_ = lobe_.Term(m.brdf, alpha, alpha, Vector3d::UnitX());
+    ch_.offset = current_;
+    for (Eigen::Vector3f& v : ch_.offset) v = -v;  // the current lobe is removed
+  }
+  const std::vector<Eigen::Vector3f>& current() const { return current_; }
+
+  ResidualFit operator()(double ax, double ay, const Vector3d& tangent) {
+    ch_.basis = lobe_.Term(to_, ax, ay, tangent);
+    return FitChange(f_, ch_);
+  }
+
+ private:
+  const ResidualFitter& f_;
+  RegionLobe lobe_;
+  BrdfModel to_;
+  std::vector<Eigen::Vector3f> current_;
+  Change ch_;
+};
+
+// The lobe's parameters are searched on `search`'s records (the region's, subsampled), then
+// fitted and scored on `f`'s.
+CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter& f,
+                               const ResidualFitter& search, int region) {
   CandidateResult out;
   out.effect = "anisotropic_reflection";
   const Material& m = cx.model.materials[region];
-  const std::vector<PixelRecord>& recs = f.records();
-  const RegionLobe lobe(recs, region, m);
-  const double alpha = *m.alpha;
-  Change ch;
-  ch.offset = lobe.Term(m.brdf, alpha, alpha, Vector3d::UnitX());
-  for (Eigen::Vector3f& v : ch.offset) v = -v;  // the current lobe is removed
-  std::vector<Eigen::Vector3f> current = ch.offset;
-  for (Eigen::Vector3f& v : current) v = -v;
-  const std::array<Vector3d, 3> plane = HighlightPlane(recs, region, current);
+  LobeFit lobe(search, region, m);
+  const std::array<Vector3d, 3> plane = HighlightPlane(search.records(), region, lobe.current());
   const BrdfModel to = AnisotropicOf(m.brdf);
   auto tangent_of = [&](double phi) {
     return (std::cos(phi) * plane[1] + std::sin(phi) * plane[2]).normalized();
   };
-  auto fit_at = [&](const LobeParams& p) {
-    ch.basis = lobe.Term(to, p.ax, p.ay, tangent_of(p.phi));
-    return FitChange(f, ch);
-  };
+  auto fit_at = [&](const LobeParams& p) { return lobe(p.ax, p.ay, tangent_of(p.phi)); };
   auto physical = [](const ResidualFit& fit) {
     return fit.coef.size() == 1 && fit.coef[0] > 0.2 && fit.coef[0] < 5;
   };
@@ -198,9 +217,17 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
         m.name, ratio, 100 * share);
     return out;
   }
-  FillScores(best, &out);
   // The narrow direction first is a convention only: report the tangent of alpha_x as fitted.
   const Vector3d tangent = tangent_of(bp.phi);
+  if (&search != &f) {
+    best = LobeFit(f, region, m)(bp.ax, bp.ay, tangent);
+    if (!physical(best)) {
+      out.note = fmt::format("region {}: the lobe found on a subsample does not fit every record",
+                             m.name);
+      return out;
+    }
+  }
+  FillScores(best, &out);
   const double k = best.coef[0];
   const std::string to_name(BrdfModelName(to));
   out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)},
@@ -318,8 +345,10 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
 // value (below that, the render's own noise at a few hundred paths per pixel hides it), in
 // held-out blocks with at least kMinBlockRecords such records (a block of one changed record
 // scores noise). Elsewhere it is set to zero: those records are outside the candidate's support.
-void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px,
+// On a subsample of every `stride`-th record the blocks hold that many times fewer records.
+void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int stride,
                        std::vector<Eigen::Vector3f>* change) {
+  const int min_records = std::max(1, kMinBlockRecords / std::max(1, stride));
   std::unordered_map<int64_t, int> count;
   auto block = [&](const PixelRecord& r) {
     return (int64_t(r.photo) << 40) + (int64_t(r.y / block_px) << 20) + r.x / block_px;
@@ -332,7 +361,7 @@ void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px,
     }
   }
   for (size_t i = 0; i < recs.size(); ++i) {
-    if (count[block(recs[i])] < kMinBlockRecords) (*change)[i].setZero();
+    if (count[block(recs[i])] < min_records) (*change)[i].setZero();
   }
 }
 
@@ -442,7 +471,38 @@ class ExtentModel {
   double declared_radius_ = 0;
 };
 
-CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, int light) {
+// A larger sphere's change of the direct term on one fitter's records, fitted per radius.
+class ExtentChange {
+ public:
+  ExtentChange(const CandidateContext& cx, const ResidualFitter& f, int light, int stride)
+      : cx_(cx), f_(f), model_(cx, f.records(), light), stride_(stride) {
+    d0_ = model_.Direct(model_.declared_radius(), &vis0_);
+  }
+  const ExtentModel& model() const { return model_; }
+  const std::vector<Eigen::Vector3f>& d0() const { return d0_; }
+  const std::vector<float>& vis0() const { return vis0_; }
+
+  ResidualFit operator()(double radius) {
+    ch_.basis = model_.Direct(radius);
+    for (size_t i = 0; i < ch_.basis.size(); ++i) ch_.basis[i] -= d0_[i];
+    KeepMarkedChanges(f_.records(), cx_.block_px, stride_, &ch_.basis);
+    return FitChange(f_, ch_);
+  }
+
+ private:
+  const CandidateContext& cx_;
+  const ResidualFitter& f_;
+  const ExtentModel model_;
+  int stride_;
+  std::vector<float> vis0_;
+  std::vector<Eigen::Vector3f> d0_;
+  Change ch_;
+};
+
+// The radius is searched on `search`'s records (every `stride`-th of f's), then fitted and scored
+// on f's.
+CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
+                          const ResidualFitter& search, int stride, int light) {
   CandidateResult out;
   out.effect = "light_source_extent";
   const Light& l = cx.model.lights[light];
@@ -456,17 +516,8 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
     out.note = "light '" + l.name + "' lights no photo";
     return out;
   }
-  const ExtentModel model(cx, recs, light);
-  const double r0 = model.declared_radius();
-  std::vector<float> vis0;
-  const std::vector<Eigen::Vector3f> d0 = model.Direct(r0, &vis0);
-  Change ch;
-  auto fit_at = [&](double radius) {
-    ch.basis = model.Direct(radius);
-    for (size_t i = 0; i < recs.size(); ++i) ch.basis[i] -= d0[i];
-    KeepMarkedChanges(recs, cx.block_px, &ch.basis);
-    return FitChange(f, ch);
-  };
+  ExtentChange fit_at(cx, search, light, &search == &f ? 1 : stride);
+  const double r0 = fit_at.model().declared_radius();
   auto physical = [](const ResidualFit& fit) {
     return fit.coef.size() == 1 && fit.coef[0] > 0.3 && fit.coef[0] < 3;
   };
@@ -508,6 +559,21 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f, i
       fit = fb, radius = std::exp(left ? m1 : m2);
     }
   }
+  std::optional<ExtentChange> every;
+  if (&search != &f) {
+    every.emplace(cx, f, light, 1);
+    fit = (*every)(radius);
+    if (!physical(fit)) {
+      out.note = fmt::format(
+          "light '{}': the radius found on a subsample ({:.3f} m) does not fit every record",
+          l.name, radius);
+      return out;
+    }
+  }
+  const ExtentChange& scored = every ? *every : fit_at;
+  const ExtentModel& model = scored.model();
+  const std::vector<Eigen::Vector3f>& d0 = scored.d0();
+  const std::vector<float>& vis0 = scored.vis0();
   // Where the change lies: at shadow edges (penumbrae) or elsewhere (highlights).
   std::vector<float> vis;
   const std::vector<Eigen::Vector3f> dr = model.Direct(radius, &vis);
@@ -555,24 +621,33 @@ CandidateResult AnisotropicReflection(const CandidateContext& cx, const Residual
     out.effect = "anisotropic_reflection";
     return out;
   }
-  int count = 0;
-  for (const PixelRecord& r : f.records()) count += r.region == region && !r.outlier;
+  int count = 0, fitted = 0;
+  for (const PixelRecord& r : f.records()) {
+    count += r.region == region && !r.outlier;
+    fitted += r.region == region && !r.outlier && !r.held_out;
+  }
   if (count < 50) {
     CandidateResult out;
     out.effect = "anisotropic_reflection";
     return out;
   }
-  return AnisotropicFit(cx, f, region);
+  // The search sees the region's records only (the others' residual is the same for every lobe,
+  // and cells do not cross regions), subsampled to about cx.search_records fitted ones.
+  const RecordSubset search(cx.model, f.records(), cx.cell_m, f.nuisance(), cx.block_px,
+                            std::max(1, fitted / std::max(1, cx.search_records)), region);
+  return AnisotropicFit(cx, f, search.fitter(), region);
 }
 
-CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light) {
+CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light,
+                                  const RecordSubset* search) {
   const Light& l = cx.model.lights[light];
   if (l.type != LightType::kPoint && l.type != LightType::kSphere) {
     CandidateResult out;
     out.effect = "light_source_extent";
     return out;
   }
-  return ExtentFit(cx, f, light);
+  return search ? ExtentFit(cx, f, search->fitter(), search->stride(), light)
+                : ExtentFit(cx, f, f, 1, light);
 }
 
 namespace {

@@ -36,7 +36,10 @@ CandidateResult AnisotropicReflection(const CandidateContext& cx, const Residual
 // light_source_extent of light `light` (point or sphere) in cx.model. apply() makes it a
 // "sphere" light at its position with the fitted radius and the same intensity
 // (radiance = intensity / (π r²)).
-CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light);
+// The radius is searched on `search`'s records when given (a subsample of f's), then fitted and
+// scored on f's.
+CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light,
+                                  const RecordSubset* search = nullptr);
 
 // ambient_light: apply() adds an "ambient" light of the fitted radiance to every lighting.
 CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f);

@@ -578,8 +578,12 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   // Textured regions first: on them the texture is most of a constant-albedo model's residual,
   // and a smooth candidate correlated with it by chance would earn a false gain
   // (texture_evidence.h).
+  // When the texture test names textured regions it has also judged the others: maps for every
+  // region are then not tried again as a last candidate of each round.
+  bool texture_judged = false;
   if (solve && o.max_steps > 0) {
     CandidateResult texture = TextureFirst(scene, st, CellSize(st.model));
+    texture_judged = texture.valid;
     if (texture.valid) {
       const MapMode next{"auto", texture.params["regions"].get<std::vector<std::string>>()};
       std::vector<Trial> one;
@@ -620,7 +624,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       if (trials.size() >= 2 && any) break;
     }
     bool kept = settle(trials, maps);
-    if (!kept && !maps.Full()) {
+    if (!kept && !maps.Full() && !texture_judged) {
       CandidateResult texture;
       texture.effect = "albedo_texture";
       texture.valid = true;

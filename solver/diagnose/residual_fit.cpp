@@ -161,4 +161,29 @@ std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>&
   return cell;
 }
 
+RecordSubset::RecordSubset(const Scene& model, const std::vector<PixelRecord>& records,
+                           double cell_m, bool nuisance, int block_px, int stride, int region)
+    : stride_(std::max(1, stride)) {
+  for (size_t i = 0; i < records.size(); ++i) {
+    // A hash of the index, not every stride-th record: records come in patterns (photo by photo,
+    // rows of pixels, regions interleaved) that a regular stride could alias.
+    uint64_t h = (uint64_t(i) + 0x9e3779b97f4a7c15ull) * 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 31;
+    h *= 0x94d049bb133111ebull;
+    h ^= h >> 29;
+    if (h % uint64_t(stride_) != 0) continue;
+    if (region < 0 || records[i].region == region) records_.push_back(records[i]);
+  }
+  int num_cells = 0;
+  std::vector<int> cells = RecordCells(model, records_, cell_m, &num_cells);
+  fitter_ = std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance,
+                                             block_px);
+}
+
+int SearchStride(const std::vector<PixelRecord>& records, int target) {
+  int64_t fitted = 0;
+  for (const PixelRecord& r : records) fitted += !r.held_out && !r.outlier;
+  return int(std::max<int64_t>(1, fitted / std::max(1, target)));
+}
+
 }  // namespace igi

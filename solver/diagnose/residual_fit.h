@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -82,6 +83,31 @@ double BlockGainZ(const std::vector<std::pair<double, double>>& blocks);
 // has an albedo map.
 std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
                              double cell_m, int* num_cells);
+
+// A subset of the records with its own fitter (cells by the same rule, the same nuisance and
+// blocks): the searches over a candidate's nonlinear parameters (an axis, a radius, a lobe's
+// roughnesses) run on it, and only the parameters they find are fitted and scored on every
+// record. One record in `stride`, drawn by a hash of its index (deterministic), of region
+// `region` only when it is >= 0.
+class RecordSubset {
+ public:
+  RecordSubset(const Scene& model, const std::vector<PixelRecord>& records, double cell_m,
+               bool nuisance, int block_px, int stride, int region = -1);
+  RecordSubset(const RecordSubset&) = delete;
+  RecordSubset& operator=(const RecordSubset&) = delete;
+
+  const ResidualFitter& fitter() const { return *fitter_; }
+  const std::vector<PixelRecord>& records() const { return records_; }
+  int stride() const { return stride_; }
+
+ private:
+  std::vector<PixelRecord> records_;
+  int stride_;
+  std::unique_ptr<ResidualFitter> fitter_;
+};
+
+// The stride that leaves about `target` fitted (not held-out, not outlier) records, at least 1.
+int SearchStride(const std::vector<PixelRecord>& records, int target);
 
 // ------------------------------------------------------------------ implementation
 // Per (cell, channel, set) the statistics are laid out as (y = photo − sim − offset, y0 = photo −

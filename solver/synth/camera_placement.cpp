@@ -45,19 +45,29 @@ struct Candidate {
   Vector3d point, eye;
 };
 
-// The best mirror viewpoint of the lamp's highlight on `region` over `tries` sampled points.
+// The incidence (cosine from the normal) a highlight view accepts and prefers.
+struct Incidence {
+  double min_cos = 0.25, max_cos = 1.0, preferred_cos = 0.7;
+};
+
+// The best mirror viewpoint of the lamp's highlight on `region` over 96 sampled points (384 for
+// a narrow incidence window).
 Candidate BestHighlightView(const SynthRoom& room, const std::string& region, Pcg32* rng,
-                            const std::vector<Vector3d>& taken) {
+                            const std::vector<Vector3d>& taken, const Incidence& incidence = {}) {
   const SynthMesh& mesh = room.mesh;
   const int region_index = mesh.FindRegion(region);
   const Vector3d lamp = room.lamps[0].position;
   Candidate best;
-  for (int attempt = 0; attempt < 96; ++attempt) {
+  const int attempts = incidence.max_cos < 1 ? 384 : 96;
+  for (int attempt = 0; attempt < attempts; ++attempt) {
     const auto [p, tri] = SampleRegionPoint(mesh, region_index, rng);
     const Vector3d n = mesh.FaceNormal(tri);
     const Vector3d l = (lamp - p).normalized();
     const double cos_l = n.dot(l);
-    if (cos_l < 0.25 || !SegmentVisible(mesh, p + 1e-3 * n, lamp, 0.06)) continue;
+    if (cos_l < incidence.min_cos || cos_l > incidence.max_cos ||
+        !SegmentVisible(mesh, p + 1e-3 * n, lamp, 0.06)) {
+      continue;
+    }
     const Vector3d r = 2 * cos_l * n - l;
     for (double d = 3.0; d >= 0.9; d -= 0.1) {
       const Vector3d eye = p + d * r;
@@ -65,7 +75,7 @@ Candidate BestHighlightView(const SynthRoom& room, const std::string& region, Pc
       if (!SegmentVisible(mesh, p + 1e-3 * n, eye)) continue;
       double spread = 1.0;
       for (const Vector3d& other : taken) spread = std::min(spread, (other - eye).norm());
-      const double score = d + spread - std::abs(cos_l - 0.7);
+      const double score = d + spread - std::abs(cos_l - incidence.preferred_cos);
       if (score > best.score) best = {score, p, eye};
       break;
     }
@@ -134,6 +144,24 @@ std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions
     PlacedCamera pc;
     pc.camera = LookAtCamera(name(), eye, target, options.width, options.height, options.fov_deg);
     eyes.push_back(eye);
+    cameras.push_back(pc);
+  }
+  // Grazing views of the floor's highlight (60–80° from the normal, 70° preferred).
+  for (int k = 0; k < options.grazing_cameras; ++k) {
+    const Candidate c = BestHighlightView(room, "floor", &rng, eyes, {0.17, 0.5, 0.34});
+    if (c.score < 0) {
+      throw InputError(
+          "igi-synth: --grazing-cameras: no viewpoint in the room sees the floor's highlight at "
+          "60-80 deg incidence under this lamp (lower it: --lamp-position x,y,z with z below "
+          "about 0.8 m, 1.5 m or more from the walls)");
+    }
+    PlacedCamera pc;
+    pc.camera =
+        LookAtCamera(name(), c.eye, c.point, options.width, options.height, options.fov_deg);
+    pc.target_region = "floor";
+    pc.highlight_point = c.point;
+    pc.highlight_pixel = *pc.camera.ImgFromWorld(c.point);
+    eyes.push_back(c.eye);
     cameras.push_back(pc);
   }
   return cameras;

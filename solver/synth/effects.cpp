@@ -216,7 +216,7 @@ Json MissingGeometry(Params& p, SynthScenes* s) {
 
 Json Ambient(Params& p, const SynthRoom& room, SynthScenes* s) {
   const double radiance = p.Number("radiance", 0.4, 0.0, 1e6);
-  const std::string kind = p.Name("kind", "panel", {"panel", "uniform"});
+  const std::string kind = p.Name("kind", "uniform", {"uniform", "panel"});
   p.Finish();
   if (kind == "uniform") {  // the contract's ambient light: the same radiance from everywhere
     s->true_scene["lights"]["ambient"] =

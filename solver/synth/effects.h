@@ -13,9 +13,11 @@
 //                           alpha_y=0.15, tangent = the box's x axis); declared isotropic
 //   light_source_extent     the lamp is truly a sphere of radius 0.25 m with the same intensity
 //   missing_geometry        a box (0.35×0.35×0.45 m, lambert 0.6) stands on the floor
-//   ambient_light           a dim undeclared 1.6×1.2 m area emitter (radiance 0.4) on wall_x4,
-//                           on in every lighting; kind=uniform: an "ambient" light of that
-//                           radiance instead (the same from every direction, never occluded)
+//   ambient_light           an undeclared "ambient" light (radiance 0.4: the same from every
+//                           direction, never occluded; CONTRACT.md's ambient light), on in
+//                           every lighting; kind=panel: a dim 1.6×1.2 m area emitter of that
+//                           radiance 2 mm in front of wall_x4 instead (stray light from a
+//                           source, which also shades the wall from the lamp)
 //   exposure_scale          one photo (photo=second photo) is scaled by `scale` (1.3)
 //   camera_response         photo = reference·(L/reference)^exponent (0.8, 1.0)
 //   pose_error              a camera's declared pose is off by rotation_deg (1°) about a random

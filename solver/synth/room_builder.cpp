@@ -241,7 +241,8 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
 
   const double radius = options.lamp == "point" ? 0.0 : 0.04;
-  room.lamps.push_back({"lamp", {2.3, 1.7, 2.4}, 30.0, radius});
+  room.lamps.push_back(
+      {"lamp", options.lamp_position.value_or(Eigen::Vector3d(2.3, 1.7, 2.4)), 30.0, radius});
   room.lamps.push_back({"lamp2", {0.8, 0.9, 2.2}, 25.0, radius});
   return room;
 }

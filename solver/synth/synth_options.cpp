@@ -1,5 +1,7 @@
 #include "solver/synth/synth_options.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string_view>
@@ -118,6 +120,18 @@ void SynthOptions::Validate() const {
     p.Add("--glossy-brdf", "", glossy_brdf, "must be ward or ward_gmd");
   }
   if (lamp != "sphere" && lamp != "point") p.Add("--lamp", "", lamp, "must be sphere or point");
+  if (lamp_position) {
+    const Eigen::Vector3d& q = *lamp_position;
+    // The room spans [0, 4] × [0, 4] × [0, 3] m (room_builder.h).
+    if (!(q.x() >= 0.1 && q.x() <= 3.9 && q.y() >= 0.1 && q.y() <= 3.9 && q.z() >= 0.1 &&
+          q.z() <= 2.9)) {
+      p.Add("--lamp-position", "", fmt::format("{},{},{}", q.x(), q.y(), q.z()),
+            "must lie inside the room, 0.1 m from its walls (x, y in [0.1, 3.9], z in [0.1, 2.9])");
+    }
+  }
+  if (grazing_cameras < 0 || grazing_cameras > 8) {
+    p.Add("--grazing-cameras", "", std::to_string(grazing_cameras), "must be 0..8");
+  }
   if (floor_texture != "tiles" && floor_texture != "smooth") {
     p.Add("--floor-texture", "", floor_texture, "must be tiles or smooth");
   }

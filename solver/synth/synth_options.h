@@ -7,9 +7,11 @@
 // Effects (CONTRACT.md §6 names) make the photos differ from what scene.json declares; each is
 // listed with its parameters in truth.json.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,6 +75,13 @@ struct SynthOptions {
   uint64_t seed = 1;                 // same seed, same options -> same files
   std::string glossy_brdf = "ward";  // ward or ward_gmd: the glossy regions' true model
   std::string lamp = "sphere";       // sphere (r = 4 cm) or point
+  // The photographed lamp's centre (default (2.3, 1.7, 2.4), below the ceiling; inside the room).
+  std::optional<Eigen::Vector3d> lamp_position;
+  // Extra cameras, after the others, that see the floor's highlight at grazing incidence
+  // (60–80° from the normal, mirror view): where a Fresnel-weighted lobe differs most from a
+  // plain one. Under the default lamp the room has no such view (it needs a lamp below about
+  // 0.8 m, --lamp-position).
+  int grazing_cameras = 0;
   // Material keys left out of scene.json (unknowns for the solver), for every reflective
   // region: any of rho_d (also removes rho_d_map), rho_s, alpha (also alpha_x/alpha_y/tangent).
   std::vector<std::string> unknowns = {"rho_d", "rho_s", "alpha"};

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -90,15 +91,18 @@ std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t see
   return out;
 }
 
-// The emission-profile candidate fitted to RoomRecords(power, exponent, seed).
-CandidateResult FitProfile(double power, double exponent, uint64_t seed) {
+// The emission-profile candidate fitted to RoomRecords(power, exponent, seed), its axis and power
+// searched on every `stride`-th record (1: on all of them).
+CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1) {
   const Scene model = RoomModel();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed);
   std::vector<int> cells(records.size());
   for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
   const ResidualFitter f(records, cells, 2, false, 8);
-  return EmissionProfile({model, declared, false}, f, 0);
+  if (stride == 1) return EmissionProfile({model, declared, false}, f, 0);
+  const RecordSubset search(model, records, 0.05, false, 8, stride);
+  return EmissionProfile({model, declared, false}, f, 0, &search);
 }
 
 // Measured (seed 1): axis 0.3° from −z, power 2.12. Searched without the response nuisance the
@@ -121,6 +125,46 @@ TEST(EmissionProfileTest, FindsTheProfileAlone) {
   EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
   EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
   EXPECT_GT(c.Gain(), 0.9);
+}
+
+// The search on a quarter of the records (as igi-diagnose does on large captures) finds the same
+// profile, and the candidate's scores are those of the fit on every record: searched on a
+// subsample whose scores were kept, the held-out error before the change would be a quarter.
+TEST(EmissionProfileTest, SearchOnASubsampleScoresOnEveryRecord) {
+  const CandidateResult all = FitProfile(2.0, 0.8, 1);
+  const CandidateResult sub = FitProfile(2.0, 0.8, 1, 4);
+  ASSERT_TRUE(all.valid) << all.note;
+  ASSERT_TRUE(sub.valid) << sub.note;
+  const std::vector<double> axis = sub.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << sub.params.dump();
+  EXPECT_NEAR(sub.params["cos_power"].get<double>(), 2.0, 0.3) << sub.params.dump();
+  EXPECT_DOUBLE_EQ(sub.held_before, all.held_before);
+  EXPECT_DOUBLE_EQ(sub.train_before, all.train_before);
+  EXPECT_NEAR(sub.Gain(), all.Gain(), 0.02);
+}
+
+// RecordSubset: one record in `stride` with no pattern, or one region's records.
+TEST(RecordSubsetTest, AQuarterOrOneRegion) {
+  const Scene model = RoomModel();
+  const std::vector<PixelRecord> records = RoomRecords(2.0, 1.0, 3);
+  const RecordSubset every(model, records, 0.05, true, 8, 1);
+  EXPECT_EQ(every.records().size(), records.size());
+  // A quarter, drawn without a pattern: the records alternate floor and wall (every 4th record
+  // would be the floor's alone, and the profile's power could not be told from the response).
+  const RecordSubset quarter(model, records, 0.05, true, 8, 4);
+  EXPECT_NEAR(double(quarter.records().size()), records.size() / 4.0, 0.05 * records.size() / 4);
+  int walls_in_quarter = 0;
+  for (const PixelRecord& r : quarter.records()) walls_in_quarter += r.region == 1;
+  EXPECT_NEAR(walls_in_quarter, quarter.records().size() / 2.0, 0.1 * quarter.records().size());
+  const RecordSubset walls(model, records, 0.05, true, 8, 1, 1);  // odd records are the wall's
+  EXPECT_EQ(walls.records().size(), records.size() / 2);
+  for (const PixelRecord& r : walls.records()) EXPECT_EQ(r.region, 1);
+  EXPECT_EQ(SearchStride(records, 1000), int(std::count_if(records.begin(), records.end(),
+                                                           [](const PixelRecord& r) {
+                                                             return !r.held_out && !r.outlier;
+                                                           }) /
+                                              1000));
+  EXPECT_EQ(SearchStride(records, 1000000), 1);
 }
 
 }  // namespace

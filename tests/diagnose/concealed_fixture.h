@@ -27,14 +27,15 @@ inline const std::string kConcealedDiagnoseFlags =
     " --spp 128 --holdout-block-px 8 --threads 2 --quiet";
 
 // Writes an igi-synth capture into dir/capture hiding `effect` ("NAME[:k=v,...]", several joined
-// by '+'; empty: none).
+// by '+'; empty: none), with `synth_extra` added to igi-synth's flags (the capture's design).
 inline std::filesystem::path SynthesizeConcealed(const std::filesystem::path& dir,
-                                                 const std::string& effect, int seed) {
+                                                 const std::string& effect, int seed,
+                                                 const std::string& synth_extra = "") {
   const std::filesystem::path capture = dir / "capture";
   std::string args = "--out " + Quote(capture.string()) +
                      " --cameras 4 --width 160 --height 120 --spp 64 --lamp point"
                      " --unknowns none --threads 2 --quiet --seed " +
-                     std::to_string(seed);
+                     std::to_string(seed) + synth_extra;
   for (size_t begin = 0; begin < effect.size();) {
     const size_t end = std::min(effect.find('+', begin), effect.size());
     args += " --effect " + effect.substr(begin, end - begin);
@@ -112,15 +113,17 @@ struct ConcealedOutcome {
   double floor = 0;
 };
 
-// Synthesizes a capture hiding `effect` (empty: none), diagnoses it, measures the floor, calls
-// `inspect` (when given) with the diagnosis folder, and removes everything (unless the environment
-// variable IGI_CONCEALED_KEEP names a folder: everything is moved there, for study).
+// Synthesizes a capture hiding `effect` (empty: none; `synth_extra`: more igi-synth flags),
+// diagnoses it, measures the floor, calls `inspect` (when given) with the diagnosis folder, and
+// removes everything (unless the environment variable IGI_CONCEALED_KEEP names a folder:
+// everything is moved there, for study).
 inline ConcealedOutcome DiagnoseConcealed(
     const std::string& effect, int seed,
-    const std::function<void(const std::filesystem::path& diag_dir)>& inspect = nullptr) {
+    const std::function<void(const std::filesystem::path& diag_dir)>& inspect = nullptr,
+    const std::string& synth_extra = "") {
   const std::filesystem::path dir =
       UniqueTempDir("igi_concealed_" + (effect.empty() ? std::string("none") : effect));
-  const std::filesystem::path capture = SynthesizeConcealed(dir, effect, seed);
+  const std::filesystem::path capture = SynthesizeConcealed(dir, effect, seed, synth_extra);
   ConcealedOutcome o;
   o.diagnosis = RunDiagnose(capture / "scene.json", dir / "diag");
   if (inspect) inspect(dir / "diag");

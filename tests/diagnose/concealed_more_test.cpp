@@ -30,8 +30,8 @@
 //   2.2915). The profile is searched with the response as a nuisance (before: axis 11° off,
 //   power 2.38, the response then not provable, 3.2× the floor).
 // Not proven here (bench/RESULTS.md): fresnel (invisible at this size: the true model's residual
-// is 0.991× the declared one's), ambient_light as a stray-light panel (igi-synth's default kind:
-// an area light, not the contract's ambient light).
+// is 0.991× the declared one's), ambient_light as a stray-light panel (igi-synth's
+// ambient_light:kind=panel: an area light, not the contract's ambient light).
 #include <gtest/gtest.h>
 
 #include <algorithm>

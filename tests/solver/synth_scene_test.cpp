@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "recon/mesh.h"
+#include "solver/sampling.h"
 #include "solver/synth/camera_placement.h"
 #include "solver/synth/effects.h"
 #include "solver/synth/room_builder.h"
@@ -201,6 +202,39 @@ TEST(SynthCameras, CeilingCamerasSeeTheCeiling) {
   EXPECT_THROW(o.Validate(), Error);
 }
 
+// --grazing-cameras N (with a low lamp): N more cameras, after the others, each the mirror view of
+// the lamp's highlight on the floor at 60-80 deg from the normal (Fresnel shows there); the room's
+// default lamp (2.4 m high) allows no such view, which is one clear error.
+TEST(SynthCameras, GrazingCamerasSeeTheFloorsHighlightAtGrazingIncidence) {
+  SynthOptions o;
+  o.cameras = 4;
+  o.lamp_position = Vector3d(2, 2, 0.6);
+  o.grazing_cameras = 2;
+  const SynthRoom room = BuildRoom(o);
+  EXPECT_EQ(room.lamps[0].position, Vector3d(2, 2, 0.6));
+  const auto cams = PlaceCameras(room, o);
+  ASSERT_EQ(cams.size(), 6u);
+  for (int i = 4; i < 6; ++i) {
+    const PlacedCamera& c = cams[i];
+    EXPECT_EQ(c.target_region, "floor");
+    const Vector3d eye = c.camera.CenterInWorld(), p = c.highlight_point;
+    const auto hit = IntersectRay(room.mesh, eye, (p - eye).normalized());
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->distance, (p - eye).norm(), 1e-6);
+    const Vector3d n = room.mesh.FaceNormal(hit->triangle);
+    const Vector3d l = (room.lamps[0].position - p).normalized();
+    const Vector3d v = (eye - p).normalized();
+    EXPECT_NEAR((2 * n.dot(l) * n - l).dot(v), 1.0, 1e-9);
+    const double incidence = std::acos(n.dot(l)) * 180 / kPi;
+    EXPECT_GT(incidence, 60.0) << "cam" << i;
+    EXPECT_LT(incidence, 80.0) << "cam" << i;
+  }
+  o.lamp_position.reset();
+  EXPECT_THROW(PlaceCameras(BuildRoom(o), o), InputError);
+  o.lamp_position = Vector3d(5, 2, 0.6);
+  EXPECT_THROW(o.Validate(), InputError);
+}
+
 TEST(SynthCameras, LookAtFollowsColmapAxes) {
   const Camera cam = LookAtCamera("c", {2, 0.3, 1.5}, {2, 3, 1.5}, 160, 120, 60);
   // Looking along +y with z up: camera x = world +x, camera y = world -z.
@@ -304,6 +338,7 @@ TEST(SynthEffects, SceneEffectsChangeOnlyTheTrueScene) {
   EXPECT_EQ(f.scenes.extra_files.count("truth/geometry/missing_object.obj"), 1u);
   f.Apply("ambient_light:radiance=0.5");
   EXPECT_EQ(f.scenes.true_scene["lightings"]["L0"].size(), 2u);
+  EXPECT_EQ(f.scenes.true_scene["lights"]["ambient"]["type"], "ambient");  // the default kind
   EXPECT_FALSE(f.scenes.declared_scene["lights"].contains("ambient"));
   f.Apply("light_emission_profile:cos_power=3");
   EXPECT_EQ(f.scenes.true_scene["lights"]["lamp"]["type"], "spot");
