@@ -12,6 +12,8 @@
 # nothing is solved (1-4 min per case).
 # A CASE is an effect (NAME or NAME:k=v,...), several joined by '+', or "none" (a control).
 # Default: every effect igi-synth can hide (ambient_light both ways), two pairs and two controls.
+# fresnel cases get a capture that can show it: the lamp 0.6 m high and a grazing view of the
+# floor (igi-synth --lamp-position 2,2,0.6 --grazing-cameras 1).
 # Output: a Markdown table on stdout; the work folders stay under
 # ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
@@ -32,7 +34,7 @@ CASES=("$@")
 if [ ${#CASES[@]} -eq 0 ]; then
   CASES=(vignetting exposure_scale camera_response ambient_light
          ambient_light:radiance=0.1 ambient_light:kind=panel light_emission_profile
-         light_intensity specular_reflection specular_lobe_shape fresnel anisotropic_reflection
+         light_intensity specular_reflection specular_lobe_shape fresnel:regions=floor anisotropic_reflection
          light_source_extent pose_error missing_geometry
          vignetting+exposure_scale light_emission_profile+camera_response none none)
 fi
@@ -79,9 +81,12 @@ for case in "${CASES[@]}"; do
     IFS='+' read -ra names <<< "$case"
     for n in "${names[@]}"; do effects+=(--effect "$n"); done
   fi
+  # fresnel shows only at grazing incidence: a low lamp and a grazing view of the floor.
+  design=()
+  case "$case" in fresnel*) design=(--lamp-position 2,2,0.6 --grazing-cameras 1) ;; esac
   "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 --spp 64 \
       --lamp point --seed $((100 + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
-      "${effects[@]}" > /dev/null
+      "${design[@]}" "${effects[@]}" > /dev/null
   start=$(date +%s)
   /usr/bin/time -f "%U %S" -o "$dir/cpu.txt" \
     "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \

@@ -29,9 +29,10 @@
 //   light_intensity (1.047) and exposure_scale; final 0.0554 against 0.0510 (1.09×; baseline
 //   2.2915). The profile is searched with the response as a nuisance (before: axis 11° off,
 //   power 2.38, the response then not provable, 3.2× the floor).
-// Not proven here (bench/RESULTS.md): fresnel (invisible at this size: the true model's residual
-// is 0.991× the declared one's), ambient_light as a stray-light panel (igi-synth's
-// ambient_light:kind=panel: an area light, not the contract's ambient light).
+// Not proven here (bench/RESULTS.md): ambient_light as a stray-light panel (igi-synth's
+// ambient_light:kind=panel: an area light, not the contract's ambient light). fresnel is proven
+// in concealed_test.cpp, on a capture with a grazing view (at the default views it is invisible:
+// the true model's residual is 0.991× the declared one's).
 #include <gtest/gtest.h>
 
 #include <algorithm>
