@@ -696,7 +696,9 @@ CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f
   // point's ρd and what the lit room reflects of it), in shadow too.
   const std::vector<Eigen::Vector3f> response = UnitAmbientResponse(cx.model, f.records());
   const PixelRecord* first = f.records().data();
-  const ResidualFit fit = f.Fit(3, [&](const PixelRecord& r, int c, double* b) {
+  // The response is rendered on its own paths: no part of the simulation's noise (a plain fit
+  // would credit it with the noise of the sim it partly replaces when the albedos are refitted).
+  const ResidualFit fit = f.FitNoiseFreeBasis(3, [&](const PixelRecord& r, int c, double* b) {
     b[c] = response[&r - first][c];
   });
   if (fit.coef.size() == 0) return out;

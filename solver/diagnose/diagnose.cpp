@@ -123,7 +123,7 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   const auto t1 = std::chrono::steady_clock::now();
   st.sims = SimulatePhotos(st.model, o, o.seed, &st.sim_var);
   const auto t2 = std::chrono::steady_clock::now();
-  if (with_records) st.records = BuildRecords(st.model, photos, st.sims, o);
+  if (with_records) st.records = BuildRecords(st.model, photos, st.sims, o, &st.sim_var);
   const auto t3 = std::chrono::steady_clock::now();
   using Seconds = std::chrono::duration<double>;
   spdlog::info(
@@ -569,7 +569,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
-      st.records = BuildRecords(st.model, photos, st.sims, o);
+      st.records = BuildRecords(st.model, photos, st.sims, o, &st.sim_var);
       maps = next_maps;
     }
     for (Trial& t : trials) sum.steps.push_back(std::move(t.step));

@@ -217,7 +217,8 @@ void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceH
 
 std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
                                       const std::vector<Image>& sims,
-                                      const DiagnoseOptions& options) {
+                                      const DiagnoseOptions& options,
+                                      const std::vector<Image>* variance) {
   const auto scenes = LightingScenes(model);
   const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
                              options.solve.holdout_seed};
@@ -254,6 +255,9 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
           for (int c = 0; c < 3; ++c) {
             r.recorded[c] = rec.at(x, y, c);
             r.sim[c] = sims[i].at(x, y, c);
+            if (variance && i < int(variance->size()) && !(*variance)[i].pixels.empty()) {
+              r.sim_var[c] = (*variance)[i].at(x, y, c);
+            }
           }
           if (!r.sim.allFinite()) continue;
           r.region = hit->region;

@@ -30,6 +30,8 @@ struct PixelRecord {
   bool outlier = false;
   Eigen::Vector3f recorded = Eigen::Vector3f::Zero();  // the photo's value
   Eigen::Vector3f sim = Eigen::Vector3f::Zero();       // the model's prediction of it
+  // The Monte Carlo variance of `sim` (SimulatePhotos' estimate; zero when unknown).
+  Eigen::Vector3f sim_var = Eigen::Vector3f::Zero();
   int region = -1;
   Eigen::Vector3f position = Eigen::Vector3f::Zero();
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // shading normal, toward the camera
@@ -62,10 +64,12 @@ PhotoSet LoadPhotoSet(const Scene& scene);
 std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
                                   std::vector<Image>* variance = nullptr);
 
-// The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel.
+// The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel, with the
+// renders' variance per pixel when `variance` is given (SimulatePhotos').
 std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
                                       const std::vector<Image>& sims,
-                                      const DiagnoseOptions& options);
+                                      const DiagnoseOptions& options,
+                                      const std::vector<Image>* variance = nullptr);
 
 // Marks the records whose residual lies far in the tail (see PixelRecord::outlier).
 void FlagOutliers(std::vector<PixelRecord>* records);

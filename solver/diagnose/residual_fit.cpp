@@ -15,17 +15,28 @@ ResidualFitter::ResidualFitter(const std::vector<PixelRecord>& records, std::vec
       nuisance_(nuisance),
       block_px_(std::max(1, block_px)) {}
 
+namespace {
+
+// Σ s² less the variance (errors in variables), kept at least half of Σ s² (a variance estimate
+// as large as the signal is noise of its own).
+double CorrectedSs(const double* st, int stride, bool noise_free) {
+  return noise_free ? std::max(0.5 * st[0], st[0] - st[stride - 3]) : st[0];
+}
+
+}  // namespace
+
 double ResidualFitter::NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
-                                    const Eigen::VectorXd& coef) const {
+                                    const Eigen::VectorXd& coef, bool noise_free) const {
   if (!nuisance_) return 0;
   const int stride = Stride(k);
   const double* st = &stats[((cell * 3 + c) * 2 + 1) * stride];
   if (!(st[0] > 0)) return 0;
+  const double ss = CorrectedSs(st, stride, noise_free), v = noise_free ? st[0] - ss : 0.0;
   // Before the fit: the plain residual y0; after: y − coef·b.
-  if (coef.size() == 0) return st[stride - 2] / st[0];
-  double sy = st[1];
+  if (coef.size() == 0) return (st[stride - 2] + v) / ss;
+  double sy = st[1] + v;
   for (int a = 0; a < coef.size(); ++a) sy -= coef[a] * st[3 + a];
-  return sy / st[0];
+  return sy / ss;
 }
 
 double ResidualFitter::Z(const std::vector<double>& gains) {
@@ -49,26 +60,31 @@ struct Projected {
   double yy0 = 0;      // the same for y0 (no offset)
 };
 
-Projected Project(const double* st, int k, bool nuisance) {
+// With noise_free, the noise-free error: the nuisance's sums corrected by the variance V
+// (ResidualFitter::FitNoiseFreeBasis); Σ y² − V − (Σ s·y + V)² / (Σ s² − V) is the least
+// Σ (y − a s)² − (1 + a)² V.
+Projected Project(const double* st, int k, bool nuisance, bool noise_free) {
   Projected p;
   p.bb = Eigen::Map<const Eigen::MatrixXd>(st + 3 + 2 * k, k, k);
   p.by = Eigen::Map<const Eigen::VectorXd>(st + 3 + k, k);
   p.yy = st[2];
-  const int stride = 5 + 2 * k + k * k;
+  const int stride = 6 + 2 * k + k * k;
   p.yy0 = st[stride - 1];
   if (nuisance && st[0] > 0) {
+    const double ss = CorrectedSs(st, stride, noise_free), v = noise_free ? st[0] - ss : 0.0;
+    const double sy = st[1] + v, sy0 = st[stride - 2] + v;
     const Eigen::Map<const Eigen::VectorXd> sb(st + 3, k);
-    p.bb -= sb * sb.transpose() / st[0];
-    p.by -= sb * (st[1] / st[0]);
-    p.yy -= st[1] * st[1] / st[0];
-    p.yy0 -= st[stride - 2] * st[stride - 2] / st[0];
+    p.bb -= sb * sb.transpose() / ss;
+    p.by -= sb * (sy / ss);
+    p.yy -= v + sy * sy / ss;
+    p.yy0 -= v + sy0 * sy0 / ss;
   }
   return p;
 }
 
 }  // namespace
 
-ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const {
+ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool noise_free) const {
   const int stride = Stride(k);
   ResidualFit fit;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
@@ -76,7 +92,8 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const
   double train_offset = 0;  // projected Σ y² (with the offset) before the fit
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
-      const Projected p = Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_);
+      const Projected p =
+          Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_, noise_free);
       a += p.bb;
       g += p.by;
       fit.train_before += p.yy0;
@@ -94,13 +111,21 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats) const
   }
   fit.train_after = train_offset - 2 * fit.coef.dot(g) + fit.coef.dot(a * fit.coef);
   // Held out: the same coefficients, the set's own nuisance.
+  double held_raw = 0;
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
       const double* st = &stats[((size_t(cell) * 3 + c) * 2 + 1) * stride];
-      const Projected p = Project(st, k, nuisance_);
+      const Projected p = Project(st, k, nuisance_, noise_free);
       fit.held_before += p.yy0;
       fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.bb * fit.coef));
+      if (noise_free) held_raw += Project(st, k, nuisance_, false).yy0;
     }
+  }
+  // The noise-free fall of the error on the raw error's scale (the refit's test: the fall of
+  // the squared error less the fall of the renders' variance, over the raw error before).
+  if (noise_free) {
+    fit.held_after = held_raw - (fit.held_before - fit.held_after);
+    fit.held_before = held_raw;
   }
   return fit;
 }

@@ -44,19 +44,37 @@ class ResidualFitter {
   // The same with a fixed change of the model, offset(record, channel), of amplitude 1 (the
   // residual fitted is photo − sim − offset; "before" is still photo − sim).
   template <class F, class G>
-  ResidualFit Fit(int k, F basis, G offset) const;
+  ResidualFit Fit(int k, F basis, G offset) const {
+    return FitImpl(k, basis, offset, false);
+  }
+
+  // Fit for a basis that carries none of the simulation's Monte Carlo noise (a light's direct
+  // term, a separately rendered response): the simulation `sim` is the nuisance's regressor and
+  // is noisy (variance PixelRecord::sim_var), and the residual photo − sim carries the same noise
+  // with the opposite sign, so a plain fit credits any basis shaped like the true sim with
+  // "explaining" that noise once the nuisance is projected out (the basis stands in for the noisy
+  // sim). Errors in variables: the nuisance's sums are corrected by the variance V (Σ s² − V,
+  // Σ s·y + V), which minimises the expected noise-free error Σ (y − a s − c·b)² − (1 + a)² V,
+  // and the scores are of that noise-free error (the held-out "before" stays the raw error, the
+  // gain's scale, as in the refit's test). Only with the nuisance (solved materials).
+  template <class F>
+  ResidualFit FitNoiseFreeBasis(int k, F basis) const {
+    return FitImpl(k, basis, [](const PixelRecord&, int) { return 0.0; }, nuisance_);
+  }
 
   const std::vector<PixelRecord>& records() const { return records_; }
   bool nuisance() const { return nuisance_; }
 
  private:
-  struct Sums;
-  ResidualFit Solve(int k, const std::vector<double>& stats) const;
-  // Σ s y / Σ s² of the held-out set per (cell, channel), before and after the fit.
+  template <class F, class G>
+  ResidualFit FitImpl(int k, F basis, G offset, bool noise_free) const;
+  ResidualFit Solve(int k, const std::vector<double>& stats, bool noise_free) const;
+  // Σ s y / Σ s² of the held-out set per (cell, channel), before and after the fit (with the
+  // variance correction when noise_free).
   double NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
-                      const Eigen::VectorXd& coef) const;
+                      const Eigen::VectorXd& coef, bool noise_free) const;
   static double Z(const std::vector<double>& gains);
-  static int Stride(int k) { return 5 + 2 * k + k * k; }
+  static int Stride(int k) { return 6 + 2 * k + k * k; }
 
   const std::vector<PixelRecord>& records_;
   std::vector<int> cell_;
@@ -112,9 +130,9 @@ int SearchStride(const std::vector<PixelRecord>& records, int target);
 // ------------------------------------------------------------------ implementation
 // Per (cell, channel, set) the statistics are laid out as (y = photo − sim − offset, y0 = photo −
 // sim): [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ,
-// then Σ s·y0 and Σ y0².
+// then Σ var(s), Σ s·y0 and Σ y0².
 template <class F, class G>
-ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
+ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) const {
   const int stride = Stride(k);
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
   std::vector<double> b(k);
@@ -127,6 +145,7 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
       const double s = r.sim[c], y0 = double(r.recorded[c]) - s, y = y0 - offset(r, c);
       double* st = &stats[((size_t(cell_[i]) * 3 + c) * 2 + (r.held_out ? 1 : 0)) * stride];
       st[0] += s * s, st[1] += s * y, st[2] += y * y;
+      st[stride - 3] += r.sim_var[c];
       st[stride - 2] += s * y0, st[stride - 1] += y0 * y0;
       for (int a = 0; a < k; ++a) {
         st[3 + a] += s * b[a];
@@ -135,7 +154,7 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
       }
     }
   }
-  ResidualFit fit = Solve(k, stats);
+  ResidualFit fit = Solve(k, stats, noise_free);
   if (fit.coef.size() == 0) return fit;
   // Held-out gain per block (photo, block_px square) for its standard error.
   // Relative gain per block (gain / the block's error before), so that a few bright blocks
@@ -155,9 +174,12 @@ ResidualFit ResidualFitter::Fit(int k, F basis, G offset) const {
       support |= y != y0 || std::any_of(b.begin(), b.end(), [](double v) { return v != 0; });
       double cb = 0;
       for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
-      const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd());
-      const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef);
+      const double a0 =
+          NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd(), noise_free);
+      const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef, noise_free);
       g += (y0 - a0 * s) * (y0 - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
+      // The render's noise in the residual, (1 + a)² var: its change is not the candidate's gain.
+      if (noise_free) g -= ((1 + a0) * (1 + a0) - (1 + a1) * (1 + a1)) * double(r.sim_var[c]);
       e += (y0 - a0 * s) * (y0 - a0 * s);
     }
     if (!support) continue;

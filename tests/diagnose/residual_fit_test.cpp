@@ -176,5 +176,70 @@ TEST(PhotoModelTest, HoldoutIsReproducibleAndHoldsTheFraction) {
   EXPECT_FALSE(PixelHoldout{}.HeldOut(0, 3, 3));
 }
 
+// A basis free of the render's noise (an ambient light's separately rendered response) against a
+// noisy simulation, with the albedos refitted: the photo is the true radiance t (plus a little
+// photo noise, and `effect` times the basis), the simulation t·(1 + 15 % noise) with its variance
+// known, and the basis smooth and shaped like t. The plain fit trades the noisy sim for the
+// noise-free basis and predicts a gain that is the render's noise alone; the noise-free fit
+// predicts none, and finds a true effect's amplitude where the plain fit's is biased.
+struct NoisySimRecords {
+  std::vector<PixelRecord> records;
+  std::vector<int> cells;
+  std::vector<float> basis;
+};
+
+NoisySimRecords NoisySim(double effect, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> n(0, 1);
+  NoisySimRecords out;
+  for (int i = 0; i < 40000; ++i) {
+    PixelRecord r;
+    r.photo = i % 4;
+    r.x = int(u(rng) * 160);
+    r.y = int(u(rng) * 120);
+    r.held_out = PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
+    const int cell = i % 20;
+    const double t = 0.5 + u(rng);  // the true radiance (before the effect)
+    const float b = float(0.3 * t * (0.8 + 0.4 * std::sin(0.01 * i)));  // shaped like t
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(t * (1 + 0.15 * n(rng)));
+      r.sim_var[c] = float(t * t * 0.15 * 0.15);
+      r.recorded[c] = float(t + effect * b + 0.01 * n(rng));
+    }
+    out.cells.push_back(cell);
+    out.basis.push_back(b);
+    out.records.push_back(r);
+  }
+  return out;
+}
+
+TEST(ResidualFitTest, ANoiseFreeBasisIsNotCreditedWithTheRendersNoise) {
+  const NoisySimRecords none = NoisySim(0.0, 5);
+  const ResidualFitter f(none.records, none.cells, 20, true, 16);
+  const PixelRecord* first = none.records.data();
+  auto basis = [&](const PixelRecord& r, int, double* b) { b[0] = none.basis[&r - first]; };
+  const ResidualFit plain = f.Fit(1, basis);
+  const ResidualFit corrected = f.FitNoiseFreeBasis(1, basis);
+  ASSERT_EQ(plain.coef.size(), 1);
+  ASSERT_EQ(corrected.coef.size(), 1);
+  std::printf("no effect: plain gain %.3f (coef %.3f), noise-free gain %.4f (coef %.4f)\n",
+              plain.Gain(), plain.coef[0], corrected.Gain(), corrected.coef[0]);
+  EXPECT_GT(plain.Gain(), 0.05);  // the trap the correction removes
+  EXPECT_LT(std::abs(corrected.Gain()), 0.01);
+  EXPECT_LT(std::abs(corrected.coef[0]), 0.05);
+  EXPECT_LT(corrected.z, 1.5);
+
+  const NoisySimRecords some = NoisySim(0.2, 6);
+  const ResidualFitter g(some.records, some.cells, 20, true, 16);
+  const PixelRecord* base = some.records.data();
+  const ResidualFit found = g.FitNoiseFreeBasis(
+      1, [&](const PixelRecord& r, int, double* b) { b[0] = some.basis[&r - base]; });
+  ASSERT_EQ(found.coef.size(), 1);
+  std::printf("effect 0.2: noise-free coef %.4f, gain %.3f, z %.1f\n", found.coef[0],
+              found.Gain(), found.z);
+  EXPECT_NEAR(found.coef[0], 0.2, 0.03);
+}
+
 }  // namespace
 }  // namespace igi
