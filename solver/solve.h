@@ -63,6 +63,13 @@ struct SolveIteration {
   double relative_rms = 0;  // over all fitted samples
   double max_change = 0;    // largest relative parameter change from the previous iteration
   Json params;              // per region: rho_d, rho_s, alpha
+  // Stage 2: "joint" or "independent" (SolveOptions::refine_update), and per region in `params`
+  // also "rho_d_independent" (the region's own refit, πL/E at the rendered E) and, for the
+  // joint update, "rho_d_joint" (the albedo that matches the photos with the light it would
+  // send, before the step share) and "feedback" (per channel, the relative change of the
+  // region's gathered irradiance per relative change of every fitted albedo together).
+  std::string albedo_update;
+  double albedo_step = 1;  // SolveOptions::refine_albedo_step
 };
 
 // Per photo: the residual of CONTRACT.md §6 at the observed pixels, the photo and the model.

@@ -71,7 +71,7 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     // shadow the gathering smoothed over); such observations are left out of the map.
     const Eigen::Vector3d e = s.obs_e[i];
     if (!(e.minCoeff() > 0) || (kPi * diffuse).cwiseQuotient(e).maxCoeff() > 1.2) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * e);
+    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
   if (seen != nullptr) *seen = builder.DirectMask();
@@ -199,6 +199,18 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
   spdlog::info("stage {} model rendered at the observed pixels: relative rms {:.4f}", stage, total);
 }
 
+void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) {
+  std::vector<RegionAtlas> atlases;
+  std::vector<Image> maps;
+  std::filesystem::create_directories(temp_dir);
+  const Scene model = CompleteScene(&atlases, &maps, temp_dir);
+  IncidentFromRenderer(model, uint64_t(round));
+  SmoothIrradiance();
+  FitAll(2, round);
+  ComputeSpecularTerms();
+  summary.stage2_iterations = round;
+}
+
 void SolverState::RunStage2() {
   const std::filesystem::path temp =
       std::filesystem::temp_directory_path() /
@@ -219,13 +231,7 @@ void SolverState::RunStage2() {
     RenderResiduals(model, 1);
   }
   for (int round = 1; round <= options.refine_iterations; ++round) {
-    std::filesystem::create_directories(temp / std::to_string(round));
-    const Scene model = CompleteScene(&atlases, &maps, temp / std::to_string(round));
-    IncidentFromRenderer(model, uint64_t(round));
-    SmoothIrradiance();
-    FitAll(2, round);
-    ComputeSpecularTerms();
-    summary.stage2_iterations = round;
+    RefineRound(round, temp / std::to_string(round));
   }
   for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
   if (options.refine_iterations > 0) {
@@ -243,6 +249,7 @@ void SolverState::RunStage2() {
         materials[r].params = stage1[r].params;
         materials[r].patch_rho_d = stage1[r].patch_rho_d;
         materials[r].last_fit = stage1[r].last_fit;
+        materials[r].map_scale = stage1[r].map_scale;
       }
       ComputeSpecularTerms();
       spdlog::warn(

@@ -49,14 +49,19 @@ struct SolveOptions {
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
-  // Share of each refinement round's albedo change that is applied. The rounds gather all
-  // indirect light from the model, whose albedos light the next fit, so full steps (1) can swing
-  // about the answer: since the gather's specular bounces made stage 1 right on igi-synth's
-  // converged room, one full round overshoots it (relit 3.15 % beyond the noise floor against
-  // the paper stage's 1.53 %; half steps: 2.47 % after one round, 1.82 % after two). Where stage
-  // 1 is biased, half steps correct it more slowly (solve_e2e_test's small room: floor −3.04 %
-  // after one half round, −3.43 % after two, −2.83 % after one full round, from −3.25 %), so the
-  // default stays 1 (bench/RESULTS.md).
+  // How each refinement round updates the albedos. The rounds gather all indirect light from
+  // the model, so its albedos feed back on themselves: a too bright model darkens the next fit.
+  // "independent": each region's albedo is refitted alone as πL/E with E rendered at the current
+  // albedos (the paper's fit against the path tracer); a round maps an error e to about
+  // −2·e + 0.8 points and overshoots (bench/RESULTS.md). "joint": the renderer also returns each
+  // gathered irradiance's derivative with respect to every region's albedo scale
+  // (Renderer::ReflectedRadiance), and the round solves for all regions' albedo scales at once
+  // so that the photos are matched with the light those new albedos would send (a Newton step
+  // on the fixed point; ρs and α are refitted as before, an albedo map keeps its per-texel
+  // detail relative to the region's scale).
+  std::string refine_update = "joint";
+  // Share of each refinement round's albedo change that is applied (1 = the full step). Half
+  // steps damp the independent update's swing (bench/RESULTS.md); the joint update needs none.
   double refine_albedo_step = 1.0;
   // The photos' absolute scale. "given": their values are radiance in the scene's units (after
   // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance

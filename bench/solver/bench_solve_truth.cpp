@@ -77,6 +77,8 @@ int main(int argc, char** argv) {
       dump = v != 0;
     else if (key == "step")
       o.refine_albedo_step = v;
+    else if (key == "joint")  // 1: refine_update "joint", 0: "independent"
+      o.refine_update = v != 0 ? "joint" : "independent";
     else if (key == "bounce")
       o.specular_bounces = v != 0;
     else if (key == "smooth")
