@@ -73,6 +73,7 @@ struct SolverState {
   // derivative of its raw indirect irradiance with respect to the logarithm of the region's
   // albedo scale (empty otherwise).
   std::vector<Eigen::Vector3d> obs_d_indirect;
+  std::vector<Eigen::Vector3d> obs_e_stage1;  // obs_e at the end of stage 1
   std::vector<Eigen::Vector3d> obs_t;
   // Per observation of a textured glossy region: the other photos' observations off the
   // highlights at the albedo map's texel (solver/held_out_albedo.h): their πL/E and their lobe
@@ -127,6 +128,12 @@ struct SolverState {
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir) const;
   void RenderResiduals(const Scene& model, int stage);
+  // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
+  // observation (gathered from the photographed patches: less noisy than the rounds' few
+  // path-traced directions) times the ratio of the rounds' to stage 1's irradiance averaged over
+  // 4 smoothing radii, so that the maps' texel detail keeps stage 1's noise while their level
+  // follows the path tracer; otherwise obs_e (stage 1's after a rejected refinement).
+  std::vector<Eigen::Vector3d> MapIrradiance() const;
   void BuildAlbedoMaps();
   Eigen::Vector3d KnownAlbedo(const Observation& o) const;
 

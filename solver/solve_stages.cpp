@@ -536,6 +536,7 @@ void SolverState::RunStage1() {
         options.max_iterations, summary.history.back().max_change, options.tolerance);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
+  obs_e_stage1 = obs_e;
   for (size_t r = 0; r < materials.size(); ++r) {
     summary.regions[r].stage1 = summary.regions[r].stage2 = materials[r].last_fit;
     materials[r].stage1_albedo_varies = materials[r].last_fit.albedo_varies;
