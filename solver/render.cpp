@@ -66,7 +66,9 @@ class PathDerivative {
     if (region >= 0) (*out_)[region] += term.cwiseProduct(share);
   }
   // A vertex whose BRDF value joins the throughput.
-  void PushVertex(int region, const Eigen::Vector3d& share) { vertices_.push_back({region, share}); }
+  void PushVertex(int region, const Eigen::Vector3d& share) {
+    vertices_.push_back({region, share});
+  }
 
  private:
   std::vector<Eigen::Vector3d>* out_;
@@ -302,7 +304,8 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d wi = frame.ToWorld(bs.wi);
     if (!(wi.dot(n_geo) > 0)) break;  // under the true surface (shading-normal artefact)
     s.throughput = s.throughput.cwiseProduct(bs.weight);
-    if (derivative != nullptr) derivative->PushVertex(ts.material, DiffuseShare(params.rho_d, bs.f));
+    if (derivative != nullptr)
+      derivative->PushVertex(ts.material, DiffuseShare(params.rho_d, bs.f));
     s.from_camera = false;
     s.bsdf_pdf = bs.pdf;
     s.last_point = p;

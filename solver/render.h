@@ -70,8 +70,8 @@ class Renderer {
   // region's diffuse albedo (map included), per channel: the part of the radiance whose paths
   // reflect off the region, each weighted by the times it does so diffusely. The inverse
   // solver's joint refinement uses it (solver/solve_stages.cpp).
-  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin,
-                                    const Eigen::Vector3d& direction, int spp, uint64_t seed,
+  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                    int spp, uint64_t seed,
                                     std::vector<Eigen::Vector3d>* d_ln_albedo) const;
 
   struct Impl;

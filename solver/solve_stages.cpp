@@ -156,9 +156,9 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
           const Eigen::Vector3d origin = q.position + q.n_geo * eps;
           const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);
-          const Eigen::Vector3d li = joint
-                                         ? renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed, &dl)
-                                         : renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed);
+          const Eigen::Vector3d li =
+              joint ? renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed, &dl)
+                    : renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed);
           e += d.weight * li;
           if (joint) {
             Eigen::Vector3d* row = &obs_d_indirect[size_t(i) * num_regions];
@@ -282,9 +282,9 @@ void SolverState::HeldOutAlbedos() {
 // fixed point: (1 + Δ_r)·(1 + Σ_j G_rj·Δ_j) = ρ̂_r/ρ0_r for every fitted region at once, per
 // channel, by Newton's method (a few iterations of an n × n system, n the fitted regions).
 // With G = 0 it is the independent refit. The new albedos are held within a factor 2 of ρ0.
-std::vector<Eigen::Vector3d> SolverState::JointAlbedos(const std::vector<int>& regions,
-                                                       const std::vector<RegionFitResult>& fits,
-                                                       std::vector<Eigen::Vector3d>* feedback) const {
+std::vector<Eigen::Vector3d> SolverState::JointAlbedos(
+    const std::vector<int>& regions, const std::vector<RegionFitResult>& fits,
+    std::vector<Eigen::Vector3d>* feedback) const {
   const size_t num_regions = materials.size();
   std::vector<Eigen::Vector3d> out(regions.size(), Eigen::Vector3d::Constant(NAN));
   feedback->assign(regions.size(), Eigen::Vector3d::Constant(NAN));

@@ -127,8 +127,9 @@ class SolveRefine : public ::testing::Test {
 TEST_F(SolveRefine, JointRoundLandsOnTheAlbedosWhereTheIndependentOneOvershoots) {
   const auto [joint_before, joint_after] = OneRound("joint", 1.05);
   const auto [indep_before, indep_after] = OneRound("independent", 1.05);
-  std::printf("worst albedo error: start %+.2f %%, joint round %+.2f %%, independent round %+.2f %%\n",
-              100 * joint_before, 100 * joint_after, 100 * indep_after);
+  std::printf(
+      "worst albedo error: start %+.2f %%, joint round %+.2f %%, independent round %+.2f %%\n",
+      100 * joint_before, 100 * joint_after, 100 * indep_after);
   EXPECT_GT(joint_before, 0.04);  // the start really is off
   // 1 %: issue 7's bar for region means. The round's own noise (64 rendered directions per
   // observation, every pixel, 256-path photos) is a few tenths of a per cent.
