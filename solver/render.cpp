@@ -10,6 +10,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "solver/render_internal.h"
@@ -45,6 +47,40 @@ struct PathState {
   Eigen::Vector3d last_point = Eigen::Vector3d::Zero();
   uint64_t rays = 0;
 };
+
+// The derivative of one path's radiance with respect to each region's albedo scale s_j (the
+// diffuse albedo of region j multiplied by s_j, at s_j = 1). Every term a path adds is a product
+// of BRDF values at its vertices (through the throughput and, for next-event estimation and the
+// ambient light, the vertex's own), each linear in its region's diffuse albedo: the term's
+// derivative with respect to ln s_j is the term times the sum, over its vertices on region j, of
+// the BRDF's diffuse share there, (ρd/π)/f per channel (the sampling densities do not depend on
+// s: they are the estimator's, not the integrand's).
+class PathDerivative {
+ public:
+  explicit PathDerivative(std::vector<Eigen::Vector3d>* per_region) : out_(per_region) {}
+  // A term added to the path's radiance: its throughput's vertices, plus (region >= 0) the
+  // current vertex with its BRDF's diffuse share `share`.
+  void Add(const Eigen::Vector3d& term, int region = -1,
+           const Eigen::Vector3d& share = Eigen::Vector3d::Zero()) {
+    for (const auto& [r, sh] : vertices_) (*out_)[r] += term.cwiseProduct(sh);
+    if (region >= 0) (*out_)[region] += term.cwiseProduct(share);
+  }
+  // A vertex whose BRDF value joins the throughput.
+  void PushVertex(int region, const Eigen::Vector3d& share) {
+    vertices_.push_back({region, share});
+  }
+
+ private:
+  std::vector<Eigen::Vector3d>* out_;
+  std::vector<std::pair<int, Eigen::Vector3d>> vertices_;
+};
+
+// (ρd/π)/f per channel: the share of the BRDF value f that the diffuse albedo makes.
+Eigen::Vector3d DiffuseShare(const Eigen::Vector3d& rho_d, const Eigen::Vector3d& f) {
+  Eigen::Vector3d share;
+  for (int c = 0; c < 3; ++c) share[c] = f[c] > 0 ? std::min(1.0, rho_d[c] * kInvPi / f[c]) : 0.0;
+  return share;
+}
 
 // The uniform numbers SampleLight reads for a light of `type`: none for the delta lights, two for
 // a sphere (the cone's θ and φ), three otherwise (triangle, then a point on it).
@@ -82,34 +118,44 @@ class PathTracer {
 
   // Radiance arriving along the ray. reflected_only: leave out the emission of what the ray
   // meets first (lights, emitters), i.e. only light reflected by the first surface.
+  // With `derivative`, also the radiance's derivatives with respect to the regions' albedo
+  // scales (PathDerivative); the same random numbers and radiance either way.
   Eigen::Vector3d Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng, uint64_t* rays,
-                        bool reflected_only = false) const;
+                        bool reflected_only = false, PathDerivative* derivative = nullptr) const;
 
  private:
   // Adds an emitter's radiance seen along the path, MIS-weighted against light sampling.
-  void AddEmission(PathState* s, int light, const Eigen::Vector3d& le, const Eigen::Vector3d& dir,
-                   const Eigen::Vector3d& hit_point, const Eigen::Vector3d& hit_normal) const {
+  // Returns the term added.
+  Eigen::Vector3d AddEmission(PathState* s, int light, const Eigen::Vector3d& le,
+                              const Eigen::Vector3d& dir, const Eigen::Vector3d& hit_point,
+                              const Eigen::Vector3d& hit_normal) const {
     double w = 1.0;
     if (!s->from_camera) {
       const double light_pdf =
           light_select_pdf_ * impl_.LightPdf(light, s->last_point, dir, hit_point, hit_normal);
       w = PowerHeuristic(1, s->bsdf_pdf, 1, light_pdf);
     }
-    s->radiance += s->throughput.cwiseProduct(le) * w;
+    const Eigen::Vector3d term = s->throughput.cwiseProduct(le) * w;
+    s->radiance += term;
+    return term;
   }
 
-  // Next-event estimation from a shading point.
-  void SampleDirectLight(PathState* s, const Eigen::Vector3d& p, const Eigen::Vector3d& n_geo,
-                         const Frame& frame, const BrdfParams& params,
-                         const Eigen::Vector3d& wo_local, Pcg32& rng) const;
+  // Next-event estimation from a shading point. Returns the term added, and the BRDF value
+  // toward the light in `f` (zero when nothing was added).
+  Eigen::Vector3d SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
+                                    const Eigen::Vector3d& n_geo, const Frame& frame,
+                                    const BrdfParams& params, const Eigen::Vector3d& wo_local,
+                                    Pcg32& rng, Eigen::Vector3d* f) const;
 
   // The ambient lights' radiance reflected toward wo: L·∫ f(wo, wi) cosθi dωi over the
   // hemisphere, i.e. L·ρd exactly plus the specular lobe's directional albedo estimated with one
   // direction drawn from the lobe alone (weight f_s·cos/pdf_s, nearly constant for Ward's lobe).
   // No ray: nothing occludes an ambient light, and no other estimator counts it (light sampling
   // skips it and a BRDF-sampled ray never reaches it).
-  void AddAmbient(PathState* s, const BrdfParams& params, const Eigen::Vector3d& wo_local,
-                  Pcg32& rng) const;
+  // Returns the term added, and in `albedo` the hemispherical reflectance it used.
+  Eigen::Vector3d AddAmbient(PathState* s, const BrdfParams& params,
+                             const Eigen::Vector3d& wo_local, Pcg32& rng,
+                             Eigen::Vector3d* albedo) const;
 
   const Renderer::Impl& impl_;
   const RenderOptions& options_;
@@ -118,48 +164,58 @@ class PathTracer {
   Eigen::Vector3d ambient_ = Eigen::Vector3d::Zero();  // total radiance of the ambient lights
 };
 
-void PathTracer::AddAmbient(PathState* s, const BrdfParams& params,
-                            const Eigen::Vector3d& wo_local, Pcg32& rng) const {
-  if (!(ambient_.maxCoeff() > 0) || !(wo_local.z() > 0)) return;
-  Eigen::Vector3d albedo = params.rho_d;
+Eigen::Vector3d PathTracer::AddAmbient(PathState* s, const BrdfParams& params,
+                                       const Eigen::Vector3d& wo_local, Pcg32& rng,
+                                       Eigen::Vector3d* albedo) const {
+  *albedo = params.rho_d;
+  if (!(ambient_.maxCoeff() > 0) || !(wo_local.z() > 0)) return Eigen::Vector3d::Zero();
   if (HasSpecularLobe(params.model) && params.rho_s.maxCoeff() > 0) {
     BrdfParams lobe = params;  // ρd = 0: the draw comes from the specular lobe, pdf its own
     lobe.rho_d.setZero();
     const BrdfSample bs = SampleBrdf(lobe, wo_local, 0.0, rng.Uniform2D());
-    if (bs.Valid()) albedo += bs.weight;
+    if (bs.Valid()) *albedo += bs.weight;
   }
-  s->radiance += s->throughput.cwiseProduct(ambient_).cwiseProduct(albedo);
+  const Eigen::Vector3d term = s->throughput.cwiseProduct(ambient_).cwiseProduct(*albedo);
+  s->radiance += term;
+  return term;
 }
 
-void PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
-                                   const Eigen::Vector3d& n_geo, const Frame& frame,
-                                   const BrdfParams& params, const Eigen::Vector3d& wo_local,
-                                   Pcg32& rng) const {
+Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
+                                              const Eigen::Vector3d& n_geo, const Frame& frame,
+                                              const BrdfParams& params,
+                                              const Eigen::Vector3d& wo_local, Pcg32& rng,
+                                              Eigen::Vector3d* f) const {
+  f->setZero();
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
   const int n = static_cast<int>(sampled_lights_.size());
-  if (n == 0) return;
+  if (n == 0) return none;
   const int light =
       sampled_lights_[n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1)];
   const LightSample ls = impl_.SampleLight(light, p, LightNumbers(impl_.lights[light].type, rng));
-  if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return;
+  if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return none;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
-  if (!(wi_local.z() > 0)) return;
+  if (!(wi_local.z() > 0)) return none;
   const BrdfEval fe = EvalBrdfAndPdf(params, wo_local, wi_local);
-  if (!(fe.f.maxCoeff() > 0)) return;
+  if (!(fe.f.maxCoeff() > 0)) return none;
   const double eps = impl_.ray_epsilon;
   // The segment stops short of the light's surface (area lights are Embree geometry too).
   const double distance = std::isfinite(ls.distance)
                               ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
                               : ls.distance;
   ++s->rays;
-  if (impl_.Occluded(p + n_geo * eps, ls.wi, distance, light)) return;
+  if (impl_.Occluded(p + n_geo * eps, ls.wi, distance, light)) return none;
   const double light_pdf = light_select_pdf_ * ls.pdf;
   const double w = ls.delta ? 1.0 : PowerHeuristic(1, light_pdf, 1, fe.pdf);
-  s->radiance +=
+  const Eigen::Vector3d term =
       s->throughput.cwiseProduct(fe.f).cwiseProduct(ls.value) * (wi_local.z() * w / light_pdf);
+  s->radiance += term;
+  *f = fe.f;
+  return term;
 }
 
 Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
-                                  uint64_t* rays, bool reflected_only) const {
+                                  uint64_t* rays, bool reflected_only,
+                                  PathDerivative* derivative) const {
   const Scene& scene = *impl_.scene;
   const TriangleMesh& mesh = scene.mesh;
   PathState s;
@@ -170,15 +226,21 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d p = origin + hit->t * dir;
     if (hit->sphere_light >= 0) {
       const Light& l = *impl_.lights[hit->sphere_light].light;
-      if (!(reflected_only && bounce == 0))
-        AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
+      if (!(reflected_only && bounce == 0)) {
+        const Eigen::Vector3d term =
+            AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
+        if (derivative != nullptr) derivative->Add(term);
+      }
       break;
     }
     if (hit->geometry > 0) {  // an area light's own mesh: emits on its front, absorbs
       const int light = impl_.area_light_of_geometry[hit->geometry];
       const Eigen::Vector3d& n = impl_.area_normals[hit->geometry][hit->primitive];
-      if (n.dot(dir) < 0 && !(reflected_only && bounce == 0))
-        AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
+      if (n.dot(dir) < 0 && !(reflected_only && bounce == 0)) {
+        const Eigen::Vector3d term =
+            AddEmission(&s, light, impl_.lights[light].light->radiance, dir, p, n);
+        if (derivative != nullptr) derivative->Add(term);
+      }
       break;
     }
     const int tri_index = hit->primitive;
@@ -186,7 +248,9 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const ShadingMaterial& m = impl_.materials[ts.material];
     Eigen::Vector3d n_geo = ts.normal;
     if (ts.emitter >= 0 && n_geo.dot(dir) < 0 && !(reflected_only && bounce == 0)) {
-      AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
+      const Eigen::Vector3d term =
+          AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
+      if (derivative != nullptr) derivative->Add(term);
     }
     if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
     const double b0 = 1.0 - hit->u - hit->v;
@@ -223,8 +287,14 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
       params.rho_d = SampleTexture(*m.rho_d_map, uv);
     }
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
-    SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng);
-    AddAmbient(&s, params, wo_local, rng);
+    Eigen::Vector3d f_light, albedo;
+    const Eigen::Vector3d direct =
+        SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng, &f_light);
+    const Eigen::Vector3d ambient = AddAmbient(&s, params, wo_local, rng, &albedo);
+    if (derivative != nullptr) {
+      derivative->Add(direct, ts.material, DiffuseShare(params.rho_d, f_light));
+      derivative->Add(ambient, ts.material, DiffuseShare(kPi * params.rho_d, albedo));
+    }
 
     // Lambert has one lobe: no number to pick it.
     const double u_lobe = HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;
@@ -234,6 +304,8 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     const Eigen::Vector3d wi = frame.ToWorld(bs.wi);
     if (!(wi.dot(n_geo) > 0)) break;  // under the true surface (shading-normal artefact)
     s.throughput = s.throughput.cwiseProduct(bs.weight);
+    if (derivative != nullptr)
+      derivative->PushVertex(ts.material, DiffuseShare(params.rho_d, bs.f));
     s.from_camera = false;
     s.bsdf_pdf = bs.pdf;
     s.last_point = p;
@@ -336,20 +408,39 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
 namespace {
 
 // The mean of `spp` paths along one ray (non-finite paths dropped).
+// With `d_ln_albedo`: also the mean's derivatives with respect to each region's albedo scale
+// (one entry per scene material, overwritten).
 Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& origin,
                              const Eigen::Vector3d& direction, int spp, uint64_t seed,
-                             bool reflected_only) {
+                             bool reflected_only,
+                             std::vector<Eigen::Vector3d>* d_ln_albedo = nullptr) {
   RenderOptions options;
   const PathTracer tracer(impl, options);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   uint64_t rays = 0;
+  std::vector<Eigen::Vector3d> path_d;
+  if (d_ln_albedo != nullptr) {
+    d_ln_albedo->assign(impl.materials.size(), Eigen::Vector3d::Zero());
+    path_d.resize(impl.materials.size());
+  }
   for (int k = 0; k < spp; ++k) {
     Pcg32 rng = PixelSampleRng(seed, reflected_only ? 1 : 0, k);
-    const Eigen::Vector3d l =
-        tracer.Trace(origin, direction.normalized(), rng, &rays, reflected_only);
-    if (l.allFinite()) sum += l;
+    std::optional<PathDerivative> derivative;
+    if (d_ln_albedo != nullptr) {
+      std::fill(path_d.begin(), path_d.end(), Eigen::Vector3d::Zero());
+      derivative.emplace(&path_d);
+    }
+    const Eigen::Vector3d l = tracer.Trace(origin, direction.normalized(), rng, &rays,
+                                           reflected_only, derivative ? &*derivative : nullptr);
+    if (!l.allFinite()) continue;
+    sum += l;
+    for (size_t r = 0; r < path_d.size(); ++r) (*d_ln_albedo)[r] += path_d[r];
   }
-  return sum / std::max(1, spp);
+  const double n = std::max(1, spp);
+  if (d_ln_albedo != nullptr) {
+    for (Eigen::Vector3d& d : *d_ln_albedo) d /= n;
+  }
+  return sum / n;
 }
 
 }  // namespace
@@ -363,6 +454,13 @@ Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction, int spp,
                                             uint64_t seed) const {
   return MeanRadiance(*impl_, origin, direction, spp, seed, true);
+}
+
+Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
+                                            const Eigen::Vector3d& direction, int spp,
+                                            uint64_t seed,
+                                            std::vector<Eigen::Vector3d>* d_ln_albedo) const {
+  return MeanRadiance(*impl_, origin, direction, spp, seed, true, d_ln_albedo);
 }
 
 }  // namespace igi

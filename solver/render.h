@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "recon/scene.h"
 #include "tools/common/image.h"
@@ -64,6 +65,14 @@ class Renderer {
   Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin,
                                     const Eigen::Vector3d& direction, int spp,
                                     uint64_t seed) const;
+  // The same (the same paths and value), and in `d_ln_albedo` (one entry per scene material,
+  // i.e. region) its derivative with respect to the logarithm of a scale applied to that
+  // region's diffuse albedo (map included), per channel: the part of the radiance whose paths
+  // reflect off the region, each weighted by the times it does so diffusely. The inverse
+  // solver's joint refinement uses it (solver/solve_stages.cpp).
+  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                    int spp, uint64_t seed,
+                                    std::vector<Eigen::Vector3d>* d_ln_albedo) const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }  // for the solver (solver/render_internal.h)

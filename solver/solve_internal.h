@@ -3,6 +3,7 @@
 // model; solve_stages.cpp: the iterations, stage 2, residuals and albedo maps).
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -29,6 +30,10 @@ struct MaterialState {
   std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
   RegionFitResult last_fit;
   bool stage1_albedo_varies = false;  // stage 1's decision, kept by the refinement
+  // Factor applied to the albedo map built from the observations' πL/E (AlbedoMapOf): the
+  // refinement's update of the region's scale (1 unless a stage-2 round moved its mean away
+  // from its independent refit: the joint update, or a partial step).
+  Eigen::Vector3d map_scale = Eigen::Vector3d::Ones();
   int observations = 0;
   bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
 };
@@ -64,6 +69,11 @@ struct SolverState {
   // specular lobe) and T = Σ S·W·v at the current α.
   std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
   std::vector<std::vector<IncidentLocal>> obs_incident;
+  // Stage 2's joint update: per observation and region (obs × materials, row-major), the
+  // derivative of its raw indirect irradiance with respect to the logarithm of the region's
+  // albedo scale (empty otherwise).
+  std::vector<Eigen::Vector3d> obs_d_indirect;
+  std::vector<Eigen::Vector3d> obs_e_stage1;  // obs_e at the end of stage 1
   std::vector<Eigen::Vector3d> obs_t;
   // Per observation of a textured glossy region: the other photos' observations off the
   // highlights at the albedo map's texel (solver/held_out_albedo.h): their πL/E and their lobe
@@ -104,11 +114,26 @@ struct SolverState {
   void ComputeSpecularTerms();
   void HeldOutAlbedos();
   double FitAll(int stage, int iteration);  // returns the largest relative change
+  // The joint update's albedos (per entry of `regions`, from their fits `fits`): the solution of
+  // the fixed point ρ_r = fit_r(E(ρ)) with E linearised by obs_d_indirect; NaN where the
+  // independent fit stands.
+  std::vector<Eigen::Vector3d> JointAlbedos(const std::vector<int>& regions,
+                                            const std::vector<RegionFitResult>& fits,
+                                            std::vector<Eigen::Vector3d>* feedback) const;
   void RunStage1();
+  // One refinement round: the model as it stands (its albedo maps written under temp_dir),
+  // rendered incident light, smoothing, FitAll(2, round), specular terms.
+  void RefineRound(int round, const std::filesystem::path& temp_dir);
   void RunStage2();
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir) const;
   void RenderResiduals(const Scene& model, int stage);
+  // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
+  // observation (gathered from the photographed patches: less noisy than the rounds' few
+  // path-traced directions) times the ratio of the rounds' to stage 1's irradiance averaged over
+  // 4 smoothing radii, so that the maps' texel detail keeps stage 1's noise while their level
+  // follows the path tracer; otherwise obs_e (stage 1's after a rejected refinement).
+  std::vector<Eigen::Vector3d> MapIrradiance() const;
   void BuildAlbedoMaps();
   Eigen::Vector3d KnownAlbedo(const Observation& o) const;
 

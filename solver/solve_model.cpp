@@ -51,7 +51,8 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 // The specular term T of each observation is noisy (few incident samples carry the reflected
 // room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
 static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
-                         const std::vector<Eigen::Vector3d>& obs_t, Image* seen = nullptr) {
+                         const std::vector<Eigen::Vector3d>& obs_t,
+                         const std::vector<Eigen::Vector3d>& obs_e, Image* seen = nullptr) {
   AlbedoMapBuilder builder(atlas);
   const MaterialState& m = s.materials[r];
   for (size_t i = 0; i < s.obs.size(); ++i) {
@@ -63,15 +64,15 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     // weight each observation by its diffuse share, and leave out those under half diffuse.
     // (from the model, not the observation: a test on the observed radiance would favour the
     // bright texels near highlights)
-    const double diffuse_pred = (s.PatchAlbedo(o.patch).cwiseProduct(s.obs_e[i]) / kPi).sum();
+    const double diffuse_pred = (s.PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi).sum();
     const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
     const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
     if (!(w > 0)) continue;
     // An albedo above 1.2 is physically impossible: its irradiance estimate is wrong (a contact
     // shadow the gathering smoothed over); such observations are left out of the map.
-    const Eigen::Vector3d e = s.obs_e[i];
+    const Eigen::Vector3d e = obs_e[i];
     if (!(e.minCoeff() > 0) || (kPi * diffuse).cwiseQuotient(e).maxCoeff() > 1.2) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse, w * e);
+    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
   if (seen != nullptr) *seen = builder.DirectMask();
@@ -84,11 +85,29 @@ static RegionAtlas AtlasOf(const SolverState& s, int r) {
   return BuildRegionAtlas(s.scene.mesh, r, ao);
 }
 
+std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
+  const bool have_stage1 = obs_e_stage1.size() == obs.size() && summary.stage2_iterations > 0;
+  if (!have_stage1 || options.refine_update != "joint") return obs_e;
+  if (!summary.refinement_accepted) return obs_e_stage1;
+  const double radius = 4 * (options.smoothing_radius_m > 0 ? options.smoothing_radius_m
+                                                            : summary.scene_diagonal_m / 96);
+  const std::vector<Eigen::Vector3d> now = NeighbourMean(obs_e, radius, false);
+  const std::vector<Eigen::Vector3d> then = NeighbourMean(obs_e_stage1, radius, false);
+  std::vector<Eigen::Vector3d> out(obs.size());
+  for (size_t i = 0; i < obs.size(); ++i) {
+    out[i] = obs_e[i];
+    if (!(then[i].minCoeff() > 0) || !now[i].allFinite()) continue;
+    out[i] = obs_e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
+  }
+  return out;
+}
+
 Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                                  const std::filesystem::path& temp_dir) const {
   Scene model = scene;
   const std::vector<Eigen::Vector3d> smooth_t =
       NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
+  const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   atlases->clear();
   maps->clear();
   bool generated = false;
@@ -107,7 +126,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
     }
     if (m.unknown_rho_d && m.last_fit.albedo_model == "per_patch") {
       atlases->push_back(AtlasOf(*this, int(r)));
-      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr, smooth_t));
+      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr, smooth_t, map_e));
       const std::filesystem::path file = temp_dir / (out.name + ".exr");
       WriteImage(file, maps->back());
       out.rho_d_map = file;
@@ -199,6 +218,18 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
   spdlog::info("stage {} model rendered at the observed pixels: relative rms {:.4f}", stage, total);
 }
 
+void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) {
+  std::vector<RegionAtlas> atlases;
+  std::vector<Image> maps;
+  std::filesystem::create_directories(temp_dir);
+  const Scene model = CompleteScene(&atlases, &maps, temp_dir);
+  IncidentFromRenderer(model, uint64_t(round));
+  SmoothIrradiance();
+  FitAll(2, round);
+  ComputeSpecularTerms();
+  summary.stage2_iterations = round;
+}
+
 void SolverState::RunStage2() {
   const std::filesystem::path temp =
       std::filesystem::temp_directory_path() /
@@ -219,13 +250,7 @@ void SolverState::RunStage2() {
     RenderResiduals(model, 1);
   }
   for (int round = 1; round <= options.refine_iterations; ++round) {
-    std::filesystem::create_directories(temp / std::to_string(round));
-    const Scene model = CompleteScene(&atlases, &maps, temp / std::to_string(round));
-    IncidentFromRenderer(model, uint64_t(round));
-    SmoothIrradiance();
-    FitAll(2, round);
-    ComputeSpecularTerms();
-    summary.stage2_iterations = round;
+    RefineRound(round, temp / std::to_string(round));
   }
   for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
   if (options.refine_iterations > 0) {
@@ -243,6 +268,7 @@ void SolverState::RunStage2() {
         materials[r].params = stage1[r].params;
         materials[r].patch_rho_d = stage1[r].patch_rho_d;
         materials[r].last_fit = stage1[r].last_fit;
+        materials[r].map_scale = stage1[r].map_scale;
       }
       ComputeSpecularTerms();
       spdlog::warn(
@@ -257,6 +283,7 @@ void SolverState::BuildAlbedoMaps() {
   std::vector<RegionAtlas> generated;
   const std::vector<Eigen::Vector3d> smooth_t =
       NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
+  const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
@@ -270,7 +297,8 @@ void SolverState::BuildAlbedoMaps() {
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
     Image seen;
-    rs.albedo_map = AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, &seen);
+    rs.albedo_map =
+        AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);
     rs.albedo_map_seen = std::move(seen);
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     rs.albedo_map_generated_uvs = atlas.generated;

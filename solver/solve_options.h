@@ -49,14 +49,25 @@ struct SolveOptions {
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
-  // Share of each refinement round's albedo change that is applied. The rounds gather all
-  // indirect light from the model, whose albedos light the next fit, so full steps (1) can swing
-  // about the answer: since the gather's specular bounces made stage 1 right on igi-synth's
-  // converged room, one full round overshoots it (relit 3.15 % beyond the noise floor against
-  // the paper stage's 1.53 %; half steps: 2.47 % after one round, 1.82 % after two). Where stage
-  // 1 is biased, half steps correct it more slowly (solve_e2e_test's small room: floor −3.04 %
-  // after one half round, −3.43 % after two, −2.83 % after one full round, from −3.25 %), so the
-  // default stays 1 (bench/RESULTS.md).
+  // How each refinement round updates the albedos. The rounds gather all indirect light from
+  // the model, so its albedos feed back on themselves: a too bright model darkens the next fit.
+  // "independent": each region's albedo is refitted alone as πL/E with E rendered at the current
+  // albedos; a round maps an error e to about −2·e + 0.8 points and overshoots (bench/
+  // RESULTS.md). "joint": the renderer also returns each gathered irradiance's derivative with
+  // respect to every region's albedo scale (Renderer::ReflectedRadiance), and the round solves
+  // for all regions' albedo scales at once so that the photos are matched with the light those
+  // new albedos would send (a Newton step on the fixed point; ρs and α are refitted as before;
+  // albedo maps keep stage 1's texel detail, scaled to the new region means). On igi-synth's
+  // 1024-spp room the joint rounds relight as well as the paper stage (1.53 / 1.49 % beyond the
+  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %), but on
+  // solve_e2e_test's small room they leave the floor at −3.03 % (independent −2.83 %, bound
+  // 3 %), so the default stays "independent" (bench/RESULTS.md, 2026-11-22 session 9).
+  std::string refine_update = "independent";
+  // Share of each refinement round's albedo change that is applied (1 = the full step). Half
+  // steps damp the independent update's swing where stage 1 is already right (igi-synth's
+  // converged room: 2.47 % beyond the floor after one round, 1.82 % after two, against 3.15 %
+  // for one full round) but correct a biased stage 1 more slowly (solve_e2e_test's small room:
+  // floor −3.04 % after one half round, −2.83 % after one full round, from −3.25 %).
   double refine_albedo_step = 1.0;
   // The photos' absolute scale. "given": their values are radiance in the scene's units (after
   // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance

@@ -196,6 +196,10 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                        {"relative_rms", Num(it.relative_rms)},
                        {"max_change", Num(it.max_change)},
                        {"params", it.params}});
+    if (!it.albedo_update.empty()) {
+      history.back()["albedo_update"] = it.albedo_update;
+      history.back()["albedo_step"] = it.albedo_step;
+    }
   }
   j["history"] = history;
   j["timing"] = {
@@ -219,6 +223,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                   {"refine_rays", o.refine_rays},
                   {"seed", o.seed},
                   {"refine_albedo_step", o.refine_albedo_step},
+                  {"refine_update", o.refine_update},
                   {"specular_bounces", o.specular_bounces},
                   {"photo_scale", o.photo_scale}};
   if (!o.albedo_map_regions.empty()) j["options"]["albedo_map_regions"] = o.albedo_map_regions;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -118,6 +119,15 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
     if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
   std::atomic<uint64_t> rays{0};
+  // The joint update also needs each irradiance's derivatives with respect to the regions'
+  // albedo scales (the same paths: the irradiance itself does not change).
+  const bool joint = options.refine_update == "joint";
+  const size_t num_regions = materials.size();
+  if (joint) {
+    obs_d_indirect.assign(obs.size() * num_regions, Eigen::Vector3d::Zero());
+  } else {
+    obs_d_indirect.clear();
+  }
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
@@ -142,10 +152,18 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         // Glossy observations that the fits use get four times the rays: noise in the specular
         // term T would bias ρs low (regression dilution).
         const int n = options.refine_rays * (glossy && in_fit[i] ? 4 : 1);
+        std::vector<Eigen::Vector3d> dl;
         for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
-          const Eigen::Vector3d li = renderers[l]->ReflectedRadiance(
-              q.position + q.n_geo * eps, d.wi, 1, Mix(Mix(options.seed, round), i * 4096 + k++));
+          const Eigen::Vector3d origin = q.position + q.n_geo * eps;
+          const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);
+          const Eigen::Vector3d li =
+              joint ? renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed, &dl)
+                    : renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed);
           e += d.weight * li;
+          if (joint) {
+            Eigen::Vector3d* row = &obs_d_indirect[size_t(i) * num_regions];
+            for (size_t r = 0; r < num_regions; ++r) row[r] += d.weight * dl[r];
+          }
           if (glossy)
             inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
         }
@@ -257,6 +275,78 @@ void SolverState::HeldOutAlbedos() {
   }
 }
 
+// Stage 2 renders E at the current albedos ρ0, and a region's refit is about ρ̂_r = πΣL/ΣE over
+// its observations. Had the albedos been ρ0_j·(1 + Δ_j), its observations would have gathered
+// ΣE·(1 + Σ_j G_rj·Δ_j), G_rj = ΣD_rj/ΣE (D the irradiance's derivative with respect to ln of
+// region j's albedo scale), and the refit would be ρ̂_r/(1 + Σ_j G_rj·Δ_j). The joint update is the
+// fixed point: (1 + Δ_r)·(1 + Σ_j G_rj·Δ_j) = ρ̂_r/ρ0_r for every fitted region at once, per
+// channel, by Newton's method (a few iterations of an n × n system, n the fitted regions).
+// With G = 0 it is the independent refit. The new albedos are held within a factor 2 of ρ0.
+std::vector<Eigen::Vector3d> SolverState::JointAlbedos(
+    const std::vector<int>& regions, const std::vector<RegionFitResult>& fits,
+    std::vector<Eigen::Vector3d>* feedback) const {
+  const size_t num_regions = materials.size();
+  std::vector<Eigen::Vector3d> out(regions.size(), Eigen::Vector3d::Constant(NAN));
+  feedback->assign(regions.size(), Eigen::Vector3d::Constant(NAN));
+  if (obs_d_indirect.size() != obs.size() * num_regions) return out;
+  std::vector<int> unknown_of(num_regions, -1), members;  // members: indices into `regions`
+  for (size_t k = 0; k < regions.size(); ++k) {
+    const MaterialState& m = materials[regions[k]];
+    if (fits[k].fitted && m.unknown_rho_d && m.params.rho_d.allFinite() &&
+        fits[k].rho_d.allFinite()) {
+      unknown_of[regions[k]] = int(members.size());
+      members.push_back(int(k));
+    }
+  }
+  const int n = int(members.size());
+  if (n == 0) return out;
+  std::vector<Eigen::Vector3d> sum_e(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> sum_d(size_t(n) * n, Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const int a = unknown_of[obs[i].region];
+    if (!in_fit[i] || a < 0) continue;
+    sum_e[a] += obs_e[i];
+    for (int b = 0; b < n; ++b) {
+      sum_d[size_t(a) * n + b] += obs_d_indirect[i * num_regions + regions[members[b]]];
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, n);
+    Eigen::VectorXd target = Eigen::VectorXd::Ones(n);
+    std::vector<bool> usable(n, false);
+    for (int a = 0; a < n; ++a) {
+      const double rho0 = materials[regions[members[a]]].params.rho_d[c];
+      if (!(rho0 > 0) || !(sum_e[a][c] > 0)) continue;  // Δ = 0 for it; its own refit stands
+      usable[a] = true;
+      target[a] = fits[members[a]].rho_d[c] / rho0;
+      for (int b = 0; b < n; ++b) g(a, b) = sum_d[size_t(a) * n + b][c] / sum_e[a][c];
+    }
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(n);
+    bool ok = true;
+    for (int it = 0; it < 10 && ok; ++it) {
+      const Eigen::VectorXd gd = g * delta;
+      Eigen::VectorXd residual(n);
+      Eigen::MatrixXd jac(n, n);
+      for (int a = 0; a < n; ++a) {
+        residual[a] = (1 + delta[a]) * (1 + gd[a]) - target[a];
+        jac.row(a) = (1 + delta[a]) * g.row(a);
+        jac(a, a) += 1 + gd[a];
+      }
+      const Eigen::VectorXd step = jac.partialPivLu().solve(-residual);
+      ok = step.allFinite();
+      if (ok) delta += step;
+      if (ok && step.lpNorm<Eigen::Infinity>() < 1e-12) break;
+    }
+    for (int a = 0; a < n; ++a) {
+      if (!ok || !usable[a]) continue;
+      const int k = members[a];
+      out[k][c] = materials[regions[k]].params.rho_d[c] * std::clamp(1 + delta[a], 0.5, 2.0);
+      (*feedback)[k][c] = g.row(a).sum();
+    }
+  }
+  return out;
+}
+
 double SolverState::FitAll(int stage, int iteration) {
   const auto start = std::chrono::steady_clock::now();
   HeldOutAlbedos();
@@ -328,6 +418,14 @@ double SolverState::FitAll(int stage, int iteration) {
   SolveIteration record;
   record.stage = stage;
   record.iteration = iteration;
+  const bool joint = stage == 2 && options.refine_update == "joint";
+  std::vector<Eigen::Vector3d> feedback;
+  const std::vector<Eigen::Vector3d> joint_rho =
+      joint ? JointAlbedos(regions, results, &feedback) : std::vector<Eigen::Vector3d>();
+  if (stage == 2) {
+    record.albedo_update = options.refine_update;
+    record.albedo_step = options.refine_albedo_step;
+  }
   for (size_t k = 0; k < regions.size(); ++k) {
     MaterialState& m = materials[regions[k]];
     const RegionFitResult& f = results[k];
@@ -343,12 +441,32 @@ double SolverState::FitAll(int stage, int iteration) {
                    ? Eigen::Vector3d(from + step * (to - from))
                    : to;
       };
-      m.params.rho_d = blend(old.rho_d, f.rho_d);
-      for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
-        const Eigen::Vector3d before = m.patch_rho_d[s].allFinite() ? m.patch_rho_d[s] : old.rho_d;
-        m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
-                               ? blend(before, f.slot_rho_d[s])
-                               : Eigen::Vector3d::Constant(NAN);
+      if (joint) {
+        // The region's mean from the joint solution; its patches and texels keep their ratios
+        // to the region's own refit (the detail), scaled to that mean.
+        Eigen::Vector3d target = f.rho_d;
+        for (int c = 0; c < 3; ++c) {
+          if (std::isfinite(joint_rho[k][c])) target[c] = joint_rho[k][c];
+        }
+        m.params.rho_d = blend(old.rho_d, target);
+        m.map_scale.setOnes();
+        for (int c = 0; c < 3; ++c) {
+          if (f.rho_d[c] > 0) m.map_scale[c] = m.params.rho_d[c] / f.rho_d[c];
+        }
+        for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
+          m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
+                                 ? Eigen::Vector3d(f.slot_rho_d[s].cwiseProduct(m.map_scale))
+                                 : Eigen::Vector3d::Constant(NAN);
+        }
+      } else {
+        m.params.rho_d = blend(old.rho_d, f.rho_d);
+        for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
+          const Eigen::Vector3d before =
+              m.patch_rho_d[s].allFinite() ? m.patch_rho_d[s] : old.rho_d;
+          m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
+                                 ? blend(before, f.slot_rho_d[s])
+                                 : Eigen::Vector3d::Constant(NAN);
+        }
       }
       change = std::max(change, RelChange(m.params.rho_d.mean(), old.rho_d.mean(), 0.01));
     }
@@ -370,7 +488,15 @@ double SolverState::FitAll(int stage, int iteration) {
         if (m.patch_rho_d[s].allFinite()) m.last_fit.slot_rho_d[s] = m.patch_rho_d[s];
       }
     }
-    record.params[scene.materials[regions[k]].name] = ParamsJson(m);
+    Json& pj = record.params[scene.materials[regions[k]].name];
+    pj = ParamsJson(m);
+    if (stage == 2 && m.unknown_rho_d) {
+      pj["rho_d_independent"] = {f.rho_d[0], f.rho_d[1], f.rho_d[2]};
+      if (joint && joint_rho[k].allFinite()) {
+        pj["rho_d_joint"] = {joint_rho[k][0], joint_rho[k][1], joint_rho[k][2]};
+        pj["feedback"] = {feedback[k][0], feedback[k][1], feedback[k][2]};
+      }
+    }
     num += f.relative_rms * f.relative_rms * f.samples;
     den += f.samples;
   }
@@ -410,6 +536,7 @@ void SolverState::RunStage1() {
         options.max_iterations, summary.history.back().max_change, options.tolerance);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
+  obs_e_stage1 = obs_e;
   for (size_t r = 0; r < materials.size(); ++r) {
     summary.regions[r].stage1 = summary.regions[r].stage2 = materials[r].last_fit;
     materials[r].stage1_albedo_varies = materials[r].last_fit.albedo_varies;

@@ -1,8 +1,9 @@
 // bench_solve_truth CAPTURE [key=value ...]: solves an igi-synth capture (CAPTURE/scene.json)
 // and prints every solved region's stage-1 and final ρd, ρs, α against CAPTURE/truth.json
 // (relative errors, %), and each albedo map's PSNR against the true texture over all texels and
-// over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), spp
-// is not a key (the capture's). For issue 7's experiments; not a test.
+// over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), rays,
+// step, bounce (0/1), smooth (m), joint (0/1: refine_update), dump; spp is not a key (the
+// capture's). For issue 7's experiments; not a test.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -77,6 +78,8 @@ int main(int argc, char** argv) {
       dump = v != 0;
     else if (key == "step")
       o.refine_albedo_step = v;
+    else if (key == "joint")  // 1: refine_update "joint", 0: "independent"
+      o.refine_update = v != 0 ? "joint" : "independent";
     else if (key == "bounce")
       o.specular_bounces = v != 0;
     else if (key == "smooth")

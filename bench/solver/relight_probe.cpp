@@ -2,9 +2,11 @@
 // igi-synth room sits, as solve_truth_test measures it (cam0, 8x8-pixel blocks), per region.
 //   build/bench/relight_probe CAPTURE_DIR OUT_DIR   env: PROBE_HELD=0/1 (held_out_albedo),
 //   PROBE_REFINE=N (refinement rounds, default 1), PROBE_BOUNCE=0/1 (specular_bounces),
-//   PROBE_STEP=S (refine_albedo_step),
+//   PROBE_STEP=S (refine_albedo_step), PROBE_UPDATE=joint|independent (refine_update),
+//   PROBE_RAYS=N (refine_rays), PROBE_SEED=N (the solver's seed),
 //   PROBE_REUSE=1 (render OUT_DIR/scene.json without solving again)
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 
@@ -32,16 +34,20 @@ int main(int argc, char** argv) {
   if (const char* e = std::getenv("PROBE_REFINE")) o.refine_iterations = std::atoi(e);
   if (const char* e = std::getenv("PROBE_BOUNCE")) o.specular_bounces = std::string(e) == "1";
   if (const char* e = std::getenv("PROBE_STEP")) o.refine_albedo_step = std::atof(e);
+  if (const char* e = std::getenv("PROBE_UPDATE")) o.refine_update = e;
+  if (const char* e = std::getenv("PROBE_RAYS")) o.refine_rays = std::atoi(e);
+  if (const char* e = std::getenv("PROBE_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   const bool reuse = std::getenv("PROBE_REUSE") != nullptr && fs::exists(out / "scene.json");
   if (!reuse) {
     const SolveSummary s = Solve(scene, o, out);
     WriteSolveOutputs(s, o, out);
     for (const RegionSolution& r : s.regions) {
       std::printf(
-          "%-14s stage1 rho_d %.4f %.4f %.4f rho_s %.4f alpha %.4f | stage2 rho_s %.4f alpha "
-          "%.4f\n",
+          "%-14s stage1 rho_d %.4f %.4f %.4f rho_s %.4f alpha %.4f | stage2 rho_d %.4f %.4f %.4f "
+          "rho_s %.4f alpha %.4f\n",
           r.name.c_str(), r.stage1.rho_d[0], r.stage1.rho_d[1], r.stage1.rho_d[2],
-          r.stage1.rho_s.mean(), r.stage1.alpha, r.stage2.rho_s.mean(), r.stage2.alpha);
+          r.stage1.rho_s.mean(), r.stage1.alpha, r.stage2.rho_d[0], r.stage2.rho_d[1],
+          r.stage2.rho_d[2], r.stage2.rho_s.mean(), r.stage2.alpha);
     }
   }
   const Scene solved = LoadScene(out / "scene.json");

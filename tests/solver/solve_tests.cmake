@@ -3,3 +3,6 @@ igi_add_test(diligent_solve_test SOURCES diligent_solve_test.cpp DEPS igi_solver
 # The paper stage's gathering: glossy surfaces pass on their specular reflection of the room
 # (a 2 m room, one 64x48 photo rendered at 256 paths per pixel, two solves; about 10 s).
 igi_add_test(solve_gather_test SOURCES solve_gather_test.cpp DEPS igi_solver)
+# Stage 2's joint albedo update against the independent refit: one round from albedos 5 % too
+# high in a bright closed room (SolverState directly; a few seconds).
+igi_add_test(solve_refine_test SOURCES solve_refine_test.cpp DEPS igi_solver)

@@ -1,0 +1,143 @@
+// Stage 2 of igi-solve (solver/solve_stages.cpp, SolverState::RefineRound): the light arriving
+// at every observation is rendered by the path tracer from the current model, so the albedos
+// light their own next fit. Refitting each region alone (πL/E at that E: "independent") then
+// overshoots in a bright closed room: albedos 5 % too high make the rendered room too bright,
+// and the next fit comes out several per cent too low. The joint update also renders the
+// irradiance's derivatives with respect to every region's albedo scale and solves for all
+// albedos at once, so one round from the same start lands on the answer.
+//
+// Scene: tests/e2e/box_room.h's closed 2 m room (both cameras, the point lamp) with bright
+// Lambertian albedos (floor 0.6, ceiling 0.8, walls 0.7/0.65/0.6: about 60 % of each surface's
+// irradiance arrives from the other surfaces), photos rendered by the path tracer at 256 paths
+// per pixel, all three albedos unknown. Stage 1 is run, its albedos are multiplied by 1.05, and
+// one stage-2 round follows.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "recon/scene.h"
+#include "solver/render.h"
+#include "solver/solve.h"
+#include "solver/solve_internal.h"
+#include "tests/e2e/box_room.h"
+#include "tests/temp_dir.h"
+#include "tools/common/image.h"
+#include "tools/common/json.h"
+
+namespace igi {
+namespace {
+namespace fs = std::filesystem;
+namespace room = test::box_room;
+
+Json BrightMaterials(bool with_albedos) {
+  Json m = {{"floor", {{"brdf", "lambert"}, {"rho_d", {0.6, 0.6, 0.6}}}},
+            {"ceiling", {{"brdf", "lambert"}, {"rho_d", {0.8, 0.8, 0.8}}}},
+            {"walls", {{"brdf", "lambert"}, {"rho_d", {0.7, 0.65, 0.6}}}}};
+  if (!with_albedos) {
+    for (auto& [name, material] : m.items()) material.erase("rho_d");
+  }
+  return m;
+}
+
+class SolveRefine : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::UniqueTempDir("solve_refine");
+    fs::create_directories(dir_ / "geometry");
+    fs::create_directories(dir_ / "photos");
+    {
+      std::FILE* f = std::fopen((dir_ / "geometry" / "room.obj").c_str(), "w");
+      ASSERT_NE(f, nullptr);
+      std::fputs(room::RoomObj(false).c_str(), f);
+      std::fclose(f);
+    }
+    Json photos = Json::array();
+    for (const char* cam : {"cam0", "cam1"}) {
+      photos.push_back(room::PhotoEntry(std::string("photos/") + cam + ".exr", cam, "L0"));
+    }
+    WriteJsonFile(dir_ / "truth.json", room::SceneDoc(BrightMaterials(true), Json::array()));
+    WriteJsonFile(dir_ / "scene.json", room::SceneDoc(BrightMaterials(false), photos));
+    SceneLoadOptions lo;
+    lo.require_complete_materials = true;
+    lo.check_images = false;
+    const Scene truth = LoadScene(dir_ / "truth.json", lo);
+    const Renderer renderer(truth, truth.FindLighting("L0"));
+    RenderOptions ro;
+    ro.spp = 256;
+    ro.seed = 9;
+    ro.num_threads = 2;
+    ro.show_progress = false;
+    for (const char* cam : {"cam0", "cam1"}) {
+      WriteImage(dir_ / "photos" / (std::string(cam) + ".exr"),
+                 renderer.Render(truth.cameras[truth.FindCamera(cam)], ro));
+    }
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Stage 1, then every solved albedo times `start_scale`, then one stage-2 round with
+  // `update`: the largest relative error of any region's albedo channel (signed), before
+  // (after the scaling) and after the round.
+  std::pair<double, double> OneRound(const std::string& update, double start_scale) const {
+    const Scene scene = LoadScene(dir_ / "scene.json");
+    SolveOptions o;
+    o.pixel_stride = 1;
+    o.refine_rays = 64;
+    o.refine_update = update;
+    o.num_threads = 2;
+    o.show_progress = false;
+    SolverState s(scene, o);
+    s.Prepare();
+    s.GatherAll();
+    s.RunStage1();
+    for (MaterialState& m : s.materials) {
+      if (!m.unknown_rho_d) continue;
+      m.params.rho_d *= start_scale;
+      for (Eigen::Vector3d& p : m.patch_rho_d) p *= start_scale;  // NaN stays NaN
+    }
+    const Json truth = BrightMaterials(true);
+    auto worst = [&]() {
+      double w = 0;
+      for (size_t r = 0; r < s.materials.size(); ++r) {
+        for (int c = 0; c < 3; ++c) {
+          const double want = truth.at(scene.materials[r].name).at("rho_d")[c].get<double>();
+          const double e = s.materials[r].params.rho_d[c] / want - 1;
+          if (std::abs(e) > std::abs(w)) w = e;
+        }
+      }
+      return w;
+    };
+    const double before = worst();
+    s.RefineRound(1, dir_ / ("maps_" + update));
+    const double after = worst();
+    for (size_t r = 0; r < s.materials.size(); ++r) {
+      const Eigen::Vector3d& v = s.materials[r].params.rho_d;
+      std::printf("  %s %-8s rho_d %.4f %.4f %.4f\n", update.c_str(),
+                  scene.materials[r].name.c_str(), v[0], v[1], v[2]);
+    }
+    EXPECT_EQ(s.summary.history.back().albedo_update, update);
+    return {before, after};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(SolveRefine, JointRoundLandsOnTheAlbedosWhereTheIndependentOneOvershoots) {
+  const auto [joint_before, joint_after] = OneRound("joint", 1.05);
+  const auto [indep_before, indep_after] = OneRound("independent", 1.05);
+  std::printf(
+      "worst albedo error: start %+.2f %%, joint round %+.2f %%, independent round %+.2f %%\n",
+      100 * joint_before, 100 * joint_after, 100 * indep_after);
+  EXPECT_GT(joint_before, 0.04);  // the start really is off
+  // 1 %: issue 7's bar for region means. The round's own noise (64 rendered directions per
+  // observation, every pixel, 256-path photos) is a few tenths of a per cent.
+  EXPECT_LT(std::abs(joint_after), 0.01);
+  // The scene must show the feedback, or the check above guards nothing: the independent
+  // round from the same start swings past the answer by more than it started off.
+  EXPECT_LT(indep_after, -0.05);
+}
+
+}  // namespace
+}  // namespace igi
