@@ -222,8 +222,8 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
   if (&search != &f) {
     best = LobeFit(f, region, m)(bp.ax, bp.ay, tangent);
     if (!physical(best)) {
-      out.note = fmt::format("region {}: the lobe found on a subsample does not fit every record",
-                             m.name);
+      out.note =
+          fmt::format("region {}: the lobe found on a subsample does not fit every record", m.name);
       return out;
     }
   }
@@ -698,9 +698,8 @@ CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f
   const PixelRecord* first = f.records().data();
   // The response is rendered on its own paths: no part of the simulation's noise (a plain fit
   // would credit it with the noise of the sim it partly replaces when the albedos are refitted).
-  const ResidualFit fit = f.FitNoiseFreeBasis(3, [&](const PixelRecord& r, int c, double* b) {
-    b[c] = response[&r - first][c];
-  });
+  const ResidualFit fit = f.FitNoiseFreeBasis(
+      3, [&](const PixelRecord& r, int c, double* b) { b[c] = response[&r - first][c]; });
   if (fit.coef.size() == 0) return out;
   const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
   if (!(radiance.minCoeff() > 0)) {

@@ -201,8 +201,8 @@ RecordSubset::RecordSubset(const Scene& model, const std::vector<PixelRecord>& r
   }
   int num_cells = 0;
   std::vector<int> cells = RecordCells(model, records_, cell_m, &num_cells);
-  fitter_ = std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance,
-                                             block_px);
+  fitter_ =
+      std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance, block_px);
 }
 
 int SearchStride(const std::vector<PixelRecord>& records, int target) {

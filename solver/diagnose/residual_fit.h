@@ -59,7 +59,8 @@ class ResidualFitter {
   // gain's scale, as in the refit's test). Only with the nuisance (solved materials).
   template <class F>
   ResidualFit FitNoiseFreeBasis(int k, F basis) const {
-    return FitImpl(k, basis, [](const PixelRecord&, int) { return 0.0; }, nuisance_);
+    return FitImpl(
+        k, basis, [](const PixelRecord&, int) { return 0.0; }, nuisance_);
   }
 
   const std::vector<PixelRecord>& records() const { return records_; }
@@ -174,8 +175,7 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) c
       support |= y != y0 || std::any_of(b.begin(), b.end(), [](double v) { return v != 0; });
       double cb = 0;
       for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
-      const double a0 =
-          NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd(), noise_free);
+      const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd(), noise_free);
       const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef, noise_free);
       g += (y0 - a0 * s) * (y0 - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
       // The render's noise in the residual, (1 + a)² var: its change is not the candidate's gain.

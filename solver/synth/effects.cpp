@@ -222,8 +222,8 @@ Json Ambient(Params& p, const SynthRoom& room, SynthScenes* s) {
     s->true_scene["lights"]["ambient"] =
         Json{{"type", "ambient"}, {"radiance", Vec(Vector3d::Constant(radiance))}};
     for (auto& [name, list] : s->true_scene["lightings"].items()) list.push_back("ambient");
-    return Json{{"light", s->true_scene["lights"]["ambient"]}, {"lightings", "all"},
-                {"kind", kind}};
+    return Json{
+        {"light", s->true_scene["lights"]["ambient"]}, {"lightings", "all"}, {"kind", kind}};
   }
   const double x = room.size.x() - 0.002;
   SynthMesh mesh;

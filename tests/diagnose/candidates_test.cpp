@@ -159,11 +159,10 @@ TEST(RecordSubsetTest, AQuarterOrOneRegion) {
   const RecordSubset walls(model, records, 0.05, true, 8, 1, 1);  // odd records are the wall's
   EXPECT_EQ(walls.records().size(), records.size() / 2);
   for (const PixelRecord& r : walls.records()) EXPECT_EQ(r.region, 1);
-  EXPECT_EQ(SearchStride(records, 1000), int(std::count_if(records.begin(), records.end(),
-                                                           [](const PixelRecord& r) {
-                                                             return !r.held_out && !r.outlier;
-                                                           }) /
-                                              1000));
+  EXPECT_EQ(SearchStride(records, 1000),
+            int(std::count_if(records.begin(), records.end(),
+                              [](const PixelRecord& r) { return !r.held_out && !r.outlier; }) /
+                1000));
   EXPECT_EQ(SearchStride(records, 1000000), 1);
 }
 

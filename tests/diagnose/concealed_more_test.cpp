@@ -1,9 +1,9 @@
 // igi-diagnose on concealed data (issue 8): the effects of the suite not proven elsewhere —
 // light_intensity, specular_reflection, ambient_light — and captures hiding a PAIR of effects.
 // Same fixture and size as diagnose_concealed_test (4 cameras of 160×120, photos at 64 paths per
-// pixel, a point lamp, materials given, seed 11). For each: the first step igi-diagnose keeps names the hidden
-// effect (for a pair, one of the two, and both are kept), and the final residual comes within
-// 1.2× of the true model's (ExpectReachesTheFloor).
+// pixel, a point lamp, materials given, seed 11). For each: the first step igi-diagnose keeps names
+// the hidden effect (for a pair, one of the two, and both are kept), and the final residual comes
+// within 1.2× of the true model's (ExpectReachesTheFloor).
 //
 // Measured 2026-11-22 (load average 5–6, 2–4 min per case):
 // - light_intensity (the lamp 1.25× brighter): light_intensity first, factor 1.241; final

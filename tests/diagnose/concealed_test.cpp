@@ -36,8 +36,8 @@ TEST_P(ConcealedEffectTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
 }
 
 // fresnel needs a capture that sees a glossy surface at grazing incidence, where Schlick's weight
-// departs from 1 (at the default views' 35-50 deg it is within 2 %, and the true model's residual is
-// the declared one's): the lamp 0.6 m above the floor and one more camera on the mirror view of
+// departs from 1 (at the default views' 35-50 deg it is within 2 %, and the true model's residual
+// is the declared one's): the lamp 0.6 m above the floor and one more camera on the mirror view of
 // the floor's highlight at 60-80 deg (igi-synth --lamp-position, --grazing-cameras). Only the
 // floor is Fresnel-weighted (at that lamp height every region would be, and the glossy box's top
 // face, lit at 90 deg, would send a narrow lobe 25x brighter into the box's camera). Measured

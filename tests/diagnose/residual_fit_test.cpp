@@ -236,8 +236,8 @@ TEST(ResidualFitTest, ANoiseFreeBasisIsNotCreditedWithTheRendersNoise) {
   const ResidualFit found = g.FitNoiseFreeBasis(
       1, [&](const PixelRecord& r, int, double* b) { b[0] = some.basis[&r - base]; });
   ASSERT_EQ(found.coef.size(), 1);
-  std::printf("effect 0.2: noise-free coef %.4f, gain %.3f, z %.1f\n", found.coef[0],
-              found.Gain(), found.z);
+  std::printf("effect 0.2: noise-free coef %.4f, gain %.3f, z %.1f\n", found.coef[0], found.Gain(),
+              found.z);
   EXPECT_NEAR(found.coef[0], 0.2, 0.03);
 }
 
