@@ -2,6 +2,8 @@
 // A 2 m cube room for end-to-end tests of igi-solve and igi-run (tests/e2e): its mesh, two
 // cameras, one point lamp, the true Lambertian materials and the scene.json around them.
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "tools/common/json.h"
@@ -69,6 +71,13 @@ inline Json SceneDoc(const Json& materials, const Json& photos) {
 inline Json PhotoEntry(const std::string& file, const std::string& camera, const std::string& lighting,
                 const Json& mask = nullptr) {
   return Json{{"file", file}, {"camera", camera}, {"lighting", lighting}, {"mask", mask}};
+}
+
+// A scene folder's skeleton: dir/geometry/room.obj (RoomObj(false)) and an empty dir/photos.
+inline void WriteRoomFolder(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "geometry");
+  std::filesystem::create_directories(dir / "photos");
+  std::ofstream(dir / "geometry" / "room.obj") << RoomObj(false);
 }
 
 }  // namespace igi::test::box_room

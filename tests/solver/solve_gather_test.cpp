@@ -41,14 +41,8 @@ class SolveGather : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::UniqueTempDir("solve_gather");
-    fs::create_directories(dir_ / "geometry");
-    fs::create_directories(dir_ / "photos");
-    {
-      std::FILE* f = std::fopen((dir_ / "geometry" / "room.obj").c_str(), "w");
-      ASSERT_NE(f, nullptr);
-      std::fputs(room::RoomObj(false).c_str(), f);
-      std::fclose(f);
-    }
+    room::WriteRoomFolder(dir_);
+    ASSERT_TRUE(fs::exists(dir_ / "geometry" / "room.obj"));
     const Json photos = Json::array({room::PhotoEntry("photos/cam1.exr", "cam1", "L0")});
     // The truth has no photos (they are rendered from it).
     WriteJsonFile(dir_ / "truth.json", room::SceneDoc(Materials(true), Json::array()));

@@ -46,14 +46,8 @@ class SolveRefine : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::UniqueTempDir("solve_refine");
-    fs::create_directories(dir_ / "geometry");
-    fs::create_directories(dir_ / "photos");
-    {
-      std::FILE* f = std::fopen((dir_ / "geometry" / "room.obj").c_str(), "w");
-      ASSERT_NE(f, nullptr);
-      std::fputs(room::RoomObj(false).c_str(), f);
-      std::fclose(f);
-    }
+    room::WriteRoomFolder(dir_);
+    ASSERT_TRUE(fs::exists(dir_ / "geometry" / "room.obj"));
     Json photos = Json::array();
     for (const char* cam : {"cam0", "cam1"}) {
       photos.push_back(room::PhotoEntry(std::string("photos/") + cam + ".exr", cam, "L0"));
