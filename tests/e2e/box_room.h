@@ -68,8 +68,8 @@ inline Json SceneDoc(const Json& materials, const Json& photos) {
       {"photos", photos}};
 }
 
-inline Json PhotoEntry(const std::string& file, const std::string& camera, const std::string& lighting,
-                const Json& mask = nullptr) {
+inline Json PhotoEntry(const std::string& file, const std::string& camera,
+                       const std::string& lighting, const Json& mask = nullptr) {
   return Json{{"file", file}, {"camera", camera}, {"lighting", lighting}, {"mask", mask}};
 }
 

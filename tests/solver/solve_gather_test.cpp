@@ -21,6 +21,7 @@
 #include "solver/render_internal.h"
 #include "solver/solve.h"
 #include "tests/e2e/box_room.h"
+#include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
@@ -47,18 +48,7 @@ class SolveGather : public ::testing::Test {
     // The truth has no photos (they are rendered from it).
     WriteJsonFile(dir_ / "truth.json", room::SceneDoc(Materials(true), Json::array()));
     WriteJsonFile(dir_ / "scene.json", room::SceneDoc(Materials(false), photos));
-    SceneLoadOptions lo;
-    lo.require_complete_materials = true;
-    lo.check_images = false;
-    const Scene truth = LoadScene(dir_ / "truth.json", lo);
-    const Renderer renderer(truth, truth.FindLighting("L0"));
-    RenderOptions ro;
-    ro.spp = 256;
-    ro.seed = 5;
-    ro.num_threads = 2;
-    ro.show_progress = false;
-    WriteImage(dir_ / "photos" / "cam1.exr",
-               renderer.Render(truth.cameras[truth.FindCamera("cam1")], ro));
+    room::RenderTruthPhotos(dir_, {"cam1"}, 256, 5);
   }
 
   // The solved ceiling albedo's relative error (paper stage only).

@@ -23,6 +23,7 @@
 #include "solver/solve.h"
 #include "solver/solve_internal.h"
 #include "tests/e2e/box_room.h"
+#include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
@@ -54,20 +55,7 @@ class SolveRefine : public ::testing::Test {
     }
     WriteJsonFile(dir_ / "truth.json", room::SceneDoc(BrightMaterials(true), Json::array()));
     WriteJsonFile(dir_ / "scene.json", room::SceneDoc(BrightMaterials(false), photos));
-    SceneLoadOptions lo;
-    lo.require_complete_materials = true;
-    lo.check_images = false;
-    const Scene truth = LoadScene(dir_ / "truth.json", lo);
-    const Renderer renderer(truth, truth.FindLighting("L0"));
-    RenderOptions ro;
-    ro.spp = 256;
-    ro.seed = 9;
-    ro.num_threads = 2;
-    ro.show_progress = false;
-    for (const char* cam : {"cam0", "cam1"}) {
-      WriteImage(dir_ / "photos" / (std::string(cam) + ".exr"),
-                 renderer.Render(truth.cameras[truth.FindCamera(cam)], ro));
-    }
+    room::RenderTruthPhotos(dir_, {"cam0", "cam1"}, 256, 9);
   }
   void TearDown() override { fs::remove_all(dir_); }
 
