@@ -345,7 +345,7 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
 // value (below that, the render's own noise at a few hundred paths per pixel hides it), in
 // held-out blocks with at least kMinBlockRecords such records (a block of one changed record
 // scores noise). Elsewhere it is set to zero: those records are outside the candidate's support.
-// On a subsample of every `stride`-th record the blocks hold that many times fewer records.
+// On a subsample of one record in `stride` the blocks hold that many times fewer records.
 void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int stride,
                        std::vector<Eigen::Vector3f>* change) {
   const int min_records = std::max(1, kMinBlockRecords / std::max(1, stride));
@@ -499,7 +499,7 @@ class ExtentChange {
   Change ch_;
 };
 
-// The radius is searched on `search`'s records (every `stride`-th of f's), then fitted and scored
+// The radius is searched on `search`'s records (one in `stride` of f's), then fitted and scored
 // on f's.
 CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
                           const ResidualFitter& search, int stride, int light) {
