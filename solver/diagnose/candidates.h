@@ -74,6 +74,15 @@ CandidateResult SpecularReflection(const CandidateContext& context, const Residu
 CandidateResult EmissionProfile(const CandidateContext& context, const ResidualFitter& fitter,
                                 int light, const RecordSubset* search = nullptr);
 
+// specular_lobe_shape (ward <-> ward_gmd) and fresnel (plain -> *_fresnel) on glossy region
+// `region`: the change of its specular term. With the materials given (the refit keeps ρs and α)
+// the alternative lobe less the current one at the same values, with an amplitude that must stay
+// near 1; with them solved (the refit re-solves ρs and α) the current lobe is replaced by the
+// alternative at a searched α' with a free ρs scale, and credited only with what it explains
+// beyond the current model re-fitted the same way. fresnel also searches the index.
+CandidateResult LobeChange(const CandidateContext& context, const ResidualFitter& fitter,
+                           int region, bool fresnel);
+
 // Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
 // `excluded` (they are not fitted at all).
 std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
