@@ -6,18 +6,18 @@
 // photos of a point light.
 #include "solver/diagnose/candidates_brdf_light.h"
 
-#include "solver/diagnose/candidates.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "solver/brdf.h"
+#include "solver/diagnose/candidates.h"
 #include "solver/photo_model.h"
 #include "solver/render.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "tests/diagnose/one_light_record.h"
 
 namespace igi {
 namespace {
@@ -76,23 +76,10 @@ std::vector<PixelRecord> PlateRecords(bool anisotropic, uint64_t seed, double tr
     const Vector3d h = Vector3d(0.15 * g(rng), 0.15 * g(rng), 1).normalized();
     const Vector3d wo = 2 * h.dot(wi) * h - wi;
     if (!(wo.z() > 0.1)) continue;
-    PixelRecord r;
-    r.photo = int(out.size() % 4);
-    r.x = int(out.size() / 4) % 160;
-    r.y = int(out.size() / 640) % 120;
-    r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(r.photo, r.x, r.y);
-    r.region = 0;
-    r.position = p.cast<float>();
-    r.normal = Vector3f::UnitZ();
-    r.view = wo.cast<float>();
-    r.albedo = kRhoD.cast<float>();
     const double e = intensity * wi.z() / (d * d);
-    RecordLightSample ls;
-    ls.light = 0;
-    ls.wi = wi.cast<float>();
-    ls.irradiance = Vector3f::Constant(float(e));
-    ls.distance = float(d);
-    r.lights.push_back(ls);
+    const int n = int(out.size());
+    PixelRecord r = test::OneLightRecord(n % 4, (n / 4) % 160, (n / 640) % 120, 0, p,
+                                         Vector3d::UnitZ(), wo, kRhoD.cast<float>(), wi, e, d);
     const double s_model = Lobe(BrdfModel::kWard, kAlpha, kAlpha, 0, wo, wi);
     const double ax = true_ax > 0 ? true_ax : anisotropic ? 0.03 : 0.08;
     const double ay = anisotropic ? (true_ay > 0 ? true_ay : 0.15) : ax;

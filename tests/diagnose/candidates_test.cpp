@@ -14,6 +14,7 @@
 #include "solver/diagnose/residual_fit.h"
 #include "solver/photo_model.h"
 #include "solver/sampling.h"
+#include "tests/diagnose/one_light_record.h"
 
 namespace igi {
 namespace {
@@ -64,22 +65,8 @@ std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t see
     const double e = kIntensity * std::max(0.0, wi.dot(n)) / (d * d);
     const double direct = kRho / kPi * e;
     const double cos_axis = wi.z();  // cos of the angle from −z of the direction lamp → point
-    PixelRecord r;
-    r.photo = i % 4;
-    r.x = (i / 4) % 160;
-    r.y = (i / 640) % 120;
-    r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(r.photo, r.x, r.y);
-    r.region = wall ? 1 : 0;
-    r.position = p.cast<float>();
-    r.normal = n.cast<float>();
-    r.view = n.cast<float>();
-    r.albedo = Vector3f::Constant(float(kRho));
-    RecordLightSample ls;
-    ls.light = 0;
-    ls.wi = wi.cast<float>();
-    ls.irradiance = Vector3f::Constant(float(e));
-    ls.distance = float(d);
-    r.lights.push_back(ls);
+    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n,
+                                         n, Vector3f::Constant(float(kRho)), wi, e, d);
     const double truth = direct * std::pow(std::max(0.0, cos_axis), power) + kBounce;
     const double recorded = ref * std::pow(truth / ref, exponent);
     for (int c = 0; c < 3; ++c) {
@@ -208,22 +195,9 @@ std::vector<PixelRecord> PlateRecords(bool fresnel_truth, double truth_alpha, do
     const double weight = fresnel_truth ? 1 + (1 / f0 - 1) * std::pow(1 - c, 5) : 1.0;
     const double truth = rho_d / kPi * e + rho_s * weight * ward(n, wi, wo, truth_alpha) * e;
     const double model = rho_d / kPi * e + model_rho_s * ward(n, wi, wo, model_alpha) * e;
-    PixelRecord r;
-    r.photo = grazing ? 1 : 0;
-    r.x = int(u(rng) * 160);
-    r.y = int(u(rng) * 120);
-    r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(r.photo, r.x, r.y);
-    r.region = 0;
-    r.position = p.cast<float>();
-    r.normal = n.cast<float>();
-    r.view = wo.cast<float>();
-    r.albedo = Vector3f::Constant(float(rho_d));
-    RecordLightSample ls;
-    ls.light = 0;
-    ls.wi = wi.cast<float>();
-    ls.irradiance = Vector3f::Constant(float(e));
-    ls.distance = float(dist);
-    r.lights.push_back(ls);
+    const int x = int(u(rng) * 160), y = int(u(rng) * 120);
+    PixelRecord r = test::OneLightRecord(grazing ? 1 : 0, x, y, 0, p, n, wo,
+                                         Vector3f::Constant(float(rho_d)), wi, e, dist);
     for (int k = 0; k < 3; ++k) {
       r.sim[k] = float(model);
       r.recorded[k] = float(truth * (1 + 0.01 * g(rng)));

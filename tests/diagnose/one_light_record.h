@@ -1,0 +1,36 @@
+#pragma once
+// A residual sample lit by one light (light 0), for the candidates' unit tests: its pixel (held
+// out by the diagnosis's default rule on 8-px blocks), surface point and the light's sample.
+// sim and recorded are left to the caller.
+
+#include <Eigen/Core>
+
+#include "solver/diagnose/pixel_records.h"
+#include "solver/photo_model.h"
+
+namespace igi::test {
+
+inline PixelRecord OneLightRecord(int photo, int x, int y, int region,
+                                  const Eigen::Vector3d& position, const Eigen::Vector3d& normal,
+                                  const Eigen::Vector3d& view, const Eigen::Vector3f& albedo,
+                                  const Eigen::Vector3d& wi, double irradiance, double distance) {
+  PixelRecord r;
+  r.photo = photo;
+  r.x = x;
+  r.y = y;
+  r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(photo, x, y);
+  r.region = region;
+  r.position = position.cast<float>();
+  r.normal = normal.cast<float>();
+  r.view = view.cast<float>();
+  r.albedo = albedo;
+  RecordLightSample ls;
+  ls.light = 0;
+  ls.wi = wi.cast<float>();
+  ls.irradiance = Eigen::Vector3f::Constant(float(irradiance));
+  ls.distance = float(distance);
+  r.lights.push_back(ls);
+  return r;
+}
+
+}  // namespace igi::test
