@@ -14,6 +14,17 @@
 namespace igi {
 namespace {
 
+// A record at a random pixel of a 160×120 photo, held out by 16-px blocks.
+PixelRecord RandomPixel(int photo, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  PixelRecord r;
+  r.photo = photo;
+  r.x = int(u(rng) * 160);
+  r.y = int(u(rng) * 120);
+  r.held_out = PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
+  return r;
+}
+
 // Records on `cells` cells; the photo is sim·(1 + k·r²)·albedo_error[cell] + noise. Each cell is
 // seen around its own image radius (as a surface seen mostly from one place in one photo), and
 // with `confounded` its albedo error follows that radius — as when an albedo map has absorbed part
@@ -32,11 +43,7 @@ std::vector<PixelRecord> Records(double k, double albedo_spread, double noise, i
   }
   std::vector<PixelRecord> out;
   for (int i = 0; i < 20000; ++i) {
-    PixelRecord r;
-    r.photo = i % 4;
-    r.x = int(u(rng) * 160);
-    r.y = int(u(rng) * 120);
-    r.held_out = PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
+    PixelRecord r = RandomPixel(i % 4, rng);
     const int cell = i % cells;
     r.r2 = float(center[cell] + 0.3 * (u(rng) - 0.5));
     cell_of->push_back(cell);
@@ -194,11 +201,7 @@ NoisySimRecords NoisySim(double effect, uint64_t seed) {
   std::normal_distribution<double> n(0, 1);
   NoisySimRecords out;
   for (int i = 0; i < 40000; ++i) {
-    PixelRecord r;
-    r.photo = i % 4;
-    r.x = int(u(rng) * 160);
-    r.y = int(u(rng) * 120);
-    r.held_out = PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
+    PixelRecord r = RandomPixel(i % 4, rng);
     const int cell = i % 20;
     const double t = 0.5 + u(rng);  // the true radiance (before the effect)
     const float b = float(0.3 * t * (0.8 + 0.4 * std::sin(0.01 * i)));  // shaped like t
