@@ -74,6 +74,71 @@ std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, 
   return t;
 }
 
+// T_c(α) for every sample as SpecularTerms computes it, with the α-independent part of each
+// incident sample's specular factor computed once (the α search evaluates T at dozens of α):
+// both models' S·W·v is g·v·exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²)/(α_x·α_y), g from the directions
+// alone; terms whose exponent passes kMaxExponent (below e⁻⁶⁰ of their own peak) are skipped.
+class LobeTable {
+ public:
+  explicit LobeTable(const RegionFitInput& in) : in_(&in) {
+    if (!HasSpecularLobe(in.model)) return;
+    begin_.reserve(in.samples.size() + 1);
+    for (const FitSample& s : in.samples) {
+      begin_.push_back(static_cast<int>(entries_.size()));
+      const Eigen::Vector3d wo = s.wo.cast<double>();
+      if (!(wo.z() > 0.0)) continue;
+      for (int k = s.incident_begin; k < s.incident_end; ++k) {
+        const IncidentLocal& inc = in.incident[k];
+        const Eigen::Vector3d wi = inc.wi.cast<double>();
+        if (!(wi.z() > 0.0)) continue;
+        const Eigen::Vector3d h = wo + wi;
+        const double hz2 = h.z() * h.z();
+        // The factor at α = 1 without its exponential, so that g·exp(−q)/(α_x·α_y) is S.
+        double g = IsGmd(in.model) ? h.squaredNorm() / (kPi * hz2 * hz2)
+                                   : 1.0 / (4.0 * kPi * std::sqrt(wo.z() * wi.z()));
+        if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
+        const Eigen::Vector3d gv = g * inc.value.cast<double>();
+        if (!(g > 0.0) || !gv.allFinite()) continue;
+        entries_.push_back(
+            {float(h.x() * h.x() / hz2), float(h.y() * h.y() / hz2), gv.cast<float>()});
+      }
+    }
+    begin_.push_back(static_cast<int>(entries_.size()));
+  }
+
+  std::vector<Eigen::Vector3d> Terms(double ax, double ay) const {
+    const RegionFitInput& in = *in_;
+    std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
+    if (!HasSpecularLobe(in.model)) return t;
+    const double ix = 1.0 / (ax * ax), iy = 1.0 / (ay * ay), norm = 1.0 / (ax * ay);
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int k = begin_[i]; k < begin_[i + 1]; ++k) {
+        const Entry& e = entries_[k];
+        const double q = e.qx * ix + e.qy * iy;
+        if (q < kMaxExponent) sum += double(std::exp(-float(q))) * e.gv.cast<double>();
+      }
+      sum *= norm;
+      const FitSample& s = in.samples[i];
+      if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
+        sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
+      }
+      t[i] = sum;
+    }
+    return t;
+  }
+
+ private:
+  static constexpr double kMaxExponent = 60.0;
+  struct Entry {  // per incident sample: h_x²/h_z², h_y²/h_z², g·v
+    float qx, qy;
+    Eigen::Vector3f gv;
+  };
+  const RegionFitInput* in_;
+  std::vector<int> begin_;
+  std::vector<Entry> entries_;
+};
+
 // The linear part for given specular terms: ρs and per-slot ρd by least squares.
 struct LinearSolution {
   double cost = std::numeric_limits<double>::infinity();
@@ -143,7 +208,8 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
   if (in.fit_rho_d) {
     for (int s = 0; s < slots; ++s) {
       for (int c = 0; c < 3; ++c) {
-        if (A[s][c] > 0) sol.slot_rho_d[s][c] = std::max(0.0, (B[s][c] - sol.rho_s[c] * C[s][c]) / A[s][c]);
+        if (A[s][c] > 0)
+          sol.slot_rho_d[s][c] = std::max(0.0, (B[s][c] - sol.rho_s[c] * C[s][c]) / A[s][c]);
       }
     }
   }
@@ -160,8 +226,9 @@ struct AlphaSearch {
 AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch) {
   AlphaSearch best;
   const bool aniso = IsAnisotropic(in.model);
+  const LobeTable table(in);
   auto eval = [&](double ax, double ay) {
-    return SolveLinear(in, pr, SpecularTerms(in, ax, ay), per_patch);
+    return SolveLinear(in, pr, table.Terms(ax, ay), per_patch);
   };
   if (!HasSpecularLobe(in.model)) {
     best.linear = eval(0.1, 0.1);
@@ -174,7 +241,7 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     double c = b - g * (b - a), d = a + g * (b - a);
     double fc = f(c), fd = f(d);
-    for (int it = 0; it < 20; ++it) {
+    for (int it = 0; it < 14; ++it) {
       if (fc < fd) {
         b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
       } else {
@@ -201,7 +268,8 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     };
     if (in.alpha_hint && *in.alpha_hint > 0) {
       // A window of ±0.4 in log α around the hint; accepted unless the minimum sits at its edge.
-      const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4), b = std::min(hi, c + 0.4);
+      const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4),
+                   b = std::min(hi, c + 0.4);
       const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
       if (la > a + 0.02 && la < b - 0.02) return finish(la);
     }
@@ -214,7 +282,8 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
       if (c < best_cost) best_cost = c, best_i = i;
     }
     const double step = (hi - lo) / (kGrid - 1);
-    const double a = lo + step * std::max(0, best_i - 1), b = lo + step * std::min(kGrid - 1, best_i + 1);
+    const double a = lo + step * std::max(0, best_i - 1),
+                 b = lo + step * std::min(kGrid - 1, best_i + 1);
     return finish(golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; }));
   }
   // Anisotropic: a coarse grid, then alternating golden sections.
@@ -303,7 +372,8 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   const bool aniso = IsAnisotropic(in.model);
   const bool fit_s = spec && !in.rho_s_grey && !in.rho_s_rgb;
   const bool fit_a = spec && !(aniso ? (in.alpha_x && in.alpha_y) : bool(in.alpha));
-  out.rho_d = start.linear.slot_rho_d.empty() ? Eigen::Vector3d::Zero() : start.linear.slot_rho_d[0];
+  out.rho_d =
+      start.linear.slot_rho_d.empty() ? Eigen::Vector3d::Zero() : start.linear.slot_rho_d[0];
   out.rho_s = start.linear.rho_s;
   out.ax = start.ax;
   out.ay = start.ay;
@@ -364,7 +434,9 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   out.message = summary.message;
   if (!out.ok) return out;
   if (in.fit_rho_d) out.rho_d = Eigen::Vector3d(d[0], d[1], d[2]);
-  if (fit_s) out.rho_s = in.grey_specular ? Eigen::Vector3d::Constant(rs[0]) : Eigen::Vector3d(rs[0], rs[1], rs[2]);
+  if (fit_s)
+    out.rho_s =
+        in.grey_specular ? Eigen::Vector3d::Constant(rs[0]) : Eigen::Vector3d(rs[0], rs[1], rs[2]);
   if (fit_a) out.ax = al[0], out.ay = aniso ? al[1] : al[0];
   // Covariance scaled by the residual variance (the weights are relative, not true sigmas).
   const int k = (in.fit_rho_d ? 3 : 0) + (fit_s ? ns : 0) + (fit_a ? na : 0);
@@ -445,7 +517,8 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
     ++(*counts)[s.slot];
     for (int c = 0; c < 3; ++c) info[s.slot] += std::pow(pr.w[i][c] * pr.a[i][c], 2) / 3;
     if (!b.slot_rho_d[s.slot].allFinite()) continue;
-    const Eigen::Vector3d pred = b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d pred =
+        b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
     if (pred.allFinite()) rss += (pr.w[i].cwiseProduct(pred - s.observed)).squaredNorm();
   }
   int used = 0;

@@ -79,6 +79,13 @@ inline uint64_t MixBits(uint64_t v) {
   return v ^ (v >> 31u);
 }
 
+// Whether item `key` is in a subset that keeps each item with probability `p`, decided by a hash
+// of the key alone: reproducible, and even over any pattern in the keys (a regular stride
+// through pixel rows aliases with a texture's period; this does not).
+inline bool InHashedSubset(uint64_t key, double p) {
+  return p >= 1.0 || double(MixBits(key + 0x9e3779b97f4a7c15ULL) >> 11) * 0x1.0p-53 < p;
+}
+
 // The generator for one sample of one pixel of a render seeded with `seed`: the same triple
 // always gives the same numbers; different triples give independent-looking streams.
 inline Pcg32 PixelSampleRng(uint64_t seed, uint64_t pixel_index, uint64_t sample_index) {
