@@ -104,6 +104,21 @@ T SpecularFactor(BrdfModel model, const T& alpha_x, const T& alpha_y,
   return lobe / (T(4.0 * kPi) * alpha_x * alpha_y * sqrt(wo.z() * wi.z()));
 }
 
+// SpecularFactor split into the parts that do not depend on the roughness, for searches over α:
+// S = g·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y). False (parts unset) when S is 0 at every α (no lobe,
+// or wo or wi at or below the surface).
+inline bool SpecularFactorParts(BrdfModel model, const Eigen::Vector3d& wo,
+                                const Eigen::Vector3d& wi, double* q_x, double* q_y, double* g) {
+  if (!HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return false;
+  const Eigen::Vector3d h = wo + wi;
+  const double hz2 = h.z() * h.z();
+  *q_x = h.x() * h.x() / hz2;
+  *q_y = h.y() * h.y() / hz2;
+  *g = IsGmd(model) ? h.squaredNorm() / (kPi * hz2 * hz2)
+                    : 1.0 / (4.0 * kPi * std::sqrt(wo.z() * wi.z()));
+  return true;
+}
+
 // W(c) of the header comment: Schlick's Fresnel factor over its normal-incidence value, with
 // F0 = ((ior − 1)/(ior + 1))² and c = |wo + wi|/2 = ĥ·wi.
 template <typename T>

@@ -76,8 +76,8 @@ std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, 
 
 // T_c(α) for every sample as SpecularTerms computes it, with the α-independent part of each
 // incident sample's specular factor computed once (the α search evaluates T at dozens of α):
-// both models' S·W·v is g·v·exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²)/(α_x·α_y), g from the directions
-// alone; terms whose exponent passes kMaxExponent (below e⁻⁶⁰ of their own peak) are skipped.
+// S·W·v is g·W·v·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y) (SpecularFactorParts, solver/brdf.h);
+// terms whose exponent passes kMaxExponent (below e⁻⁶⁰ of their own peak) are skipped.
 class LobeTable {
  public:
   explicit LobeTable(const RegionFitInput& in) : in_(&in) {
@@ -86,21 +86,15 @@ class LobeTable {
     for (const FitSample& s : in.samples) {
       begin_.push_back(static_cast<int>(entries_.size()));
       const Eigen::Vector3d wo = s.wo.cast<double>();
-      if (!(wo.z() > 0.0)) continue;
       for (int k = s.incident_begin; k < s.incident_end; ++k) {
         const IncidentLocal& inc = in.incident[k];
         const Eigen::Vector3d wi = inc.wi.cast<double>();
-        if (!(wi.z() > 0.0)) continue;
-        const Eigen::Vector3d h = wo + wi;
-        const double hz2 = h.z() * h.z();
-        // The factor at α = 1 without its exponential, so that g·exp(−q)/(α_x·α_y) is S.
-        double g = IsGmd(in.model) ? h.squaredNorm() / (kPi * hz2 * hz2)
-                                   : 1.0 / (4.0 * kPi * std::sqrt(wo.z() * wi.z()));
+        double qx = 0, qy = 0, g = 0;
+        if (!SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
         if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
         const Eigen::Vector3d gv = g * inc.value.cast<double>();
         if (!(g > 0.0) || !gv.allFinite()) continue;
-        entries_.push_back(
-            {float(h.x() * h.x() / hz2), float(h.y() * h.y() / hz2), gv.cast<float>()});
+        entries_.push_back({float(qx), float(qy), gv.cast<float>()});
       }
     }
     begin_.push_back(static_cast<int>(entries_.size()));

@@ -165,7 +165,9 @@ FakeCamera::FakeCamera(const std::string& serial, const std::filesystem::path& l
             return args;
           }(),
           log_path) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  // Returns as soon as the port is bound; the generous limit is for a loaded machine (a 5 s limit
+  // failed once while a build ran beside the suite on 2 cores).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline && process_.Running()) {
     if (GvcpPortInUse()) {
       ready_ = true;

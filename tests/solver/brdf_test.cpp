@@ -287,6 +287,31 @@ TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicroface
   EXPECT_NEAR(FresnelWeight(1.5, a, b), 22.97755, 22.98e-6);
 }
 
+// The solver's α search builds SpecularFactor from these parts once per direction pair
+// (solver/region_fit.cpp): they must give it back at any roughness, and nothing below the surface.
+TEST(BrdfEvalTest, SpecularFactorPartsGiveTheFactorAtAnyRoughness) {
+  Pcg32 rng(5, 6);
+  for (BrdfModel model : kAllModels) {
+    for (int i = 0; i < 500; ++i) {
+      const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
+      const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
+      const double ax = 0.02 + 0.5 * rng.UniformDouble(), ay = 0.02 + 0.5 * rng.UniformDouble();
+      double qx = 0, qy = 0, g = 0;
+      const double s = SpecularFactor<double>(model, ax, ay, wo, wi);
+      if (!SpecularFactorParts(model, wo, wi, &qx, &qy, &g)) {
+        EXPECT_FALSE(HasSpecularLobe(model));
+        EXPECT_EQ(s, 0.0);
+        continue;
+      }
+      const double parts = g * std::exp(-(qx / (ax * ax) + qy / (ay * ay))) / (ax * ay);
+      EXPECT_NEAR(parts, s, 1e-12 * std::max(1.0, s)) << BrdfModelName(model);
+    }
+    double qx = 0, qy = 0, g = 0;
+    EXPECT_FALSE(SpecularFactorParts(model, {0, 0.6, -0.8}, {0, 0, 1}, &qx, &qy, &g));
+    EXPECT_FALSE(SpecularFactorParts(model, {0, 0, 1}, {0.6, 0, -0.8}, &qx, &qy, &g));
+  }
+}
+
 TEST(BrdfEvalTest, IsReciprocal) {
   Pcg32 rng(3, 4);
   for (BrdfModel model : kAllModels) {
