@@ -32,7 +32,6 @@ double Since(Clock::time_point t) {
 // Fit samples per region and stage (SolverState::SelectFitSamples).
 constexpr size_t kMaxFitSamples = 6000;
 constexpr size_t kMaxHighlightSamples = kMaxFitSamples * 2 / 3;
-constexpr size_t kMinOtherSamples = 2000;
 
 // Marks about `count` of `indices` in `chosen` (all when there are no more), each drawn with the
 // same probability by a hash of its value; returns how many it marked.
@@ -246,14 +245,13 @@ void SolverState::SelectFitSamples() {
     (highlight ? near : rest)[o.region].push_back(int(i));
   }
   // The highlight observations carry ρs and α, the rest mostly the albedo: up to
-  // kMaxHighlightSamples of the first, then the rest up to kMaxFitSamples in all (at least
-  // kMinOtherSamples). Both drawn by a hash of the observation's index: a regular stride through
-  // the photos' pixel rows aliased with a texture's period (the SolveSynth room's textured floor,
-  // ρs 0.04: −10.3 % with the stride, +2.1 % drawn by hash).
+  // kMaxHighlightSamples of the first, then the rest up to kMaxFitSamples in all. Both drawn by a
+  // hash of the observation's index: a regular stride through the photos' pixel rows aliased with a
+  // texture's period (the SolveSynth room's textured floor, ρs 0.04: −10.3 % with the stride, +2.1
+  // % drawn by hash).
   for (size_t r = 0; r < materials.size(); ++r) {
     const size_t taken = DrawSubset(near[r], kMaxHighlightSamples, &in_fit);
-    const size_t budget =
-        std::max(kMinOtherSamples, kMaxFitSamples - std::min(taken, kMaxFitSamples));
+    const size_t budget = kMaxFitSamples - std::min(taken, kMaxHighlightSamples);
     DrawSubset(rest[r], budget, &in_fit);
   }
 }
