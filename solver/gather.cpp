@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "solver/brdf.h"
 #include "solver/sampling.h"
@@ -99,9 +100,31 @@ void GatherAmbient(const Eigen::Vector3d& radiance, const GatherQuery& q, int k,
   }
 }
 
-void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples, Pcg32& rng,
-                  PointSamples* out) {
+// A multiplier coprime with k: sample s's pixel stratum is (s·m) mod k, decorrelated from its
+// stratum on the light.
+int CoprimeStride(int k) {
+  for (int m : {7, 5, 11, 13, 3}) {
+    if (std::gcd(m, k) == 1) return m;
+  }
+  return 1;
+}
+
+// The pixel point (u, v) of sample s of k: stratified over a side×side grid for the first side²
+// samples (in a shuffled order), random after.
+Eigen::Vector2d PixelStratum(int s, int k, Pcg32& rng) {
+  const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
+  Eigen::Vector2d u = rng.Uniform2D();
+  if (s < side * side) {
+    const int cell = int((int64_t(s) * CoprimeStride(side * side)) % (side * side));
+    u = Eigen::Vector2d(((cell % side) + u.x()) / side, ((cell / side) + u.y()) / side);
+  }
+  return u;
+}
+
+void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples,
+                  int footprint_samples, Pcg32& rng, PointSamples* out) {
   const double eps = scene.ray_epsilon;
+  const bool footprint = q.footprint.has_value();
   for (int l = 0; l < static_cast<int>(scene.lights.size()); ++l) {
     const LightType type = scene.lights[l].type;
     if (type == LightType::kAmbient) {
@@ -110,7 +133,7 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
     }
     const bool delta =
         type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
-    const int k = delta ? 1 : light_samples;
+    const int k = delta ? (footprint ? std::max(1, footprint_samples) : 1) : light_samples;
     const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
     for (int s = 0; s < k; ++s) {
       // Stratified over a side×side grid for the first side² samples, random after.
@@ -119,7 +142,12 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
         u.x() = ((s % side) + u.x()) / side;
         u.y() = ((s / side) + u.y()) / side;
       }
-      const LightSample ls = scene.SampleLight(l, q.position, u);
+      Eigen::Vector3d position = q.position;
+      if (footprint) {
+        const Eigen::Vector2d px = PixelStratum(s, k, rng);
+        position = q.FootprintPoint(px.x(), px.y());
+      }
+      const LightSample ls = scene.SampleLight(l, position, u);
       if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0)) continue;
       const double cos_geo = ls.wi.dot(q.n_geo), cos_s = ls.wi.dot(q.n_s);
       if (!(cos_geo > 0) || !(cos_s > 0)) continue;
@@ -127,7 +155,7 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
                                   ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
                                   : ls.distance;
       ++out->rays;
-      if (scene.Occluded(q.position + q.n_geo * eps, ls.wi, distance, l)) continue;
+      if (scene.Occluded(position + q.n_geo * eps, ls.wi, distance, l)) continue;
       DirectSample d;
       d.wi = ls.wi.cast<float>();
       d.value = (ls.value * (cos_s / (ls.pdf * k))).cast<float>();
@@ -159,6 +187,17 @@ void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const 
 }
 
 }  // namespace
+
+Eigen::Vector3d GatherQuery::FootprintPoint(double u, double v) const {
+  if (!footprint) return position;
+  const Footprint& f = *footprint;
+  const Eigen::Vector3d d = f.ray00 + u * f.ray_du + v * f.ray_dv;
+  const double den = n_geo.dot(d);
+  if (!(std::abs(den) > 1e-12 * d.norm())) return position;
+  const double t = n_geo.dot(position - f.eye) / den;
+  if (!(t > 0) || !std::isfinite(t)) return position;
+  return f.eye + t * d;
+}
 
 std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
                                                     Pcg32& rng) {
@@ -220,7 +259,8 @@ GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
         for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
           Pcg32 rng = PixelSampleRng(options.seed, uint64_t(i), 0x5eed);
           PointSamples ps;
-          GatherDirect(scene, queries[i], options.light_samples, rng, &ps);
+          GatherDirect(scene, queries[i], options.light_samples, options.footprint_samples, rng,
+                       &ps);
           GatherIndirect(scene, patches, queries[i], options, rng, &ps);
           chunk.push_back(std::move(ps));
         }

@@ -256,6 +256,24 @@ void SolverState::SelectFitSamples() {
   }
 }
 
+// The footprint of observation o's pixel (solver/gather.h): ray directions at unit depth, so
+// that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion is
+// linearised over the pixel).
+GatherQuery::Footprint SolverState::PixelFootprint(const Observation& o) const {
+  const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+  const Eigen::Quaterniond world_from_cam = cam.cam_from_world.rotation.conjugate();
+  auto ray = [&](double u, double v) -> Eigen::Vector3d {
+    const Eigen::Vector3d d = cam.CamRayFromImg(Eigen::Vector2d(o.x + u, o.y + v));
+    return world_from_cam * (d / d.z());
+  };
+  GatherQuery::Footprint f;
+  f.eye = cam.CenterInWorld();
+  f.ray00 = ray(0, 0);
+  f.ray_du = ray(1, 0) - f.ray00;
+  f.ray_dv = ray(0, 1) - f.ray00;
+  return f;
+}
+
 void SolverState::GatherAll() {
   const auto start = Clock::now();
   lighting_state.resize(scene.lightings.size());
@@ -264,6 +282,7 @@ void SolverState::GatherAll() {
   go.light_samples = options.light_samples;
   go.indirect_rays = options.indirect_rays;
   go.specular_bounces = options.specular_bounces;
+  go.footprint_samples = options.footprint_samples;
   go.seed = options.seed;
   go.num_threads = options.num_threads;
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
@@ -281,6 +300,7 @@ void SolverState::GatherAll() {
       q.n_s = o.normal.cast<double>();
       q.view = o.view.cast<double>();
       q.lobe = HasSpecularLobe(materials[o.region].params.model);
+      if (options.pixel_footprint) q.footprint = PixelFootprint(o);
       obs_point[i] = static_cast<int>(queries.size());
       st.obs.push_back(int(i));
       queries.push_back(q);

@@ -92,6 +92,7 @@ struct SolverState {
   void CollectAllObservations();
   void SelectFitSamples();
   void GatherAll();
+  GatherQuery::Footprint PixelFootprint(const Observation& o) const;
   void BuildPatchLobes(LightingState* st) const;
   Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
   Eigen::Vector3d PatchAlbedo(int patch) const;

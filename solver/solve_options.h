@@ -27,6 +27,11 @@ struct SolveOptions {
   // radiance and the direct light's highlight (the ceiling of igi-synth's room gathers 2 % too
   // little; bench/solver/bench_solve_truth bounce=0).
   bool specular_bounces = true;
+  // Sample each observation's direct light over its pixel's footprint on the surface (a pixel
+  // records the mean over it; solver/gather.h GatherQuery::Footprint), with footprint_samples
+  // points per delta light. Off (--pixel-footprint false): at the centre ray's point only.
+  bool pixel_footprint = true;
+  int footprint_samples = 4;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
   // surface is averaged to remove gathering noise; 0 = auto (the scene diagonal / 96).
   double smoothing_radius_m = 0;
@@ -59,10 +64,11 @@ struct SolveOptions {
   // new albedos would send (a Newton step on the fixed point; ρs and α are refitted as before;
   // albedo maps keep stage 1's texel detail, scaled to the new region means). On igi-synth's
   // 1024-spp room the joint rounds relight as well as the paper stage (1.53 / 1.49 % beyond the
-  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %), but on
-  // solve_e2e_test's small room they leave the floor at −3.03 % (independent −2.83 %, bound
-  // 3 %), so the default stays "independent" (bench/RESULTS.md, 2026-11-22 session 9).
-  std::string refine_update = "independent";
+  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %). The default
+  // since session 11: solve_e2e_test's small room, which had held it back (floor −3.03 % vs
+  // −2.83 % independent), owed its −3 % to the noise of its 64-spp photos, not to the update
+  // (bench/RESULTS.md).
+  std::string refine_update = "joint";
   // Share of each refinement round's albedo change that is applied (1 = the full step). Half
   // steps damp the independent update's swing where stage 1 is already right (igi-synth's
   // converged room: 2.47 % beyond the floor after one round, 1.82 % after two, against 3.15 %

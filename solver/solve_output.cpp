@@ -225,6 +225,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                   {"refine_albedo_step", o.refine_albedo_step},
                   {"refine_update", o.refine_update},
                   {"specular_bounces", o.specular_bounces},
+                  {"pixel_footprint", o.pixel_footprint},
                   {"photo_scale", o.photo_scale}};
   if (!o.albedo_map_regions.empty()) j["options"]["albedo_map_regions"] = o.albedo_map_regions;
   return j;

@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
   app.add_option("--refine-albedo-step", o.refine_albedo_step,
                  "share of each refinement round's albedo change applied (1 = full step)")
       ->capture_default_str();
+  app.add_option("--pixel-footprint", o.pixel_footprint,
+                 "sample each observation's direct light over the surface its pixel covers (true) "
+                 "or at its centre ray's point only (false)")
+      ->capture_default_str();
   app.add_option("--specular-bounces", o.specular_bounces,
                  "gathering follows glossy surfaces' reflection of the room (true) or takes only "
                  "their diffuse radiance and the lights' highlights (false)")
