@@ -30,8 +30,15 @@ double Since(Clock::time_point t) {
 }
 
 // Fit samples per region and stage (SolverState::SelectFitSamples).
+// Observations near a highlight carry a faint lobe's ρs and α: up to kMaxHighlightSamples of
+// them. igi-synth's textured floor (ρs 0.04, α 0.15, ~60 000 such observations in the demo):
+// with 4000 drawn its ρs came out anywhere in −11..+4 % over sub-pixel pose changes (session 10),
+// with all of them within −4..0 %; on the demo's registered capture α −10.7 % with 4000, −5.5 %
+// with 16 000, −2.1 % with all, at a solve of 57, 66 and 103 s (bench/RESULTS.md). The rest
+// carry the albedo: kMaxFitSamples less the highlight samples, never under a third of it.
+constexpr size_t kMaxHighlightSamples = 16000;
 constexpr size_t kMaxFitSamples = 6000;
-constexpr size_t kMaxHighlightSamples = kMaxFitSamples * 2 / 3;
+constexpr size_t kMinRestSamples = kMaxFitSamples / 3;
 
 // Marks about `count` of `indices` in `chosen` (all when there are no more), each drawn with the
 // same probability by a hash of its value; returns how many it marked.
@@ -245,13 +252,15 @@ void SolverState::SelectFitSamples() {
     (highlight ? near : rest)[o.region].push_back(int(i));
   }
   // The highlight observations carry ρs and α, the rest mostly the albedo: up to
-  // kMaxHighlightSamples of the first, then the rest up to kMaxFitSamples in all. Both drawn by a
+  // kMaxHighlightSamples of the first, then the rest (kMaxFitSamples in all, at least
+  // kMinRestSamples of them). Both drawn by a
   // hash of the observation's index: a regular stride through the photos' pixel rows aliased with a
   // texture's period (the SolveSynth room's textured floor, ρs 0.04: −10.3 % with the stride, +2.1
   // % drawn by hash).
   for (size_t r = 0; r < materials.size(); ++r) {
     const size_t taken = DrawSubset(near[r], kMaxHighlightSamples, &in_fit);
-    const size_t budget = kMaxFitSamples - std::min(taken, kMaxHighlightSamples);
+    const size_t budget =
+        std::max(kMinRestSamples, kMaxFitSamples - std::min(taken, kMaxFitSamples));
     DrawSubset(rest[r], budget, &in_fit);
   }
 }
