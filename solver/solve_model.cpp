@@ -157,10 +157,21 @@ void SolverState::RenderResiduals(const Scene& model, int stage) {
         const Observation& o = obs[i];
         const Photo& p = scene.photos[o.photo];
         const Camera& cam = scene.cameras[p.camera];
-        const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5));
+        // Each path through its own point of the pixel (the photo's pixel is the mean over its
+        // footprint; igi-render's box filter), stratified 2×2 per half.
         const uint64_t seed = options.seed * 7919 + uint64_t(i) * 2;
-        pred1[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp / 2, seed);
-        pred2[i] = renderers[p.lighting]->Radiance(cam.CenterInWorld(), dir, kSpp / 2, seed + 1);
+        Pcg32 rng = PixelSampleRng(seed, uint64_t(i), 0xf00);
+        Eigen::Vector3d half[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+        for (int k = 0; k < kSpp; ++k) {
+          const int cell = (k / 2) % 4;
+          const Eigen::Vector2d u = rng.Uniform2D();
+          const Eigen::Vector2d px(o.x + 0.5 * ((cell % 2) + u.x()),
+                                   o.y + 0.5 * ((cell / 2) + u.y()));
+          half[k % 2] += renderers[p.lighting]->Radiance(
+              cam.CenterInWorld(), cam.WorldRayFromImg(px), 1, seed * kSpp + uint64_t(k));
+        }
+        pred1[i] = half[0] / (kSpp / 2);
+        pred2[i] = half[1] / (kSpp / 2);
         pred[i] = 0.5 * (pred1[i] + pred2[i]);
       },
       options.num_threads);
