@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "solver/brdf.h"
 
@@ -78,13 +79,25 @@ std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, 
 // incident sample's specular factor computed once (the α search evaluates T at dozens of α):
 // S·W·v is g·W·v·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y) (SpecularFactorParts, solver/brdf.h);
 // terms whose exponent passes kMaxExponent (below e⁻⁶⁰ of their own peak) are skipped.
+inline double ScalarPart(double x) { return x; }
+template <typename J, int N>
+double ScalarPart(const ceres::Jet<J, N>& x) {
+  return x.a;
+}
+
+// The specular term T(α) of every sample from a per-incident-sample table of the α-independent
+// factors (SpecularFactorParts; Fresnel folded in): T = Σ exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy).
+// Each sample's entries are sorted by qx + qy, so a sum stops at the first entry whose exponent
+// is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double) and by Ceres'
+// polish (Jets), so both see the same lobe.
 class LobeTable {
  public:
   explicit LobeTable(const RegionFitInput& in) : in_(&in) {
     if (!HasSpecularLobe(in.model)) return;
     begin_.reserve(in.samples.size() + 1);
     for (const FitSample& s : in.samples) {
-      begin_.push_back(static_cast<int>(entries_.size()));
+      const size_t first = entries_.size();
+      begin_.push_back(static_cast<int>(first));
       const Eigen::Vector3d wo = s.wo.cast<double>();
       for (int k = s.incident_begin; k < s.incident_end; ++k) {
         const IncidentLocal& inc = in.incident[k];
@@ -96,23 +109,40 @@ class LobeTable {
         if (!(g > 0.0) || !gv.allFinite()) continue;
         entries_.push_back({float(qx), float(qy), gv.cast<float>()});
       }
+      std::sort(entries_.begin() + first, entries_.end(),
+                [](const Entry& a, const Entry& b) { return a.qx + a.qy < b.qx + b.qy; });
     }
     begin_.push_back(static_cast<int>(entries_.size()));
+  }
+
+  // Sample i's term at (αx, αy), without the held-out albedo's share (Terms adds it).
+  template <typename T>
+  Eigen::Matrix<T, 3, 1> Term(size_t i, const T& ax, const T& ay) const {
+    Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
+    if (begin_.empty()) return sum;
+    const T ix = T(1.0) / (ax * ax), iy = T(1.0) / (ay * ay);
+    const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
+    for (int k = begin_[i]; k < begin_[i + 1]; ++k) {
+      const Entry& e = entries_[k];
+      if (imin * (double(e.qx) + double(e.qy)) >= kMaxExponent) break;
+      if (double(e.qx) * ix0 + double(e.qy) * iy0 >= kMaxExponent) continue;
+      T f;
+      if constexpr (std::is_same_v<T, double>) {
+        f = double(std::exp(-float(e.qx * ix0 + e.qy * iy0)));
+      } else {
+        f = exp(-(T(double(e.qx)) * ix + T(double(e.qy)) * iy));
+      }
+      for (int c = 0; c < 3; ++c) sum[c] += f * double(e.gv[c]);
+    }
+    return sum / (ax * ay);
   }
 
   std::vector<Eigen::Vector3d> Terms(double ax, double ay) const {
     const RegionFitInput& in = *in_;
     std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
     if (!HasSpecularLobe(in.model)) return t;
-    const double ix = 1.0 / (ax * ax), iy = 1.0 / (ay * ay), norm = 1.0 / (ax * ay);
     for (size_t i = 0; i < in.samples.size(); ++i) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (int k = begin_[i]; k < begin_[i + 1]; ++k) {
-        const Entry& e = entries_[k];
-        const double q = e.qx * ix + e.qy * iy;
-        if (q < kMaxExponent) sum += double(std::exp(-float(q))) * e.gv.cast<double>();
-      }
-      sum *= norm;
+      Eigen::Vector3d sum = Term<double>(i, ax, ay);
       const FitSample& s = in.samples[i];
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
         sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
@@ -316,11 +346,12 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
 struct SampleResidual {
   const RegionFitInput* in = nullptr;
   const FitSample* s = nullptr;
+  const LobeTable* table = nullptr;
+  size_t index = 0;  // of the sample in `in` and `table`
   Eigen::Vector3d w, a;
   int block_d = -1, block_s = -1, block_a = -1;
   Eigen::Vector3d rho_d_fixed, rho_s_fixed;
   double ax_fixed = 0.1, ay_fixed = 0.1;
-  std::vector<double> fresnel;  // per incident sample (1 without Fresnel)
 
   template <typename T>
   bool operator()(T const* const* p, T* residual) const {
@@ -336,14 +367,7 @@ struct SampleResidual {
       ax = p[block_a][0];
       ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
     }
-    V3 t = V3::Zero();
-    const V3 wo = s->wo.cast<double>().cast<T>();
-    for (int k = s->incident_begin; k < s->incident_end; ++k) {
-      const IncidentLocal& inc = in->incident[k];
-      const V3 wi = inc.wi.cast<double>().cast<T>();
-      const T sf = SpecularFactor<T>(in->model, ax, ay, wo, wi) * fresnel[k - s->incident_begin];
-      t += inc.value.cast<double>().cast<T>() * sf;
-    }
+    const V3 t = table->Term<T>(index, ax, ay);
     for (int c = 0; c < 3; ++c) {
       residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
     }
@@ -379,22 +403,19 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   int block_d = -1, block_s = -1, block_a = -1;
   const int ns = in.grey_specular ? 1 : 3, na = aniso ? 2 : 1;
   ceres::Problem problem;
+  const LobeTable table(in);
   for (size_t i = 0; i < in.samples.size(); ++i) {
     auto* r = new SampleResidual;
     r->in = &in;
     r->s = &in.samples[i];
+    r->table = &table;
+    r->index = i;
     r->w = pr.w[i];
     r->a = pr.a[i];
     r->rho_d_fixed = in.samples[i].rho_d_known;
     r->rho_s_fixed = out.rho_s;
     r->ax_fixed = out.ax;
     r->ay_fixed = out.ay;
-    for (int k = r->s->incident_begin; k < r->s->incident_end; ++k) {
-      r->fresnel.push_back(HasFresnel(in.model)
-                               ? FresnelWeight<double>(in.ior, r->s->wo.cast<double>(),
-                                                       in.incident[k].wi.cast<double>())
-                               : 1.0);
-    }
     auto* cost = new ceres::DynamicAutoDiffCostFunction<SampleResidual, 8>(r);
     blocks.clear();
     int b = 0;
