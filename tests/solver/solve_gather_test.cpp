@@ -65,6 +65,15 @@ class SolveGather : public ::testing::Test {
     return ceiling.stage1.rho_d.mean() / 0.7 - 1;
   }
 
+  // `doc` written as dir_/name and loaded complete (no photos read).
+  Scene WriteAndLoad(const Json& doc, const std::string& name) const {
+    WriteJsonFile(dir_ / name, doc);
+    SceneLoadOptions lo;
+    lo.require_complete_materials = true;
+    lo.check_images = false;
+    return LoadScene(dir_ / name, lo);
+  }
+
   fs::path dir_;
 };
 
@@ -88,11 +97,7 @@ TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {
   Json doc = ReadJsonFile(dir_ / "truth.json");
   doc["lights"]["amb"] = {{"type", "ambient"}, {"radiance", {0.3, 0.2, 0.1}}};
   doc["lightings"]["L0"] = Json::array({"amb"});
-  WriteJsonFile(dir_ / "ambient.json", doc);
-  SceneLoadOptions lo;
-  lo.require_complete_materials = true;
-  lo.check_images = false;
-  const Scene scene = LoadScene(dir_ / "ambient.json", lo);
+  const Scene scene = WriteAndLoad(doc, "ambient.json");
   const auto rs = BuildRenderScene(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   std::vector<GatherQuery> queries(3);
@@ -129,11 +134,7 @@ TEST_F(SolveGather, DirectLightIsTheMeanOverThePixelsFootprint) {
   doc["lights"]["lamp"] = {{"type", "point"},
                            {"position", {1.0, 1.0, h}},
                            {"intensity", {intensity, intensity, intensity}}};
-  WriteJsonFile(dir_ / "near_lamp.json", doc);
-  SceneLoadOptions lo;
-  lo.require_complete_materials = true;
-  lo.check_images = false;
-  const Scene scene = LoadScene(dir_ / "near_lamp.json", lo);
+  const Scene scene = WriteAndLoad(doc, "near_lamp.json");
   const auto rs = BuildRenderScene(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   // A camera at (1, 1, 1.9) looking straight down; its pixel's corner rays at unit depth.
