@@ -53,50 +53,38 @@ Prepared Prepare(const RegionFitInput& in) {
   return p;
 }
 
-// T_c(α) for every sample.
-std::vector<Eigen::Vector3d> SpecularTerms(const RegionFitInput& in, double ax, double ay) {
-  std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
-  if (!HasSpecularLobe(in.model)) return t;
-  for (size_t i = 0; i < in.samples.size(); ++i) {
-    const FitSample& s = in.samples[i];
-    const Eigen::Vector3d wo = s.wo.cast<double>();
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int k = s.incident_begin; k < s.incident_end; ++k) {
-      const IncidentLocal& inc = in.incident[k];
-      const double sw = SpecularWeight(in.model, ax, ay, in.ior, wo, inc.wi.cast<double>());
-      if (sw > 0) sum += sw * inc.value.cast<double>();
-    }
-    // The held-out albedo's own lobe (see RegionFitInput::use_held_albedo).
-    if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
-      sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
-    }
-    t[i] = sum;
-  }
-  return t;
-}
-
-// T_c(α) for every sample as SpecularTerms computes it, with the α-independent part of each
-// incident sample's specular factor computed once (the α search evaluates T at dozens of α):
-// S·W·v is g·W·v·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y) (SpecularFactorParts, solver/brdf.h);
-// terms whose exponent passes kMaxExponent (below e⁻⁶⁰ of their own peak) are skipped.
+// The scalar value of a double or a Ceres Jet (LobeTable::Term's cut-off test).
 inline double ScalarPart(double x) { return x; }
 template <typename J, int N>
 double ScalarPart(const ceres::Jet<J, N>& x) {
   return x.a;
 }
 
-// The specular term T(α) of every sample from a per-incident-sample table of the α-independent
-// factors (SpecularFactorParts; Fresnel folded in): T = Σ exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy).
+// The specular term T_c(α) = Σ S·W·v of every sample from a per-incident-sample table of the
+// α-independent factors, computed once per region fit (the α search evaluates T at dozens of α):
+// S·W·v = exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy) (SpecularFactorParts, solver/brdf.h; Fresnel
+// folded into g).
 // Each sample's entries are sorted by qx + qy, so a sum stops at the first entry whose exponent
 // is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double) and by Ceres'
 // polish (Jets), so both see the same lobe.
 class LobeTable {
  public:
-  explicit LobeTable(const RegionFitInput& in) : in_(&in) {
+  // Built once per region fit from all its samples; any subset of them (the held-albedo
+  // variant's) is looked up by its incident range.
+  explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
     if (!HasSpecularLobe(in.model)) return;
-    begin_.reserve(in.samples.size() + 1);
-    for (const FitSample& s : in.samples) {
+    std::vector<std::pair<int, int>> order;  // (incident_begin, sample)
+    order.reserve(in.samples.size());
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      order.emplace_back(in.samples[i].incident_begin, int(i));
+    }
+    std::sort(order.begin(), order.end());
+    starts_.reserve(order.size());
+    begin_.reserve(order.size() + 1);
+    for (const auto& [start, i] : order) {
+      const FitSample& s = in.samples[i];
       const size_t first = entries_.size();
+      starts_.push_back(start);
       begin_.push_back(static_cast<int>(first));
       const Eigen::Vector3d wo = s.wo.cast<double>();
       for (int k = s.incident_begin; k < s.incident_end; ++k) {
@@ -115,14 +103,16 @@ class LobeTable {
     begin_.push_back(static_cast<int>(entries_.size()));
   }
 
-  // Sample i's term at (αx, αy), without the held-out albedo's share (Terms adds it).
+  // Sample s's term at (αx, αy), without the held-out albedo's share (Terms adds it).
   template <typename T>
-  Eigen::Matrix<T, 3, 1> Term(size_t i, const T& ax, const T& ay) const {
+  Eigen::Matrix<T, 3, 1> Term(const FitSample& s, const T& ax, const T& ay) const {
     Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
-    if (begin_.empty()) return sum;
+    const auto it = std::lower_bound(starts_.begin(), starts_.end(), s.incident_begin);
+    if (it == starts_.end() || *it != s.incident_begin) return sum;
+    const size_t row = size_t(it - starts_.begin());
     const T ix = T(1.0) / (ax * ax), iy = T(1.0) / (ay * ay);
     const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
-    for (int k = begin_[i]; k < begin_[i + 1]; ++k) {
+    for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
       const Entry& e = entries_[k];
       if (imin * (double(e.qx) + double(e.qy)) >= kMaxExponent) break;
       if (double(e.qx) * ix0 + double(e.qy) * iy0 >= kMaxExponent) continue;
@@ -137,13 +127,14 @@ class LobeTable {
     return sum / (ax * ay);
   }
 
-  std::vector<Eigen::Vector3d> Terms(double ax, double ay) const {
-    const RegionFitInput& in = *in_;
+  // T_c(α) for every sample of `in` (the table's input or a subset of its samples), less the
+  // held-out albedo's own lobe where `in` fits with it (RegionFitInput::use_held_albedo).
+  std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, double ax, double ay) const {
     std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
-    if (!HasSpecularLobe(in.model)) return t;
+    if (!HasSpecularLobe(model_)) return t;
     for (size_t i = 0; i < in.samples.size(); ++i) {
-      Eigen::Vector3d sum = Term<double>(i, ax, ay);
       const FitSample& s = in.samples[i];
+      Eigen::Vector3d sum = Term<double>(s, ax, ay);
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
         sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
       }
@@ -158,7 +149,8 @@ class LobeTable {
     float qx, qy;
     Eigen::Vector3f gv;
   };
-  const RegionFitInput* in_;
+  BrdfModel model_;
+  std::vector<int> starts_;  // each row's incident_begin, ascending
   std::vector<int> begin_;
   std::vector<Entry> entries_;
 };
@@ -247,12 +239,12 @@ struct AlphaSearch {
 };
 
 // Minimises the projected cost over α (or αx, αy).
-AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch) {
+AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch,
+                        const LobeTable& table) {
   AlphaSearch best;
   const bool aniso = IsAnisotropic(in.model);
-  const LobeTable table(in);
   auto eval = [&](double ax, double ay) {
-    return SolveLinear(in, pr, table.Terms(ax, ay), per_patch);
+    return SolveLinear(in, pr, table.Terms(in, ax, ay), per_patch);
   };
   if (!HasSpecularLobe(in.model)) {
     best.linear = eval(0.1, 0.1);
@@ -347,7 +339,6 @@ struct SampleResidual {
   const RegionFitInput* in = nullptr;
   const FitSample* s = nullptr;
   const LobeTable* table = nullptr;
-  size_t index = 0;  // of the sample in `in` and `table`
   Eigen::Vector3d w, a;
   int block_d = -1, block_s = -1, block_a = -1;
   Eigen::Vector3d rho_d_fixed, rho_s_fixed;
@@ -367,7 +358,7 @@ struct SampleResidual {
       ax = p[block_a][0];
       ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
     }
-    const V3 t = table->Term<T>(index, ax, ay);
+    const V3 t = table->Term<T>(*s, ax, ay);
     for (int c = 0; c < 3; ++c) {
       residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
     }
@@ -384,7 +375,7 @@ struct Polish {
 };
 
 Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaSearch& start,
-                      const RegionFitOptions& options) {
+                      const RegionFitOptions& options, const LobeTable& table) {
   Polish out;
   const bool spec = HasSpecularLobe(in.model);
   const bool aniso = IsAnisotropic(in.model);
@@ -403,13 +394,11 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   int block_d = -1, block_s = -1, block_a = -1;
   const int ns = in.grey_specular ? 1 : 3, na = aniso ? 2 : 1;
   ceres::Problem problem;
-  const LobeTable table(in);
   for (size_t i = 0; i < in.samples.size(); ++i) {
     auto* r = new SampleResidual;
     r->in = &in;
     r->s = &in.samples[i];
     r->table = &table;
-    r->index = i;
     r->w = pr.w[i];
     r->a = pr.a[i];
     r->rho_d_fixed = in.samples[i].rho_d_known;
@@ -588,8 +577,9 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   }
   r.fitted = true;
   const Prepared pr = Prepare(in);
-  const AlphaSearch a = SearchAlpha(in, pr, false);
-  const Polish pa = PolishConstant(in, pr, a, options);
+  const LobeTable table(in);  // every search, the polish and the terms below
+  const AlphaSearch a = SearchAlpha(in, pr, false, table);
+  const Polish pa = PolishConstant(in, pr, a, options, table);
   r.rho_d = pa.rho_d;
   r.rho_s = pa.rho_s;
   r.alpha = r.alpha_x = pa.ax;
@@ -602,7 +592,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.slot_rho_d.assign(in.num_slots, in.fit_rho_d ? r.rho_d : Eigen::Vector3d::Constant(kNan));
   r.slot_count.assign(in.num_slots, 0);
   for (const FitSample& s : in.samples) ++r.slot_count[s.slot];
-  std::vector<Eigen::Vector3d> t = SpecularTerms(in, r.alpha_x, r.alpha_y);
+  std::vector<Eigen::Vector3d> t = table.Terms(in, r.alpha_x, r.alpha_y);
   r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
   if (!in.fit_rho_d || in.num_slots <= 1) return r;
   // Per-patch albedo from the observations off the highlights (specular part < 10 % of the
@@ -629,8 +619,8 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   AlphaSearch b;
   if (in.use_held_albedo && FitWithHeldAlbedo(in, &held)) {
     const Prepared ph = Prepare(held);
-    b = SearchAlpha(held, ph, false);
-    t = SpecularTerms(in, b.ax, b.ay);
+    b = SearchAlpha(held, ph, false, table);
+    t = table.Terms(in, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
     patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }
@@ -639,8 +629,8 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
       const Eigen::Vector3d& v = patch.slot_rho_d[smp.slot];
       smp.rho_d_known = v.allFinite() ? v : r.rho_d;
     }
-    b = SearchAlpha(held, pr, false);
-    t = SpecularTerms(in, b.ax, b.ay);
+    b = SearchAlpha(held, pr, false, table);
+    t = table.Terms(in, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
     patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }
