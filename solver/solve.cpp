@@ -253,10 +253,9 @@ void SolverState::SelectFitSamples() {
   }
   // The highlight observations carry ρs and α, the rest mostly the albedo: up to
   // kMaxHighlightSamples of the first, then the rest (kMaxFitSamples in all, at least
-  // kMinRestSamples of them). Both drawn by a
-  // hash of the observation's index: a regular stride through the photos' pixel rows aliased with a
-  // texture's period (the SolveSynth room's textured floor, ρs 0.04: −10.3 % with the stride, +2.1
-  // % drawn by hash).
+  // kMinRestSamples of them). Both drawn by a hash of the observation's index: a regular stride
+  // through the photos' pixel rows aliased with a texture's period (the SolveSynth room's
+  // textured floor, ρs 0.04: −10.3 % with the stride, +2.1 % drawn by hash).
   for (size_t r = 0; r < materials.size(); ++r) {
     const size_t taken = DrawSubset(near[r], kMaxHighlightSamples, &in_fit);
     const size_t budget =
