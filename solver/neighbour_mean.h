@@ -19,7 +19,8 @@ struct NeighbourPoint {
 // j in `subset` with points[j] of the same region, |p_j − p_i| <= radius, n_j·n_i >= 0.9 and,
 // when `same_photo`, the same photo (i itself always counts). Writes out[i] for i in `subset`;
 // `out` must have values.size() elements. Exact (every neighbour counts); a uniform grid of
-// cells of the radius, points sorted by (region, cell) into flat arrays.
+// cells of the radius, points sorted by (region, cell); per cell, the points of its 27 cells in
+// flat arrays tested and summed without branches (vectorised).
 void NeighbourMean(const std::vector<NeighbourPoint>& points,
                    const std::vector<Eigen::Vector3d>& values, const std::vector<int>& subset,
                    double radius, bool same_photo, int num_threads,

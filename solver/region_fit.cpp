@@ -3,9 +3,9 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
-#include <type_traits>
 
 #include "solver/brdf.h"
 
@@ -60,17 +60,33 @@ double ScalarPart(const ceres::Jet<J, N>& x) {
   return x.a;
 }
 
+// exp(x) for −2^21 < x <= 0 in float (relative error under 3e−7 for x > −2, 4e−6 down to −87;
+// 0 below −87), written so that the compiler vectorises a loop of it (libm's expf is a call per
+// value): 2^(x·log2 e) split into an integer power of two, built in the float's exponent bits
+// (zero where it would be subnormal), and 2^f, |f| <= 1/2, by its Taylor series to the 6th power.
+inline float ExpNonPositive(float x) {
+  const float t = x * 1.44269504f;
+  const float r = (t + 12582912.0f) - 12582912.0f;  // t rounded to an integer (1.5·2^23)
+  const float g = (t - r) * 0.693147181f;           // |g| <= ln 2 / 2
+  const float p =
+      1.0f +
+      g * (1.0f + g * (0.5f + g * (1.0f / 6 + g * (1.0f / 24 + g * (1.0f / 120 + g / 720)))));
+  const int e = static_cast<int>(r) + 127;        // 2^r's biased exponent
+  const int bits = (e << 23) & ~((e - 1) >> 31);  // 0 (the float 0) where e < 1
+  return p * std::bit_cast<float>(bits);
+}
+
 // The specular term T_c(α) = Σ S·W·v of every sample from a per-incident-sample table of the
 // α-independent factors, computed once per region fit (the α search evaluates T at dozens of α):
 // S·W·v = exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy) (SpecularFactorParts, solver/brdf.h; Fresnel
 // folded into g).
-// Each sample's entries are sorted by qx + qy, so a sum stops at the first entry whose exponent
-// is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double) and by Ceres'
-// polish (Jets), so both see the same lobe.
+// Each sample's entries (a row) are sorted by qx + qy, so a sum stops at the first entry whose
+// exponent is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double, vectorised)
+// and by Ceres' polish (Jets), so both see the same lobe.
 class LobeTable {
  public:
   // Built once per region fit from all its samples; any subset of them (the held-albedo
-  // variant's) is looked up by its incident range.
+  // variant's) finds its rows by incident range (Rows).
   explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
     if (!HasSpecularLobe(in.model)) return;
     std::vector<std::pair<int, int>> order;  // (incident_begin, sample)
@@ -81,12 +97,17 @@ class LobeTable {
     std::sort(order.begin(), order.end());
     starts_.reserve(order.size());
     begin_.reserve(order.size() + 1);
+    struct Entry {
+      float qx, qy;
+      Eigen::Vector3f gv;
+    };
+    std::vector<Entry> row;
     for (const auto& [start, i] : order) {
       const FitSample& s = in.samples[i];
-      const size_t first = entries_.size();
       starts_.push_back(start);
-      begin_.push_back(static_cast<int>(first));
+      begin_.push_back(static_cast<int>(qx_.size()));
       const Eigen::Vector3d wo = s.wo.cast<double>();
+      row.clear();
       for (int k = s.incident_begin; k < s.incident_end; ++k) {
         const IncidentLocal& inc = in.incident[k];
         const Eigen::Vector3d wi = inc.wi.cast<double>();
@@ -95,46 +116,72 @@ class LobeTable {
         if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
         const Eigen::Vector3d gv = g * inc.value.cast<double>();
         if (!(g > 0.0) || !gv.allFinite()) continue;
-        entries_.push_back({float(qx), float(qy), gv.cast<float>()});
+        row.push_back({float(qx), float(qy), gv.cast<float>()});
       }
-      std::sort(entries_.begin() + first, entries_.end(),
+      std::sort(row.begin(), row.end(),
                 [](const Entry& a, const Entry& b) { return a.qx + a.qy < b.qx + b.qy; });
+      for (const Entry& e : row) {
+        qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
+        gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
+      }
     }
-    begin_.push_back(static_cast<int>(entries_.size()));
+    begin_.push_back(static_cast<int>(qx_.size()));
   }
 
-  // Sample s's term at (αx, αy), without the held-out albedo's share (Terms adds it).
+  // The row of each sample of `in` (the table's input or a subset of its samples); −1: none.
+  std::vector<int> Rows(const RegionFitInput& in) const {
+    std::vector<int> rows(in.samples.size(), -1);
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const auto it =
+          std::lower_bound(starts_.begin(), starts_.end(), in.samples[i].incident_begin);
+      if (it != starts_.end() && *it == in.samples[i].incident_begin) {
+        rows[i] = int(it - starts_.begin());
+      }
+    }
+    return rows;
+  }
+
+  // One row's term at (αx, αy) (Ceres' polish: T a double or a Jet), without the held-out
+  // albedo's share (Terms adds it).
   template <typename T>
-  Eigen::Matrix<T, 3, 1> Term(const FitSample& s, const T& ax, const T& ay) const {
+  Eigen::Matrix<T, 3, 1> Term(int row, const T& ax, const T& ay) const {
+    using std::exp;
     Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
-    const auto it = std::lower_bound(starts_.begin(), starts_.end(), s.incident_begin);
-    if (it == starts_.end() || *it != s.incident_begin) return sum;
-    const size_t row = size_t(it - starts_.begin());
+    if (row < 0) return sum;
     const T ix = T(1.0) / (ax * ax), iy = T(1.0) / (ay * ay);
     const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
     for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
-      const Entry& e = entries_[k];
-      if (imin * (double(e.qx) + double(e.qy)) >= kMaxExponent) break;
-      if (double(e.qx) * ix0 + double(e.qy) * iy0 >= kMaxExponent) continue;
-      T f;
-      if constexpr (std::is_same_v<T, double>) {
-        f = double(std::exp(-float(e.qx * ix0 + e.qy * iy0)));
-      } else {
-        f = exp(-(T(double(e.qx)) * ix + T(double(e.qy)) * iy));
-      }
-      for (int c = 0; c < 3; ++c) sum[c] += f * double(e.gv[c]);
+      if (imin * double(qs_[k]) >= kMaxExponent) break;
+      if (double(qx_[k]) * ix0 + double(qy_[k]) * iy0 >= kMaxExponent) continue;
+      const T f = exp(-(T(double(qx_[k])) * ix + T(double(qy_[k])) * iy));
+      sum[0] += f * double(gr_[k]), sum[1] += f * double(gg_[k]), sum[2] += f * double(gb_[k]);
     }
     return sum / (ax * ay);
   }
 
-  // T_c(α) for every sample of `in` (the table's input or a subset of its samples), less the
-  // held-out albedo's own lobe where `in` fits with it (RegionFitInput::use_held_albedo).
-  std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, double ax, double ay) const {
+  // T_c(α) for every sample of `in` (its rows from Rows(in)), less the held-out albedo's own lobe
+  // where `in` fits with it (RegionFitInput::use_held_albedo). The α search's inner loop: the
+  // exponentials of a row up to its cut-off in one vectorised pass, then their weighted sums.
+  std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, const std::vector<int>& rows,
+                                     double ax, double ay) const {
     std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
     if (!HasSpecularLobe(model_)) return t;
+    const float ix = float(1.0 / (ax * ax)), iy = float(1.0 / (ay * ay));
+    const float cut = float(kMaxExponent / std::min(1.0 / (ax * ax), 1.0 / (ay * ay)));
+    const double scale = 1.0 / (ax * ay);
+    std::vector<float> f;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
-      Eigen::Vector3d sum = Term<double>(s, ax, ay);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      if (rows[i] >= 0) {
+        const int b = begin_[rows[i]];
+        const int e =
+            int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[rows[i] + 1], cut) -
+                qs_.begin());
+        f.resize(size_t(e - b));
+        Exponentials(qx_.data() + b, qy_.data() + b, e - b, ix, iy, f.data());
+        sum = WeightedSum(f.data(), b, e - b) * scale;
+      }
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
         sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
       }
@@ -145,14 +192,30 @@ class LobeTable {
 
  private:
   static constexpr double kMaxExponent = 60.0;
-  struct Entry {  // per incident sample: h_x²/h_z², h_y²/h_z², g·v
-    float qx, qy;
-    Eigen::Vector3f gv;
-  };
+  static void Exponentials(const float* __restrict qx, const float* __restrict qy, int n, float ix,
+                           float iy, float* __restrict f) {
+    for (int k = 0; k < n; ++k) f[k] = ExpNonPositive(-(qx[k] * ix + qy[k] * iy));
+  }
+  // Σ f_k·(r, g, b)_k over entries [b, b + n), in two-lane double partial sums (SSE2 packets).
+  Eigen::Vector3d WeightedSum(const float* f, int b, int n) const {
+    using A2 = Eigen::Array2d;
+    A2 sr = A2::Zero(), sg = sr, sb = sr;
+    int k = 0;
+    for (; k + 2 <= n; k += 2) {
+      const A2 fk(f[k], f[k + 1]);
+      sr += fk * A2(gr_[b + k], gr_[b + k + 1]);
+      sg += fk * A2(gg_[b + k], gg_[b + k + 1]);
+      sb += fk * A2(gb_[b + k], gb_[b + k + 1]);
+    }
+    Eigen::Vector3d sum(sr.sum(), sg.sum(), sb.sum());
+    for (; k < n; ++k) sum += double(f[k]) * Eigen::Vector3d(gr_[b + k], gg_[b + k], gb_[b + k]);
+    return sum;
+  }
   BrdfModel model_;
   std::vector<int> starts_;  // each row's incident_begin, ascending
-  std::vector<int> begin_;
-  std::vector<Entry> entries_;
+  std::vector<int> begin_;   // each row's first entry (+1: the end)
+  // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v.
+  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
 };
 
 // The linear part for given specular terms: ρs and per-slot ρd by least squares.
@@ -232,6 +295,54 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
   return sol;
 }
 
+// The minimum of f on [a, b] by Brent's method (golden sections, and parabolic steps through the
+// three best points where they behave), to within about 2·tol; at most max_evals calls of f.
+template <typename F>
+double BrentMinimum(double a, double b, double tol, int max_evals, F&& f) {
+  constexpr double kGold = 0.3819660112501051;  // (3 − √5)/2
+  double x = a + kGold * (b - a), w = x, v = x;
+  double fx = f(x), fw = fx, fv = fx;
+  double step = 0, before = 0;  // the last step, and the one before it
+  for (int evals = 1; evals < max_evals; ++evals) {
+    const double mid = 0.5 * (a + b);
+    if (std::abs(x - mid) <= 2 * tol - 0.5 * (b - a)) break;
+    bool parabolic = false;
+    if (std::abs(before) > tol) {
+      const double r = (x - w) * (fx - fv);
+      double q = (x - v) * (fx - fw);
+      double p = (x - v) * q - (x - w) * r;
+      q = 2 * (q - r);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      // Accepted when it moves less than half the step before last and stays inside [a, b].
+      if (std::abs(p) < std::abs(0.5 * q * before) && p > q * (a - x) && p < q * (b - x)) {
+        before = step;
+        step = p / q;
+        if (x + step - a < 2 * tol || b - (x + step) < 2 * tol) step = mid >= x ? tol : -tol;
+        parabolic = true;
+      }
+    }
+    if (!parabolic) {
+      before = x >= mid ? a - x : b - x;
+      step = kGold * before;
+    }
+    const double u = std::abs(step) >= tol ? x + step : x + (step > 0 ? tol : -tol);
+    const double fu = f(u);
+    if (fu <= fx) {
+      (u >= x ? a : b) = x;
+      v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w, fv = fw, w = u, fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u, fv = fu;
+      }
+    }
+  }
+  return x;
+}
+
 struct AlphaSearch {
   double ax = 0.1, ay = 0.1;
   LinearSolution linear;
@@ -243,8 +354,9 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
                         const LobeTable& table) {
   AlphaSearch best;
   const bool aniso = IsAnisotropic(in.model);
+  const std::vector<int> rows = table.Rows(in);
   auto eval = [&](double ax, double ay) {
-    return SolveLinear(in, pr, table.Terms(in, ax, ay), per_patch);
+    return SolveLinear(in, pr, table.Terms(in, rows, ax, ay), per_patch);
   };
   if (!HasSpecularLobe(in.model)) {
     best.linear = eval(0.1, 0.1);
@@ -253,19 +365,7 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
   const std::optional<double> known_x = aniso ? in.alpha_x : in.alpha;
   const std::optional<double> known_y = aniso ? in.alpha_y : in.alpha;
   const double lo = std::log(0.005), hi = std::log(1.0);
-  auto golden = [&](double a, double b, auto&& f) {
-    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double c = b - g * (b - a), d = a + g * (b - a);
-    double fc = f(c), fd = f(d);
-    for (int it = 0; it < 14; ++it) {
-      if (fc < fd) {
-        b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
-      } else {
-        a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
-      }
-    }
-    return fc < fd ? c : d;
-  };
+  auto minimise = [](double a, double b, auto&& f) { return BrentMinimum(a, b, 1e-4, 40, f); };
   if (!aniso) {
     if (known_x) {
       best.ax = best.ay = *known_x;
@@ -286,7 +386,8 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
       // A window of ±0.4 in log α around the hint; accepted unless the minimum sits at its edge.
       const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4),
                    b = std::min(hi, c + 0.4);
-      const double la = golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
+      const double la =
+          minimise(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
       if (la > a + 0.02 && la < b - 0.02) return finish(la);
     }
     constexpr int kGrid = 28;
@@ -300,9 +401,9 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     const double step = (hi - lo) / (kGrid - 1);
     const double a = lo + step * std::max(0, best_i - 1),
                  b = lo + step * std::min(kGrid - 1, best_i + 1);
-    return finish(golden(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; }));
+    return finish(minimise(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; }));
   }
-  // Anisotropic: a coarse grid, then alternating golden sections.
+  // Anisotropic: a coarse grid, then alternating Brent minimisations.
   double bx = known_x.value_or(0.1), by = known_y.value_or(0.1);
   if (!known_x || !known_y) {
     constexpr int kGrid = 12;
@@ -318,12 +419,12 @@ AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_p
     for (int round = 0; round < 3; ++round) {
       const double w = (hi - lo) / 11.0 / (round + 1);
       if (!known_x) {
-        bx = std::exp(golden(std::log(bx) - w, std::log(bx) + w,
-                             [&](double x) { return eval(std::exp(x), by).cost; }));
+        bx = std::exp(minimise(std::log(bx) - w, std::log(bx) + w,
+                               [&](double x) { return eval(std::exp(x), by).cost; }));
       }
       if (!known_y) {
-        by = std::exp(golden(std::log(by) - w, std::log(by) + w,
-                             [&](double y) { return eval(bx, std::exp(y)).cost; }));
+        by = std::exp(minimise(std::log(by) - w, std::log(by) + w,
+                               [&](double y) { return eval(bx, std::exp(y)).cost; }));
       }
     }
   }
@@ -339,6 +440,7 @@ struct SampleResidual {
   const RegionFitInput* in = nullptr;
   const FitSample* s = nullptr;
   const LobeTable* table = nullptr;
+  int row = -1;  // s's row in the table
   Eigen::Vector3d w, a;
   int block_d = -1, block_s = -1, block_a = -1;
   Eigen::Vector3d rho_d_fixed, rho_s_fixed;
@@ -358,7 +460,7 @@ struct SampleResidual {
       ax = p[block_a][0];
       ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
     }
-    const V3 t = table->Term<T>(*s, ax, ay);
+    const V3 t = table->Term<T>(row, ax, ay);
     for (int c = 0; c < 3; ++c) {
       residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
     }
@@ -394,8 +496,10 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   int block_d = -1, block_s = -1, block_a = -1;
   const int ns = in.grey_specular ? 1 : 3, na = aniso ? 2 : 1;
   ceres::Problem problem;
+  const std::vector<int> rows = table.Rows(in);
   for (size_t i = 0; i < in.samples.size(); ++i) {
     auto* r = new SampleResidual;
+    r->row = rows[i];
     r->in = &in;
     r->s = &in.samples[i];
     r->table = &table;
@@ -592,7 +696,8 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.slot_rho_d.assign(in.num_slots, in.fit_rho_d ? r.rho_d : Eigen::Vector3d::Constant(kNan));
   r.slot_count.assign(in.num_slots, 0);
   for (const FitSample& s : in.samples) ++r.slot_count[s.slot];
-  std::vector<Eigen::Vector3d> t = table.Terms(in, r.alpha_x, r.alpha_y);
+  const std::vector<int> rows = table.Rows(in);
+  std::vector<Eigen::Vector3d> t = table.Terms(in, rows, r.alpha_x, r.alpha_y);
   r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
   if (!in.fit_rho_d || in.num_slots <= 1) return r;
   // Per-patch albedo from the observations off the highlights (specular part < 10 % of the
@@ -614,13 +719,17 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   }
   if (!r.albedo_varies) return r;
   // The albedo varies: ρs and α again with each patch's albedo held (NaN: the region's), twice.
-  RegionFitInput held = in;
+  // The held variant copies the samples but not their incident samples: the lobe table has what
+  // the searches need of them (a region with every highlight sample has ~100 MB of them).
+  RegionFitInput held;
+  static_cast<RegionFitSettings&>(held) = in;
+  held.samples = in.samples;
   held.fit_rho_d = false;
   AlphaSearch b;
   if (in.use_held_albedo && FitWithHeldAlbedo(in, &held)) {
     const Prepared ph = Prepare(held);
     b = SearchAlpha(held, ph, false, table);
-    t = table.Terms(in, b.ax, b.ay);
+    t = table.Terms(in, rows, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
     patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }
@@ -630,7 +739,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
       smp.rho_d_known = v.allFinite() ? v : r.rho_d;
     }
     b = SearchAlpha(held, pr, false, table);
-    t = table.Terms(in, b.ax, b.ay);
+    t = table.Terms(in, rows, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
     patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }

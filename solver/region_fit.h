@@ -9,7 +9,7 @@
 // with E the gathered irradiance and (wi_k, v_k) the incident samples (v = L_in·cosθ/pdf, so
 // Σ v = E), S the model's colourless specular factor and W its Fresnel weight (solver/brdf.h).
 // For a given α the model is linear in ρd and ρs: they are projected out (variable projection)
-// and α is found by a log-grid search refined by golden sections; Ceres then polishes all
+// and α is found by a log-grid search refined by Brent's method; Ceres then polishes all
 // parameters jointly (autodiff through EvalBrdf's specular factor) and gives their covariance.
 // Residuals are weighted as for shot noise, 1/√((ρ̄E/π + 0.1·mean L)·mean L) per channel, ρ̄
 // the region's mean ratio of L to E/π: weights that follow neither the photos' noise nor that of
@@ -45,7 +45,8 @@ struct FitSample {
   int incident_begin = 0, incident_end = 0;       // into RegionFitInput::incident
 };
 
-struct RegionFitInput {
+// What a region's fit knows and decides, apart from its samples.
+struct RegionFitSettings {
   std::string name;
   BrdfModel model = BrdfModel::kLambert;
   bool fit_rho_d = true;             // false: FitSample::rho_d_known is used
@@ -73,6 +74,9 @@ struct RegionFitInput {
   bool use_held_albedo = false;
   int num_slots = 1;
   std::vector<double> slot_area;  // m², per slot
+};
+
+struct RegionFitInput : RegionFitSettings {
   std::vector<FitSample> samples;
   std::vector<IncidentLocal> incident;
 };
