@@ -3,17 +3,23 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
 #include "solver/brdf.h"
+#include "solver/numeric.h"
 
 namespace igi {
 
 double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
                       const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
-  double s = SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
+  // SpecularFactor from its parts, so that a direction far off the lobe (exponent beyond 60:
+  // exp(−60) ≈ 1e−26, nothing) costs no exponential: most of the solver's calls.
+  double qx = 0, qy = 0, g = 0;
+  if (!SpecularFactorParts(model, wo, wi, &qx, &qy, &g)) return 0.0;
+  const double x = qx / (alpha_x * alpha_x) + qy / (alpha_y * alpha_y);
+  if (!(x < 60.0)) return 0.0;
+  double s = g * std::exp(-x) / (alpha_x * alpha_y);
   if (HasFresnel(model) && s > 0) s *= FresnelWeight<double>(ior, wo, wi);
   return s;
 }
@@ -58,22 +64,6 @@ inline double ScalarPart(double x) { return x; }
 template <typename J, int N>
 double ScalarPart(const ceres::Jet<J, N>& x) {
   return x.a;
-}
-
-// exp(x) for −2^21 < x <= 0 in float (relative error under 3e−7 for x > −2, 4e−6 down to −87;
-// 0 below −87), written so that the compiler vectorises a loop of it (libm's expf is a call per
-// value): 2^(x·log2 e) split into an integer power of two, built in the float's exponent bits
-// (zero where it would be subnormal), and 2^f, |f| <= 1/2, by its Taylor series to the 6th power.
-inline float ExpNonPositive(float x) {
-  const float t = x * 1.44269504f;
-  const float r = (t + 12582912.0f) - 12582912.0f;  // t rounded to an integer (1.5·2^23)
-  const float g = (t - r) * 0.693147181f;           // |g| <= ln 2 / 2
-  const float p =
-      1.0f +
-      g * (1.0f + g * (0.5f + g * (1.0f / 6 + g * (1.0f / 24 + g * (1.0f / 120 + g / 720)))));
-  const int e = static_cast<int>(r) + 127;        // 2^r's biased exponent
-  const int bits = (e << 23) & ~((e - 1) >> 31);  // 0 (the float 0) where e < 1
-  return p * std::bit_cast<float>(bits);
 }
 
 // The specular term T_c(α) = Σ S·W·v of every sample from a per-incident-sample table of the
@@ -293,54 +283,6 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
     }
   }
   return sol;
-}
-
-// The minimum of f on [a, b] by Brent's method (golden sections, and parabolic steps through the
-// three best points where they behave), to within about 2·tol; at most max_evals calls of f.
-template <typename F>
-double BrentMinimum(double a, double b, double tol, int max_evals, F&& f) {
-  constexpr double kGold = 0.3819660112501051;  // (3 − √5)/2
-  double x = a + kGold * (b - a), w = x, v = x;
-  double fx = f(x), fw = fx, fv = fx;
-  double step = 0, before = 0;  // the last step, and the one before it
-  for (int evals = 1; evals < max_evals; ++evals) {
-    const double mid = 0.5 * (a + b);
-    if (std::abs(x - mid) <= 2 * tol - 0.5 * (b - a)) break;
-    bool parabolic = false;
-    if (std::abs(before) > tol) {
-      const double r = (x - w) * (fx - fv);
-      double q = (x - v) * (fx - fw);
-      double p = (x - v) * q - (x - w) * r;
-      q = 2 * (q - r);
-      if (q > 0) p = -p;
-      q = std::abs(q);
-      // Accepted when it moves less than half the step before last and stays inside [a, b].
-      if (std::abs(p) < std::abs(0.5 * q * before) && p > q * (a - x) && p < q * (b - x)) {
-        before = step;
-        step = p / q;
-        if (x + step - a < 2 * tol || b - (x + step) < 2 * tol) step = mid >= x ? tol : -tol;
-        parabolic = true;
-      }
-    }
-    if (!parabolic) {
-      before = x >= mid ? a - x : b - x;
-      step = kGold * before;
-    }
-    const double u = std::abs(step) >= tol ? x + step : x + (step > 0 ? tol : -tol);
-    const double fu = f(u);
-    if (fu <= fx) {
-      (u >= x ? a : b) = x;
-      v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
-    } else {
-      (u < x ? a : b) = u;
-      if (fu <= fw || w == x) {
-        v = w, fv = fw, w = u, fw = fu;
-      } else if (fu <= fv || v == x || v == w) {
-        v = u, fv = fu;
-      }
-    }
-  }
-  return x;
 }
 
 struct AlphaSearch {

@@ -58,6 +58,11 @@ struct RegionSolution {
   // from its neighbours (seen by no photo, or outside the region's charts). One channel.
   std::optional<Image> albedo_map_seen;
   bool albedo_map_generated_uvs = false;
+  // The map's mean over its seen texels (equal areas: a texel is texel_size_m square on the
+  // surface), NaN without a map (report.json's albedo_map.seen_mean). The region's ρd stays the
+  // fit's (each patch with samples weighted by its area); the two differ by a few per cent on
+  // textured regions (bench/RESULTS.md, session 12).
+  Eigen::Vector3d albedo_map_seen_mean = Eigen::Vector3d::Constant(NAN);
 };
 
 struct SolveIteration {

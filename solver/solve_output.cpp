@@ -166,6 +166,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                           {"width", r.albedo_map ? r.albedo_map->width : 0},
                           {"height", r.albedo_map ? r.albedo_map->height : 0},
                           {"coverage", Num(r.albedo_map_coverage)},
+                          {"seen_mean", Vec(r.albedo_map_seen_mean)},
                           {"generated_uvs", r.albedo_map_generated_uvs}};
       // Which texels the photos estimate (255) and which were filled from neighbours (0).
       if (r.albedo_map_seen) rj["albedo_map"]["seen_file"] = SeenFile(r.albedo_map_file);
