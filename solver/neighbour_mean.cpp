@@ -91,7 +91,7 @@ struct Candidates {
 void NeighbourMean(const std::vector<NeighbourPoint>& points,
                    const std::vector<Eigen::Vector3d>& values, const std::vector<int>& subset,
                    double radius, bool same_photo, int num_threads,
-                   std::vector<Eigen::Vector3d>* out) {
+                   std::vector<Eigen::Vector3d>* out, const std::vector<float>* point_radius) {
   if (subset.empty()) return;
   const double inv = 1.0 / radius;
   auto cell_of = [&](int i) {
@@ -146,7 +146,8 @@ void NeighbourMean(const std::vector<NeighbourPoint>& points,
         for (int k = cells[cell].first; k < cells[cell].second; ++k) {
           const int i = keyed[k].second;
           const NeighbourPoint& p = points[i];
-          cand.Weigh(p, r2, same_photo);
+          const float ri = point_radius ? std::min((*point_radius)[i], float(radius)) : 0.0f;
+          cand.Weigh(p, point_radius ? ri * ri : r2, same_photo);
           const Eigen::Vector4d sum = cand.WeightedSum();
           const double count = sum[3];
           (*out)[i] = count > 0 ? Eigen::Vector3d(sum.head<3>() / count) : values[i];

@@ -21,9 +21,12 @@ struct NeighbourPoint {
 // `out` must have values.size() elements. Exact (every neighbour counts); a uniform grid of
 // cells of the radius, points sorted by (region, cell); per cell, the points of its 27 cells in
 // flat arrays tested and summed without branches (vectorised).
+// With `point_radius` (per point, each <= radius), point i's neighbours are those within
+// point_radius[i] instead.
 void NeighbourMean(const std::vector<NeighbourPoint>& points,
                    const std::vector<Eigen::Vector3d>& values, const std::vector<int>& subset,
                    double radius, bool same_photo, int num_threads,
-                   std::vector<Eigen::Vector3d>* out);
+                   std::vector<Eigen::Vector3d>* out,
+                   const std::vector<float>* point_radius = nullptr);
 
 }  // namespace igi

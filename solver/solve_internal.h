@@ -110,8 +110,13 @@ struct SolverState {
   void IncidentFromPatches();
   void IncidentFromRenderer(const Scene& model, uint64_t round);
   void SmoothIrradiance();
-  std::vector<Eigen::Vector3d> NeighbourMean(const std::vector<Eigen::Vector3d>& values,
-                                             double radius, bool same_photo) const;
+  std::vector<Eigen::Vector3d> NeighbourMean(
+      const std::vector<Eigen::Vector3d>& values, double radius, bool same_photo,
+      const std::vector<float>* point_radius = nullptr) const;
+  // Per observation, the adaptive smoothing's radius (SolveOptions::smoothing_accuracy), from
+  // stage 1's gather; empty until SmoothIrradiance first needs it.
+  std::vector<float> obs_smoothing_radius;
+  void ComputeSmoothingRadii(double radius);
   void ComputeSpecularTerms();
   void HeldOutAlbedos();
   double FitAll(int stage, int iteration);  // returns the largest relative change

@@ -22,6 +22,8 @@ void SolveOptions::Validate() const {
         std::to_string(indirect_rays), "must be in [0, 4096]");
   check(smoothing_radius_m >= 0, "--smoothing-radius-m", fmt::format("{}", smoothing_radius_m),
         "must be >= 0 (0 = auto)");
+  check(smoothing_accuracy >= 0 && smoothing_accuracy <= 10, "--smoothing-accuracy",
+        fmt::format("{}", smoothing_accuracy), "must be in [0, 10] (0 = a fixed radius)");
   check(max_iterations >= 1 && max_iterations <= 100, "--max-iterations",
         std::to_string(max_iterations), "must be in [1, 100]");
   check(tolerance > 0 && tolerance < 1, "--tolerance", fmt::format("{}", tolerance),

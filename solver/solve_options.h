@@ -35,6 +35,14 @@ struct SolveOptions {
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
   // surface is averaged to remove gathering noise; 0 = auto (the scene diagonal / 96).
   double smoothing_radius_m = 0;
+  // Adaptive smoothing (0 = off: every observation averages over smoothing_radius_m): each
+  // observation's radius is this factor times the harmonic mean distance of its indirect rays'
+  // hits (the validity radius of Ward's irradiance cache: the irradiance changes on the scale
+  // of the nearby geometry), held within [1/4, 2] × smoothing_radius_m. Near a contact or a
+  // corner the light changes fast and the radius shrinks; in the open it grows, averaging more
+  // of the gathering noise. 0.3: igi-synth's smooth-floor capture's albedo map 33.13 → 33.50 dB
+  // over the seen texels, 35.01 → 36.33 dB two texels inside (bench/RESULTS.md, session 12).
+  double smoothing_accuracy = 0.3;
   // The paper's alternation: fit, recompute specular differences, refit.
   int max_iterations = 8;
   double tolerance = 2e-3;  // largest relative parameter change that counts as converged

@@ -214,6 +214,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["texel_size_m"] = s.texel_size_m;
   j["observations"] = s.observations;
   j["options"] = {{"pixel_stride", o.pixel_stride},
+                  {"smoothing_accuracy", o.smoothing_accuracy},
                   {"light_samples", o.light_samples},
                   {"indirect_rays", o.indirect_rays},
                   {"max_iterations", o.max_iterations},

@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
   app.add_option("--smoothing-radius-m", o.smoothing_radius_m,
                  "radius for averaging indirect irradiance (0 = auto)")
       ->capture_default_str();
+  app.add_option("--smoothing-accuracy", o.smoothing_accuracy,
+                 "adaptive smoothing: radius = this x the harmonic mean distance of the "
+                 "indirect rays' hits, within [1/4, 2] x the radius (0 = fixed radius)")
+      ->capture_default_str();
   app.add_option("--max-iterations", o.max_iterations, "iterations of the paper's alternation")
       ->capture_default_str();
   app.add_option("--tolerance", o.tolerance, "relative parameter change that ends iterating")

@@ -2,8 +2,8 @@
 // and prints every solved region's stage-1 and final ρd, ρs, α against CAPTURE/truth.json
 // (relative errors, %), and each albedo map's PSNR against the true texture over all texels and
 // over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), rays,
-// step, bounce (0/1), smooth (m), joint (0/1: refine_update), dump; spp is not a key (the
-// capture's). For issue 7's experiments; not a test.
+// step, bounce (0/1), smooth (m), acc (smoothing_accuracy), joint (0/1: refine_update), dump;
+// spp is not a key (the capture's). For issue 7's experiments; not a test.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
       o.specular_bounces = v != 0;
     else if (key == "smooth")
       o.smoothing_radius_m = v;
+    else if (key == "acc")  // adaptive smoothing's factor (SolveOptions::smoothing_accuracy)
+      o.smoothing_accuracy = v;
     else {
       std::fprintf(stderr, "unknown key %s\n", key.c_str());
       return 2;

@@ -14,14 +14,16 @@ namespace {
 std::vector<Eigen::Vector3d> BruteForce(const std::vector<NeighbourPoint>& pts,
                                         const std::vector<Eigen::Vector3d>& values,
                                         const std::vector<int>& subset, double radius,
-                                        bool same_photo) {
+                                        bool same_photo,
+                                        const std::vector<float>* point_radius = nullptr) {
   std::vector<Eigen::Vector3d> out(values.size(), Eigen::Vector3d::Zero());
   for (int i : subset) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
+    const float r = point_radius ? (*point_radius)[i] : float(radius);
     for (int j : subset) {
       const NeighbourPoint &a = pts[i], &b = pts[j];
-      if (a.region != b.region || (a.position - b.position).squaredNorm() > radius * radius ||
+      if (a.region != b.region || (a.position - b.position).squaredNorm() > r * r ||
           a.normal.dot(b.normal) < 0.9f || (same_photo && a.photo != b.photo)) {
         continue;
       }
@@ -82,6 +84,27 @@ TEST(NeighbourMeanTest, MatchesBruteForce) {
         ASSERT_LT((fast[i] - slow[i]).norm(), 1e-9) << "point " << i << " radius " << radius;
       }
     }
+  }
+}
+
+// The adaptive smoothing's per-point radii (each within the cell size).
+TEST(NeighbourMeanTest, PerPointRadiiMatchBruteForce) {
+  const Points p = RandomPoints(3000, 9);
+  std::vector<int> subset(3000);
+  for (int i = 0; i < 3000; ++i) subset[i] = i;
+  std::vector<float> radii(3000);
+  for (int i = 0; i < 3000; ++i) radii[i] = 0.01f + 0.09f * float((i * 37) % 100) / 99.0f;
+  for (bool same_photo : {false, true}) {
+    std::vector<Eigen::Vector3d> fast(p.values.size());
+    NeighbourMean(p.pts, p.values, subset, 0.1, same_photo, 2, &fast, &radii);
+    const auto slow = BruteForce(p.pts, p.values, subset, 0.1, same_photo, &radii);
+    const auto fixed = BruteForce(p.pts, p.values, subset, 0.1, same_photo);
+    int differ = 0;
+    for (int i = 0; i < 3000; ++i) {
+      ASSERT_LT((fast[i] - slow[i]).norm(), 1e-9) << "point " << i;
+      differ += (slow[i] - fixed[i]).norm() > 1e-6;
+    }
+    EXPECT_GT(differ, 1000);  // the radii matter
   }
 }
 
