@@ -13,13 +13,7 @@ namespace igi {
 
 double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
                       const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
-  // SpecularFactor from its parts, so that a direction far off the lobe (exponent beyond 60:
-  // exp(−60) ≈ 1e−26, nothing) costs no exponential: most of the solver's calls.
-  double qx = 0, qy = 0, g = 0;
-  if (!SpecularFactorParts(model, wo, wi, &qx, &qy, &g)) return 0.0;
-  const double x = qx / (alpha_x * alpha_x) + qy / (alpha_y * alpha_y);
-  if (!(x < 60.0)) return 0.0;
-  double s = g * std::exp(-x) / (alpha_x * alpha_y);
+  double s = SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
   if (HasFresnel(model) && s > 0) s *= FresnelWeight<double>(ior, wo, wi);
   return s;
 }

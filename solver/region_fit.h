@@ -106,8 +106,7 @@ struct RegionFitOptions {
 
 RegionFitResult FitRegion(const RegionFitInput& input, const RegionFitOptions& options);
 
-// The colourless specular factor times the Fresnel weight, S·W, for one sample (double); 0 where
-// the lobe's exponent is beyond 60.
+// The colourless specular factor times the Fresnel weight, S·W, for one sample (double).
 double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
                       const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
 
