@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -357,7 +358,15 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   options.Validate();
   const auto start = std::chrono::steady_clock::now();
   const Camera camera = ScaledCamera(camera_in, options.width, options.height);
-  Image image(camera.width, camera.height, 3);
+  const std::vector<uint8_t>* mask = options.pixel_mask;
+  if (mask && mask->size() != size_t(camera.width) * camera.height) {
+    throw InputError(DescribeProblem("", "pixel_mask", std::to_string(mask->size()),
+                                     "must hold one value per output pixel (" +
+                                         std::to_string(camera.width) + " x " +
+                                         std::to_string(camera.height) + ")"));
+  }
+  Image image(camera.width, camera.height, 3,
+              mask ? std::numeric_limits<float>::quiet_NaN() : 0.0f);
   const PathTracer tracer(*impl_, options);
   const Eigen::Vector3d center = camera.CenterInWorld();
   // PINHOLE rays straight from the intrinsics and a rotation matrix (what WorldRayFromImg
@@ -379,6 +388,7 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
         uint64_t rays = 0;
         for (int x = 0; x < camera.width; ++x) {
           const uint64_t pixel = uint64_t(y) * camera.width + x;
+          if (mask && (*mask)[pixel] == 0) continue;
           Eigen::Vector3d sum = Eigen::Vector3d::Zero();
           for (int k = 0; k < options.spp; ++k) {
             Pcg32 rng = PixelSampleRng(options.seed, pixel, k);
@@ -399,7 +409,9 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   if (summary != nullptr) {
     summary->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    summary->camera_rays = uint64_t(camera.width) * camera.height * options.spp;
+    uint64_t pixels = uint64_t(camera.width) * camera.height;
+    if (mask) pixels = uint64_t(std::count_if(mask->begin(), mask->end(), [](uint8_t v) { return v != 0; }));
+    summary->camera_rays = pixels * options.spp;
     summary->rays = total_rays.load();
   }
   return image;

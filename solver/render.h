@@ -26,6 +26,10 @@ struct RenderOptions {
   int width = 0;            // output size; 0 = the camera's. Another size rescales the
   int height = 0;           // intrinsics (same field of view).
   bool show_progress = true;
+  // When set: one value per output pixel (row-major), and only the pixels whose value is nonzero
+  // are rendered; the others are NaN. A pixel's value does not depend on which others are
+  // rendered (each has its own random streams), so parts rendered separately equal one render.
+  const std::vector<uint8_t>* pixel_mask = nullptr;
 
   // Throws InputError naming the field and the rule.
   void Validate() const;

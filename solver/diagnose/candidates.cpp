@@ -313,11 +313,17 @@ class ProfileFit {
     const Eigen::Vector3f ax = axis.cast<float>();
     const PixelRecord* base = f_.records().data();
     const int k_regions = f_.nuisance() ? 1 : num_regions_;
+    // cos^n − 1 of the last record asked for (the fit asks per channel, record by record).
+    const PixelRecord* last = nullptr;
+    double change = 0;
     auto offset = [&](const PixelRecord& r, int c) {
       const LightTerm& t = terms_[size_t(&r - base)];
       if (!t.lit) return 0.0;
-      const double cs = std::max(0.0f, t.from_light.dot(ax));
-      return double(t.direct[c]) * (std::pow(cs, n) - 1);
+      if (&r != last) {
+        last = &r;
+        change = std::pow(double(std::max(0.0f, t.from_light.dot(ax))), n) - 1;
+      }
+      return double(t.direct[c]) * change;
     };
     return f_.Fit(
         k_regions + (response_nuisance ? 2 : 0),

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -80,8 +81,9 @@ bool HasUnknowns(const Scene& scene) {
 struct ModelState {
   fs::path dir;
   Scene model;
-  std::vector<Image> sims;
-  std::vector<Image> sim_var;  // Monte Carlo variance of sims (SimulatePhotos)
+  // The photos re-rendered (complete, except a trial's, rendered only where its held-out test
+  // reads until it is applied: CompleteModel).
+  Simulation sim;
   std::vector<PixelRecord> records;
   ResidualSums train, held;
 };
@@ -94,10 +96,12 @@ struct MapMode {
   bool Full() const { return maps == "auto" && only.empty(); }
 };
 
-// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it;
-// with `with_records`, also builds its residual samples (only the kept model's are ever used).
+// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it
+// (only the pixels `only` marks, when given); with `with_records`, also builds its residual
+// samples (only the kept model's are ever used; they need the complete simulation).
 ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const fs::path& dir,
-                    const DiagnoseOptions& o, const PhotoSet& photos, bool with_records) {
+                    const DiagnoseOptions& o, const PhotoSet& photos, bool with_records,
+                    const PixelMasks* only = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
   ModelState st;
   st.dir = dir;
@@ -121,20 +125,33 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   lo.require_complete_materials = true;
   st.model = LoadScene(model_path, lo);
   const auto t1 = std::chrono::steady_clock::now();
-  st.sims = SimulatePhotos(st.model, o, o.seed, &st.sim_var);
+  SimulatePhotos(st.model, o, o.seed, &st.sim, only);
   const auto t2 = std::chrono::steady_clock::now();
-  if (with_records) st.records = BuildRecords(st.model, photos, st.sims, o, &st.sim_var);
+  if (with_records) st.records = BuildRecords(st.model, photos, st.sim.sims, o, &st.sim.variance);
   const auto t3 = std::chrono::steady_clock::now();
   using Seconds = std::chrono::duration<double>;
   spdlog::info(
-      "igi-diagnose: {}: {}{:.1f} s simulating the photos{}", dir.filename().string(),
+      "igi-diagnose: {}: {}{:.1f} s simulating the photos{}{}", dir.filename().string(),
       solve ? fmt::format("{:.1f} s solving, ", Seconds(t1 - t0).count()) : "",
-      Seconds(t2 - t1).count(),
+      Seconds(t2 - t1).count(), st.sim.Complete() ? "" : " (the held-out test's pixels)",
       with_records ? fmt::format(", {:.1f} s building records", Seconds(t3 - t2).count()) : "");
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
-  st.train = ResidualOverPhotos(photos, st.sims, holdout, false);
-  st.held = ResidualOverPhotos(photos, st.sims, holdout, true);
+  st.train = ResidualOverPhotos(photos, st.sim.sims, holdout, false);
+  st.held = ResidualOverPhotos(photos, st.sim.sims, holdout, true);
   return st;
+}
+
+// Renders the pixels a trial's simulation lacks (it is being applied) and updates its residuals.
+void CompleteModel(ModelState* st, const DiagnoseOptions& o, const PhotoSet& photos) {
+  if (st->sim.Complete()) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  SimulatePhotos(st->model, o, o.seed, &st->sim);
+  spdlog::info("igi-diagnose: {}: {:.1f} s simulating the rest of the photos",
+               st->dir.filename().string(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  st->train = ResidualOverPhotos(photos, st->sim.sims, holdout, false);
+  st->held = ResidualOverPhotos(photos, st->sim.sims, holdout, true);
 }
 
 // The held-out gain of `after` over `before` (share of the squared error) and its significance
@@ -150,11 +167,11 @@ using BlockFilter = std::function<bool(size_t photo, int bx, int by)>;
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const ModelState& before_state,
                                       const ModelState& after_state, const PixelHoldout& h,
                                       const BlockFilter& only = nullptr, bool pixel_units = true) {
-  const std::vector<Image>& before = before_state.sims;
-  const std::vector<Image>& after = after_state.sims;
+  const std::vector<Image>& before = before_state.sim.sims;
+  const std::vector<Image>& after = after_state.sim.sims;
   auto var = [](const ModelState& s, size_t i, size_t k) {
-    return i < s.sim_var.size() && k < s.sim_var[i].pixels.size() ? double(s.sim_var[i].pixels[k])
-                                                                  : 0.0;
+    const std::vector<Image>& v = s.sim.variance;
+    return i < v.size() && k < v[i].pixels.size() ? double(v[i].pixels[k]) : 0.0;
   };
   // Per block: gain and error before.
   std::unordered_map<int64_t, std::pair<double, double>> gain;
@@ -279,6 +296,28 @@ double NoiseFloor(const PhotoSet& photos, const std::vector<Image>& sims) {
   return den > 0 ? std::sqrt(num / den) : 0;
 }
 
+// The grid of a trial's fitted pixels (HeldOutTestMasks): every kTrialGrid-th pixel in x and y.
+constexpr int kTrialGrid = 8;
+
+// `sims` where `trial` (a trial's partial simulation) is rendered, NaN elsewhere; with
+// `grid_only`, only on the grid of kTrialGrid.
+std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vector<Image>& trial,
+                                bool grid_only) {
+  std::vector<Image> out = sims;
+  for (size_t i = 0; i < out.size() && i < trial.size(); ++i) {
+    Image& im = out[i];
+    for (int y = 0; y < im.height; ++y) {
+      for (int x = 0; x < im.width; ++x) {
+        const bool keep = std::isfinite(trial[i].at(x, y, 0)) &&
+                          (!grid_only || (x % kTrialGrid == 0 && y % kTrialGrid == 0));
+        if (keep) continue;
+        for (int c = 0; c < im.channels; ++c) im.at(x, y, c) = std::numeric_limits<float>::quiet_NaN();
+      }
+    }
+  }
+  return out;
+}
+
 Image ResidualImage(const PhotoSet& photos, const std::vector<Image>& sims, size_t i) {
   const Image& rec = photos.recorded[i];
   Image out(rec.width, rec.height, 3);
@@ -286,7 +325,8 @@ Image ResidualImage(const PhotoSet& photos, const std::vector<Image>& sims, size
     for (int x = 0; x < rec.width; ++x) {
       const bool ok = photos.valid[i].at(x, y, 0) > 0.5f;
       for (int c = 0; c < 3; ++c) {
-        out.at(x, y, c) = ok ? sims[i].at(x, y, c) - rec.at(x, y, c) : 0.0f;
+        const float d = sims[i].at(x, y, c) - rec.at(x, y, c);
+        out.at(x, y, c) = ok && std::isfinite(d) ? d : 0.0f;
       }
     }
   }
@@ -406,6 +446,10 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   sum.solved = solve;
   Json declared = AbsolutePaths(scene.document, scene.dir);
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  // A trial's refit is rendered only where its held-out test reads (and on a sparse grid for its
+  // fitted pixels' residual), and completed only when it is applied: most trials are rejected
+  // (or lose to a better one), and their renders were most of a diagnosis's time.
+  const PixelMasks test_masks = HeldOutTestMasks(scene, holdout, kTrialGrid);
 
   // Albedo maps are themselves a model to earn: the baseline (when solving) has constant
   // albedos per region, so that a map cannot absorb an effect of the image or the lights before
@@ -445,7 +489,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
         if (st.model.cameras[k].name == c.params.value("camera", "")) pose_camera = k;
       }
       if (pose_camera >= 0) {
-        const PoseRefinement pr = RefinePose(st.model, pose_camera, photos, st.sims, o, solve,
+        const PoseRefinement pr = RefinePose(st.model, pose_camera, photos, st.sim.sims, o, solve,
                                              CellSize(st.model), 8, &t.next);
         c.params["iterations"] = pr.iterations;
         c.params["rotation_deg"] = pr.rotation_deg;
@@ -473,19 +517,27 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     if (masks) t.photos = MaskedPhotoSet(photos, missing.excluded);
     const PhotoSet& ph = masks ? *t.photos : photos;
     try {
-      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph, false);
+      t.state = FitModel(t.next, solve, next_maps, ds.model_dir, o, ph, false, &test_masks);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
       return t;
     }
-    ds.residual_after = t.state.train.Relative();
+    // Until the step is applied (settle), the fitted pixels' residual is over the grid of
+    // HeldOutTestMasks only, before and after alike.
+    ds.residual_before =
+        ResidualOverPhotos(ph, RenderedPart(st.sim.sims, t.state.sim.sims, true), holdout, false)
+            .Relative();
+    ds.residual_after =
+        ResidualOverPhotos(ph, RenderedPart(t.state.sim.sims, t.state.sim.sims, true), holdout,
+                           false)
+            .Relative();
     ds.held_out_after = t.state.held.Relative();
     // A pose error shows on edges: its significance counts the blocks with edges.
     // A material change of one region shows where the region is seen: its significance counts
     // those blocks (the gain is still over every held-out block).
     const BlockFilter only =
-        pose_camera >= 0 ? EdgeBlocks(st.model, pose_camera, st.sims, holdout) : nullptr;
+        pose_camera >= 0 ? EdgeBlocks(st.model, pose_camera, st.sim.sims, holdout) : nullptr;
     const BlockFilter region_only =
         ChangesRegionMaterial(c)
             ? RegionBlocks(st.model, st.records, c.params["region"].get<std::string>(), holdout)
@@ -525,10 +577,6 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
                                  "parameter(s)",
                                  -100 * gain, z, c.num_params);
     }
-    const size_t img = MostImprovedPhoto(photos, st.sims, t.state.sims);
-    ds.image_photo = scene.photos[img].file.filename().string();
-    ds.residual_before_image = ResidualImage(photos, st.sims, img);
-    ds.residual_after_image = ResidualImage(ph, t.state.sims, img);
     spdlog::info("igi-diagnose: {} {}", c.effect, ds.verdict);
     if (c.effect == "albedo_texture" && ds.kept && !c.params.contains("regions")) {
       Json regions = Json::array();
@@ -543,12 +591,35 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     ds.candidate = std::move(c);
     return t;
   };
+  // The step's residual images (photo where it helped most), and, for the step applied, the
+  // complete simulation and the fitted pixels' residual over all of them.
+  auto finish = [&](Trial& t, bool applied) {
+    DiagnosisStep& ds = t.step;
+    const PhotoSet& ph = t.photos ? *t.photos : photos;
+    if (applied) {
+      CompleteModel(&t.state, o, ph);
+      ds.residual_before = st.train.Relative();
+      ds.residual_after = t.state.train.Relative();
+    } else {
+      ds.residual_pixels = fmt::format("every {}th pixel", kTrialGrid);
+    }
+    if (t.state.sim.sims.empty()) return;  // the refit failed
+    const size_t img = MostImprovedPhoto(photos, st.sim.sims, t.state.sim.sims);
+    ds.image_photo = scene.photos[img].file.filename().string();
+    // A step not applied is shown where it is rendered (its held-out test's pixels), before and
+    // after alike.
+    const std::vector<Image> before =
+        applied ? st.sim.sims : RenderedPart(st.sim.sims, t.state.sim.sims, false);
+    ds.residual_before_image = ResidualImage(photos, before, img);
+    ds.residual_after_image = ResidualImage(ph, t.state.sim.sims, img);
+  };
   // Applies the best of `trials` that passed; records the others. Returns whether one was kept.
   auto settle = [&](std::vector<Trial>& trials, const MapMode& next_maps) {
     int best = -1;
     for (int i = 0; i < int(trials.size()); ++i) {
       if (trials[i].step.kept && (best < 0 || trials[i].gain > trials[best].gain)) best = i;
     }
+    for (int i = 0; i < int(trials.size()); ++i) finish(trials[i], i == best);
     for (int i = 0; i < int(trials.size()); ++i) {
       DiagnosisStep& ds = trials[i].step;
       // A step that passed but explained less than the best stays a candidate of the next round
@@ -569,7 +640,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
-      st.records = BuildRecords(st.model, photos, st.sims, o, &st.sim_var);
+      st.records = BuildRecords(st.model, photos, st.sim.sims, o, &st.sim.variance);
       maps = next_maps;
     }
     for (Trial& t : trials) sum.steps.push_back(std::move(t.step));
@@ -599,7 +670,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
     if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
       missing =
-          LocateMissingGeometry(st.model, photos, st.sims, st.records, holdout, out_dir / "masks");
+          LocateMissingGeometry(st.model, photos, st.sim.sims, st.records, holdout, out_dir / "masks");
       cands.push_back(missing.candidate);
     }
     sum.last_candidates = cands;
@@ -638,16 +709,16 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   }
   sum.final_residual = st.train.Relative();
   sum.final_held_out = st.held.Relative();
-  sum.noise_floor = NoiseFloor(photos, st.sims);
+  sum.noise_floor = NoiseFloor(photos, st.sim.sims);
   sum.unexplained = Unexplained(st, sum.noise_floor);
   sum.final_model_dir = st.dir;
   const fs::path model_file = st.dir / (solve ? "scene.json" : "declared.json");
   sum.final_scene = RelativePaths(AbsolutePaths(ReadJsonFile(model_file), st.dir), out_dir);
   if (!scene.photos.empty()) {
-    Image render = st.sims[0];
+    Image render = st.sim.sims[0];
     sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},
                         {render, "re-render of the improved model"},
-                        {ResidualImage(photos, st.sims, 0), "residual (render − photo)"}};
+                        {ResidualImage(photos, st.sim.sims, 0), "residual (render − photo)"}};
   }
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return sum;

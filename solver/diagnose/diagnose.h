@@ -30,6 +30,10 @@ namespace igi {
 struct DiagnosisStep {
   CandidateResult candidate;  // what was fitted and predicted
   double residual_before = 0, residual_after = 0;  // all valid fitted pixels, refitted scene
+  // Empty: the residuals are over every valid fitted pixel. A step not applied is rendered only
+  // where its held-out test reads, and its fitted pixels' residual (before and after) is over a
+  // regular subsample of them, named here ("every 8th pixel").
+  std::string residual_pixels;
   double held_out_before = 0, held_out_after = 0;
   double z = 0;  // held-out gain over its standard error
   bool kept = false;

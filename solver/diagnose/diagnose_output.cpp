@@ -45,6 +45,7 @@ Json DiagnosisJson(const DiagnosisSummary& s, const DiagnoseOptions& o) {
                                                            : Json(d.candidate.num_params)},
                  {"z", Num(d.z)},
                  {"verdict", d.verdict}};
+    if (!d.residual_pixels.empty()) step["residual_pixels"] = d.residual_pixels;
     (d.kept ? steps : rejected).push_back(std::move(step));
   }
   j["steps"] = steps;
@@ -81,7 +82,8 @@ void WriteDiagnosisOutputs(const DiagnosisSummary& s, const DiagnoseOptions& o,
   std::vector<std::vector<std::string>> rows, classes;
   for (const DiagnosisStep& d : s.steps) {
     rows.push_back({d.candidate.effect, d.candidate.evidence, d.candidate.params.dump(),
-                    fmt::format("{:.4f} → {:.4f}", d.residual_before, d.residual_after),
+                    fmt::format("{:.4f} → {:.4f}{}", d.residual_before, d.residual_after,
+                                d.residual_pixels.empty() ? "" : " (" + d.residual_pixels + ")"),
                     fmt::format("{:.4f} → {:.4f}", d.held_out_before, d.held_out_after),
                     d.verdict});
     classes.push_back({"", "", "", "", d.kept ? "good" : "bad", ""});
@@ -97,7 +99,11 @@ void WriteDiagnosisOutputs(const DiagnosisSummary& s, const DiagnoseOptions& o,
     if (d.residual_before_image.width == 0) continue;
     page.Heading(d.candidate.effect + (d.kept ? " (kept)" : " (rejected)"), 3);
     page.Paragraph("Residual (render − photo) of " + d.image_photo +
-                   " before and after the step, same colour scale.");
+                   " before and after the step, same colour scale" +
+                   (d.residual_pixels.empty()
+                        ? std::string(".")
+                        : std::string(", where the step's held-out test reads (a step not "
+                                      "applied is rendered only there).")));
     double scale = 0;
     for (float v : d.residual_before_image.pixels) scale = std::max(scale, double(std::abs(v)));
     page.ResidualImage(d.residual_before_image, "before", scale * 0.5, 320);

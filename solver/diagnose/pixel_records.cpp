@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "solver/observations.h"
@@ -95,51 +96,121 @@ Image BoxMean(const Image& in, int r) {
 
 }  // namespace
 
-std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
-                                  std::vector<Image>* variance) {
-  std::vector<Image> sims(model.photos.size());
-  if (variance) variance->assign(model.photos.size(), Image());
+void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+                    Simulation* sim, const PixelMasks* only) {
+  const size_t n = model.photos.size();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const bool first = sim->sims.size() != n;
+  if (first) {
+    sim->sims.assign(n, Image());
+    sim->variance.assign(n, Image());
+    sim->raw_variance.assign(n, Image());
+    sim->rendered.assign(n, {});
+  }
   std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
-  const bool split = variance && options.spp >= 2;
+  const bool split = options.spp >= 2;
   const int spp1 = split ? options.spp / 2 : options.spp, spp2 = options.spp - spp1;
-  for (size_t i = 0; i < model.photos.size(); ++i) {
+  for (size_t i = 0; i < n; ++i) {
     const Photo& p = model.photos[i];
-    if (!renderers[p.lighting])
+    const Camera& cam = model.cameras[p.camera];
+    const size_t pixels = size_t(cam.width) * cam.height;
+    if (sim->sims[i].empty()) {
+      sim->sims[i] = Image(cam.width, cam.height, 3, nan);
+      sim->raw_variance[i] = Image(cam.width, cam.height, 3);
+      sim->rendered[i].assign(pixels, 0);
+    }
+    // What this call renders: wanted and not yet rendered.
+    std::vector<uint8_t> todo(pixels, 0);
+    size_t count = 0;
+    for (size_t k = 0; k < pixels; ++k) {
+      const bool want = only == nullptr || (i < only->size() && (*only)[i][k] != 0);
+      todo[k] = want && sim->rendered[i][k] == 0;
+      count += todo[k];
+    }
+    if (count == 0) continue;
+    if (!renderers[p.lighting]) {
       renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+    }
     RenderOptions ro;
     ro.spp = spp1;
     ro.seed = seed + 7919 * i;
     ro.num_threads = options.num_threads;
     ro.show_progress = false;
-    Image h1 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
-    if (!split) {
+    ro.pixel_mask = count == pixels ? nullptr : &todo;
+    Image h1 = renderers[p.lighting]->Render(cam, ro);
+    Image h2;
+    if (split) {
+      ro.spp = spp2;
+      ro.seed = seed + 7919 * i + 0x5bd1e995ULL;
+      h2 = renderers[p.lighting]->Render(cam, ro);
+    }
+    Image mean = h1;
+    if (split) {
+      for (size_t k = 0; k < mean.pixels.size(); ++k) {
+        mean.pixels[k] =
+            float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) / options.spp);
+      }
       ApplyExposureAndResponse(p, &h1);
-      if (variance) (*variance)[i] = Image(h1.width, h1.height, h1.channels);
-      sims[i] = std::move(h1);
-      continue;
+      ApplyExposureAndResponse(p, &h2);
     }
-    ro.spp = spp2;
-    ro.seed = seed + 7919 * i + 0x5bd1e995ULL;
-    Image h2 = renderers[p.lighting]->Render(model.cameras[p.camera], ro);
-    sims[i] = Image(h1.width, h1.height, h1.channels);
-    for (size_t k = 0; k < sims[i].pixels.size(); ++k) {
-      sims[i].pixels[k] =
-          float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) / options.spp);
-    }
-    ApplyExposureAndResponse(p, &sims[i]);
-    ApplyExposureAndResponse(p, &h1);
-    ApplyExposureAndResponse(p, &h2);
-    const double k_var = 1.0 / (options.spp * (1.0 / spp1 + 1.0 / spp2));
-    Image raw(h1.width, h1.height, h1.channels);
-    for (size_t k = 0; k < raw.pixels.size(); ++k) {
-      const double d = double(h1.pixels[k]) - double(h2.pixels[k]);
-      raw.pixels[k] = std::isfinite(d) ? float(k_var * d * d) : 0.0f;
+    ApplyExposureAndResponse(p, &mean);
+    const double k_var = split ? 1.0 / (options.spp * (1.0 / spp1 + 1.0 / spp2)) : 0.0;
+    Image& out = sim->sims[i];
+    Image& raw = sim->raw_variance[i];
+    for (size_t k = 0; k < pixels; ++k) {
+      if (!todo[k]) continue;
+      sim->rendered[i][k] = 1;
+      for (int c = 0; c < 3; ++c) {
+        const size_t j = k * 3 + c;
+        out.pixels[j] = mean.pixels[j];
+        const double d = split ? double(h1.pixels[j]) - double(h2.pixels[j]) : 0.0;
+        raw.pixels[j] = std::isfinite(d) ? float(k_var * d * d) : 0.0f;
+      }
     }
     // One pixel's estimate has one degree of freedom (its noise is as large as itself): averaged
     // over a 5 × 5 window, where the variance changes slowly, it adds little noise to the gains.
-    (*variance)[i] = BoxMean(raw, 2);
+    sim->variance[i] = BoxMean(raw, 2);
   }
-  return sims;
+  bool complete = true;
+  for (const std::vector<uint8_t>& r : sim->rendered) {
+    complete = complete && std::all_of(r.begin(), r.end(), [](uint8_t v) { return v != 0; });
+  }
+  if (complete) sim->rendered.clear();
+}
+
+PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int grid) {
+  constexpr int kWindow = 2;  // SimulatePhotos' variance window
+  PixelMasks masks(model.photos.size());
+  for (size_t i = 0; i < masks.size(); ++i) {
+    const Camera& cam = model.cameras[model.photos[i].camera];
+    const int w = cam.width, h = cam.height;
+    std::vector<uint8_t> held(size_t(w) * h, 0), rows(size_t(w) * h, 0);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) held[size_t(y) * w + x] = holdout.HeldOut(int(i), x, y);
+    }
+    // Widened by the window: a separable maximum, along x then y.
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int u = std::max(0, x - kWindow); u <= std::min(w - 1, x + kWindow) && !v; ++u) {
+          v = held[size_t(y) * w + u];
+        }
+        rows[size_t(y) * w + x] = v;
+      }
+    }
+    std::vector<uint8_t>& m = masks[i];
+    m.assign(size_t(w) * h, 0);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = grid > 0 && x % grid == 0 && y % grid == 0;
+        for (int t = std::max(0, y - kWindow); t <= std::min(h - 1, y + kWindow) && !v; ++t) {
+          v = rows[size_t(t) * w + x];
+        }
+        m[size_t(y) * w + x] = v;
+      }
+    }
+  }
+  return masks;
 }
 
 namespace {

@@ -55,17 +55,40 @@ struct PhotoSet {
 // and its footprint (centre and four corners) lies on one reflective region.
 PhotoSet LoadPhotoSet(const Scene& scene);
 
+// Per photo, one value per pixel (row-major): nonzero where a simulation renders the pixel.
+using PixelMasks = std::vector<std::vector<uint8_t>>;
+
+// Re-renders of the photos (SimulatePhotos), possibly of some pixels only (the others NaN).
+struct Simulation {
+  std::vector<Image> sims;
+  // Per pixel and channel, an estimate of the Monte Carlo variance of sims (see SimulatePhotos);
+  // zero where unknown.
+  std::vector<Image> variance;
+  std::vector<Image> raw_variance;  // the same before its 5 × 5 mean
+  PixelMasks rendered;              // per photo: what is rendered; an empty list: every pixel
+  bool Complete() const { return rendered.empty(); }
+};
+
 // Renders every photo's camera under its lighting and applies the photo model (scale, response).
-// With `variance`: each render is the mean of two independent renders of half the paths, and
-// (*variance)[i] holds, per pixel and channel, an unbiased estimate of the Monte Carlo variance of
-// sims[i] from their difference: (h1 − h2)² / (spp (1/spp1 + 1/spp2)), zero when spp is 1.
-// A model whose render is less noisy (an exact ambient term, lower albedos) has a lower residual²
-// against the photos for that reason alone; the held-out gains subtract this variance.
-std::vector<Image> SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
-                                  std::vector<Image>* variance = nullptr);
+// Each render is the mean of two independent renders of half the paths, and the variance holds,
+// per pixel and channel, an unbiased estimate of the Monte Carlo variance of sims[i] from their
+// difference, (h1 − h2)² / (spp (1/spp1 + 1/spp2)), averaged over a 5 × 5 window (zero when spp
+// is 1). A model whose render is less noisy (an exact ambient term, lower albedos) has a lower
+// residual² against the photos for that reason alone; the held-out gains subtract this variance.
+// With `only`, just the pixels it marks are rendered; a later call (with `only` or without)
+// renders those of its pixels that `sim` lacks, and the result equals, bit for bit, one call for
+// them all (each pixel's paths have their own random streams). The variance's window reads
+// unrendered pixels as 0: it is exact where the 5 × 5 window around a pixel is rendered.
+void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+                    Simulation* sim, const PixelMasks* only = nullptr);
+
+// The pixels a step's held-out test reads (HeldOutGain): the held-out blocks widened by the
+// variance's window (2 pixels), and every `grid`-th pixel in x and y (for an estimate of the
+// fitted pixels' residual).
+PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int grid);
 
 // The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel, with the
-// renders' variance per pixel when `variance` is given (SimulatePhotos').
+// renders' variance per pixel when `variance` is given (SimulatePhotos'). `sims` complete.
 std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
                                       const std::vector<Image>& sims,
                                       const DiagnoseOptions& options,

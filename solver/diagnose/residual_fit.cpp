@@ -13,7 +13,15 @@ ResidualFitter::ResidualFitter(const std::vector<PixelRecord>& records, std::vec
       cell_(std::move(cell)),
       num_cells_(num_cells),
       nuisance_(nuisance),
-      block_px_(std::max(1, block_px)) {}
+      block_px_(std::max(1, block_px)) {
+  // Without the nuisance the cells play no part in a fit: one cell holds every record's sums
+  // (with maps' voxel cells, thousands of per-cell sums would be zeroed, filled and read back
+  // at every fit of a search).
+  if (!nuisance_) {
+    std::fill(cell_.begin(), cell_.end(), 0);
+    num_cells_ = std::min(num_cells_, 1);
+  }
+}
 
 namespace {
 
@@ -52,10 +60,13 @@ double ResidualFitter::Z(const std::vector<double>& gains) {
 
 namespace {
 
-// The projected quantities of one (cell, channel, set) block.
+// The projected quantities of one (cell, channel, set) block (reused from block to block: no
+// allocation per block).
 struct Projected {
+  explicit Projected(int k) : bb(k, k), by(k), tmp(k) {}
   Eigen::MatrixXd bb;  // Σ b bᵀ − (Σ s b)(Σ s b)ᵀ / Σ s²
   Eigen::VectorXd by;  // Σ b y − (Σ s b)(Σ s y) / Σ s²
+  Eigen::VectorXd tmp;
   double yy = 0;       // Σ y² − (Σ s y)² / Σ s²
   double yy0 = 0;      // the same for y0 (no offset)
 };
@@ -63,8 +74,8 @@ struct Projected {
 // With noise_free, the noise-free error: the nuisance's sums corrected by the variance V
 // (ResidualFitter::FitNoiseFreeBasis); Σ y² − V − (Σ s·y + V)² / (Σ s² − V) is the least
 // Σ (y − a s)² − (1 + a)² V.
-Projected Project(const double* st, int k, bool nuisance, bool noise_free) {
-  Projected p;
+void Project(const double* st, int k, bool nuisance, bool noise_free, Projected* out) {
+  Projected& p = *out;
   p.bb = Eigen::Map<const Eigen::MatrixXd>(st + 3 + 2 * k, k, k);
   p.by = Eigen::Map<const Eigen::VectorXd>(st + 3 + k, k);
   p.yy = st[2];
@@ -74,12 +85,11 @@ Projected Project(const double* st, int k, bool nuisance, bool noise_free) {
     const double ss = CorrectedSs(st, stride, noise_free), v = noise_free ? st[0] - ss : 0.0;
     const double sy = st[1] + v, sy0 = st[stride - 2] + v;
     const Eigen::Map<const Eigen::VectorXd> sb(st + 3, k);
-    p.bb -= sb * sb.transpose() / ss;
-    p.by -= sb * (sy / ss);
+    p.bb.noalias() -= sb * sb.transpose() / ss;
+    p.by.noalias() -= sb * (sy / ss);
     p.yy -= v + sy * sy / ss;
     p.yy0 -= v + sy0 * sy0 / ss;
   }
-  return p;
 }
 
 }  // namespace
@@ -89,11 +99,11 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool 
   ResidualFit fit;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(k);
+  Projected p(k), raw(k);
   double train_offset = 0;  // projected Σ y² (with the offset) before the fit
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
-      const Projected p =
-          Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_, noise_free);
+      Project(&stats[((size_t(cell) * 3 + c) * 2 + 0) * stride], k, nuisance_, noise_free, &p);
       a += p.bb;
       g += p.by;
       fit.train_before += p.yy0;
@@ -115,10 +125,14 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool 
   for (int cell = 0; cell < num_cells_; ++cell) {
     for (int c = 0; c < 3; ++c) {
       const double* st = &stats[((size_t(cell) * 3 + c) * 2 + 1) * stride];
-      const Projected p = Project(st, k, nuisance_, noise_free);
+      Project(st, k, nuisance_, noise_free, &p);
+      p.tmp.noalias() = p.bb * fit.coef;
       fit.held_before += p.yy0;
-      fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.bb * fit.coef));
-      if (noise_free) held_raw += Project(st, k, nuisance_, false).yy0;
+      fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.tmp));
+      if (noise_free) {
+        Project(st, k, nuisance_, false, &raw);
+        held_raw += raw.yy0;
+      }
     }
   }
   // The noise-free fall of the error on the raw error's scale (the refit's test: the fall of

@@ -137,6 +137,9 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) c
   const int stride = Stride(k);
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
   std::vector<double> b(k);
+  // A basis is mostly zeros (one column per region, of which a record has one): only its
+  // nonzero entries are accumulated (the sums are the same: adding a zero product changes none).
+  std::vector<int> nz(k);
   for (size_t i = 0; i < records_.size(); ++i) {
     const PixelRecord& r = records_[i];
     if (r.outlier) continue;
@@ -148,10 +151,16 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) c
       st[0] += s * s, st[1] += s * y, st[2] += y * y;
       st[stride - 3] += r.sim_var[c];
       st[stride - 2] += s * y0, st[stride - 1] += y0 * y0;
+      int n = 0;
       for (int a = 0; a < k; ++a) {
+        if (b[a] != 0) nz[n++] = a;
+      }
+      for (int ia = 0; ia < n; ++ia) {
+        const int a = nz[ia];
         st[3 + a] += s * b[a];
         st[3 + k + a] += b[a] * y;
-        for (int e = 0; e < k; ++e) st[3 + 2 * k + a * k + e] += b[a] * b[e];
+        double* row = st + 3 + 2 * k + a * k;
+        for (int ie = 0; ie < n; ++ie) row[nz[ie]] += b[a] * b[nz[ie]];
       }
     }
   }

@@ -165,6 +165,45 @@ TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
   EXPECT_NE(renderer.Render(scene.cameras[0], options).pixels, one.pixels);
 }
 
+// A pixel mask renders its pixels exactly as the whole render does (each pixel has its own random
+// streams) and leaves the others NaN; two complementary masks make up the whole image.
+TEST(RenderTest, PixelMaskRendersThePixelsOfTheWholeRender) {
+  const auto dir = TempSceneDir("mask");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
+      R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
+  const Renderer renderer(scene, 0);
+  RenderOptions options;
+  options.spp = 3;
+  options.show_progress = false;
+  const Image whole = renderer.Render(scene.cameras[0], options);
+  std::vector<uint8_t> mask(size_t(whole.width) * whole.height, 0), rest = mask;
+  for (size_t k = 0; k < mask.size(); ++k) (k % 7 < 3 ? mask : rest)[k] = 1;
+  options.pixel_mask = &mask;
+  RenderSummary summary;
+  const Image part = renderer.Render(scene.cameras[0], options, &summary);
+  options.pixel_mask = &rest;
+  const Image other = renderer.Render(scene.cameras[0], options);
+  size_t rendered = 0;
+  for (size_t k = 0; k < mask.size(); ++k) {
+    for (int c = 0; c < 3; ++c) {
+      const size_t j = k * 3 + c;
+      if (mask[k]) {
+        EXPECT_EQ(part.pixels[j], whole.pixels[j]) << k;
+        EXPECT_TRUE(std::isnan(other.pixels[j])) << k;
+      } else {
+        EXPECT_TRUE(std::isnan(part.pixels[j])) << k;
+        EXPECT_EQ(other.pixels[j], whole.pixels[j]) << k;
+      }
+    }
+    rendered += mask[k];
+  }
+  EXPECT_EQ(summary.camera_rays, rendered * 3);
+  std::vector<uint8_t> wrong(5, 1);
+  options.pixel_mask = &wrong;
+  EXPECT_THROW(renderer.Render(scene.cameras[0], options), InputError);
+}
+
 TEST(RenderTest, TextureIsSampledWithVUp) {
   const auto dir = TempSceneDir("texture");
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
