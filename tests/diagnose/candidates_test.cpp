@@ -208,7 +208,7 @@ std::vector<PixelRecord> PlateRecords(bool fresnel_truth, double truth_alpha, do
 }
 
 CandidateResult PlateCandidate(bool fresnel, const std::vector<PixelRecord>& records,
-                               double model_rho_s, double model_alpha) {
+                               double model_rho_s, double model_alpha, bool solved = true) {
   Scene model;
   Material m;
   m.name = "plate";
@@ -220,8 +220,21 @@ CandidateResult PlateCandidate(bool fresnel, const std::vector<PixelRecord>& rec
   const Json declared = Json::object();
   int num_cells = 0;
   const std::vector<int> cells = RecordCells(model, records, 0.05, &num_cells);
-  const ResidualFitter f(records, cells, num_cells, true, 8);
-  return LobeChange({model, declared, true}, f, 0, fresnel);
+  const ResidualFitter f(records, cells, num_cells, solved, 8);
+  return LobeChange({model, declared, solved}, f, 0, fresnel);
+}
+
+// Materials given (ρs and α as true, the truth Fresnel-weighted at index 1.5, F0 = 0.04): the
+// weight's change has one shape at every index, which sets only its scale, so the index is read
+// from the fitted scale, with the amplitude the refit applies (1). (Picked from a list, every
+// index fitted alike and rounding chose: 1.33 or 1.5 from one build to the next.)
+TEST(LobeChangeTest, FresnelIndexWithMaterialsGivenIsTheFittedScale) {
+  const std::vector<PixelRecord> records = PlateRecords(true, 0.15, 0.05, 0.15, 3);
+  const CandidateResult c = PlateCandidate(true, records, 0.05, 0.15, false);
+  ASSERT_TRUE(c.valid) << c.note;
+  EXPECT_NEAR(c.params["ior"].get<double>(), 1.5, 0.02);
+  EXPECT_NEAR(c.params["amplitude"].get<double>(), 1.0, 1e-3);
+  EXPECT_GT(c.Gain(), 0.5);  // the weight is all of the residual but the photos' 1 % noise
 }
 
 // Fresnel-weighted truth (ior 1.5), and the plain lobe a solver fitted over both views (ρs 30 %
