@@ -85,6 +85,8 @@ std::vector<std::string> ExtractorArgs(const std::filesystem::path& images_dir,
                                 Threads(o.threads),
                                 "--SiftExtraction.max_image_size",
                                 std::to_string(o.max_image_size),
+                                "--SiftExtraction.max_num_features",
+                                std::to_string(o.max_features),
                                 "--ImageReader.single_camera",
                                 o.single_camera || o.intrinsics ? "1" : "0"};
   if (o.intrinsics) {
@@ -165,6 +167,9 @@ void ColmapRunOptions::Validate() const {
   }
   if (max_image_size < 100) {
     problems.Add("", "--max-image-size", std::to_string(max_image_size), "must be >= 100");
+  }
+  if (max_features < 100) {
+    problems.Add("", "--max-features", std::to_string(max_features), "must be >= 100");
   }
   problems.ThrowIfAny();
 }

@@ -459,6 +459,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(6, 1000000));
   app.add_option("--max-image-size", args.colmap.max_image_size,
                  "SIFT extraction downscales larger photos to this size");
+  app.add_option("--max-features", args.colmap.max_features,
+                 "At most this many SIFT keypoints per photo (COLMAP's default 8192; CPU "
+                 "matching time grows with it)");
   app.add_option("--camera-model", args.colmap.camera_model,
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
                  "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")

@@ -67,10 +67,10 @@ TEST(ColmapRunnerTest, MissingOrWrongColmapIsReported) {
   fs::remove_all(dir);
 }
 
-// The self-calibrated camera model and guided matching reach COLMAP's command line (a fake
+// The self-calibrated camera model, guided matching and the feature cap reach COLMAP's command line (a fake
 // COLMAP that logs its arguments and reconstructs nothing); a model igi cannot read is refused
 // before anything runs.
-TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
+TEST(ColmapRunnerTest, CameraModelGuidedMatchingAndFeatureCapArePassed) {
   const fs::path dir = test::UniqueTempDir("igi_colmap_runner_args");
   const fs::path fake = dir / "fake-colmap";
   std::ofstream(fake) << "#!/bin/sh\necho 'COLMAP 3.8 -- Structure-from-Motion'\n";
@@ -97,6 +97,14 @@ TEST(ColmapRunnerTest, CameraModelAndGuidedMatchingArePassed) {
   EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
   const std::string asked = ReadFileToString(dir / "work" / "colmap.log");
   EXPECT_NE(asked.find("--SiftMatching.guided_matching 1"), std::string::npos) << asked;
+  EXPECT_NE(asked.find("--SiftExtraction.max_num_features 8192"), std::string::npos) << asked;
+  options.max_features = 1024;  // the demo's
+  EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
+  const std::string fewer = ReadFileToString(dir / "work" / "colmap.log");
+  EXPECT_NE(fewer.find("--SiftExtraction.max_num_features 1024"), std::string::npos) << fewer;
+  options.max_features = 50;
+  EXPECT_THROW(options.Validate(), InputError);
+  options.max_features = 1024;
   options.camera_model = "FULL_OPENCV";
   EXPECT_THROW(options.Validate(), InputError);
   fs::remove_all(dir);
