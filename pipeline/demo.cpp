@@ -362,18 +362,65 @@ std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scen
   return out;
 }
 
+std::map<std::string, Eigen::Vector3d> TrueAlbedoOverSolvedTexels(const fs::path& solved_scene,
+                                                                  const fs::path& truth_json) {
+  std::map<std::string, Eigen::Vector3d> out;
+  const Json solved = ReadJsonFile(solved_scene).value("materials", Json::object());
+  const Json truth = ReadJsonFile(truth_json).value("materials", Json::object());
+  const fs::path report_file = solved_scene.parent_path() / "report.json";
+  const Json report = fs::exists(report_file) ? ReadJsonFile(report_file) : Json::object();
+  for (const auto& [name, t] : truth.items()) {
+    if (!t.contains("rho_d_map") || !t["rho_d_map"].is_string() || !solved.contains(name) ||
+        !solved[name].contains("rho_d_map") || !solved[name]["rho_d_map"].is_string()) {
+      continue;
+    }
+    // A map on charts igi-solve generated has other UVs than the true texture's.
+    bool generated = false;
+    for (const Json& r : report.value("regions", Json::array())) {
+      if (r.value("name", "") == name && r.contains("albedo_map")) {
+        generated = r["albedo_map"].value("generated_uvs", false);
+      }
+    }
+    if (generated) continue;
+    const fs::path map = solved_scene.parent_path() / solved[name]["rho_d_map"].get<std::string>();
+    const fs::path seen_file = map.parent_path() / (map.stem().string() + "_seen.png");
+    if (!fs::exists(seen_file)) continue;
+    const Image texture =
+        ReadImage(truth_json.parent_path() / t["rho_d_map"].get<std::string>(), 3);
+    const Image seen = ReadImage(seen_file, 1);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (int y = 0; y < seen.height; ++y) {
+      for (int x = 0; x < seen.width; ++x) {
+        if (!(seen.at(x, y, 0) > 0.5f)) continue;
+        // Texel centres, v up (row 0 at the top of the UV square), as the renderer reads maps.
+        const Eigen::Vector2f uv(float((x + 0.5) / seen.width), float(1 - (y + 0.5) / seen.height));
+        sum += TextureAt(texture, uv);
+        ++count;
+      }
+    }
+    if (count > 0) out[name] = sum / count;
+  }
+  return out;
+}
+
 Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
                       const std::vector<std::string>& given) {
   const Json solved = ReadJsonFile(solved_scene)["materials"];
   Json truth = ReadJsonFile(truth_json)["materials"];
   for (const std::string& name : given) truth.erase(name);
-  // A textured region's truth is its texture's mean over the surface the photos see (what the
-  // solver can recover), when the true scene is there to say which part that is.
+  // A textured region's truth is its texture's mean over the part the photos show (what the
+  // solver can recover): over the texels of the solved map that observations cover when the
+  // solve wrote its seen mask, else over the surface the true cameras see (when the true scene is
+  // there to say which part that is).
   const fs::path truth_scene = truth_json.parent_path() / "truth" / "scene.json";
   const std::map<std::string, Eigen::Vector3d> seen =
       fs::exists(truth_scene) ? SeenTrueAlbedo(truth_scene)
                               : std::map<std::string, Eigen::Vector3d>{};
+  const std::map<std::string, Eigen::Vector3d> texels =
+      TrueAlbedoOverSolvedTexels(solved_scene, truth_json);
   auto true_rho_d = [&](const std::string& name, const Json& t) {
+    if (const auto it = texels.find(name); it != texels.end()) return it->second.mean();
     const auto it = seen.find(name);
     return it != seen.end() ? it->second.mean() : Mean(Rgb(t["rho_d"]));
   };
@@ -399,9 +446,14 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
                 {"recovered", Mean(sv)},
                 {"recovered_over_k", got},
                 {"relative_error", truth_mean > 0 ? got / truth_mean - 1 : 0.0}};
-      if (rho_d && seen.count(name)) {
+      if (rho_d && (seen.count(name) || texels.count(name))) {
         r[key]["truth_whole_texture"] = Mean(tv);
-        r[key]["truth_is"] = "the true texture's mean over the surface the photos see";
+        if (seen.count(name)) r[key]["truth_seen_by_the_cameras"] = seen.at(name).mean();
+        r[key]["truth_is"] =
+            texels.count(name)
+                ? "the true texture's mean over the texels of the solved map that observations "
+                  "cover (its _seen.png)"
+                : "the true texture's mean over the surface the photos see";
       }
     }
     regions.push_back(r);
@@ -413,7 +465,9 @@ Json CompareWithTruth(const fs::path& solved_scene, const fs::path& truth_json,
            "k = median over regions of recovered/true mean rho_d: the HDR maps' free constant "
            "(the response is recovered up to a factor); rho_d and rho_s errors are after "
            "dividing by k, alpha needs no k. A textured region's true rho_d is its texture's "
-           "mean over the surface some photo sees (truth_whole_texture: over the whole texture)"},
+           "mean over the texels of the solved map that observations cover, or without a map "
+           "over the surface some photo sees (truth_seen_by_the_cameras; truth_whole_texture: "
+           "over the whole texture)"},
           {"regions", regions}};
 }
 

@@ -104,10 +104,20 @@ double MeasureRadianceScale(const std::filesystem::path& hdr_dir,
 std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const std::filesystem::path& truth_scene,
                                                       int samples = 200000, uint64_t seed = 1);
 
+// The true albedo textures' mean over the texels of the solved albedo maps that observations
+// cover (igi-solve's REGION_seen.png beside each map), per region with a true texture and a
+// solved map on the mesh's own UVs: exactly the surface the solver recovered. The cameras'
+// geometric view (SeenTrueAlbedo) also counts what no valid pixel shows: measured on the demo
+// (2026-11-23), wall_x4's truth there 0.2752, over its solved map's seen texels 0.2669 (its map
+// against the true texture texel by texel: 1.037 = k, whatever the row band).
+std::map<std::string, Eigen::Vector3d> TrueAlbedoOverSolvedTexels(
+    const std::filesystem::path& solved_scene, const std::filesystem::path& truth_json);
+
 // Compares a solved scene with truth.json: per region and parameter (see demo.h's note on k).
 // Regions in `given` (their material was given to the solver, e.g. the reference) are left out.
-// A textured region's true rho_d is SeenTrueAlbedo's when truth/scene.json lies beside
-// truth.json, else the texture's mean (truth.json's rho_d).
+// A textured region's true rho_d is TrueAlbedoOverSolvedTexels' when the solve wrote its map's
+// seen mask, else SeenTrueAlbedo's when truth/scene.json lies beside truth.json, else the
+// texture's mean (truth.json's rho_d).
 Json CompareWithTruth(const std::filesystem::path& solved_scene,
                       const std::filesystem::path& truth_json,
                       const std::vector<std::string>& given = {});

@@ -179,5 +179,56 @@ TEST(DemoCalibrationTest, SeenTrueAlbedoAveragesTheSeenSurfaceOnly) {
   fs::remove_all(dir);
 }
 
+// The truth over the solved map's seen texels: a true texture 0.2 on its left half (u < 0.5) and
+// 0.8 on its right; the solved map (8 x 4 texels) marks its two left columns seen (u < 0.25): the
+// truth there is 0.2, and a solved ρd of 0.2 is exact; without the mask the comparison falls back
+// to the whole texture's mean (no true scene beside truth.json), 0.5.
+TEST(DemoCalibrationTest, TruthOverTheSolvedMapsSeenTexels) {
+  const fs::path dir = test::UniqueTempDir("demo_texels");
+  fs::create_directories(dir / "textures");
+  fs::create_directories(dir / "solve" / "albedo");
+  Image texture = Constant(64, 64, 0.2f);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 32; x < 64; ++x) {
+      for (int c = 0; c < 3; ++c) texture.pixels[(size_t(y) * 64 + x) * 3 + c] = 0.8f;
+    }
+  }
+  WriteImage(dir / "textures" / "floor.exr", texture);
+  WriteJsonFile(dir / "truth.json",
+                Json{{"materials",
+                      {{"floor", {{"rho_d", {0.5, 0.5, 0.5}}, {"rho_d_map", "textures/floor.exr"}}},
+                       {"wall", {{"rho_d", {0.3, 0.3, 0.3}}}}}}});
+  WriteJsonFile(dir / "solve" / "scene.json",
+                Json{{"materials",
+                      {{"floor", {{"rho_d", {0.2, 0.2, 0.2}}, {"rho_d_map", "albedo/floor.exr"}}},
+                       {"wall", {{"rho_d", {0.3, 0.3, 0.3}}}}}}});
+  WriteImage(dir / "solve" / "albedo" / "floor.exr", Constant(8, 4, 0.2f));
+  Image seen(8, 4, 1);
+  for (int y = 0; y < 4; ++y) seen.at(0, y, 0) = seen.at(1, y, 0) = 1.0f;
+  WriteImageOptions mo;
+  mo.type = PixelType::kUInt8;
+  WriteImage(dir / "solve" / "albedo" / "floor_seen.png", seen, mo);
+
+  const auto texels = TrueAlbedoOverSolvedTexels(dir / "solve" / "scene.json", dir / "truth.json");
+  ASSERT_EQ(texels.size(), 1u);  // the wall has no texture
+  EXPECT_NEAR(texels.at("floor").x(), 0.2, 1e-6);
+  const Json d = CompareWithTruth(dir / "solve" / "scene.json", dir / "truth.json");
+  for (const Json& r : d["regions"]) {
+    EXPECT_NEAR(r["rho_d"]["relative_error"].get<double>(), 0.0, 1e-6) << r.dump();
+    if (r["region"] == "floor") {
+      EXPECT_NE(r["rho_d"]["truth_is"].get<std::string>().find("texels"), std::string::npos);
+      EXPECT_NEAR(r["rho_d"]["truth_whole_texture"].get<double>(), 0.5, 1e-9);
+    }
+  }
+  fs::remove(dir / "solve" / "albedo" / "floor_seen.png");
+  const Json whole = CompareWithTruth(dir / "solve" / "scene.json", dir / "truth.json");
+  for (const Json& r : whole["regions"]) {
+    if (r["region"] == "floor") {
+      EXPECT_NEAR(r["rho_d"]["truth"].get<double>(), 0.5, 1e-9);
+    }
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace igi
