@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -887,9 +887,8 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   ParallelFor(0, int64_t(tasks.size()), [&](int64_t i) {
     const auto start = std::chrono::steady_clock::now();
     results[size_t(i)] = tasks[size_t(i)].run();
-    spdlog::debug(
-        "igi-diagnose: candidate {} evaluated in {:.1f} s", results[size_t(i)].Key(),
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s", results[size_t(i)].Key(),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   });
   std::vector<CandidateResult> out;
   for (size_t i = 0; i < tasks.size(); ++i) {

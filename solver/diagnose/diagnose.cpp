@@ -311,7 +311,9 @@ std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vecto
         const bool keep = std::isfinite(trial[i].at(x, y, 0)) &&
                           (!grid_only || (x % kTrialGrid == 0 && y % kTrialGrid == 0));
         if (keep) continue;
-        for (int c = 0; c < im.channels; ++c) im.at(x, y, c) = std::numeric_limits<float>::quiet_NaN();
+        for (int c = 0; c < im.channels; ++c) {
+          im.at(x, y, c) = std::numeric_limits<float>::quiet_NaN();
+        }
       }
     }
   }
@@ -669,8 +671,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<CandidateResult> cands = EvaluateCandidates(cx, st.records, excluded);
     if (std::find(excluded.begin(), excluded.end(), "missing_geometry") == excluded.end()) {
-      missing =
-          LocateMissingGeometry(st.model, photos, st.sim.sims, st.records, holdout, out_dir / "masks");
+      missing = LocateMissingGeometry(st.model, photos, st.sim.sims, st.records, holdout,
+                                      out_dir / "masks");
       cands.push_back(missing.candidate);
     }
     sum.last_candidates = cands;
