@@ -147,11 +147,16 @@ TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
   }
 }
 
-TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
-  const auto dir = TempSceneDir("determinism");
+// The floor under a sphere light beside the camera's axis: soft, noisy renders (in `name`).
+Scene SphereLitFloor(const std::string& name) {
+  const auto dir = TempSceneDir(name);
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
-  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
+  return LoadTestScene(dir, FloorScene(ParseJson(
       R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
+}
+
+TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
+  const Scene scene = SphereLitFloor("determinism");
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = 4;
@@ -168,10 +173,7 @@ TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
 // A pixel mask renders its pixels exactly as the whole render does (each pixel has its own random
 // streams) and leaves the others NaN; two complementary masks make up the whole image.
 TEST(RenderTest, PixelMaskRendersThePixelsOfTheWholeRender) {
-  const auto dir = TempSceneDir("mask");
-  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
-  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
-      R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
+  const Scene scene = SphereLitFloor("mask");
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = 3;
