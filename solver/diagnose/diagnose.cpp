@@ -299,18 +299,14 @@ double NoiseFloor(const PhotoSet& photos, const std::vector<Image>& sims) {
 // The grid of a trial's fitted pixels (HeldOutTestMasks): every kTrialGrid-th pixel in x and y.
 constexpr int kTrialGrid = 8;
 
-// `sims` where `trial` (a trial's partial simulation) is rendered, NaN elsewhere; with
-// `grid_only`, only on the grid of kTrialGrid.
-std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vector<Image>& trial,
-                                bool grid_only) {
+// `sims` where `trial` (a trial's partial simulation) is rendered, NaN elsewhere.
+std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vector<Image>& trial) {
   std::vector<Image> out = sims;
   for (size_t i = 0; i < out.size() && i < trial.size(); ++i) {
     Image& im = out[i];
     for (int y = 0; y < im.height; ++y) {
       for (int x = 0; x < im.width; ++x) {
-        const bool keep = std::isfinite(trial[i].at(x, y, 0)) &&
-                          (!grid_only || (x % kTrialGrid == 0 && y % kTrialGrid == 0));
-        if (keep) continue;
+        if (std::isfinite(trial[i].at(x, y, 0))) continue;
         for (int c = 0; c < im.channels; ++c) {
           im.at(x, y, c) = std::numeric_limits<float>::quiet_NaN();
         }
@@ -318,6 +314,31 @@ std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vecto
     }
   }
   return out;
+}
+
+// The fitted pixels' residual of `sims` over the grid of kTrialGrid where `trial` is rendered
+// (ResidualOverPhotos' sums, on those pixels only).
+ResidualSums GridResidual(const PhotoSet& photos, const std::vector<Image>& sims,
+                          const std::vector<Image>& trial, const PixelHoldout& holdout) {
+  ResidualSums s;
+  for (size_t i = 0; i < sims.size() && i < trial.size(); ++i) {
+    const Image& rec = photos.recorded[i];
+    for (int y = 0; y < rec.height; y += kTrialGrid) {
+      for (int x = 0; x < rec.width; x += kTrialGrid) {
+        if (photos.valid[i].at(x, y, 0) < 0.5f || holdout.HeldOut(int(i), x, y) ||
+            !std::isfinite(trial[i].at(x, y, 0))) {
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const double p = rec.at(x, y, c), m = sims[i].at(x, y, c);
+          if (!std::isfinite(m)) continue;
+          s.sq_err += (m - p) * (m - p);
+          s.sq_photo += p * p;
+        }
+      }
+    }
+  }
+  return s;
 }
 
 Image ResidualImage(const PhotoSet& photos, const std::vector<Image>& sims, size_t i) {
@@ -527,13 +548,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     }
     // Until the step is applied (settle), the fitted pixels' residual is over the grid of
     // HeldOutTestMasks only, before and after alike.
-    ds.residual_before =
-        ResidualOverPhotos(ph, RenderedPart(st.sim.sims, t.state.sim.sims, true), holdout, false)
-            .Relative();
-    ds.residual_after =
-        ResidualOverPhotos(ph, RenderedPart(t.state.sim.sims, t.state.sim.sims, true), holdout,
-                           false)
-            .Relative();
+    ds.residual_before = GridResidual(ph, st.sim.sims, t.state.sim.sims, holdout).Relative();
+    ds.residual_after = GridResidual(ph, t.state.sim.sims, t.state.sim.sims, holdout).Relative();
     ds.held_out_after = t.state.held.Relative();
     // A pose error shows on edges: its significance counts the blocks with edges.
     // A material change of one region shows where the region is seen: its significance counts
@@ -611,7 +627,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     // A step not applied is shown where it is rendered (its held-out test's pixels), before and
     // after alike.
     const std::vector<Image> before =
-        applied ? st.sim.sims : RenderedPart(st.sim.sims, t.state.sim.sims, false);
+        applied ? st.sim.sims : RenderedPart(st.sim.sims, t.state.sim.sims);
     ds.residual_before_image = ResidualImage(photos, before, img);
     ds.residual_after_image = ResidualImage(ph, t.state.sim.sims, img);
   };
