@@ -49,38 +49,76 @@ struct PathState {
   uint64_t rays = 0;
 };
 
-// The derivative of one path's radiance with respect to each region's albedo scale s_j (the
-// diffuse albedo of region j multiplied by s_j, at s_j = 1). Every term a path adds is a product
-// of BRDF values at its vertices (through the throughput and, for next-event estimation and the
-// ambient light, the vertex's own), each linear in its region's diffuse albedo: the term's
-// derivative with respect to ln s_j is the term times the sum, over its vertices on region j, of
-// the BRDF's diffuse share there, (ρd/π)/f per channel (the sampling densities do not depend on
-// s: they are the estimator's, not the integrand's).
-class PathDerivative {
- public:
-  explicit PathDerivative(std::vector<Eigen::Vector3d>* per_region) : out_(per_region) {}
-  // A term added to the path's radiance: its throughput's vertices, plus (region >= 0) the
-  // current vertex with its BRDF's diffuse share `share`.
-  void Add(const Eigen::Vector3d& term, int region = -1,
-           const Eigen::Vector3d& share = Eigen::Vector3d::Zero()) {
-    for (const auto& [r, sh] : vertices_) (*out_)[r] += term.cwiseProduct(sh);
-    if (region >= 0) (*out_)[region] += term.cwiseProduct(share);
-  }
-  // A vertex whose BRDF value joins the throughput.
-  void PushVertex(int region, const Eigen::Vector3d& share) {
-    vertices_.push_back({region, share});
-  }
-
- private:
-  std::vector<Eigen::Vector3d>* out_;
-  std::vector<std::pair<int, Eigen::Vector3d>> vertices_;
+// The derivatives of one path's radiance with respect to each region's parameters: the logarithm
+// of a scale on its diffuse albedo, of a scale on its ρs, and of a scale on its roughness (α, or
+// αx and αy together), at scale 1 (Renderer::kDerivativeKinds per region, region-major). Every
+// term a path adds is a product of BRDF values at its vertices (through the throughput and, for
+// next-event estimation and the ambient light, the vertex's own): the term's derivative with
+// respect to a parameter's log-scale is the term times the sum, over its vertices on that
+// parameter's region, of ∂ln f/∂ln(scale) there (VertexShares; the sampling densities do not
+// depend on the parameters: they are the estimator's, not the integrand's).
+struct VertexShares {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();  // (ρd/π)/f: linear in the albedo scale
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();  // (f − ρd/π)/f: the lobe is linear in ρs
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // ∂ln f/∂ln α
 };
 
-// (ρd/π)/f per channel: the share of the BRDF value f that the diffuse albedo makes.
-Eigen::Vector3d DiffuseShare(const Eigen::Vector3d& rho_d, const Eigen::Vector3d& f) {
-  Eigen::Vector3d share;
-  for (int c = 0; c < 3; ++c) share[c] = f[c] > 0 ? std::min(1.0, rho_d[c] * kInvPi / f[c]) : 0.0;
-  return share;
+class PathDerivative {
+ public:
+  static constexpr int kKinds = Renderer::kDerivativeKinds;
+  explicit PathDerivative(std::vector<Eigen::Vector3d>* per_param) : out_(per_param) {}
+  // A term added to the path's radiance: its throughput's vertices, plus (region >= 0) the
+  // current vertex with its shares.
+  void Add(const Eigen::Vector3d& term, int region = -1, const VertexShares& shares = {}) {
+    for (const auto& [r, sh] : vertices_) AddShares(term, r, sh);
+    if (region >= 0) AddShares(term, region, shares);
+  }
+  // A vertex whose BRDF value joins the throughput.
+  void PushVertex(int region, const VertexShares& shares) { vertices_.push_back({region, shares}); }
+
+ private:
+  void AddShares(const Eigen::Vector3d& term, int region, const VertexShares& sh) {
+    Eigen::Vector3d* out = &(*out_)[size_t(region) * kKinds];
+    out[0] += term.cwiseProduct(sh.d);
+    out[1] += term.cwiseProduct(sh.s);
+    out[2] += term.cwiseProduct(sh.a);
+  }
+  std::vector<Eigen::Vector3d>* out_;
+  std::vector<std::pair<int, VertexShares>> vertices_;
+};
+
+// The shares of a BRDF value f = EvalBrdf(params, wo, wi) (local frame). The lobe's part
+// ρs·W·S has S = g·exp(−Q)/(αx·αy), Q = qx/αx² + qy/αy² (SpecularFactorParts), so scaling both
+// roughnesses by e^t gives ∂ln S/∂t = 2Q − 2 at t = 0.
+VertexShares BrdfShares(const BrdfParams& params, const Eigen::Vector3d& wo,
+                        const Eigen::Vector3d& wi, const Eigen::Vector3d& f) {
+  VertexShares out;
+  double lobe_log_slope = 0;
+  double qx = 0, qy = 0, g = 0;
+  if (SpecularFactorParts(params.model, wo, wi, &qx, &qy, &g)) {
+    const double ax = params.AlphaX(), ay = params.AlphaY();
+    lobe_log_slope = 2 * (qx / (ax * ax) + qy / (ay * ay)) - 2;
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (!(f[c] > 0)) continue;
+    const double diffuse = params.rho_d[c] * kInvPi;
+    out.d[c] = std::min(1.0, diffuse / f[c]);
+    out.s[c] = std::clamp((f[c] - diffuse) / f[c], 0.0, 1.0);
+    out.a[c] = out.s[c] * lobe_log_slope;
+  }
+  return out;
+}
+
+// The shares of a hemispherical reflectance `albedo` (the ambient light's): its diffuse part is
+// ρd, the rest the lobe's; the lobe's reflectance barely depends on α (no share).
+VertexShares AlbedoShares(const Eigen::Vector3d& rho_d, const Eigen::Vector3d& albedo) {
+  VertexShares out;
+  for (int c = 0; c < 3; ++c) {
+    if (!(albedo[c] > 0)) continue;
+    out.d[c] = std::min(1.0, rho_d[c] / albedo[c]);
+    out.s[c] = 1.0 - out.d[c];
+  }
+  return out;
 }
 
 // The uniform numbers SampleLight reads for a light of `type`: none for the delta lights, two for
@@ -142,11 +180,13 @@ class PathTracer {
   }
 
   // Next-event estimation from a shading point. Returns the term added, and the BRDF value
-  // toward the light in `f` (zero when nothing was added).
+  // toward the light in `f` (zero when nothing was added) and the light's direction in the
+  // local frame in `wi_local`.
   Eigen::Vector3d SampleDirectLight(PathState* s, const Eigen::Vector3d& p,
                                     const Eigen::Vector3d& n_geo, const Frame& frame,
                                     const BrdfParams& params, const Eigen::Vector3d& wo_local,
-                                    Pcg32& rng, Eigen::Vector3d* f) const;
+                                    Pcg32& rng, Eigen::Vector3d* f,
+                                    Eigen::Vector3d* wi_local) const;
 
   // The ambient lights' radiance reflected toward wo: L·∫ f(wo, wi) cosθi dωi over the
   // hemisphere, i.e. L·ρd exactly plus the specular lobe's directional albedo estimated with one
@@ -185,8 +225,9 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
                                               const Eigen::Vector3d& n_geo, const Frame& frame,
                                               const BrdfParams& params,
                                               const Eigen::Vector3d& wo_local, Pcg32& rng,
-                                              Eigen::Vector3d* f) const {
+                                              Eigen::Vector3d* f, Eigen::Vector3d* wi_out) const {
   f->setZero();
+  wi_out->setUnit(2);
   const Eigen::Vector3d none = Eigen::Vector3d::Zero();
   const int n = static_cast<int>(sampled_lights_.size());
   if (n == 0) return none;
@@ -196,6 +237,7 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return none;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
   if (!(wi_local.z() > 0)) return none;
+  *wi_out = wi_local;
   const BrdfEval fe = EvalBrdfAndPdf(params, wo_local, wi_local);
   if (!(fe.f.maxCoeff() > 0)) return none;
   const double eps = impl_.ray_epsilon;
@@ -288,13 +330,13 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
       params.rho_d = SampleTexture(*m.rho_d_map, uv);
     }
     const Eigen::Vector3d wo_local = frame.ToLocal(wo);
-    Eigen::Vector3d f_light, albedo;
+    Eigen::Vector3d f_light, light_wi, albedo;
     const Eigen::Vector3d direct =
-        SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng, &f_light);
+        SampleDirectLight(&s, p, n_geo, frame, params, wo_local, rng, &f_light, &light_wi);
     const Eigen::Vector3d ambient = AddAmbient(&s, params, wo_local, rng, &albedo);
     if (derivative != nullptr) {
-      derivative->Add(direct, ts.material, DiffuseShare(params.rho_d, f_light));
-      derivative->Add(ambient, ts.material, DiffuseShare(kPi * params.rho_d, albedo));
+      derivative->Add(direct, ts.material, BrdfShares(params, wo_local, light_wi, f_light));
+      derivative->Add(ambient, ts.material, AlbedoShares(params.rho_d, albedo));
     }
 
     // Lambert has one lobe: no number to pick it.
@@ -306,7 +348,7 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     if (!(wi.dot(n_geo) > 0)) break;  // under the true surface (shading-normal artefact)
     s.throughput = s.throughput.cwiseProduct(bs.weight);
     if (derivative != nullptr)
-      derivative->PushVertex(ts.material, DiffuseShare(params.rho_d, bs.f));
+      derivative->PushVertex(ts.material, BrdfShares(params, wo_local, bs.wi, bs.f));
     s.from_camera = false;
     s.bsdf_pdf = bs.pdf;
     s.last_point = p;
@@ -410,7 +452,9 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
     summary->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     uint64_t pixels = uint64_t(camera.width) * camera.height;
-    if (mask) pixels = uint64_t(std::count_if(mask->begin(), mask->end(), [](uint8_t v) { return v != 0; }));
+    if (mask)
+      pixels =
+          uint64_t(std::count_if(mask->begin(), mask->end(), [](uint8_t v) { return v != 0; }));
     summary->camera_rays = pixels * options.spp;
     summary->rays = total_rays.load();
   }
@@ -420,25 +464,26 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
 namespace {
 
 // The mean of `spp` paths along one ray (non-finite paths dropped).
-// With `d_ln_albedo`: also the mean's derivatives with respect to each region's albedo scale
-// (one entry per scene material, overwritten).
+// With `d_ln_params`: also the mean's derivatives with respect to each region's parameter
+// scales (Renderer::kDerivativeKinds entries per scene material, overwritten).
 Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& origin,
                              const Eigen::Vector3d& direction, int spp, uint64_t seed,
                              bool reflected_only,
-                             std::vector<Eigen::Vector3d>* d_ln_albedo = nullptr) {
+                             std::vector<Eigen::Vector3d>* d_ln_params = nullptr) {
   RenderOptions options;
   const PathTracer tracer(impl, options);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   uint64_t rays = 0;
   std::vector<Eigen::Vector3d> path_d;
-  if (d_ln_albedo != nullptr) {
-    d_ln_albedo->assign(impl.materials.size(), Eigen::Vector3d::Zero());
-    path_d.resize(impl.materials.size());
+  if (d_ln_params != nullptr) {
+    const size_t n = impl.materials.size() * Renderer::kDerivativeKinds;
+    d_ln_params->assign(n, Eigen::Vector3d::Zero());
+    path_d.resize(n);
   }
   for (int k = 0; k < spp; ++k) {
     Pcg32 rng = PixelSampleRng(seed, reflected_only ? 1 : 0, k);
     std::optional<PathDerivative> derivative;
-    if (d_ln_albedo != nullptr) {
+    if (d_ln_params != nullptr) {
       std::fill(path_d.begin(), path_d.end(), Eigen::Vector3d::Zero());
       derivative.emplace(&path_d);
     }
@@ -446,11 +491,11 @@ Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& 
                                            reflected_only, derivative ? &*derivative : nullptr);
     if (!l.allFinite()) continue;
     sum += l;
-    for (size_t r = 0; r < path_d.size(); ++r) (*d_ln_albedo)[r] += path_d[r];
+    for (size_t r = 0; r < path_d.size(); ++r) (*d_ln_params)[r] += path_d[r];
   }
   const double n = std::max(1, spp);
-  if (d_ln_albedo != nullptr) {
-    for (Eigen::Vector3d& d : *d_ln_albedo) d /= n;
+  if (d_ln_params != nullptr) {
+    for (Eigen::Vector3d& d : *d_ln_params) d /= n;
   }
   return sum / n;
 }
@@ -471,8 +516,8 @@ Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
 Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction, int spp,
                                             uint64_t seed,
-                                            std::vector<Eigen::Vector3d>* d_ln_albedo) const {
-  return MeanRadiance(*impl_, origin, direction, spp, seed, true, d_ln_albedo);
+                                            std::vector<Eigen::Vector3d>* d_ln_params) const {
+  return MeanRadiance(*impl_, origin, direction, spp, seed, true, d_ln_params);
 }
 
 }  // namespace igi

@@ -60,23 +60,26 @@ class Renderer {
 
   // Radiance arriving along one ray (world frame), estimated with `spp` paths; for tests and
   // the solver.
-  Eigen::Vector3d Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                           int spp, uint64_t seed) const;
+  Eigen::Vector3d Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, int spp,
+                           uint64_t seed) const;
 
   // Radiance reflected toward `origin` by the first surface along the ray, the emission of
   // whatever the ray meets first (a light, an emitter) left out: the light a surface at
   // `origin` receives from that direction by reflection (the solver's indirect light).
-  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin,
-                                    const Eigen::Vector3d& direction, int spp,
-                                    uint64_t seed) const;
-  // The same (the same paths and value), and in `d_ln_albedo` (one entry per scene material,
-  // i.e. region) its derivative with respect to the logarithm of a scale applied to that
-  // region's diffuse albedo (map included), per channel: the part of the radiance whose paths
-  // reflect off the region, each weighted by the times it does so diffusely. The inverse
-  // solver's joint refinement uses it (solver/solve_stages.cpp).
+  Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                    int spp, uint64_t seed) const;
+  // The same (the same paths and value), and in `d_ln_params` its derivatives with respect to
+  // the logarithm of a scale applied to each region's (scene material's) parameters, per
+  // channel: kDerivativeKinds entries per region, region-major — its diffuse albedo (map
+  // included), its ρs, and its roughness (α, or αx and αy together). Each is the part of the
+  // radiance whose paths reflect off the region, weighted at each such reflection by the share
+  // of the BRDF value (or ∂ln f) that the parameter makes. The inverse solver's joint
+  // refinement uses them (solver/solve_stages.cpp).
+  static constexpr int kDerivativeKinds = 3;
+  enum DerivativeKind { kLnRhoD = 0, kLnRhoS = 1, kLnAlpha = 2 };
   Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                     int spp, uint64_t seed,
-                                    std::vector<Eigen::Vector3d>* d_ln_albedo) const;
+                                    std::vector<Eigen::Vector3d>* d_ln_params) const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }  // for the solver (solver/render_internal.h)

@@ -16,9 +16,10 @@
 // parameters are refitted against the photos with the same model (gradients through the BRDF
 // by Ceres autodiff), and this is repeated. The albedos are refitted per region against the
 // light rendered from the old ones, or (SolveOptions::refine_update "joint") jointly, with the
-// rendered light's derivatives with respect to every region's albedo scale (the renderer's
-// gradients): each round then solves for the albedos that match the photos with the light those
-// albedos would send, instead of overshooting in bright rooms. Both stages are reported.
+// rendered light's derivatives with respect to every region's albedo, ρs and α scales (the
+// renderer's gradients): each round then solves for the albedos and ρs that match the photos
+// with the light those parameters would send, instead of overshooting in bright rooms or
+// following a glossy surface's reflected light. Both stages are reported.
 //
 // Finally the albedo of every texel of the regions that need a map is π(L − specular)/E
 // averaged over the observations that fall in it.
@@ -71,11 +72,12 @@ struct SolveIteration {
   double relative_rms = 0;  // over all fitted samples
   double max_change = 0;    // largest relative parameter change from the previous iteration
   Json params;              // per region: rho_d, rho_s, alpha
-  // Stage 2: "joint" or "independent" (SolveOptions::refine_update), and per region in `params`
-  // also "rho_d_independent" (the region's own refit, πL/E at the rendered E) and, for the
-  // joint update, "rho_d_joint" (the albedo that matches the photos with the light it would
-  // send, before the step share) and "feedback" (per channel, the relative change of the
-  // region's gathered irradiance per relative change of every fitted albedo together).
+  // Stage 2: "joint", "joint_albedo" or "independent" (SolveOptions::refine_update), and per
+  // region in `params` also "rho_d_independent" (the region's own refit, πL/E at the rendered E)
+  // and, for a joint update, "rho_d_joint" (the albedo that matches the photos with the light it
+  // would send, before the step share) and "feedback" (per channel, the relative change of the
+  // region's gathered irradiance per relative change of every fitted albedo together); for
+  // "joint", a region with unknown ρs also has "rho_s_independent" and "rho_s_joint".
   std::string albedo_update;
   double albedo_step = 1;  // SolveOptions::refine_albedo_step
 };

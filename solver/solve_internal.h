@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "solver/brdf.h"
@@ -49,6 +50,52 @@ struct LightingState {
   std::vector<DirectSample> lobes;
 };
 
+// Stage 2's joint update: the rendered light's derivatives with respect to every region's
+// parameters (Renderer::ReflectedRadiance: the log-scales of ρd, ρs and α), summed per fitted
+// region r over its fit observations. Row r of d_e: the derivatives of the raw indirect
+// irradiance E; of d_t: those of the specular term T = Σ S·W·v at the rendered α (glossy
+// regions); t: ΣT itself. Rows are regions × Renderer::kDerivativeKinds long.
+struct JointSums {
+  size_t regions = 0;
+  std::vector<Eigen::Vector3d> d_e, d_t, t;
+  void Resize(size_t n) {
+    regions = n;
+    const size_t k = n * n * Renderer::kDerivativeKinds;
+    d_e.assign(k, Eigen::Vector3d::Zero());
+    d_t.assign(k, Eigen::Vector3d::Zero());
+    t.assign(n, Eigen::Vector3d::Zero());
+  }
+  // Region `r`'s observation: its derivative rows and its T.
+  void Add(int r, const std::vector<Eigen::Vector3d>& de, const std::vector<Eigen::Vector3d>& dt,
+           const Eigen::Vector3d& tr) {
+    const size_t row = regions * Renderer::kDerivativeKinds, o = size_t(r) * row;
+    for (size_t j = 0; j < row; ++j) d_e[o + j] += de[j], d_t[o + j] += dt[j];
+    t[r] += tr;
+  }
+  void Add(const JointSums& other) {
+    if (other.regions != regions) return;
+    for (size_t j = 0; j < d_e.size(); ++j) d_e[j] += other.d_e[j], d_t[j] += other.d_t[j];
+    for (size_t j = 0; j < t.size(); ++j) t[j] += other.t[j];
+  }
+  // Row r's entry for region j's parameter `kind`.
+  const Eigen::Vector3d& E(const std::vector<Eigen::Vector3d>& v, int r, int j, int kind) const {
+    return v[(size_t(r) * regions + j) * Renderer::kDerivativeKinds + kind];
+  }
+};
+
+// The joint update's result per fitted region (NaN where the region's own refit stands):
+// its albedo, its ρs, and per channel the relative change of its fitted light per unit relative
+// change of every region's albedo ("feedback").
+struct JointUpdate {
+  std::vector<Eigen::Vector3d> rho_d, rho_s, feedback;
+};
+
+// "joint" (every region's ρd and ρs jointly, the α changes included) or "joint_albedo" (the
+// albedos only, session 11's update).
+inline bool IsJointUpdate(const std::string& update) {
+  return update == "joint" || update == "joint_albedo";
+}
+
 struct SolverState {
   const Scene& scene;
   SolveOptions options;
@@ -69,10 +116,9 @@ struct SolverState {
   // specular lobe) and T = Σ S·W·v at the current α.
   std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
   std::vector<std::vector<IncidentLocal>> obs_incident;
-  // Stage 2's joint update: per observation and region (obs × materials, row-major), the
-  // derivative of its raw indirect irradiance with respect to the logarithm of the region's
-  // albedo scale (empty otherwise).
-  std::vector<Eigen::Vector3d> obs_d_indirect;
+  // Stage 2's joint update (empty otherwise): the rendered light's derivatives, summed per
+  // fitted region over its fit observations.
+  JointSums joint_sums;
   std::vector<Eigen::Vector3d> obs_e_stage1;  // obs_e at the end of stage 1
   std::vector<Eigen::Vector3d> obs_t;
   // Per observation of a textured glossy region: the other photos' observations off the
@@ -120,12 +166,10 @@ struct SolverState {
   void ComputeSpecularTerms();
   void HeldOutAlbedos();
   double FitAll(int stage, int iteration);  // returns the largest relative change
-  // The joint update's albedos (per entry of `regions`, from their fits `fits`): the solution of
-  // the fixed point ρ_r = fit_r(E(ρ)) with E linearised by obs_d_indirect; NaN where the
-  // independent fit stands.
-  std::vector<Eigen::Vector3d> JointAlbedos(const std::vector<int>& regions,
-                                            const std::vector<RegionFitResult>& fits,
-                                            std::vector<Eigen::Vector3d>* feedback) const;
+  // The joint update (per entry of `regions`, from their fits `fits`): the solution of the
+  // fixed point p_r = fit_r(light(p)) with the light linearised by joint_sums.
+  JointUpdate JointParams(const std::vector<int>& regions,
+                          const std::vector<RegionFitResult>& fits) const;
   void RunStage1();
   // One refinement round: the model as it stands (its albedo maps written under temp_dir),
   // rendered incident light, smoothing, FitAll(2, round), specular terms.

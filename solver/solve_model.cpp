@@ -87,7 +87,7 @@ static RegionAtlas AtlasOf(const SolverState& s, int r) {
 
 std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
   const bool have_stage1 = obs_e_stage1.size() == obs.size() && summary.stage2_iterations > 0;
-  if (!have_stage1 || options.refine_update != "joint") return obs_e;
+  if (!have_stage1 || !IsJointUpdate(options.refine_update)) return obs_e;
   if (!summary.refinement_accepted) return obs_e_stage1;
   const double radius = 4 * (options.smoothing_radius_m > 0 ? options.smoothing_radius_m
                                                             : summary.scene_diagonal_m / 96);

@@ -40,8 +40,9 @@ void SolveOptions::Validate() const {
         "must be in [1, 4096]");
   check(refine_albedo_step > 0 && refine_albedo_step <= 1, "--refine-albedo-step",
         std::to_string(refine_albedo_step), "must be in (0, 1]");
-  check(refine_update == "joint" || refine_update == "independent", "--refine-update",
-        refine_update, "must be joint or independent");
+  check(
+      refine_update == "joint" || refine_update == "joint_albedo" || refine_update == "independent",
+      "--refine-update", refine_update, "must be joint, joint_albedo or independent");
   check(photo_scale == "given" || photo_scale == "solve", "--photo-scale", photo_scale,
         "must be given or solve");
   check(holdout_fraction >= 0 && holdout_fraction < 1, "--holdout-fraction",

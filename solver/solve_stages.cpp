@@ -119,60 +119,95 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
     if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
   std::atomic<uint64_t> rays{0};
-  // The joint update also needs each irradiance's derivatives with respect to the regions'
-  // albedo scales (the same paths: the irradiance itself does not change).
-  const bool joint = options.refine_update == "joint";
+  // The joint update also needs the derivatives of each region's fitted light with respect to
+  // every region's parameters (the same paths: the light itself does not change), summed over
+  // the region's fit observations (JointSums). They are summed per fixed chunk of observations
+  // and the chunks added in order, so the sums do not depend on the threads.
+  const bool joint = IsJointUpdate(options.refine_update);
   const size_t num_regions = materials.size();
-  if (joint) {
-    obs_d_indirect.assign(obs.size() * num_regions, Eigen::Vector3d::Zero());
-  } else {
-    obs_d_indirect.clear();
-  }
+  const size_t row = num_regions * Renderer::kDerivativeKinds;
+  constexpr int64_t kChunk = 256;
+  const int64_t num_chunks = (int64_t(obs.size()) + kChunk - 1) / kChunk;
+  std::vector<JointSums> chunk_sums(joint ? num_chunks : 0);
   ParallelFor(
-      0, int64_t(obs.size()),
-      [&](int64_t i) {
-        const Observation& o = obs[i];
-        const int l = scene.photos[o.photo].lighting;
-        const LightingState& st = lighting_state[l];
-        const GatherPoint& gp = st.gather.points[obs_point[i]];
-        const bool glossy = HasSpecularLobe(materials[o.region].params.model);
-        const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
-        GatherQuery q;
-        q.position = o.position.cast<double>();
-        q.view = o.view.cast<double>();
-        q.n_geo = FaceNormalToward(scene.mesh, o.triangle, q.view);
-        q.n_s = o.normal.cast<double>();
-        q.lobe = glossy;
-        Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
-        std::vector<IncidentLocal> inc;
-        if (glossy) inc = DirectIncident(st, gp, frame);
-        const double eps = lighting_scenes[l]->ray_epsilon;
-        Eigen::Vector3d e = Eigen::Vector3d::Zero();
-        int k = 0;
-        // Glossy observations that the fits use get four times the rays: noise in the specular
-        // term T would bias ρs low (regression dilution).
-        const int n = options.refine_rays * (glossy && in_fit[i] ? 4 : 1);
-        std::vector<Eigen::Vector3d> dl;
-        for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
-          const Eigen::Vector3d origin = q.position + q.n_geo * eps;
-          const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);
-          const Eigen::Vector3d li =
-              joint ? renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed, &dl)
-                    : renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed);
-          e += d.weight * li;
-          if (joint) {
-            Eigen::Vector3d* row = &obs_d_indirect[size_t(i) * num_regions];
-            for (size_t r = 0; r < num_regions; ++r) row[r] += d.weight * dl[r];
+      0, num_chunks,
+      [&](int64_t chunk) {
+        JointSums* sums = joint ? &chunk_sums[chunk] : nullptr;
+        if (sums != nullptr) sums->Resize(num_regions);
+        std::vector<Eigen::Vector3d> dl, d_e(row), d_t(row);
+        const int64_t end = std::min<int64_t>(int64_t(obs.size()), (chunk + 1) * kChunk);
+        for (int64_t i = chunk * kChunk; i < end; ++i) {
+          const Observation& o = obs[i];
+          const int l = scene.photos[o.photo].lighting;
+          const LightingState& st = lighting_state[l];
+          const GatherPoint& gp = st.gather.points[obs_point[i]];
+          const MaterialState& m = materials[o.region];
+          const bool glossy = HasSpecularLobe(m.params.model);
+          const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
+          GatherQuery q;
+          q.position = o.position.cast<double>();
+          q.view = o.view.cast<double>();
+          q.n_geo = FaceNormalToward(scene.mesh, o.triangle, q.view);
+          q.n_s = o.normal.cast<double>();
+          q.lobe = glossy;
+          Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
+          std::vector<IncidentLocal> inc;
+          if (glossy) inc = DirectIncident(st, gp, frame);
+          const double eps = lighting_scenes[l]->ray_epsilon;
+          const bool summed = sums != nullptr && in_fit[i];
+          const Eigen::Vector3d wo = frame.ToLocal(q.view);
+          // The lobe's weight of an incident direction (ComputeSpecularTerms' T = Σ S·W·v).
+          auto lobe_weight = [&](const Eigen::Vector3d& wi_local) {
+            const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                            m.params.ior, wo, wi_local);
+            return w > 0 ? w : 0.0;
+          };
+          Eigen::Vector3d t = Eigen::Vector3d::Zero();
+          if (summed && glossy) {
+            for (const IncidentLocal& in : inc) {
+              t += lobe_weight(in.wi.cast<double>()) * in.value.cast<double>();
+            }
           }
-          if (glossy)
-            inc.push_back({frame.ToLocal(d.wi).cast<float>(), (d.weight * li).cast<float>()});
+          if (summed) {
+            std::fill(d_e.begin(), d_e.end(), Eigen::Vector3d::Zero());
+            std::fill(d_t.begin(), d_t.end(), Eigen::Vector3d::Zero());
+          }
+          Eigen::Vector3d e = Eigen::Vector3d::Zero();
+          int k = 0;
+          // Glossy observations that the fits use get four times the rays: noise in the
+          // specular term T would bias ρs low (regression dilution).
+          const int n = options.refine_rays * (glossy && in_fit[i] ? 4 : 1);
+          for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
+            const Eigen::Vector3d origin = q.position + q.n_geo * eps;
+            const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);
+            const Eigen::Vector3d li =
+                summed ? renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed, &dl)
+                       : renderers[l]->ReflectedRadiance(origin, d.wi, 1, seed);
+            e += d.weight * li;
+            const Eigen::Vector3d wi_local = frame.ToLocal(d.wi);
+            const double w_lobe = glossy ? lobe_weight(wi_local) : 0.0;
+            if (summed) {
+              for (size_t j = 0; j < row; ++j) d_e[j] += d.weight * dl[j];
+              if (w_lobe > 0) {
+                for (size_t j = 0; j < row; ++j) d_t[j] += (w_lobe * d.weight) * dl[j];
+              }
+              t += (w_lobe * d.weight) * li;
+            }
+            if (glossy) inc.push_back({wi_local.cast<float>(), (d.weight * li).cast<float>()});
+          }
+          if (summed) sums->Add(o.region, d_e, d_t, t);
+          rays += k;
+          obs_e_direct[i] = gp.e_direct.cast<double>();
+          obs_e_indirect[i] = e;
+          obs_incident[i] = std::move(inc);
         }
-        rays += k;
-        obs_e_direct[i] = gp.e_direct.cast<double>();
-        obs_e_indirect[i] = e;
-        obs_incident[i] = std::move(inc);
       },
       options.num_threads);
+  joint_sums = JointSums();
+  if (joint) {
+    joint_sums.Resize(num_regions);
+    for (const JointSums& c : chunk_sums) joint_sums.Add(c);
+  }
   summary.seconds_rays +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.rays += rays.load();
@@ -319,73 +354,119 @@ void SolverState::HeldOutAlbedos() {
   }
 }
 
-// Stage 2 renders E at the current albedos ρ0, and a region's refit is about ρ̂_r = πΣL/ΣE over
-// its observations. Had the albedos been ρ0_j·(1 + Δ_j), its observations would have gathered
-// ΣE·(1 + Σ_j G_rj·Δ_j), G_rj = ΣD_rj/ΣE (D the irradiance's derivative with respect to ln of
-// region j's albedo scale), and the refit would be ρ̂_r/(1 + Σ_j G_rj·Δ_j). The joint update is the
-// fixed point: (1 + Δ_r)·(1 + Σ_j G_rj·Δ_j) = ρ̂_r/ρ0_r for every fitted region at once, per
-// channel, by Newton's method (a few iterations of an n × n system, n the fitted regions).
-// With G = 0 it is the independent refit. The new albedos are held within a factor 2 of ρ0.
-std::vector<Eigen::Vector3d> SolverState::JointAlbedos(
-    const std::vector<int>& regions, const std::vector<RegionFitResult>& fits,
-    std::vector<Eigen::Vector3d>* feedback) const {
+// Stage 2 renders the light at the current parameters p0, and a region's refit is about
+// ρ̂d_r = πΣL/ΣE and ρ̂s_r ∝ 1/ΣT over its observations (E its irradiance, T its specular term).
+// Had region j's parameter q (ρd, ρs or α) been scaled by (1 + Δ_jq), its observations would have
+// gathered ΣE·(1 + Σ_jq G_r,jq·Δ_jq), G_r,jq = ΣD_r,jq/ΣE (D the derivative of the rendered
+// irradiance with respect to ln of that scale: JointSums), and ΣT·(1 + Σ_jq H_r,jq·Δ_jq) likewise
+// with the derivatives of T; the refits would be ρ̂d_r/(1 + G_r·Δ) and ρ̂s_r/(1 + H_r·Δ). The joint
+// update is the fixed point (1 + Δ_u)(1 + C_u·Δ) = p̂_u/p0_u for every unknown ρd and ρs u at
+// once (C_u the row G or H), per channel, by Newton's method (a few iterations of an n × n system,
+// n the unknowns). α is a shape, not a level, so a region's own refit stands; its change enters
+// the others' light as a known Δ. With C = 0 it is the independent refit. The new values are held
+// within a factor 2 of p0. "joint_albedo": ρd only (no ρs unknown, no α change).
+JointUpdate SolverState::JointParams(const std::vector<int>& regions,
+                                     const std::vector<RegionFitResult>& fits) const {
+  constexpr int kD = Renderer::kLnRhoD, kS = Renderer::kLnRhoS, kA = Renderer::kLnAlpha;
   const size_t num_regions = materials.size();
-  std::vector<Eigen::Vector3d> out(regions.size(), Eigen::Vector3d::Constant(NAN));
-  feedback->assign(regions.size(), Eigen::Vector3d::Constant(NAN));
-  if (obs_d_indirect.size() != obs.size() * num_regions) return out;
-  std::vector<int> unknown_of(num_regions, -1), members;  // members: indices into `regions`
+  const Eigen::Vector3d none = Eigen::Vector3d::Constant(NAN);
+  JointUpdate out;
+  out.rho_d.assign(regions.size(), none);
+  out.rho_s.assign(regions.size(), none);
+  out.feedback.assign(regions.size(), none);
+  const JointSums& js = joint_sums;
+  if (js.regions != num_regions) return out;
+  const bool lobes = options.refine_update == "joint";
+  // The unknowns (entry of `regions`, kind), and the known α changes (ln of the ratio).
+  struct Unknown {
+    int k;
+    int kind;
+  };
+  std::vector<Unknown> unknowns;
+  std::vector<double> ln_alpha(num_regions, 0.0);
   for (size_t k = 0; k < regions.size(); ++k) {
     const MaterialState& m = materials[regions[k]];
-    if (fits[k].fitted && m.unknown_rho_d && m.params.rho_d.allFinite() &&
-        fits[k].rho_d.allFinite()) {
-      unknown_of[regions[k]] = int(members.size());
-      members.push_back(int(k));
+    const RegionFitResult& f = fits[k];
+    if (!f.fitted) continue;
+    if (m.unknown_rho_d && m.params.rho_d.allFinite() && f.rho_d.allFinite()) {
+      unknowns.push_back({int(k), kD});
+    }
+    if (!lobes || !HasSpecularLobe(m.params.model) || m.no_highlight) continue;
+    if (m.unknown_rho_s && m.params.rho_s.allFinite() && f.rho_s.allFinite()) {
+      unknowns.push_back({int(k), kS});
+    }
+    if (m.unknown_alpha && m.params.AlphaX() > 0 && m.params.AlphaY() > 0 && f.alpha_x > 0) {
+      BrdfParams fitted = m.params;
+      fitted.alpha = f.alpha, fitted.alpha_x = f.alpha_x, fitted.alpha_y = f.alpha_y;
+      const double lx = std::log(fitted.AlphaX() / m.params.AlphaX());
+      const double ly = std::log(fitted.AlphaY() / m.params.AlphaY());
+      if (std::isfinite(lx) && std::isfinite(ly)) ln_alpha[regions[k]] = 0.5 * (lx + ly);
     }
   }
-  const int n = int(members.size());
+  const int n = int(unknowns.size());
   if (n == 0) return out;
-  std::vector<Eigen::Vector3d> sum_e(n, Eigen::Vector3d::Zero());
-  std::vector<Eigen::Vector3d> sum_d(size_t(n) * n, Eigen::Vector3d::Zero());
+  // ΣE per fitted region over its fit observations (the fits' E: smoothed, direct included).
+  std::vector<Eigen::Vector3d> sum_e(num_regions, Eigen::Vector3d::Zero());
   for (size_t i = 0; i < obs.size(); ++i) {
-    const int a = unknown_of[obs[i].region];
-    if (!in_fit[i] || a < 0) continue;
-    sum_e[a] += obs_e[i];
-    for (int b = 0; b < n; ++b) {
-      sum_d[size_t(a) * n + b] += obs_d_indirect[i * num_regions + regions[members[b]]];
-    }
+    if (in_fit[i]) sum_e[obs[i].region] += obs_e[i];
   }
   for (int c = 0; c < 3; ++c) {
     Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, n);
-    Eigen::VectorXd target = Eigen::VectorXd::Ones(n);
+    Eigen::VectorXd target = Eigen::VectorXd::Ones(n), known = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd albedo_feedback = Eigen::VectorXd::Zero(n);
     std::vector<bool> usable(n, false);
-    for (int a = 0; a < n; ++a) {
-      const double rho0 = materials[regions[members[a]]].params.rho_d[c];
-      if (!(rho0 > 0) || !(sum_e[a][c] > 0)) continue;  // Δ = 0 for it; its own refit stands
-      usable[a] = true;
-      target[a] = fits[members[a]].rho_d[c] / rho0;
-      for (int b = 0; b < n; ++b) g(a, b) = sum_d[size_t(a) * n + b][c] / sum_e[a][c];
+    for (int u = 0; u < n; ++u) {
+      const int k = unknowns[u].k, r = regions[k];
+      const MaterialState& m = materials[r];
+      const bool diffuse = unknowns[u].kind == kD;
+      const double p0 = diffuse ? m.params.rho_d[c] : m.params.rho_s[c];
+      const double p1 = diffuse ? fits[k].rho_d[c] : fits[k].rho_s[c];
+      const std::vector<Eigen::Vector3d>& d = diffuse ? js.d_e : js.d_t;
+      const double level = diffuse ? sum_e[r][c] : js.t[r][c];
+      if (!(p0 > 0) || !(level > 0)) continue;  // Δ = 0 for it; its own refit stands
+      usable[u] = true;
+      target[u] = p1 / p0;
+      for (int v = 0; v < n; ++v) {
+        g(u, v) = js.E(d, r, regions[unknowns[v].k], unknowns[v].kind)[c] / level;
+        if (unknowns[v].kind == kD) albedo_feedback[u] += g(u, v);
+      }
+      for (size_t j = 0; j < num_regions; ++j) {
+        if (ln_alpha[j] != 0) known[u] += js.E(d, r, int(j), kA)[c] / level * ln_alpha[j];
+      }
     }
     Eigen::VectorXd delta = Eigen::VectorXd::Zero(n);
     bool ok = true;
     for (int it = 0; it < 10 && ok; ++it) {
-      const Eigen::VectorXd gd = g * delta;
+      const Eigen::VectorXd gd = g * delta + known;
       Eigen::VectorXd residual(n);
       Eigen::MatrixXd jac(n, n);
-      for (int a = 0; a < n; ++a) {
-        residual[a] = (1 + delta[a]) * (1 + gd[a]) - target[a];
-        jac.row(a) = (1 + delta[a]) * g.row(a);
-        jac(a, a) += 1 + gd[a];
+      for (int u = 0; u < n; ++u) {
+        residual[u] = (1 + delta[u]) * (1 + gd[u]) - target[u];
+        jac.row(u) = (1 + delta[u]) * g.row(u);
+        jac(u, u) += 1 + gd[u];
       }
       const Eigen::VectorXd step = jac.partialPivLu().solve(-residual);
       ok = step.allFinite();
       if (ok) delta += step;
       if (ok && step.lpNorm<Eigen::Infinity>() < 1e-12) break;
     }
-    for (int a = 0; a < n; ++a) {
-      if (!ok || !usable[a]) continue;
-      const int k = members[a];
-      out[k][c] = materials[regions[k]].params.rho_d[c] * std::clamp(1 + delta[a], 0.5, 2.0);
-      (*feedback)[k][c] = g.row(a).sum();
+    for (int u = 0; u < n; ++u) {
+      if (!ok || !usable[u]) continue;
+      const int k = unknowns[u].k;
+      const MaterialState& m = materials[regions[k]];
+      const double scale = std::clamp(1 + delta[u], 0.5, 2.0);
+      if (unknowns[u].kind == kD) {
+        out.rho_d[k][c] = m.params.rho_d[c] * scale;
+        out.feedback[k][c] = albedo_feedback[u];
+      } else {
+        out.rho_s[k][c] = m.params.rho_s[c] * scale;
+      }
+    }
+  }
+  // A grey lobe stays grey: the channels' mean.
+  if (options.specular_colour == "grey") {
+    for (Eigen::Vector3d& v : out.rho_s) {
+      if (v.allFinite()) v.setConstant(v.mean());
     }
   }
   return out;
@@ -462,10 +543,10 @@ double SolverState::FitAll(int stage, int iteration) {
   SolveIteration record;
   record.stage = stage;
   record.iteration = iteration;
-  const bool joint = stage == 2 && options.refine_update == "joint";
-  std::vector<Eigen::Vector3d> feedback;
-  const std::vector<Eigen::Vector3d> joint_rho =
-      joint ? JointAlbedos(regions, results, &feedback) : std::vector<Eigen::Vector3d>();
+  const bool joint = stage == 2 && IsJointUpdate(options.refine_update);
+  const JointUpdate ju = joint ? JointParams(regions, results) : JointUpdate();
+  const std::vector<Eigen::Vector3d>& joint_rho = ju.rho_d;
+  const std::vector<Eigen::Vector3d>& feedback = ju.feedback;
   if (stage == 2) {
     record.albedo_update = options.refine_update;
     record.albedo_step = options.refine_albedo_step;
@@ -516,6 +597,7 @@ double SolverState::FitAll(int stage, int iteration) {
     }
     if (m.unknown_rho_s) {
       m.params.rho_s = f.rho_s;
+      if (joint && ju.rho_s[k].allFinite()) m.params.rho_s = ju.rho_s[k];
       change = std::max(change, RelChange(m.params.rho_s.mean(), old.rho_s.mean(), 0.01));
     }
     if (m.unknown_alpha) {
@@ -526,6 +608,7 @@ double SolverState::FitAll(int stage, int iteration) {
       change = std::max(change, RelChange(m.params.AlphaY(), old.AlphaY(), 0.005));
     }
     m.last_fit = f;
+    if (m.unknown_rho_s) m.last_fit.rho_s = m.params.rho_s;
     if (m.unknown_rho_d) {
       m.last_fit.rho_d = m.params.rho_d;
       for (size_t s = 0; s < m.patch_rho_d.size() && s < m.last_fit.slot_rho_d.size(); ++s) {
@@ -540,6 +623,10 @@ double SolverState::FitAll(int stage, int iteration) {
         pj["rho_d_joint"] = {joint_rho[k][0], joint_rho[k][1], joint_rho[k][2]};
         pj["feedback"] = {feedback[k][0], feedback[k][1], feedback[k][2]};
       }
+    }
+    if (joint && m.unknown_rho_s && ju.rho_s[k].allFinite()) {
+      pj["rho_s_independent"] = {f.rho_s[0], f.rho_s[1], f.rho_s[2]};
+      pj["rho_s_joint"] = {ju.rho_s[k][0], ju.rho_s[k][1], ju.rho_s[k][2]};
     }
     num += f.relative_rms * f.relative_rms * f.samples;
     den += f.samples;

@@ -56,9 +56,10 @@ int main(int argc, char** argv) {
   app.add_option("--refine-rays", o.refine_rays, "path-traced directions per observation")
       ->capture_default_str();
   app.add_option("--refine-update", o.refine_update,
-                 "stage 2's albedo update: independent (each region's πL/E with the light the "
-                 "current model sends) or joint (all regions at once, with the renderer's "
-                 "derivatives of that light with respect to each region's albedo)")
+                 "stage 2's update: independent (each region refitted with the light the "
+                 "current model sends), joint (every region's albedo and ρs at once, with the "
+                 "renderer's derivatives of that light with respect to each region's albedo, "
+                 "ρs and α) or joint_albedo (the albedos only)")
       ->capture_default_str();
   app.add_option("--refine-albedo-step", o.refine_albedo_step,
                  "share of each refinement round's albedo change applied (1 = full step)")

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "tests/solver/test_scenes.h"
 
@@ -29,8 +31,10 @@ double MeanChannel(const Image& im, int c, int x0 = 0, int y0 = 0, int x1 = -1, 
 // A Lambertian floor (rho = 0.5) lit from above, seen by a camera looking straight down at its
 // centre: with nothing else in the scene there is no interreflection, so the centre pixel is
 // rho/pi * E exactly, E the light's irradiance at the centre.
-Json FloorScene(const Json& light, const std::string& material = R"({"brdf":"lambert","rho_d":0.5})") {
-  return Json{{"format", "igi-scene"}, {"version", 1},
+Json FloorScene(const Json& light,
+                const std::string& material = R"({"brdf":"lambert","rho_d":0.5})") {
+  return Json{{"format", "igi-scene"},
+              {"version", 1},
               {"geometry", {{{"file", "floor.obj"}}}},
               {"materials", {{"floor", ParseJson(material, "material")}}},
               {"lights", {{"l", light}}},
@@ -58,8 +62,8 @@ TEST(RenderTest, PointLightDirectIsExact) {
   const auto dir = TempSceneDir("point");
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
   // I = 10 W/sr at height 2: E = 10 / 4 = 2.5, L = 0.5 / pi * 2.5.
-  const Scene scene = LoadTestScene(dir, FloorScene(ParseJson(
-      R"({"type":"point","position":[0,0,2],"intensity":10})", "l")));
+  const Scene scene = LoadTestScene(
+      dir, FloorScene(ParseJson(R"({"type":"point","position":[0,0,2],"intensity":10})", "l")));
   const Eigen::Vector3d l = CentrePixel(scene, 16);
   // The centre pixel spans ±0.0025 m on the floor: E varies by < 1e-5 over it.
   EXPECT_NEAR(l.x(), 0.5 / M_PI * 2.5, 1e-4 * l.x());
@@ -74,9 +78,11 @@ TEST(RenderTest, DirectionalLightAndSpotProfileAreExact) {
   Scene scene = LoadTestScene(dir, FloorScene(light));
   EXPECT_NEAR(CentrePixel(scene, 8).x(), 0.5 / M_PI * 1.5, 1e-6);
   // A cos^4 spot aimed 30° away from the floor's centre: relative intensity cos(30°)^4.
-  Json spot{{"type", "spot"}, {"position", {0, 0, 2}},
+  Json spot{{"type", "spot"},
+            {"position", {0, 0, 2}},
             {"direction", {std::sin(M_PI / 6), 0.0, -std::cos(M_PI / 6)}},
-            {"intensity", 10}, {"profile", {{"cos_power", 4}}}};
+            {"intensity", 10},
+            {"profile", {{"cos_power", 4}}}};
   scene = LoadTestScene(dir, FloorScene(spot));
   const double expected = 0.5 / M_PI * 2.5 * std::pow(std::cos(M_PI / 6), 4);
   EXPECT_NEAR(CentreRadiance(scene, 4).x(), expected, 1e-6 * expected);
@@ -130,7 +136,8 @@ TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
   const std::filesystem::path ball =
       std::filesystem::path(IGI_SHARED_DATA_DIR) / "real/diligent_ball/geometry/ball.obj";
   for (double rho : {0.5, 0.8}) {
-    Json doc{{"format", "igi-scene"}, {"version", 1},
+    Json doc{{"format", "igi-scene"},
+             {"version", 1},
              {"geometry", {{{"file", ball.string()}}}},
              {"materials", {{"ball", {{"brdf", "lambert"}, {"rho_d", rho}}}}},
              {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", 1}}}}},
@@ -151,8 +158,9 @@ TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
 Scene SphereLitFloor(const std::string& name) {
   const auto dir = TempSceneDir(name);
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
-  return LoadTestScene(dir, FloorScene(ParseJson(
-      R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
+  return LoadTestScene(
+      dir, FloorScene(ParseJson(
+               R"({"type":"sphere","center":[0.3,0,1],"radius":0.3,"radiance":50})", "l")));
 }
 
 TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
@@ -206,6 +214,115 @@ TEST(RenderTest, PixelMaskRendersThePixelsOfTheWholeRender) {
   EXPECT_THROW(renderer.Render(scene.cameras[0], options), InputError);
 }
 
+// Renderer::ReflectedRadiance's derivatives with respect to a region's parameter log-scales
+// (kLnRhoD, kLnRhoS, kLnAlpha) against central differences of the radiance itself, for the
+// floor's `material` (a JSON object) with `key` ("rho_d", "rho_s" or "alpha") scaled by e^±h.
+struct DerivativeCheck {
+  Eigen::Vector3d analytic, numeric;
+};
+DerivativeCheck CheckDerivative(const std::filesystem::path& dir, const std::string& obj,
+                                const Json& materials, const std::string& region,
+                                const std::string& key, int kind, const Json& light,
+                                const Eigen::Vector3d& origin, const Eigen::Vector3d& target,
+                                int spp, double h) {
+  WriteText(dir / "scene.obj", obj);
+  auto scene_with = [&](double scale) {
+    Json m = materials;
+    Json& v = m[region][key];
+    if (v.is_array()) {
+      for (Json& x : v) x = x.get<double>() * scale;
+    } else {
+      v = v.get<double>() * scale;
+    }
+    return LoadTestScene(dir, Json{{"format", "igi-scene"},
+                                   {"version", 1},
+                                   {"geometry", {{{"file", "scene.obj"}}}},
+                                   {"materials", m},
+                                   {"lights", {{"l", light}}},
+                                   {"lightings", {{"L", {"l"}}}},
+                                   {"cameras", {{"top", DownCamera(0, 0, 3, 9, 9, 400)}}}});
+  };
+  const Eigen::Vector3d dir_to = (target - origin).normalized();
+  const Scene scene = scene_with(1.0);
+  std::vector<Eigen::Vector3d> d;
+  Renderer(scene, 0).ReflectedRadiance(origin, dir_to, spp, 5, &d);
+  int r = 0;
+  while (scene.materials[r].name != region) ++r;
+  DerivativeCheck out;
+  out.analytic = d.at(size_t(r) * Renderer::kDerivativeKinds + kind);
+  const Eigen::Vector3d up =
+      Renderer(scene_with(std::exp(h)), 0).ReflectedRadiance(origin, dir_to, spp, 5);
+  const Eigen::Vector3d down =
+      Renderer(scene_with(std::exp(-h)), 0).ReflectedRadiance(origin, dir_to, spp, 5);
+  out.numeric = (up - down) / (2 * h);
+  return out;
+}
+
+// One glossy floor under a point light, seen near the mirror direction: the reflected radiance
+// is the BRDF times the light's irradiance with no random number in it, so each derivative must
+// equal the central difference to rounding.
+TEST(RenderTest, ParameterDerivativesOfOneReflectionAreExact) {
+  const auto dir = TempSceneDir("derivative_exact");
+  const Json light = ParseJson(R"({"type":"point","position":[0.5,0,1],"intensity":10})", "l");
+  const Json materials = ParseJson(
+      R"({"floor":{"brdf":"ward_gmd","rho_d":[0.3,0.4,0.5],"rho_s":[0.2,0.2,0.2],"alpha":0.15}})",
+      "m");
+  const struct {
+    const char* key;
+    int kind;
+  } params[] = {
+      {"rho_d", Renderer::kLnRhoD}, {"rho_s", Renderer::kLnRhoS}, {"alpha", Renderer::kLnAlpha}};
+  for (const auto& p : params) {
+    // Off the mirror direction by a little, so that α's derivative is not near its zero.
+    const DerivativeCheck c =
+        CheckDerivative(dir, SquareObj("floor", 2.0), materials, "floor", p.key, p.kind, light,
+                        {-0.5, 0, 1}, {0.05, 0.02, 0}, 1, 1e-4);
+    for (int ch = 0; ch < 3; ++ch) {
+      EXPECT_GT(std::abs(c.numeric[ch]), 1e-3) << p.key;  // the check is not about zeros
+      EXPECT_NEAR(c.analytic[ch], c.numeric[ch], 1e-5 * std::abs(c.numeric[ch])) << p.key;
+    }
+  }
+}
+
+// A glossy floor and a white ceiling face to face with a point light between them: paths bounce
+// between the two, so the derivatives collect terms from the throughput's vertices as well as
+// the last one. Each is an estimate over many paths, against the central difference of two
+// estimates with a ±15 % scale (the radiance is a low-order polynomial in ρd and ρs, for which
+// that difference is nearly exact); the tolerance is the noise of the estimates: about 1 % for
+// ρd and ρs, 5 % for α, whose derivative is a small difference of large terms (at 6.4 million
+// paths every one agrees within 0.7 %).
+TEST(RenderTest, ParameterDerivativesThroughInterreflectionMatchDifferences) {
+  const auto dir = TempSceneDir("derivative_paths");
+  const Json light = ParseJson(R"({"type":"point","position":[0.3,0,0.7],"intensity":10})", "l");
+  const Json materials = ParseJson(
+      R"({"floor":{"brdf":"ward_gmd","rho_d":0.3,"rho_s":0.3,"alpha":0.2},
+          "ceiling":{"brdf":"lambert","rho_d":0.7}})",
+      "m");
+  // Two squares (SquareObj's face indices are those of a file with one square).
+  const std::string obj =
+      "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+      "usemtl floor\nf 1 2 3\nf 1 3 4\nusemtl ceiling\nf 5 7 6\nf 5 8 7\n";
+  const struct {
+    const char* region;
+    const char* key;
+    int kind;
+    double tolerance;
+  } params[] = {{"floor", "rho_s", Renderer::kLnRhoS, 0.03},
+                {"floor", "alpha", Renderer::kLnAlpha, 0.12},
+                {"ceiling", "rho_d", Renderer::kLnRhoD, 0.03},
+                {"floor", "rho_d", Renderer::kLnRhoD, 0.03}};
+  // Looking up at the ceiling from beside the light: every path first reflects off the ceiling,
+  // and the floor's parameters act only through later vertices.
+  for (const auto& p : params) {
+    const DerivativeCheck c = CheckDerivative(dir, obj, materials, p.region, p.key, p.kind, light,
+                                              {-0.2, 0.1, 0.4}, {-0.4, 0.1, 1.0}, 400000, 0.15);
+    const double a = c.analytic.mean(), n = c.numeric.mean();
+    std::printf("  %s %s: derivative %.5f, difference %.5f\n", p.region, p.key, a, n);
+    EXPECT_GT(std::abs(n), 1e-3) << p.region << " " << p.key;
+    EXPECT_NEAR(a, n, p.tolerance * std::abs(n)) << p.region << " " << p.key;
+  }
+}
+
 TEST(RenderTest, TextureIsSampledWithVUp) {
   const auto dir = TempSceneDir("texture");
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
@@ -217,8 +334,9 @@ TEST(RenderTest, TextureIsSampledWithVUp) {
       tex.at(x, 1, c) = 0.2f;
     }
   WriteImage(dir / "tex.exr", tex);
-  Json doc = FloorScene(ParseJson(R"({"type":"directional","direction":[0,0,-1],"irradiance":1})", "l"),
-                        R"({"brdf":"lambert","rho_d_map":"tex.exr"})");
+  Json doc =
+      FloorScene(ParseJson(R"({"type":"directional","direction":[0,0,-1],"irradiance":1})", "l"),
+                 R"({"brdf":"lambert","rho_d_map":"tex.exr"})");
   // Rows 1 and 7 see y in ±[1.25, 1.75] m: v in [0.81, 0.94] and [0.06, 0.19], texel centres
   // clamp there, so each row sees one texel value exactly.
   doc["cameras"]["top"] = DownCamera(0, 0, 3, 9, 9, 6);
