@@ -15,16 +15,18 @@
 //     P = k·ρd/π·E_direct + ρd/π·G        (G: the gathered indirect irradiance, photo units)
 // which is linear in k: k = Σ(P − ρd/π·G)/Σ(ρd/π·E_direct) over every reference observation and
 // channel (a ratio of sums, which a noisy albedo lookup on a textured reference does not bias as
-// it does least squares; samples whose residual exceeds 4 robust standard deviations are left
-// out, then it is solved again). The estimate is taken after the paper's stage has converged, so that the
-// patches no photo sees radiate with their region's fitted albedo (which follows the photos'
-// units) rather than a placeholder; the photos are divided by k and the stage is run again, until
-// k changes by less than 0.1 %. What stays outside the photos' units is the light from regions
-// no photo sees at all (their albedo is a placeholder): the estimate is exact only as far as
-// the reference's light comes from the lamps and from seen surfaces.
+// it does least squares; surface patches whose own ratio is beyond 4 robust standard deviations
+// of the others' are left out, then it is solved again: RobustPhotoScale). The estimate is taken
+// after the paper's stage has converged, so that the patches no photo sees radiate with their
+// region's fitted albedo (which follows the photos' units) rather than a placeholder; the photos
+// are divided by k and the stage is run again, until k changes by less than 0.1 %. What stays
+// outside the photos' units is the light from regions no photo sees at all (their albedo is a
+// placeholder): the estimate is exact only as far as the reference's light comes from the lamps and
+// from seen surfaces.
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace igi {
@@ -32,15 +34,29 @@ namespace igi {
 struct SolverState;
 
 struct PhotoScaleEstimate {
-  double scale = 1;      // k: photo value = k × radiance in the scene's units (all photos)
-  double sigma = 0;      // its standard error (from the residual scatter)
+  double scale = 1;  // k: photo value = k × radiance in the scene's units (all photos)
+  double sigma = 0;  // its standard error (from the residual scatter)
   Eigen::Vector3d rgb = Eigen::Vector3d::Ones();  // k fitted per channel (a colour cast check)
   std::vector<std::string> reference_regions;     // the regions of known reflectance used
-  int samples = 0;      // reference observations × channels in the final fit
-  int rejected = 0;     // left out as outliers
-  int rounds = 0;       // estimate-rescale rounds
+  int samples = 0;          // reference observations × channels in the final fit
+  int rejected = 0;         // left out as outliers
+  int rounds = 0;           // estimate-rescale rounds
   double direct_share = 0;  // mean share of the reference's light that arrives directly
 };
+
+// One reference sample: photo value P = k·a + b for one channel of one observation (a: the
+// direct light's part ρd/π·E_direct, b: the gathered part ρd/π·G), on the surface patch `group`
+// (0-based).
+struct PhotoScaleSample {
+  double p = 0, a = 0, b = 0;
+  int group = 0;
+};
+
+// k = Σ(P − b)/Σa over the samples, with the patches (groups of at least 8 observations' samples)
+// whose own ratio is beyond 4 robust standard deviations of the others' left out; its standard
+// error from the patches' residual sums. `rejected`: the samples left out.
+std::pair<double, double> RobustPhotoScale(const std::vector<PhotoScaleSample>& samples,
+                                           int* rejected);
 
 // The reference regions of `state` (observed, reflectance given in full, diffuse). Throws
 // InputError naming the scene file when there is none.

@@ -2,7 +2,8 @@
 // and prints every solved region's stage-1 and final ρd, ρs, α against CAPTURE/truth.json
 // (relative errors, %), and each albedo map's PSNR against the true texture over all texels and
 // over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), rays,
-// step, bounce (0/1), smooth (m), acc (smoothing_accuracy), joint (0/1: refine_update), dump;
+// step, bounce (0/1), smooth (m), acc (smoothing_accuracy), joint (0/1/2: independent, joint,
+// joint_albedo), dump;
 // spp is not a key (the capture's). For issue 7's experiments; not a test.
 #include <algorithm>
 #include <chrono>
@@ -78,8 +79,8 @@ int main(int argc, char** argv) {
       dump = v != 0;
     else if (key == "step")
       o.refine_albedo_step = v;
-    else if (key == "joint")  // 1: refine_update "joint", 0: "independent"
-      o.refine_update = v != 0 ? "joint" : "independent";
+    else if (key == "joint")  // 1: refine_update "joint", 2: "joint_albedo", 0: "independent"
+      o.refine_update = v == 2 ? "joint_albedo" : v != 0 ? "joint" : "independent";
     else if (key == "bounce")
       o.specular_bounces = v != 0;
     else if (key == "smooth")
