@@ -121,13 +121,16 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   std::atomic<uint64_t> rays{0};
   // The joint update also needs the derivatives of each region's fitted light with respect to
   // every region's parameters (the same paths: the light itself does not change), summed over
-  // the region's fit observations (JointSums). They are summed per fixed chunk of observations
-  // and the chunks added in order, so the sums do not depend on the threads.
+  // the region's fit observations (JointSums). They are summed per chunk of observations (a
+  // partition that depends on the count only) and the chunks added in order, so the sums do
+  // not depend on the threads.
   const bool joint = IsJointUpdate(options.refine_update);
   const size_t num_regions = materials.size();
   const size_t row = num_regions * Renderer::kDerivativeKinds;
-  constexpr int64_t kChunk = 256;
-  const int64_t num_chunks = (int64_t(obs.size()) + kChunk - 1) / kChunk;
+  // At most 64 chunks (each holds regions² × kinds sums), of at least 256 observations.
+  const int64_t num_obs = int64_t(obs.size());
+  const int64_t num_chunks = std::clamp<int64_t>((num_obs + 255) / 256, 1, 64);
+  const int64_t chunk_size = (num_obs + num_chunks - 1) / num_chunks;
   std::vector<JointSums> chunk_sums(joint ? num_chunks : 0);
   ParallelFor(
       0, num_chunks,
@@ -135,8 +138,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         JointSums* sums = joint ? &chunk_sums[chunk] : nullptr;
         if (sums != nullptr) sums->Resize(num_regions);
         std::vector<Eigen::Vector3d> dl, d_e(row), d_t(row);
-        const int64_t end = std::min<int64_t>(int64_t(obs.size()), (chunk + 1) * kChunk);
-        for (int64_t i = chunk * kChunk; i < end; ++i) {
+        const int64_t end = std::min(num_obs, (chunk + 1) * chunk_size);
+        for (int64_t i = chunk * chunk_size; i < end; ++i) {
           const Observation& o = obs[i];
           const int l = scene.photos[o.photo].lighting;
           const LightingState& st = lighting_state[l];

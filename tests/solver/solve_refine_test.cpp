@@ -78,13 +78,14 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
   // Lambertian region's albedo channel (signed), before (after the scaling) and after the round;
   // and in `rho_s_after` the floor's ρs error after it (if glossy).
   std::pair<double, double> OneRound(const std::string& update, double start_scale,
-                                     double rho_s_scale = 1, double* rho_s_after = nullptr) const {
+                                     double rho_s_scale = 1, double* rho_s_after = nullptr,
+                                     int threads = 2) const {
     const Scene scene = LoadScene(dir_ / "scene.json");
     SolveOptions o;
     o.pixel_stride = 1;
     o.refine_rays = 64;
     o.refine_update = update;
-    o.num_threads = 2;
+    o.num_threads = threads;
     o.show_progress = false;
     SolverState s(scene, o);
     s.Prepare();
@@ -172,6 +173,12 @@ TEST_P(SolveRefineGlossy, JointRoundFollowsTheGlossyFloorsReflectedLight) {
   EXPECT_LT(std::abs(joint_after), 0.005);
   EXPECT_LT(albedo_after, -0.01);  // the scene shows the lobe's share of the feedback
   EXPECT_LT(std::abs(rho_s_joint), 0.08);
+  // The derivatives are summed per chunk of observations fixed by their count, not by the
+  // threads: one thread gives the same round to the last bit.
+  double rho_s_one_thread = 0;
+  const auto [one_before, one_after] = OneRound("joint", 1.0, 1.4, &rho_s_one_thread, 1);
+  EXPECT_EQ(one_after, joint_after);
+  EXPECT_EQ(rho_s_one_thread, rho_s_joint);
 }
 INSTANTIATE_TEST_SUITE_P(Room, SolveRefineGlossy, ::testing::Values(true));
 
