@@ -329,12 +329,7 @@ ResidualSums GridResidual(const PhotoSet& photos, const std::vector<Image>& sims
             !std::isfinite(trial[i].at(x, y, 0))) {
           continue;
         }
-        for (int c = 0; c < 3; ++c) {
-          const double p = rec.at(x, y, c), m = sims[i].at(x, y, c);
-          if (!std::isfinite(m)) continue;
-          s.sq_err += (m - p) * (m - p);
-          s.sq_photo += p * p;
-        }
+        s.AddPixel(rec, sims[i], x, y);
       }
     }
   }

@@ -401,12 +401,7 @@ ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>
         if (photos.valid[i].at(x, y, 0) < 0.5f || holdout.HeldOut(int(i), x, y) != held_out) {
           continue;
         }
-        for (int c = 0; c < 3; ++c) {
-          const double p = rec.at(x, y, c), m = sims[i].at(x, y, c);
-          if (!std::isfinite(m)) continue;
-          s.sq_err += (m - p) * (m - p);
-          s.sq_photo += p * p;
-        }
+        s.AddPixel(rec, sims[i], x, y);
       }
     }
   }

@@ -4,6 +4,7 @@
 // of physics shows itself (image position, surface, region, light directions).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "recon/scene.h"
@@ -101,6 +102,15 @@ void FlagOutliers(std::vector<PixelRecord>* records);
 struct ResidualSums {
   double sq_err = 0, sq_photo = 0;
   double Relative() const { return sq_photo > 0 ? std::sqrt(sq_err / sq_photo) : 0; }
+  // Adds pixel (x, y) of photo `rec` against the simulation `sim` (channels where it is finite).
+  void AddPixel(const Image& rec, const Image& sim, int x, int y) {
+    for (int c = 0; c < 3; ++c) {
+      const double p = rec.at(x, y, c), m = sim.at(x, y, c);
+      if (!std::isfinite(m)) continue;
+      sq_err += (m - p) * (m - p);
+      sq_photo += p * p;
+    }
+  }
 };
 ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out);
 
