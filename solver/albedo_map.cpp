@@ -318,4 +318,17 @@ AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, con
   return out;
 }
 
+Eigen::Vector3d SeenTexelMean(const Image& map, const Image& seen) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double count = 0;
+  for (int y = 0; y < seen.height; ++y) {
+    for (int x = 0; x < seen.width; ++x) {
+      if (!(seen.at(x, y) > 0.5f)) continue;
+      for (int c = 0; c < 3; ++c) sum[c] += map.at(x, y, std::min(c, map.channels - 1));
+      ++count;
+    }
+  }
+  return count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d::Constant(NAN);
+}
+
 }  // namespace igi

@@ -90,4 +90,8 @@ struct AlbedoComparison {
 AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, const Image& truth,
                                    double peak);
 
+// The map's mean RGB over the texels `seen` marks (> 0.5; one channel, the map's size); NaN when
+// none is. A 1-channel map is grey.
+Eigen::Vector3d SeenTexelMean(const Image& map, const Image& seen);
+
 }  // namespace igi

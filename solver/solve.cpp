@@ -533,7 +533,58 @@ void SolverState::FinishRegions() {
           n > 0 ? Eigen::Vector3d(mean / n) : Eigen::Vector3d::Constant(0.5);
       if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
     }
+    BoundReflectances(r);
     rs.final_params = materials[r].params;
+  }
+}
+
+// scene.json refuses a reflectance above 1, and no passive surface has one: a fitted ρd or ρs
+// above 1 is held at 1 (the fit's value goes to the report), the albedo map is scaled by the same
+// factor per channel and its texels clipped at 1. The photos' excess stays in the residual, where
+// igi-diagnose can look for its cause.
+void SolverState::BoundReflectances(size_t r) {
+  RegionSolution& rs = summary.regions[r];
+  BrdfParams& p = materials[r].params;
+  Eigen::Vector3d map_factor = Eigen::Vector3d::Ones();
+  for (int c = 0; c < 3; ++c) {
+    if (p.rho_d[c] > 1) {
+      rs.rho_d_fitted = p.rho_d;
+      map_factor[c] = 1 / p.rho_d[c];
+    }
+    if (p.rho_s[c] > 1) rs.rho_s_fitted = p.rho_s;
+  }
+  p.rho_d = p.rho_d.cwiseMin(1.0);
+  p.rho_s = p.rho_s.cwiseMin(1.0);
+  if (rs.albedo_map) {
+    Image& map = *rs.albedo_map;
+    for (int y = 0; y < map.height; ++y) {
+      for (int x = 0; x < map.width; ++x) {
+        for (int c = 0; c < std::min(map.channels, 3); ++c) {
+          float& v = map.at(x, y, c);
+          v = float(v * map_factor[c]);
+          if (v > 1.0f) {
+            v = 1.0f;
+            ++rs.albedo_texels_clipped;
+          }
+        }
+      }
+    }
+  }
+  if (rs.albedo_map && rs.albedo_map_seen &&
+      (map_factor != Eigen::Vector3d::Ones() || rs.albedo_texels_clipped > 0)) {
+    rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, *rs.albedo_map_seen);
+  }
+  rs.bounded =
+      rs.rho_d_fitted.allFinite() || rs.rho_s_fitted.allFinite() || rs.albedo_texels_clipped > 0;
+  if (rs.rho_d_fitted.allFinite() || rs.rho_s_fitted.allFinite()) {
+    spdlog::warn(
+        "region {}: the fit wants a reflectance above 1 (rho_d {:.3f} {:.3f} {:.3f}, rho_s "
+        "{:.3f}): the photos are brighter than any passive surface under the scene's lights "
+        "(check the lights' power and the photos' exposure_scale, or run igi-diagnose); held at 1",
+        rs.name, rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[0] : p.rho_d[0],
+        rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[1] : p.rho_d[1],
+        rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[2] : p.rho_d[2],
+        rs.rho_s_fitted.allFinite() ? rs.rho_s_fitted.maxCoeff() : p.rho_s.maxCoeff());
   }
 }
 

@@ -64,6 +64,15 @@ struct RegionSolution {
   // fit's (each patch with samples weighted by its area); the two differ by a few per cent on
   // textured regions (bench/RESULTS.md, session 12).
   Eigen::Vector3d albedo_map_seen_mean = Eigen::Vector3d::Constant(NAN);
+  // A reflectance is at most 1 (scene.json's rule). When a fit comes out above it (photos brighter
+  // than any passive surface under the declared lights: a light too weak, an exposure_scale too
+  // low, light the scene leaves out), the written model holds it at 1 and these say what the fit
+  // wanted: the fitted ρd / ρs per channel (NaN where not bounded), and how many albedo-map texels
+  // were above 1 (the map is scaled by the region's bound, then clipped at 1).
+  bool bounded = false;
+  Eigen::Vector3d rho_d_fitted = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d rho_s_fitted = Eigen::Vector3d::Constant(NAN);
+  long long albedo_texels_clipped = 0;
 };
 
 struct SolveIteration {

@@ -192,6 +192,7 @@ struct SolverState {
   void ChooseTexelSize();
   void AnalyseCoverage();
   void FinishRegions();
+  void BoundReflectances(size_t r);
 };
 
 }  // namespace igi

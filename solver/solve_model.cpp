@@ -310,16 +310,7 @@ void SolverState::BuildAlbedoMaps() {
     Image seen;
     rs.albedo_map =
         AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    double count = 0;
-    for (int y = 0; y < seen.height; ++y) {
-      for (int x = 0; x < seen.width; ++x) {
-        if (!(seen.at(x, y) > 0.5f)) continue;
-        for (int c = 0; c < 3; ++c) sum[c] += rs.albedo_map->at(x, y, c);
-        ++count;
-      }
-    }
-    if (count > 0) rs.albedo_map_seen_mean = sum / count;
+    rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, seen);
     rs.albedo_map_seen = std::move(seen);
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     rs.albedo_map_generated_uvs = atlas.generated;

@@ -161,6 +161,16 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     rj["observations"] = r.observations;
     rj["paper"] = FitJson(r.stage1, r.final_params.model);
     rj["refined"] = FitJson(r.stage2, r.final_params.model);
+    if (r.bounded) {
+      rj["bounded"] = {
+          {"rho_d_fitted", Vec(r.rho_d_fitted)},
+          {"rho_s_fitted", Vec(r.rho_s_fitted)},
+          {"albedo_texels_clipped", r.albedo_texels_clipped},
+          {"meaning",
+           "the fit wanted a reflectance above 1 (null: not bounded); scene.json holds it at 1 "
+           "(the albedo map scaled by the same factor, texels clipped at 1): the photos are "
+           "brighter than the scene's lights can make any passive surface"}};
+    }
     if (!r.albedo_map_file.empty()) {
       rj["albedo_map"] = {{"file", r.albedo_map_file},
                           {"width", r.albedo_map ? r.albedo_map->width : 0},

@@ -280,9 +280,9 @@ TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
 // photo_scale, 1 / 0.25), the solved scene's exposure_scale is the true 1, and the floor's and
 // walls' albedos are right. Tolerances: 3 % on the scale and exposure (measured 3.986 ± 0.014,
 // -0.4 %; with 64-spp photos 3.954, -1.2 %), 4 % on the albedos (measured floor -0.66 % at worst,
-// walls +0.2 %: the happy path's error above plus the scale's, which every albedo inherits). Without the option the
-// same scene solves to a floor 1.3x too bright (checked below, so the test fails if the option
-// stops doing anything).
+// walls +0.2 %: the happy path's error above plus the scale's, which every albedo inherits).
+// Without the option the same scene solves to a floor 1.3x too bright (checked below, so the test
+// fails if the option stops doing anything).
 TEST_F(SolveE2E, PhotoScaleIsSolvedFromARegionOfKnownReflectance) {
   RenderPhotos(false);
   Json m = TrueMaterials(false);
@@ -321,6 +321,67 @@ TEST_F(SolveE2E, PhotoScaleIsSolvedFromARegionOfKnownReflectance) {
   const Json given = ReadJsonFile(given_out / "scene.json");
   EXPECT_GT(given.at("materials").at("floor").at("rho_d")[0].get<double>(),
             1.2 * truth.at("floor").at("rho_d")[0].get<double>());
+}
+
+// Photos brighter than the declared light can make any passive surface (the lamp declared at a
+// thirtieth of the power that lit them): the fit wants albedos above 1. The written scene holds
+// them at 1 (scene.json's rule, so that it loads and renders), the report keeps the fit's values,
+// and one warning line names the region.
+TEST_F(SolveE2E, AlbedosAboveOneAreHeldAtOneAndReported) {
+  RenderPhotos(false);
+  Json m = TrueMaterials(false);
+  m["floor"].erase("rho_d");
+  m["walls"].erase("rho_d");
+  Json doc = SceneDoc(m, Json::array({PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"),
+                                      PhotoEntry("photos/cam1_L0.exr", "cam1", "L0")}));
+  doc["lights"]["lamp"]["intensity"] = {0.1, 0.1, 0.1};
+  const fs::path scene = WriteScene(doc);
+  std::string not_quiet = kFast;
+  not_quiet.erase(not_quiet.find(" --quiet"), 8);
+  const auto r = RunTool("igi-solve", Quote(scene.string()) + " --out " + Quote(Out().string()) +
+                                          not_quiet + " --albedo-maps all");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("region walls: the fit wants a reflectance above 1"), std::string::npos)
+      << r.err;
+  const Json solved = ReadJsonFile(Out() / "scene.json");
+  const Json report = ReadJsonFile(Out() / "report.json");
+  int bounded_channels = 0;
+  for (const Json& region : report.at("regions")) {
+    const std::string name = region.at("name");
+    if (name == "ceiling") {
+      EXPECT_FALSE(region.contains("bounded"));
+      continue;
+    }
+    const Json& rho_d = solved.at("materials").at(name).at("rho_d");
+    const Json& fitted = region.at("refined").at("rho_d");
+    std::printf("%s: fitted %s, written %s\n", name.c_str(), fitted.dump().c_str(),
+                rho_d.dump().c_str());
+    for (int c = 0; c < 3; ++c) {
+      const double f = fitted[c].get<double>();
+      if (f > 1) {
+        ++bounded_channels;
+        EXPECT_EQ(rho_d[c].get<double>(), 1.0) << name << " channel " << c;
+        ASSERT_TRUE(region.contains("bounded")) << name;
+        EXPECT_EQ(region.at("bounded").at("rho_d_fitted")[c].get<double>(), f) << name;
+      } else {
+        EXPECT_EQ(rho_d[c].get<double>(), f) << name << " channel " << c;
+      }
+    }
+  }
+  EXPECT_GE(bounded_channels, 3);
+  // The walls' albedo map is scaled by the same bound and clipped: no texel above 1.
+  const Image map =
+      ReadImage(Out() / solved.at("materials").at("walls").at("rho_d_map").get<std::string>());
+  float highest = 0;
+  for (float v : map.pixels) highest = std::max(highest, v);
+  EXPECT_LE(highest, 1.0f);
+  EXPECT_GT(highest, 0.9f);
+  // It loads as a complete scene and renders.
+  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
+                                                " --camera cam0 --lighting L0 --spp 2 --quiet "
+                                                "--out " +
+                                                Quote((dir_ / "check.exr").string()));
+  EXPECT_EQ(render.exit_code, 0) << render.err;
 }
 
 // --photo-scale solve with no region of known reflectance: exit 2, one line naming the scene
