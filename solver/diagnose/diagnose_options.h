@@ -27,7 +27,16 @@ struct DiagnoseOptions {
   uint64_t seed = 1;
   int num_threads = 0;
   bool show_progress = true;
-  SolveOptions solve;      // used when materials are unknown (refits re-solve them)
+  // Used when materials are unknown (refits re-solve them). Every pixel is an observation: an
+  // albedo map's texel is the pixel footprint times the stride, and at igi-solve's default of 2
+  // the maps cannot follow a texture the photos resolve (the full-size light_emission_profile
+  // capture: the final residual 1.53 → 1.09 × the true model's, 86 → 93 s; bench/RESULTS.md,
+  // Diagnosis, session 15).
+  SolveOptions solve = [] {
+    SolveOptions s;
+    s.pixel_stride = 1;
+    return s;
+  }();
 
   void Validate() const;
 };
