@@ -574,17 +574,14 @@ void SolverState::BoundReflectances(size_t r) {
       (map_factor != Eigen::Vector3d::Ones() || rs.albedo_texels_clipped > 0)) {
     rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, *rs.albedo_map_seen);
   }
-  rs.bounded =
-      rs.rho_d_fitted.allFinite() || rs.rho_s_fitted.allFinite() || rs.albedo_texels_clipped > 0;
   if (rs.rho_d_fitted.allFinite() || rs.rho_s_fitted.allFinite()) {
+    const Eigen::Vector3d d = rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted : p.rho_d;
+    const Eigen::Vector3d s = rs.rho_s_fitted.allFinite() ? rs.rho_s_fitted : p.rho_s;
     spdlog::warn(
         "region {}: the fit wants a reflectance above 1 (rho_d {:.3f} {:.3f} {:.3f}, rho_s "
         "{:.3f}): the photos are brighter than any passive surface under the scene's lights "
         "(check the lights' power and the photos' exposure_scale, or run igi-diagnose); held at 1",
-        rs.name, rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[0] : p.rho_d[0],
-        rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[1] : p.rho_d[1],
-        rs.rho_d_fitted.allFinite() ? rs.rho_d_fitted[2] : p.rho_d[2],
-        rs.rho_s_fitted.allFinite() ? rs.rho_s_fitted.maxCoeff() : p.rho_s.maxCoeff());
+        rs.name, d[0], d[1], d[2], s.maxCoeff());
   }
 }
 

@@ -69,10 +69,12 @@ struct RegionSolution {
   // low, light the scene leaves out), the written model holds it at 1 and these say what the fit
   // wanted: the fitted ρd / ρs per channel (NaN where not bounded), and how many albedo-map texels
   // were above 1 (the map is scaled by the region's bound, then clipped at 1).
-  bool bounded = false;
   Eigen::Vector3d rho_d_fitted = Eigen::Vector3d::Constant(NAN);
   Eigen::Vector3d rho_s_fitted = Eigen::Vector3d::Constant(NAN);
   long long albedo_texels_clipped = 0;
+  bool Bounded() const {
+    return rho_d_fitted.allFinite() || rho_s_fitted.allFinite() || albedo_texels_clipped > 0;
+  }
 };
 
 struct SolveIteration {

@@ -161,7 +161,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     rj["observations"] = r.observations;
     rj["paper"] = FitJson(r.stage1, r.final_params.model);
     rj["refined"] = FitJson(r.stage2, r.final_params.model);
-    if (r.bounded) {
+    if (r.Bounded()) {
       rj["bounded"] = {
           {"rho_d_fitted", Vec(r.rho_d_fitted)},
           {"rho_s_fitted", Vec(r.rho_s_fitted)},
