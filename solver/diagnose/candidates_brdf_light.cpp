@@ -268,7 +268,7 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
 // kConeSamples directions toward the light: 64 samples, the same for every radius.
 constexpr int kFootprint = 16, kConeSamples = 4;
 constexpr float kMinChange = 0.15f;
-constexpr int kMinBlockRecords = 4;
+constexpr int kMinBlockRecords = 4;  // in a 16-pixel block; in proportion to the block's area
 
 // A light as a sphere of `intensity` (W/sr) at `center`.
 struct SphereSource {
@@ -343,12 +343,17 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
 
 // The change is kept where it can show: on records where it reaches kMinChange of the model's
 // value (below that, the render's own noise at a few hundred paths per pixel hides it), in
-// held-out blocks with at least kMinBlockRecords such records (a block of one changed record
-// scores noise). Elsewhere it is set to zero: those records are outside the candidate's support.
-// On a subsample of one record in `stride` the blocks hold that many times fewer records.
+// held-out blocks with at least kMinBlockRecords such records per 16 × 16 pixels of the block (a
+// 16-pixel block of one changed record scores noise). Elsewhere it is set to zero: those records
+// are outside the candidate's support. On a subsample of one record in `stride` the blocks hold
+// that many times fewer records. (In proportion to the area since session 16: with 8-pixel blocks
+// the fixed 4 left no held-out block to a penumbra 2–3 records wide, and the suite's
+// light_source_extent candidate, at the right radius, predicted a gain of exactly 0.)
 void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int stride,
                        std::vector<Eigen::Vector3f>* change) {
-  const int min_records = std::max(1, kMinBlockRecords / std::max(1, stride));
+  const int min_records = std::max(
+      1, int(std::lround(kMinBlockRecords * (block_px / 16.0) * (block_px / 16.0) /
+                         std::max(1, stride))));
   std::unordered_map<int64_t, int> count;
   auto block = [&](const PixelRecord& r) {
     return (int64_t(r.photo) << 40) + (int64_t(r.y / block_px) << 20) + r.x / block_px;

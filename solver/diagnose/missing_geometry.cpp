@@ -336,7 +336,10 @@ std::vector<CarveView> WithoutSurfaceBlobs(const std::vector<CarveView>& views, 
           blob += s > 0.5f;
           clear += s > -0.5f && !(s > 0.5f);
         }
-        if (blob > 0 && clear == 0) out[a].state.at(x, y) = -1.0f;
+        // Most of the other cameras that see the point (not all: a blob near the threshold is
+        // missed here and there by the photo noise, and a texture's blobs would then raise a
+        // phantom above the surface).
+        if (blob > clear) out[a].state.at(x, y) = -1.0f;
       }
     });
   }

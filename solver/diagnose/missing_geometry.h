@@ -4,9 +4,10 @@
 // 1. Blobs: per photo, coherent regions where the photo and the model differ by much more than
 //    the noise (a 3×3-smoothed relative residual above a threshold, isolated pixels removed,
 //    connected regions of a minimum area kept). Held-out and invalid pixels are "unknown".
-// 2. Surface blobs: a blob pixel whose modelled surface point every other camera that sees it
-//    also shows in a blob is a change on the modelled surface (a shadow): the photos agree on the
-//    surface point. The other blob pixels show something in front of the surfaces.
+// 2. Surface blobs: a blob pixel whose modelled surface point most of the other cameras that see
+//    it also show in a blob is a change on the modelled surface (a shadow, a stain, a texture):
+//    the photos agree on the surface point. The other blob pixels show something in front of
+//    the surfaces. Most, not all: a blob near the threshold is missed by the odd photo's noise.
 // 3. Carving: a voxel grid over the scene's bounding box; a voxel is carved ("something there
 //    the model lacks") when at least two cameras see it (it lies in front of the modelled surface
 //    along their pixel ray) with its projection in a blob, and no photo that sees it shows a
@@ -100,8 +101,9 @@ std::vector<uint8_t> CarveVoxels(const std::vector<CarveView>& views, const Voxe
 std::vector<uint8_t> NearSurfaceVoxels(const TriangleMesh& mesh, const VoxelGrid& grid);
 
 // The views with their "surface" blob pixels made unknown: those whose modelled surface point
-// every other camera that sees it (and knows) shows in a blob too — a change on the modelled
-// surface (a shadow, a stain), which carving would otherwise raise into a phantom volume above it.
+// more of the other cameras that see it (and know) show in a blob than clear — a change on the
+// modelled surface (a shadow, a stain, a texture), which carving would otherwise raise into a
+// phantom volume above it.
 std::vector<CarveView> WithoutSurfaceBlobs(const std::vector<CarveView>& views, double margin_m);
 
 // The objects, largest first: off-surface voxels of `carved_object` (carved from the views

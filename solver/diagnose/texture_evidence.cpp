@@ -53,11 +53,39 @@ double NeighbourMean(const CellGrid& g, const Eigen::Vector3i& c, int min_n) {
   return count >= 3 ? sum / count : NAN;
 }
 
+// Ranks 0..n-1 (ties share their mean rank).
+std::vector<double> Ranks(const std::vector<double>& v) {
+  std::vector<size_t> order(v.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return v[a] < v[b]; });
+  std::vector<double> rank(v.size());
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i;
+    while (j + 1 < order.size() && v[order[j + 1]] == v[order[i]]) ++j;
+    for (size_t k = i; k <= j; ++k) rank[order[k]] = 0.5 * double(i + j);
+    i = j + 1;
+  }
+  return rank;
+}
+
+// Spearman's rank correlation of a and b (0 when either is constant).
+double RankCorrelation(const std::vector<double>& a, const std::vector<double>& b) {
+  const std::vector<double> ra = Ranks(a), rb = Ranks(b);
+  const double mean = 0.5 * double(a.size() - 1);
+  double ab = 0, aa = 0, bb = 0;
+  for (size_t i = 0; i < ra.size(); ++i) {
+    ab += (ra[i] - mean) * (rb[i] - mean);
+    aa += (ra[i] - mean) * (ra[i] - mean);
+    bb += (rb[i] - mean) * (rb[i] - mean);
+  }
+  return aa > 0 && bb > 0 ? ab / std::sqrt(aa * bb) : 0.0;
+}
+
 TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellGrid& b,
                          const TextureEvidenceOptions& o) {
   TextureEvidence e;
   e.region = name;
-  std::vector<double> products;
+  std::vector<double> products, high_a, high_b;
   double mean_sum = 0;
   int agree = 0;
   for (const auto& [key, ca] : a.cells) {
@@ -72,13 +100,17 @@ TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellG
     if (!std::isfinite(na) || !std::isfinite(nb)) continue;
     const double ha = ca.Mean() - na, hb = it->second.Mean() - nb;
     products.push_back(ha * hb);
+    high_a.push_back(ha);
+    high_b.push_back(hb);
     agree += ha * hb > 0;
     mean_sum += 0.5 * (ca.Mean() + it->second.Mean());
   }
   e.cells = int(products.size());
   if (e.cells == 0) return e;
   e.agreement = double(agree) / e.cells;
-  e.z = (e.agreement - 0.5) * 2 * std::sqrt(double(e.cells));
+  e.sign_z = (e.agreement - 0.5) * 2 * std::sqrt(double(e.cells));
+  e.rank_correlation = RankCorrelation(high_a, high_b);
+  e.z = e.rank_correlation * std::sqrt(double(e.cells - 1));
   // Trimmed: the largest tenth of the products (sharp edges: a shadow, a highlight) left out.
   std::sort(products.begin(), products.end());
   const size_t keep = products.size() - products.size() / 10;

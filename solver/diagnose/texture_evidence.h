@@ -11,8 +11,13 @@
 // camera in scale: those are smooth on a surface (or sharp along a few edges), a texture changes
 // from cell to cell everywhere. So the test looks at the high-pass part of the ratio over surface
 // cells (each cell's mean ratio minus its neighbours' mean) and asks that it be (a) reproducible
-// between even and odd photos — photo noise is not; (b) of the same sign in most cells — a few
-// shadow or highlight edges are not most cells; (c) at least `min_amplitude` of the ratio.
+// between even and odd photos — photo noise is not: the rank correlation of the two sets' values
+// over the cells, as a z (Spearman's ρ·√(n−1), a standard normal without a texture; ranks, so
+// that a few extreme cells cannot carry it); (b) of the same sign in most cells — a few shadow or
+// highlight edges are not most cells; (c) at least `min_amplitude` of the ratio.
+// (a) was the sign agreement's z until session 16: it ignores how large each cell's values are,
+// and the suite's control, a textured floor at 4 % amplitude, stayed at z 3.9–4.1 (64 % of 218
+// cells agreeing) — unmodelled, its texture raised a false missing_geometry.
 
 #include <string>
 #include <vector>
@@ -26,7 +31,7 @@ struct TextureEvidenceOptions {
   double cell_m = 0.05;          // surface cell, metres
   int min_cells = 30;            // cells seen by both photo sets with enough neighbours
   double min_agreement = 0.6;    // share of those cells whose high-pass signs agree
-  double min_z = 5;              // the agreement's z against coin flips
+  double min_z = 5;              // the rank correlation's z (test (a))
   double min_amplitude = 0.015;  // reproducible high-pass RMS, relative to the mean ratio
   int min_records_per_cell = 2;  // per photo set
 };
@@ -35,7 +40,9 @@ struct TextureEvidence {
   std::string region;
   int cells = 0;         // cells compared
   double agreement = 0;  // share of cells whose high-pass signs agree between the photo sets
-  double z = 0;          // (agreement − ½)·2·√cells
+  double sign_z = 0;     // (agreement − ½)·2·√cells (reported)
+  double rank_correlation = 0;  // Spearman's ρ of the two sets' high-pass values
+  double z = 0;                 // ρ·√(cells − 1): the test (a)
   double amplitude = 0;  // √(trimmed mean of hA·hB) / mean ratio
   bool textured = false;
 };

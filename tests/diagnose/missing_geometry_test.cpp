@@ -159,6 +159,48 @@ TEST(MissingGeometryTest, ABlobOnTheSurfaceIsNoObject) {
   EXPECT_FALSE(CarvedObjects(carved, carved, near, grid, 8).empty());
 }
 
+// A texture on the floor near the blob threshold: every view shows the patch as a blob but misses
+// a different quarter of it (the photo noise). Each blob pixel's surface point is then "clear" in
+// one of the three other views and a blob in two: by most views it is still a change on the
+// surface, no object. (With the unanimous rule of before, those pixels stayed object blobs and
+// carved a phantom above the floor: the suite's control saw one, 10 voxels, 8 the minimum.)
+TEST(MissingGeometryTest, ABlobThatOneViewPartlyMissesIsStillOnTheSurface) {
+  Truth truth;
+  truth.with_object = false;
+  const VoxelGrid grid = Grid();
+  std::vector<CarveView> views = Views(truth);
+  const Eigen::Vector2d mid = truth.shadow.center();
+  for (int k = 0; k < int(views.size()); ++k) {
+    CarveView& v = views[size_t(k)];
+    const Eigen::Vector3d o = v.camera.CenterInWorld();
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        if (!(v.state.at(x, y) > 0.5f)) continue;
+        const Eigen::Vector3d p =
+            o + double(v.depth_m.at(x, y)) * v.camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+        const int quarter = (p.x() > mid.x() ? 1 : 0) + (p.y() > mid.y() ? 2 : 0);
+        if (quarter == k) v.state.at(x, y) = 0.0f;  // missed here: clear
+      }
+    }
+  }
+  const std::vector<uint8_t> carved = CarveVoxels(views, grid, 2);
+  const std::vector<CarveView> object_views = WithoutSurfaceBlobs(views, grid.voxel_m);
+  const std::vector<uint8_t> near = NearSurfaceVoxels(Floor(), grid);
+  EXPECT_TRUE(CarvedObjects(CarveVoxels(object_views, grid, 2), carved, near, grid, 8).empty());
+  // Every blob pixel that the other views see became unknown.
+  for (size_t k = 0; k < views.size(); ++k) {
+    int blob = 0, unknown = 0;
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        blob += views[k].state.at(x, y) > 0.5f;
+        unknown += views[k].state.at(x, y) > 0.5f && object_views[k].state.at(x, y) < -0.5f;
+      }
+    }
+    ASSERT_GT(blob, 50);
+    EXPECT_GT(unknown, blob * 9 / 10) << "view " << k;
+  }
+}
+
 // One camera alone cannot place a blob: with a single view nothing is carved.
 TEST(MissingGeometryTest, OneViewCarvesNothing) {
   const std::vector<CarveView> views = Views(Truth{});
