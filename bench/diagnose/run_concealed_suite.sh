@@ -6,7 +6,7 @@
 # part of the photos' noise on the fitted pixels, so the held-out ratio is the honest one), and
 # the time.
 #
-#   [MATERIALS=unknown|given] [SPP=256] [THREADS=2] [CAMERAS=6] \
+#   [MATERIALS=unknown|given] [SPP=256] [THREADS=2] [CAMERAS=6] [SEED=100] \
 #     bench/diagnose/run_concealed_suite.sh [BUILD_DIR] [CASE...]
 #
 # MATERIALS=unknown (default): scene.json leaves ρd, ρs and α out and igi-diagnose solves them at
@@ -21,6 +21,7 @@
 # solved albedo, and a soft shadow or an ambient term's shape on a surface is an albedo texture;
 # no data from that lighting alone can tell them apart. Under a second lighting the albedos are the
 # same and the light is not.
+# The i-th case's capture has igi-synth seed SEED + i (SEED=107 none: the 8th case's capture).
 # Output: a Markdown table on stdout; the work folders stay under
 # ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
@@ -32,6 +33,7 @@ SPP="${SPP:-256}"
 MATERIALS="${MATERIALS:-unknown}"
 THREADS="${THREADS:-2}"
 CAMERAS="${CAMERAS:-6}"
+SEED="${SEED:-100}"
 case "$MATERIALS" in
   unknown) UNKNOWNS=() ;;
   given) UNKNOWNS=(--unknowns none) ;;
@@ -95,7 +97,7 @@ for case in "${CASES[@]}"; do
     light_*|ambient_light*) if [ "$MATERIALS" = unknown ]; then design=(--photo-lightings L0,L1); fi ;;
   esac
   "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 --spp 64 \
-      --lamp point --seed $((100 + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
+      --lamp point --seed $((SEED + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
       "${design[@]}" "${effects[@]}" > /dev/null
   start=$(date +%s)
   /usr/bin/time -f "%U %S" -o "$dir/cpu.txt" \

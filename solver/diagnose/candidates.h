@@ -8,6 +8,7 @@
 // an emission axis, a lobe width — are searched on a grid), with the global scale free as a
 // nuisance where the materials are solved (it is absorbed by the albedos when refitted).
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -42,6 +43,11 @@ struct CandidateResult {
   double z = 0;           // held-out gain over its standard error (across blocks)
   bool valid = false;
   std::string note;  // why a candidate could not be fitted (e.g. degenerate)
+  // For an effect that changes the photos only in places (a source's extent: its penumbrae and
+  // highlight edges), the held-out blocks (photo, block x, block y) where its change shows. The
+  // step's significance then counts these blocks (its gain is still over every held-out block):
+  // the others hold only the refit's small albedo changes and their noise. Empty: every block.
+  std::vector<std::array<int, 3>> support_blocks;
   // Writes the fitted model into the declared scene document.
   std::function<void(Json* declared)> apply;
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <set>
 #include <unordered_map>
 
 #include "solver/brdf.h"
@@ -494,6 +495,18 @@ class ExtentChange {
     return FitChange(f_, ch_);
   }
 
+  // The held-out blocks where the last call's change is kept (KeepMarkedChanges' support).
+  std::vector<std::array<int, 3>> HeldOutSupport() const {
+    std::set<std::array<int, 3>> blocks;
+    const std::vector<PixelRecord>& recs = f_.records();
+    for (size_t i = 0; i < recs.size() && i < ch_.basis.size(); ++i) {
+      if (recs[i].held_out && ch_.basis[i].squaredNorm() > 0) {
+        blocks.insert({recs[i].photo, recs[i].x / cx_.block_px, recs[i].y / cx_.block_px});
+      }
+    }
+    return {blocks.begin(), blocks.end()};
+  }
+
  private:
   const CandidateContext& cx_;
   const ResidualFitter& f_;
@@ -575,6 +588,7 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
       return out;
     }
   }
+  if (!every) fit = fit_at(radius);  // the golden section's last call may be another radius
   const ExtentChange& scored = every ? *every : fit_at;
   const ExtentModel& model = scored.model();
   const std::vector<Eigen::Vector3f>& d0 = scored.d0();
@@ -589,6 +603,7 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
     ++(penumbra ? edge : other);
   }
   FillScores(fit, &out);
+  out.support_blocks = scored.HeldOutSupport();
   const double amplitude = fit.coef[0];
   const Vector3d center = model.source().center, intensity = model.source().intensity;
   out.params = {

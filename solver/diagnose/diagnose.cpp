@@ -265,6 +265,14 @@ BlockFilter RegionBlocks(const Scene& model, const std::vector<PixelRecord>& rec
   return [blocks](size_t photo, int bx, int by) { return blocks->count({photo, bx, by}) > 0; };
 }
 
+// The held-out blocks of a candidate's support (CandidateResult::support_blocks), or none.
+BlockFilter SupportBlocks(const CandidateResult& c) {
+  if (c.support_blocks.size() < 2) return nullptr;
+  auto blocks = std::make_shared<std::set<std::tuple<size_t, int, int>>>();
+  for (const auto& b : c.support_blocks) blocks->insert({size_t(b[0]), b[1], b[2]});
+  return [blocks](size_t photo, int bx, int by) { return blocks->count({photo, bx, by}) > 0; };
+}
+
 // Effects that change one region's material (their params name the region).
 bool ChangesRegionMaterial(const CandidateResult& c) {
   static const std::set<std::string> kEffects = {"specular_reflection", "fresnel",
@@ -558,11 +566,16 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
         ChangesRegionMaterial(c)
             ? RegionBlocks(st.model, st.records, c.params["region"].get<std::string>(), holdout)
             : nullptr;
+    // A local change (a source's extent) shows in the blocks of its support.
+    const BlockFilter support_only = SupportBlocks(c);
     const auto [gain_all, z_all] = HeldOutGain(ph, st, t.state, holdout);
     const double gain = gain_all;
     double z = only ? HeldOutGain(ph, st, t.state, holdout, only).second : z_all;
     if (region_only) {
       z = HeldOutGain(ph, st, t.state, holdout, region_only, false).second;
+    }
+    if (support_only) {
+      z = HeldOutGain(ph, st, t.state, holdout, support_only, false).second;
     }
     t.gain = gain;
     ds.z = z;
@@ -583,10 +596,14 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
           "changed the held-out residual² by {:.1f}% (same pixels before and after)",
           ds.kept ? "kept" : "rejected", 100 * c.Gain(), c.z, -100 * gain);
     } else {
+      const std::string units =
+          support_only ? fmt::format("the {} held-out blocks where it changes the model",
+                                     c.support_blocks.size())
+                       : std::string("the held-out blocks");
       ds.verdict = ds.kept ? fmt::format(
                                  "kept: held-out residual² down {:.1f}% ({:.1f} standard "
-                                 "errors over the held-out blocks)",
-                                 100 * gain, z)
+                                 "errors over {})",
+                                 100 * gain, z, units)
                            : fmt::format(
                                  "rejected: held-out residual² changed by {:.1f}% ({:.1f} "
                                  "standard errors): the model does not earn its {} "
