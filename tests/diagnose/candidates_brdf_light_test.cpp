@@ -363,5 +363,41 @@ TEST(LightSourceExtentTest, APointLightEarnsNothing) {
   }
 }
 
+// ---------------------------------------------------------------- ambient_light
+// With the materials solved (the albedo nuisance on), an ambient light's basis is its first
+// reflection at the point: the solved albedos already carry its share of the interreflections.
+// Photos that hold the model plus ρd·L (a lambert floor's first reflection of an ambient light L)
+// in the lamp's light and in the blocker's shadow give L back, whatever albedo scale the
+// nuisance takes.
+TEST(AmbientLightTest, WithSolvedMaterialsTheFirstReflectionGivesTheRadianceBack) {
+  Scene model = ShadowScene(0);
+  Camera camera;
+  camera.name = "cam";
+  camera.width = camera.height = 120;
+  camera.params = {100, 100, 60, 60};
+  model.cameras = {camera};
+  model.photos[0].camera = 0;
+  const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}, {"lightings", {{"L0", {"lamp"}}}}};
+  std::vector<PixelRecord> records = ShadowRecords(model, 0);
+  const Vector3f ambient(0.3f, 0.2f, 0.1f);
+  int shadowed = 0;
+  for (PixelRecord& r : records) {
+    r.recorded += r.albedo.cwiseProduct(ambient);
+    shadowed += r.sim.maxCoeff() == 0.0f;
+  }
+  ASSERT_GT(shadowed, 50);
+  const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, true, 8);
+  const CandidateResult c = AmbientLight({model, declared, true}, f);
+  ASSERT_TRUE(c.valid) << c.note;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(c.params["radiance"][k].get<double>(), ambient[k], 0.03 * ambient[k]) << k;
+  }
+  EXPECT_NE(c.evidence.find("first reflection"), std::string::npos) << c.evidence;
+  Json doc = declared;
+  c.apply(&doc);
+  EXPECT_EQ(doc["lights"]["ambient"]["type"], "ambient");
+  EXPECT_EQ(doc["lightings"]["L0"].size(), 2u);
+}
+
 }  // namespace
 }  // namespace igi
