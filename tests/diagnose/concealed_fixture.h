@@ -28,14 +28,17 @@ inline const std::string kConcealedDiagnoseFlags =
 
 // Writes an igi-synth capture into dir/capture hiding `effect` ("NAME[:k=v,...]", several joined
 // by '+'; empty: none), with `synth_extra` added to igi-synth's flags (the capture's design).
+// With `materials_given` false the scene leaves every material value out (igi-synth's default
+// unknowns) and igi-diagnose solves them at every step.
 inline std::filesystem::path SynthesizeConcealed(const std::filesystem::path& dir,
                                                  const std::string& effect, int seed,
-                                                 const std::string& synth_extra = "") {
+                                                 const std::string& synth_extra = "",
+                                                 bool materials_given = true) {
   const std::filesystem::path capture = dir / "capture";
   std::string args = "--out " + Quote(capture.string()) +
-                     " --cameras 4 --width 160 --height 120 --spp 64 --lamp point"
-                     " --unknowns none --threads 2 --quiet --seed " +
-                     std::to_string(seed) + synth_extra;
+                     " --cameras 4 --width 160 --height 120 --spp 64 --lamp point" +
+                     std::string(materials_given ? " --unknowns none" : "") +
+                     " --threads 2 --quiet --seed " + std::to_string(seed) + synth_extra;
   for (size_t begin = 0; begin < effect.size();) {
     const size_t end = std::min(effect.find('+', begin), effect.size());
     args += " --effect " + effect.substr(begin, end - begin);
@@ -117,15 +120,19 @@ struct ConcealedOutcome {
 // diagnoses it, measures the floor, calls `inspect` (when given) with the diagnosis folder, and
 // removes everything (unless the environment variable IGI_CONCEALED_KEEP names a folder:
 // everything is moved there, for study).
+// `materials_given` false: the materials are solved (SynthesizeConcealed), igi-diagnose without
+// stage 2 (--refine-iterations 0, as the full suite).
 inline ConcealedOutcome DiagnoseConcealed(
     const std::string& effect, int seed,
     const std::function<void(const std::filesystem::path& diag_dir)>& inspect = nullptr,
-    const std::string& synth_extra = "") {
+    const std::string& synth_extra = "", bool materials_given = true) {
   const std::filesystem::path dir =
       UniqueTempDir("igi_concealed_" + (effect.empty() ? std::string("none") : effect));
-  const std::filesystem::path capture = SynthesizeConcealed(dir, effect, seed, synth_extra);
+  const std::filesystem::path capture =
+      SynthesizeConcealed(dir, effect, seed, synth_extra, materials_given);
   ConcealedOutcome o;
-  o.diagnosis = RunDiagnose(capture / "scene.json", dir / "diag");
+  o.diagnosis = RunDiagnose(capture / "scene.json", dir / "diag",
+                            materials_given ? "" : " --refine-iterations 0");
   if (inspect) inspect(dir / "diag");
   o.floor = FloorResidual(WriteTrueModel(capture), dir / "floor");
   if (const char* keep = std::getenv("IGI_CONCEALED_KEEP"); keep != nullptr && *keep != 0) {

@@ -84,5 +84,27 @@ INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest,
                          testing::Values("vignetting+exposure_scale",
                                          "light_emission_profile+camera_response"));
 
+// ambient_light with the materials unknown (solved at every step), both lightings photographed
+// (under one lighting an ambient term's shape on a surface is an albedo texture). The candidate's
+// basis is then the ambient light's first reflection: the solved albedos already carry its share
+// of the interreflections. Its whole response (bounces too) had fitted about a third of the
+// radiance on the full-size suite's capture (0.11–0.13 for 0.4), and a false exposure_scale
+// followed (bench/RESULTS.md, Diagnosis, "Session 17"). Measured 2026-11-25: passes in 237 s on
+// 2 cores; with the whole response as the basis it fails (camera_response is kept first).
+TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
+  const ConcealedOutcome o = DiagnoseConcealed("ambient_light:kind=uniform", 11, nullptr,
+                                               " --photo-lightings L0,L1", false);
+  const Json& d = o.diagnosis;
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  const Json& first = d["steps"][0];
+  EXPECT_EQ(first["effect"], "ambient_light") << d.dump(1);
+  if (first["effect"] == "ambient_light") {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(first["params"]["radiance"][c].get<double>(), 0.4, 0.1) << c;  // truth 0.4
+    }
+  }
+  ExpectReachesTheFloor(o);
+}
+
 }  // namespace
 }  // namespace igi
