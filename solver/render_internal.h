@@ -24,6 +24,9 @@ struct ShadingMaterial {
   Eigen::Vector3d emission = Eigen::Vector3d::Zero();  // "emitter": radiance of the front side
 };
 
+// `m` ready to shade (its albedo map read, if any; unknown values as placeholders).
+ShadingMaterial MakeShadingMaterial(const Material& m);
+
 // A set of emitting triangles sampled by area (an area light, or the scene's emitter
 // materials). Triangles emit `radiance` from their front (counter-clockwise) side.
 struct TriangleEmitter {

@@ -45,6 +45,8 @@ unsigned AttachTriangles(RTCDevice device, RTCScene rtc_scene,
   return id;
 }
 
+}  // namespace
+
 ShadingMaterial MakeShadingMaterial(const Material& m) {
   ShadingMaterial s;
   s.model = m.brdf;
@@ -70,6 +72,8 @@ ShadingMaterial MakeShadingMaterial(const Material& m) {
   }
   return s;
 }
+
+namespace {
 
 void AddTriangle(TriangleEmitter* e, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                  const Eigen::Vector3d& c, const Eigen::Vector3d& radiance) {

@@ -714,25 +714,19 @@ std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
 std::vector<Eigen::Vector3f> UnitAmbientFirstReflection(const Scene& model,
                                                         const std::vector<PixelRecord>& records) {
   constexpr int kSide = 8;
+  std::vector<ShadingMaterial> materials;
+  for (const Material& m : model.materials) materials.push_back(MakeShadingMaterial(m));
   std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
   ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
     const PixelRecord& r = records[i];
-    if (r.region < 0 || r.region >= int(model.materials.size())) return;
-    const Material& m = model.materials[r.region];
-    if (!IsReflective(m.brdf)) return;
-    BrdfParams params;
-    params.model = m.brdf;
+    if (r.region < 0 || r.region >= int(materials.size())) return;
+    const ShadingMaterial& sm = materials[r.region];
+    if (!IsReflective(sm.model)) return;
+    BrdfParams params = sm.params;
     params.rho_d = r.albedo.cast<double>();
-    if (HasSpecularLobe(m.brdf)) {
-      params.rho_s = m.rho_s.value_or(Vector3d::Zero());
-      params.alpha = m.alpha.value_or(0.1);
-      params.alpha_x = m.alpha_x.value_or(params.alpha);
-      params.alpha_y = m.alpha_y.value_or(params.alpha);
-      params.ior = m.ior.value_or(Material::kDefaultIor);
-    }
     const Vector3d n = r.normal.cast<double>();
-    const Frame frame = IsAnisotropic(m.brdf) && m.tangent
-                            ? Frame::FromNormalTangent(n, *m.tangent)
+    const Frame frame = IsAnisotropic(params.model) && sm.tangent
+                            ? Frame::FromNormalTangent(n, *sm.tangent)
                             : Frame::FromNormal(n);
     const Vector3d wo = frame.ToLocal(r.view.cast<double>());
     Pcg32 rng(uint64_t(i) + 1, 17);

@@ -249,6 +249,12 @@ BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>&
   };
 }
 
+// The blocks of `blocks` (photo, block x, block y).
+BlockFilter BlockSetFilter(std::set<std::tuple<size_t, int, int>> blocks) {
+  auto set = std::make_shared<const std::set<std::tuple<size_t, int, int>>>(std::move(blocks));
+  return [set](size_t photo, int bx, int by) { return set->count({photo, bx, by}) > 0; };
+}
+
 // The held-out blocks where the records see region `region` (by name): where a change of the
 // region's material shows. Its refit also changes the path tracer's random paths in every block
 // whose paths meet the region (their light bounced off it changes little; their noise changes
@@ -256,21 +262,21 @@ BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>&
 BlockFilter RegionBlocks(const Scene& model, const std::vector<PixelRecord>& records,
                          const std::string& region, const PixelHoldout& h) {
   const int index = model.FindMaterial(region);  // -1: no such region, no block
-  auto blocks = std::make_shared<std::set<std::tuple<size_t, int, int>>>();
+  std::set<std::tuple<size_t, int, int>> blocks;
   for (const PixelRecord& r : records) {
     if (r.region == index && r.held_out) {
-      blocks->insert({size_t(r.photo), r.x / h.block_px, r.y / h.block_px});
+      blocks.insert({size_t(r.photo), r.x / h.block_px, r.y / h.block_px});
     }
   }
-  return [blocks](size_t photo, int bx, int by) { return blocks->count({photo, bx, by}) > 0; };
+  return BlockSetFilter(std::move(blocks));
 }
 
 // The held-out blocks of a candidate's support (CandidateResult::support_blocks), or none.
 BlockFilter SupportBlocks(const CandidateResult& c) {
   if (c.support_blocks.size() < 2) return nullptr;
-  auto blocks = std::make_shared<std::set<std::tuple<size_t, int, int>>>();
-  for (const auto& b : c.support_blocks) blocks->insert({size_t(b[0]), b[1], b[2]});
-  return [blocks](size_t photo, int bx, int by) { return blocks->count({photo, bx, by}) > 0; };
+  std::set<std::tuple<size_t, int, int>> blocks;
+  for (const auto& b : c.support_blocks) blocks.insert({size_t(b[0]), b[1], b[2]});
+  return BlockSetFilter(std::move(blocks));
 }
 
 // Effects that change one region's material (their params name the region).
