@@ -331,4 +331,19 @@ Eigen::Vector3d SeenTexelMean(const Image& map, const Image& seen) {
   return count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d::Constant(NAN);
 }
 
+Eigen::Vector3d TextureMeanOverSeenTexels(const Image& texture, const Image& seen) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double count = 0;
+  for (int y = 0; y < texture.height; ++y) {
+    const int sy = std::min(seen.height - 1, int((y + 0.5) * seen.height / texture.height));
+    for (int x = 0; x < texture.width; ++x) {
+      const int sx = std::min(seen.width - 1, int((x + 0.5) * seen.width / texture.width));
+      if (!(seen.at(sx, sy) > 0.5f)) continue;
+      for (int c = 0; c < 3; ++c) sum[c] += texture.at(x, y, std::min(c, texture.channels - 1));
+      ++count;
+    }
+  }
+  return count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d::Constant(NAN);
+}
+
 }  // namespace igi

@@ -81,9 +81,9 @@ double AlbedoPsnr(const Image& estimate, const Image& truth, double peak);
 // (AlbedoMapBuilder::DirectMask()), only the true texels whose lookup reads seen texels alone
 // (of those with a non-zero bilinear weight) are compared.
 struct AlbedoComparison {
-  double psnr_db = 0;         // 10·log10(peak² / MSE) over the compared texels and channels
-  double rms = 0;             // √MSE
-  double compared = 0;        // fraction of the true texels compared
+  double psnr_db = 0;   // 10·log10(peak² / MSE) over the compared texels and channels
+  double rms = 0;       // √MSE
+  double compared = 0;  // fraction of the true texels compared
 };
 // Throws igi::Error when an image is empty, `seen` differs in size from `estimate`, peak <= 0,
 // or no texel is compared.
@@ -93,5 +93,11 @@ AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, con
 // The map's mean RGB over the texels `seen` marks (> 0.5; one channel, the map's size); NaN when
 // none is. A 1-channel map is grey.
 Eigen::Vector3d SeenTexelMean(const Image& map, const Image& seen);
+
+// The mean RGB of `texture` (any resolution, on the same UV square as `seen`) over the texels of
+// `seen` marked seen: each texture texel counts where its centre falls, so at equal resolution it
+// is SeenTexelMean(texture, seen). The truth SeenTexelMean of an estimated map is compared with.
+// NaN when no texel falls in a seen one.
+Eigen::Vector3d TextureMeanOverSeenTexels(const Image& texture, const Image& seen);
 
 }  // namespace igi

@@ -533,6 +533,17 @@ void SolverState::FinishRegions() {
           n > 0 ? Eigen::Vector3d(mean / n) : Eigen::Vector3d::Constant(0.5);
       if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
     }
+    // A region with an albedo map: its ρd is the map's mean over the texels the photos show
+    // (equal areas: a texel is texel_size_m square on the surface), the albedo the written scene
+    // renders there. The fit's region mean (each patch with samples weighted by its area, in
+    // report.json's paper/refined blocks) weights each patch's texture by where its samples
+    // crowd and by its irradiance: +1.7 % on SolveAlbedoTruth's floor where the map's mean is
+    // within 0.2 % of the true texture's over the same texels (bench/RESULTS.md, session 18).
+    if (rs.albedo_map && rs.albedo_map_seen_mean.allFinite() &&
+        rs.albedo_map_seen_mean.minCoeff() > 0) {
+      rs.rho_d_from_map = true;
+      materials[r].params.rho_d = rs.albedo_map_seen_mean;
+    }
     BoundReflectances(r);
     rs.final_params = materials[r].params;
   }

@@ -60,10 +60,12 @@ struct RegionSolution {
   std::optional<Image> albedo_map_seen;
   bool albedo_map_generated_uvs = false;
   // The map's mean over its seen texels (equal areas: a texel is texel_size_m square on the
-  // surface), NaN without a map (report.json's albedo_map.seen_mean). The region's ρd stays the
-  // fit's (each patch with samples weighted by its area); the two differ by a few per cent on
-  // textured regions (bench/RESULTS.md, session 12).
+  // surface), NaN without a map (report.json's albedo_map.seen_mean). It is the region's final ρd
+  // (final_params.rho_d, scene.json's rho_d; rho_d_from_map) where it is positive; stage1/stage2
+  // keep the fit's region mean (each patch with samples weighted by its area), which runs a few
+  // per cent off on textured regions (bench/RESULTS.md, sessions 12 and 18).
   Eigen::Vector3d albedo_map_seen_mean = Eigen::Vector3d::Constant(NAN);
+  bool rho_d_from_map = false;
   // A reflectance is at most 1 (scene.json's rule). When a fit comes out above it (photos brighter
   // than any passive surface under the declared lights: a light too weak, an exposure_scale too
   // low, light the scene leaves out), the written model holds it at 1 and these say what the fit

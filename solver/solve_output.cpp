@@ -161,6 +161,10 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     rj["observations"] = r.observations;
     rj["paper"] = FitJson(r.stage1, r.final_params.model);
     rj["refined"] = FitJson(r.stage2, r.final_params.model);
+    // scene.json's rho_d and where it comes from: the albedo map's mean over its seen texels
+    // where the region has a map, else the fit's region mean (after the bound at 1).
+    rj["rho_d"] = Vec(r.final_params.rho_d);
+    rj["rho_d_source"] = r.rho_d_from_map ? "albedo_map_seen_mean" : "fit";
     if (r.Bounded()) {
       rj["bounded"] = {
           {"rho_d_fitted", Vec(r.rho_d_fitted)},

@@ -148,6 +148,16 @@ int main(int argc, char** argv) {
             "%+.2f %%, fit's rho_d %+.2f %% of the seen true mean\n",
             r.name.c_str(), 100 * (mt.mean() / full.mean() - 1), 100 * (me.mean() / mt.mean() - 1),
             100 * (r.stage1.rho_d.mean() / mt.mean() - 1));
+        // The truth over the texels SeenTexelMean takes.
+        const Eigen::Vector3d mn = igi::TextureMeanOverSeenTexels(want, *r.albedo_map_seen);
+        std::printf(
+            "%s: scene.json's rho_d %+.2f %+.2f %+.2f %% of the truth over the map's seen texels\n",
+            r.name.c_str(), rel(r.final_params.rho_d[0], mn[0]),
+            rel(r.final_params.rho_d[1], mn[1]), rel(r.final_params.rho_d[2], mn[2]));
+        std::printf("%s: scene.json's rho_d (%s) %+.2f %+.2f %+.2f %% of the seen true mean\n",
+                    r.name.c_str(), r.rho_d_from_map ? "the map's seen mean" : "the fit's",
+                    rel(r.final_params.rho_d[0], mt[0]), rel(r.final_params.rho_d[1], mt[1]),
+                    rel(r.final_params.rho_d[2], mt[2]));
       }
       for (int r_erode : {2, 4}) {  // away from unseen texels and the region's border
         igi::Image eroded = *r.albedo_map_seen;

@@ -1,14 +1,15 @@
 // Albedo maps (solver/albedo_map.h): splatting ratio samples into an atlas, push-pull filling,
 // and PSNR.
 #include "solver/albedo_map.h"
-#include "solver/render_internal.h"
-#include "tools/common/error.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <random>
+
+#include "solver/render_internal.h"
+#include "tools/common/error.h"
 
 namespace igi {
 namespace {
@@ -45,7 +46,9 @@ TriangleMesh Box() {
 }
 
 // The renderer's own lookup (solver/render_internal.h): the map must match what it reads.
-Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) { return SampleTexture(tex, uv); }
+Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) {
+  return SampleTexture(tex, uv);
+}
 
 // A smooth albedo over the quad, different in every channel and asymmetric in x and y (so a
 // flipped or transposed map cannot pass).
@@ -344,6 +347,32 @@ TEST(AlbedoMap, CompareAlbedoMapsCountsOnlyTheSeenTexels) {
   Image nothing(32, 16, 1);
   EXPECT_THROW(CompareAlbedoMaps(estimate, &nothing, truth, 1.0), Error);
   EXPECT_THROW(CompareAlbedoMaps(estimate, &truth, truth, 1.0), Error);  // mask size differs
+}
+
+// The seen means: SeenTexelMean over the map's own texels, TextureMeanOverSeenTexels over a
+// finer texture's texels by the map texel their centre falls in (here 4 × 4 per map texel).
+TEST(AlbedoMap, SeenMeansCountOnlyTheSeenTexels) {
+  Image map(4, 2, 3, 0.0f), seen(4, 2, 1, 0.0f), texture(16, 8, 3, 0.0f);
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      for (int c = 0; c < 3; ++c) map.at(x, y, c) = float(0.1 * (x + 4 * y) + 0.01 * c);
+    }
+  }
+  seen.at(1, 0) = seen.at(2, 1) = 1.0f;  // values 0.1 and 0.6 (+0.01 c)
+  const Eigen::Vector3d m = SeenTexelMean(map, seen);
+  EXPECT_NEAR(m[0], 0.35, 1e-6);
+  EXPECT_NEAR(m[2], 0.37, 1e-6);
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      for (int c = 0; c < 3; ++c) texture.at(x, y, c) = float(x + 100 * y + 1000 * c);
+    }
+  }
+  // Map texel (1, 0) holds texture columns 4..7 and rows 0..3; (2, 1) columns 8..11, rows 4..7.
+  const Eigen::Vector3d t = TextureMeanOverSeenTexels(texture, seen);
+  EXPECT_NEAR(t[0], (155.5 + 559.5) / 2, 1e-3);  // mean x 5.5 + 100 × mean y 1.5, and 9.5 + 550
+  EXPECT_NEAR(t[2], 357.5 + 2000, 1e-3);
+  EXPECT_TRUE(std::isnan(SeenTexelMean(map, Image(4, 2, 1, 0.0f))[0]));
+  EXPECT_TRUE(std::isnan(TextureMeanOverSeenTexels(texture, Image(4, 2, 1, 0.0f))[1]));
 }
 
 }  // namespace

@@ -99,7 +99,23 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
   // off-highlight test took the region's mean albedo); guarded at issue 7's bar, 5 %.
   EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
   EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
-  // Issue 7: region-mean albedos within 1 % on (nearly) noise-free photos. The regions of one
+  // Issue 7: region-mean albedos within 1 %. The floor's (scene.json's rho_d) is its map's mean
+  // over the texels the photos show, against the true texture's over the same texels: measured
+  // -0.18..-0.33 % in session 18 (the fit's patch-area mean, kept in report.json, +1.73 %: it
+  // weights each patch's texture by where its samples crowd).
+  {
+    ASSERT_TRUE(floor.rho_d_from_map);
+    const Eigen::Vector3d over_map = TextureMeanOverSeenTexels(want, *floor.albedo_map_seen);
+    std::printf("floor: final rho_d %+.2f %+.2f %+.2f %%\n",
+                100 * (floor.final_params.rho_d[0] / over_map[0] - 1),
+                100 * (floor.final_params.rho_d[1] / over_map[1] - 1),
+                100 * (floor.final_params.rho_d[2] / over_map[2] - 1));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LT(RelErr(floor.final_params.rho_d[c], over_map[c]), 0.01)
+          << "floor rho_d[" << c << "]";
+    }
+  }
+  // The regions of one
   // albedo (all but the textured floor), paper stage: measured -0.56..+0.83 % (glossy_box's red,
   // rho_d 0.1, +0.83 %; the ceiling +0.27..+0.60 %; +0.59..+0.87 % with session 12's adaptive
   // smoothing, where the wider mean over the open ceiling moved it). Without the specular bounces
