@@ -110,8 +110,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   if (GetParam().noise) so.noise = NoiseModel::kRealistic;
   Synthesize(so);
   const Scene scene = LoadScene(so.out / "scene.json");
-  SolveOptions o;
-  o.refine_iterations = 1;
+  SolveOptions o;  // igi-solve's defaults: two refinement rounds
   const SolveSummary s = Solve(scene, o, tmp / "out");
   WriteSolveOutputs(s, o, tmp / "out");
   const Json truth = ReadJsonFile(so.out / "truth.json")["materials"];
@@ -188,7 +187,10 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
                   100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
                   100 * (f.alpha / t["alpha"].get<double>() - 1));
     }
-    std::printf("\n");
+    std::printf("; final rho_d %+.2f %+.2f %+.2f %%\n",
+                100 * (r.final_params.rho_d[0] / t["rho_d"][0].get<double>() - 1),
+                100 * (r.final_params.rho_d[1] / t["rho_d"][1].get<double>() - 1),
+                100 * (r.final_params.rho_d[2] / t["rho_d"][2].get<double>() - 1));
     for (int c = 0; c < 3; ++c) {
       // Issue 7 asks 1 %. Measured (clean), since glossy patches pass on their specular
       // reflection of the room (solver/gather.h): matte_box +0.7..+1.1 %, glossy_sphere
@@ -199,6 +201,10 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // +1.5..+1.8 %, wall_y0 +1.0..+1.5 %). 3 % guards those.
       EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.03)
           << r.name << " rho_d[" << c << "]";
+      // The written (refined) value: session 18, 64-spp photos, -1.93..+1.75 % (the ceiling's
+      // blue, wall_x4); from 1024-spp photos -1.20..+0.66 % (wall_x0's red; bench/RESULTS.md).
+      EXPECT_LT(RelErr(r.final_params.rho_d[c], t["rho_d"][c].get<double>()), 0.03)
+          << r.name << " final rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
       // Issue 7: within 5 %; measured (clean) glossy_box +0.0 % / +0.1 %, wall_y4 -2.4 % /
@@ -290,16 +296,14 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   };
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
-  // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here). Measured
-  // 4.6 % beyond the floor (clean photos: model 0.0538, floor 0.0283) and 4.3 % (with sensor
-  // noise: 0.0516); 5 % guards both. The refinement round makes it: the paper stage's solution
-  // relights to 2.95 % beyond (bench/solver/relight_probe PROBE_REFINE=0), the refined one
-  // renders the floor 2.8 % too bright (76 % of the squared error on the floor's blocks): each
-  // round gathers the indirect light from the previous solution and swings about the answer
-  // (2 rounds: floor -3.2 %, 4.35 % beyond). Before glossy patches passed on their specular
-  // reflection of the room (solver/gather.h) the paper stage's albedos were 0.5-2 % high and the
-  // swing landed nearer: 3.4 % / 3.6 % (paper stage alone 2.95 % then too). bench/RESULTS.md.
-  EXPECT_LT(err, std::sqrt(floor * floor + 0.05 * 0.05));
+  // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here). Session
+  // 18, igi-solve's defaults (two refinement rounds): 2.63 % beyond (clean: model 0.0386, floor
+  // 0.0283); one round 2.99 %. What is left is the input photos' noise: 78 % of the squared error
+  // sits on the floor's blocks with a mean signed error of -0.2 %, i.e. the texel noise of a map
+  // from 64-spp photos (most texels hold one or two observations). From 256- and 1024-spp photos
+  // the same solve relights to 1.39 % and 1.09 % beyond (bench/solver/relight_probe,
+  // bench/RESULTS.md). Guarded at 3.5 %.
+  EXPECT_LT(err, std::sqrt(floor * floor + 0.035 * 0.035));
 }
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
