@@ -269,7 +269,8 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
 // kConeSamples directions toward the light: 64 samples, the same for every radius.
 constexpr int kFootprint = 16, kConeSamples = 4;
 constexpr float kMinChange = 0.15f;
-constexpr int kMinBlockRecords = 4;  // in a 16-pixel block; in proportion to the block's area
+constexpr int kMinBlockRecords = 4;     // in a 16-pixel block; in proportion to the block's area
+constexpr double kLargestRadius = 0.5;  // m: the largest sphere ExtentFit tries
 
 // A light as a sphere of `intensity` (W/sr) at `center`.
 struct SphereSource {
@@ -352,9 +353,8 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
 // light_source_extent candidate, at the right radius, predicted a gain of exactly 0.)
 void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int stride,
                        std::vector<Eigen::Vector3f>* change) {
-  const int min_records = std::max(
-      1, int(std::lround(kMinBlockRecords * (block_px / 16.0) * (block_px / 16.0) /
-                         std::max(1, stride))));
+  const int min_records = std::max(1, int(std::lround(kMinBlockRecords * (block_px / 16.0) *
+                                                      (block_px / 16.0) / std::max(1, stride))));
   std::unordered_map<int64_t, int> count;
   auto block = [&](const PixelRecord& r) {
     return (int64_t(r.photo) << 40) + (int64_t(r.y / block_px) << 20) + r.x / block_px;
@@ -547,7 +547,7 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
     return fit.train_after + (1 - a) * (1 - a) * (fit.train_before - fit.train_after) / (a * a);
   };
   std::vector<std::pair<double, ResidualFit>> tried;
-  for (double radius : {0.02, 0.035, 0.05, 0.08, 0.12, 0.17, 0.23, 0.3, 0.4, 0.5}) {
+  for (double radius : {0.02, 0.035, 0.05, 0.08, 0.12, 0.17, 0.23, 0.3, 0.4, kLargestRadius}) {
     if (radius > 1.25 * r0 + 0.005) tried.emplace_back(radius, fit_at(radius));
   }
   int best = -1;
@@ -666,8 +666,53 @@ CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitt
     out.effect = "light_source_extent";
     return out;
   }
-  return search ? ExtentFit(cx, f, search->fitter(), search->stride(), light)
-                : ExtentFit(cx, f, f, 1, light);
+  // Records flagged as outliers (far in the residual's tail) take no part in the other fits; at
+  // this light's shadow edges the tail is the extent's own signal (a hard shadow where the photos
+  // show a penumbra): those whose direct term the largest sphere tried changes take part here, as
+  // pose_error takes back its camera's sharp edges.
+  const std::vector<PixelRecord>& recs = f.records();
+  std::vector<size_t> flagged;
+  for (size_t i = 0; i < recs.size(); ++i) {
+    if (recs[i].outlier) flagged.push_back(i);
+  }
+  std::vector<PixelRecord> tail;
+  for (size_t i : flagged) tail.push_back(recs[i]);
+  int taken_back = 0;
+  std::vector<PixelRecord> records;
+  if (!tail.empty()) {
+    const ExtentModel model(cx, tail, light);
+    std::vector<float> vis0, vis1;
+    const std::vector<Eigen::Vector3f> d0 = model.Direct(model.declared_radius(), &vis0);
+    const std::vector<Eigen::Vector3f> d1 = model.Direct(kLargestRadius, &vis1);
+    for (size_t k = 0; k < tail.size(); ++k) {
+      const bool edge = (vis1[k] > 0.02f && vis1[k] < 0.98f) || std::abs(vis1[k] - vis0[k]) > 0.02f;
+      if (edge && (d1[k] - d0[k]).norm() > kMinChange * tail[k].sim.norm()) {
+        if (records.empty()) records = recs;
+        records[flagged[k]].outlier = false;
+        ++taken_back;
+      }
+    }
+  }
+  CandidateResult out;
+  if (taken_back == 0) {
+    out = search ? ExtentFit(cx, f, search->fitter(), search->stride(), light)
+                 : ExtentFit(cx, f, f, 1, light);
+  } else {
+    int num_cells = 0;
+    std::vector<int> cells = RecordCells(cx.model, records, cx.cell_m, &num_cells);
+    const ResidualFitter edges(records, std::move(cells), num_cells, f.nuisance(), cx.block_px);
+    if (search) {
+      const RecordSubset sub(cx.model, records, cx.cell_m, f.nuisance(), cx.block_px,
+                             search->stride());
+      out = ExtentFit(cx, edges, sub.fitter(), search->stride(), light);
+    } else {
+      out = ExtentFit(cx, edges, edges, 1, light);
+    }
+    const std::string taken = fmt::format(
+        "; {} records of the residual's tail at the light's shadow edges taken back", taken_back);
+    (out.valid ? out.evidence : out.note) += taken;
+  }
+  return out;
 }
 
 namespace {
@@ -733,7 +778,8 @@ std::vector<Eigen::Vector3f> UnitAmbientFirstReflection(const Scene& model,
     Vector3d sum = Vector3d::Zero();
     for (int a = 0; a < kSide; ++a) {
       for (int b = 0; b < kSide; ++b) {
-        const Eigen::Vector2d u((a + rng.UniformDouble()) / kSide, (b + rng.UniformDouble()) / kSide);
+        const Eigen::Vector2d u((a + rng.UniformDouble()) / kSide,
+                                (b + rng.UniformDouble()) / kSide);
         const BrdfSample smp = SampleBrdf(params, wo, rng.UniformDouble(), u);
         if (smp.Valid()) sum += smp.weight;
       }

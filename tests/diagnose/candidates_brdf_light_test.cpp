@@ -15,6 +15,7 @@
 
 #include "solver/brdf.h"
 #include "solver/diagnose/candidates.h"
+#include "solver/diagnose/pixel_records.h"
 #include "solver/photo_model.h"
 #include "solver/render.h"
 #include "solver/render_internal.h"
@@ -352,6 +353,37 @@ TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
   EXPECT_GE(10 * at_edges, 6 * int(c.support_blocks.size()));
 }
 
+// igi-diagnose flags the residual's far tail as outliers (FlagOutliers: fireflies, unmodelled
+// objects), and the other candidates leave those records out; at the light's shadow edges the
+// tail is the extent's own signal. The candidate takes back the flagged records whose direct
+// term a larger sphere changes, and still finds the radius.
+TEST(LightSourceExtentTest, TakesBackTheTailAtItsShadowEdges) {
+  const Scene model = ShadowScene(0);
+  const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
+  std::vector<PixelRecord> records = ShadowRecords(model, 0.2);
+  FlagOutliers(&records);
+  int flagged = 0;
+  for (const PixelRecord& r : records) flagged += r.outlier;
+  ASSERT_GT(flagged, 20);  // the penumbrae's records differ from the hard shadow by far more
+  const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
+  const CandidateResult c = LightSourceExtent({model, declared, false}, f, 0);
+  ASSERT_TRUE(c.valid) << c.note;
+  EXPECT_NE(c.evidence.find("taken back"), std::string::npos) << c.evidence;
+  EXPECT_NEAR(c.params["radius"].get<double>(), 0.2, 0.03);
+  EXPECT_GT(c.Gain(), 0.5);
+  EXPECT_GT(c.z, 5);
+  // Left out, as the other candidates leave them, the flagged records take the evidence with them.
+  std::vector<PixelRecord> kept;
+  for (const PixelRecord& r : records) {
+    if (!r.outlier) kept.push_back(r);
+  }
+  const ResidualFitter g(kept, std::vector<int>(kept.size(), 0), 1, false, 8);
+  const CandidateResult without = LightSourceExtent({model, declared, false}, g, 0);
+  std::printf("with the tail taken back: z %.1f, radius %.3f; without it: %s z %.1f\n", c.z,
+              c.params["radius"].get<double>(), without.valid ? "valid" : "invalid", without.z);
+  if (without.valid) EXPECT_GT(c.z, without.z);
+}
+
 TEST(LightSourceExtentTest, APointLightEarnsNothing) {
   const Scene model = ShadowScene(0);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
@@ -377,7 +409,8 @@ TEST(AmbientLightTest, WithSolvedMaterialsTheFirstReflectionGivesTheRadianceBack
   camera.params = {100, 100, 60, 60};
   model.cameras = {camera};
   model.photos[0].camera = 0;
-  const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}, {"lightings", {{"L0", {"lamp"}}}}};
+  const Json declared =
+      Json{{"lights", {{"lamp", {{"type", "point"}}}}}, {"lightings", {{"L0", {"lamp"}}}}};
   std::vector<PixelRecord> records = ShadowRecords(model, 0);
   const Vector3f ambient(0.3f, 0.2f, 0.1f);
   int shadowed = 0;
