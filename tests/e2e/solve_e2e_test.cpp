@@ -353,9 +353,14 @@ TEST_F(SolveE2E, AlbedosAboveOneAreHeldAtOneAndReported) {
       continue;
     }
     const Json& rho_d = solved.at("materials").at(name).at("rho_d");
-    const Json& fitted = region.at("refined").at("rho_d");
-    std::printf("%s: fitted %s, written %s\n", name.c_str(), fitted.dump().c_str(),
-                rho_d.dump().c_str());
+    // The value before the bound: the fit's, or for a region with an albedo map the map's mean
+    // over its seen texels (report.json rho_d_source; after a bound `bounded.rho_d_fitted`).
+    const bool from_map = region.at("rho_d_source") == "albedo_map_seen_mean";
+    const Json& fitted = !from_map                ? region.at("refined").at("rho_d")
+                         : region.contains("bounded") ? region.at("bounded").at("rho_d_fitted")
+                                                      : region.at("albedo_map").at("seen_mean");
+    std::printf("%s: %s %s, written %s\n", name.c_str(), from_map ? "map's seen mean" : "fitted",
+                fitted.dump().c_str(), rho_d.dump().c_str());
     for (int c = 0; c < 3; ++c) {
       const double f = fitted[c].get<double>();
       if (f > 1) {
