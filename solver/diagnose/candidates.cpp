@@ -482,8 +482,27 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
                "the albedos";
     return out;
   }
-  const ResidualFit fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-    b[0] = r.sim[c] * share[size_t(&r - recs.data())];
+  // Where the light's size shows (penumbrae, highlights: WhereLightSizeShows) its intensity is
+  // not fitted: the records there take no part (as outliers do) and the cells are drawn again.
+  const std::vector<bool> size_shows = WhereLightSizeShows(cx, recs, light);
+  int left_out = 0;
+  std::vector<PixelRecord> kept_records;
+  std::optional<ResidualFitter> kept_fitter;
+  for (size_t i = 0; i < recs.size(); ++i) {
+    if (!size_shows[i] || recs[i].outlier) continue;
+    if (kept_records.empty()) kept_records = recs;
+    kept_records[i].outlier = true;
+    ++left_out;
+  }
+  if (left_out > 0) {
+    int num_cells = 0;
+    std::vector<int> cells = RecordCells(cx.model, kept_records, cx.cell_m, &num_cells);
+    kept_fitter.emplace(kept_records, std::move(cells), num_cells, f.nuisance(), cx.block_px);
+  }
+  const ResidualFitter& fitter = kept_fitter ? *kept_fitter : f;
+  const PixelRecord* first = fitter.records().data();
+  const ResidualFit fit = fitter.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    b[0] = r.sim[c] * share[size_t(&r - first)];
   });
   if (fit.coef.size() == 0) return out;
   FillScores(fit, &out);
@@ -495,6 +514,12 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
   out.evidence = fmt::format(
       "where light '{}' dominates, the photos are {:.3f}x the model; elsewhere they agree", l.name,
       factor);
+  if (left_out > 0) {
+    out.evidence += fmt::format(
+        " ({} samples in its penumbrae and highlights, where a larger source would differ, left "
+        "out of the fit)",
+        left_out);
+  }
   out.valid = true;
   const std::string name = l.name;
   out.apply = [name, factor](Json* doc) {

@@ -715,6 +715,22 @@ CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitt
   return out;
 }
 
+std::vector<bool> WhereLightSizeShows(const CandidateContext& cx,
+                                      const std::vector<PixelRecord>& records, int light) {
+  std::vector<bool> out(records.size(), false);
+  const Light& l = cx.model.lights[light];
+  if (l.type != LightType::kPoint && l.type != LightType::kSphere) return out;
+  if (records.empty()) return out;
+  const ExtentModel model(cx, records, light);
+  if (!(kLargestRadius > model.declared_radius())) return out;
+  const std::vector<Eigen::Vector3f> d0 = model.Direct(model.declared_radius());
+  const std::vector<Eigen::Vector3f> d1 = model.Direct(kLargestRadius);
+  for (size_t i = 0; i < records.size(); ++i) {
+    out[i] = (d1[i] - d0[i]).norm() > kMinChange * records[i].sim.norm();
+  }
+  return out;
+}
+
 namespace {
 
 // ---------------------------------------------------------------- ambient_light

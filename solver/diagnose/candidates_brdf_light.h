@@ -41,6 +41,16 @@ CandidateResult AnisotropicReflection(const CandidateContext& cx, const Residual
 CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light,
                                   const RecordSubset* search = nullptr);
 
+// Per record: whether light `light` (point or sphere) made a sphere of the largest radius
+// light_source_extent tries changes the record's direct term by more than that candidate's
+// threshold (kMinChange of the model's value): a penumbra at a shadow edge or a highlight, where
+// the light's size shows. All false for other light types. light_intensity leaves these out: a
+// source larger than declared darkens the lit side of every penumbra and the peak of every
+// highlight, where a point model's basis is large, and brightens the shadowed side, where it is
+// small, so a fit of its intensity there reads the extent as a weaker light.
+std::vector<bool> WhereLightSizeShows(const CandidateContext& cx,
+                                      const std::vector<PixelRecord>& records, int light);
+
 // ambient_light: apply() adds an "ambient" light of the fitted radiance to every lighting.
 CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f);
 
