@@ -487,19 +487,17 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
   const std::vector<bool> size_shows = WhereLightSizeShows(cx, recs, light);
   int left_out = 0;
   std::vector<PixelRecord> kept_records;
-  std::optional<ResidualFitter> kept_fitter;
   for (size_t i = 0; i < recs.size(); ++i) {
     if (!size_shows[i] || recs[i].outlier) continue;
     if (kept_records.empty()) kept_records = recs;
     kept_records[i].outlier = true;
     ++left_out;
   }
+  std::optional<RecordSubset> kept;
   if (left_out > 0) {
-    int num_cells = 0;
-    std::vector<int> cells = RecordCells(cx.model, kept_records, cx.cell_m, &num_cells);
-    kept_fitter.emplace(kept_records, std::move(cells), num_cells, f.nuisance(), cx.block_px);
+    kept.emplace(cx.model, std::move(kept_records), cx.cell_m, f.nuisance(), cx.block_px);
   }
-  const ResidualFitter& fitter = kept_fitter ? *kept_fitter : f;
+  const ResidualFitter& fitter = kept ? kept->fitter() : f;
   const PixelRecord* first = fitter.records().data();
   const ResidualFit fit = fitter.Fit(1, [&](const PixelRecord& r, int c, double* b) {
     b[0] = r.sim[c] * share[size_t(&r - first)];

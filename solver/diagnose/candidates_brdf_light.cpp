@@ -698,15 +698,13 @@ CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitt
     out = search ? ExtentFit(cx, f, search->fitter(), search->stride(), light)
                  : ExtentFit(cx, f, f, 1, light);
   } else {
-    int num_cells = 0;
-    std::vector<int> cells = RecordCells(cx.model, records, cx.cell_m, &num_cells);
-    const ResidualFitter edges(records, std::move(cells), num_cells, f.nuisance(), cx.block_px);
+    const RecordSubset edges(cx.model, std::move(records), cx.cell_m, f.nuisance(), cx.block_px);
     if (search) {
-      const RecordSubset sub(cx.model, records, cx.cell_m, f.nuisance(), cx.block_px,
+      const RecordSubset sub(cx.model, edges.records(), cx.cell_m, f.nuisance(), cx.block_px,
                              search->stride());
-      out = ExtentFit(cx, edges, sub.fitter(), search->stride(), light);
+      out = ExtentFit(cx, edges.fitter(), sub.fitter(), search->stride(), light);
     } else {
-      out = ExtentFit(cx, edges, edges, 1, light);
+      out = ExtentFit(cx, edges.fitter(), edges.fitter(), 1, light);
     }
     const std::string taken = fmt::format(
         "; {} records of the residual's tail at the light's shadow edges taken back", taken_back);

@@ -219,6 +219,15 @@ RecordSubset::RecordSubset(const Scene& model, const std::vector<PixelRecord>& r
       std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance, block_px);
 }
 
+RecordSubset::RecordSubset(const Scene& model, std::vector<PixelRecord> records, double cell_m,
+                           bool nuisance, int block_px)
+    : records_(std::move(records)), stride_(1) {
+  int num_cells = 0;
+  std::vector<int> cells = RecordCells(model, records_, cell_m, &num_cells);
+  fitter_ =
+      std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance, block_px);
+}
+
 int SearchStride(const std::vector<PixelRecord>& records, int target) {
   int64_t fitted = 0;
   for (const PixelRecord& r : records) fitted += !r.held_out && !r.outlier;

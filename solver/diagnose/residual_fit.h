@@ -112,6 +112,10 @@ class RecordSubset {
  public:
   RecordSubset(const Scene& model, const std::vector<PixelRecord>& records, double cell_m,
                bool nuisance, int block_px, int stride, int region = -1);
+  // Every record as given (a candidate's own copy whose outlier marks it changed: records taken
+  // out of its fit or back into it), with its fitter; stride 1.
+  RecordSubset(const Scene& model, std::vector<PixelRecord> records, double cell_m, bool nuisance,
+               int block_px);
   RecordSubset(const RecordSubset&) = delete;
   RecordSubset& operator=(const RecordSubset&) = delete;
 

@@ -422,12 +422,15 @@ TEST(LightIntensityTest, ASoftShadowIsNotAWeakerLight) {
   ASSERT_EQ(plain.coef.size(), 1);
   const double plain_factor = 1 + plain.coef[0];
   // The candidate, the others excluded.
-  std::vector<std::string> excluded = {"exposure_scale", "vignetting", "camera_response",
-                                       "ambient_light", "light_emission_profile:lamp",
+  std::vector<std::string> excluded = {"exposure_scale",
+                                       "vignetting",
+                                       "camera_response",
+                                       "ambient_light",
+                                       "light_emission_profile:lamp",
                                        "light_source_extent:lamp"};
   for (const char* region : {"floor", "blocker"}) {
-    for (const char* e : {"specular_lobe_shape:", "fresnel:", "anisotropic_reflection:",
-                          "specular_reflection:"}) {
+    for (const char* e :
+         {"specular_lobe_shape:", "fresnel:", "anisotropic_reflection:", "specular_reflection:"}) {
       excluded.push_back(std::string(e) + region);
     }
   }

@@ -356,7 +356,7 @@ TEST_F(SolveE2E, AlbedosAboveOneAreHeldAtOneAndReported) {
     // The value before the bound: the fit's, or for a region with an albedo map the map's mean
     // over its seen texels (report.json rho_d_source; after a bound `bounded.rho_d_fitted`).
     const bool from_map = region.at("rho_d_source") == "albedo_map_seen_mean";
-    const Json& fitted = !from_map                ? region.at("refined").at("rho_d")
+    const Json& fitted = !from_map                    ? region.at("refined").at("rho_d")
                          : region.contains("bounded") ? region.at("bounded").at("rho_d_fitted")
                                                       : region.at("albedo_map").at("seen_mean");
     std::printf("%s: %s %s, written %s\n", name.c_str(), from_map ? "map's seen mean" : "fitted",
