@@ -67,8 +67,8 @@ struct Projected {
   Eigen::MatrixXd bb;  // Σ b bᵀ − (Σ s b)(Σ s b)ᵀ / Σ s²
   Eigen::VectorXd by;  // Σ b y − (Σ s b)(Σ s y) / Σ s²
   Eigen::VectorXd tmp;
-  double yy = 0;       // Σ y² − (Σ s y)² / Σ s²
-  double yy0 = 0;      // the same for y0 (no offset)
+  double yy = 0;   // Σ y² − (Σ s y)² / Σ s²
+  double yy0 = 0;  // the same for y0 (no offset)
 };
 
 // With noise_free, the noise-free error: the nuisance's sums corrected by the variance V
@@ -94,7 +94,8 @@ void Project(const double* st, int k, bool nuisance, bool noise_free, Projected*
 
 }  // namespace
 
-ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool noise_free) const {
+ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool noise_free,
+                                  int k_base) const {
   const int stride = Stride(k);
   ResidualFit fit;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
@@ -120,6 +121,16 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool 
     return fit;
   }
   fit.train_after = train_offset - 2 * fit.coef.dot(g) + fit.coef.dot(a * fit.coef);
+  // FitBeyond (no offset, not noise-free): "before" is the base columns' own fit.
+  if (k_base > 0 && k_base < k) {
+    Eigen::LDLT<Eigen::MatrixXd> base(a.topLeftCorner(k_base, k_base));
+    fit.base_coef = Eigen::VectorXd::Zero(k);
+    if (base.info() == Eigen::Success) fit.base_coef.head(k_base) = base.solve(g.head(k_base));
+    if (!fit.base_coef.allFinite()) fit.base_coef.setZero();
+    fit.train_before =
+        train_offset - 2 * fit.base_coef.dot(g) + fit.base_coef.dot(a * fit.base_coef);
+  }
+  const bool beyond = fit.base_coef.size() == k;
   // Held out: the same coefficients, the set's own nuisance.
   double held_raw = 0;
   for (int cell = 0; cell < num_cells_; ++cell) {
@@ -127,7 +138,9 @@ ResidualFit ResidualFitter::Solve(int k, const std::vector<double>& stats, bool 
       const double* st = &stats[((size_t(cell) * 3 + c) * 2 + 1) * stride];
       Project(st, k, nuisance_, noise_free, &p);
       p.tmp.noalias() = p.bb * fit.coef;
-      fit.held_before += p.yy0;
+      fit.held_before +=
+          beyond ? p.yy - (2 * fit.base_coef.dot(p.by) - fit.base_coef.dot(p.bb * fit.base_coef))
+                 : p.yy0;
       fit.held_after += p.yy - (2 * fit.coef.dot(p.by) - fit.coef.dot(p.tmp));
       if (noise_free) {
         Project(st, k, nuisance_, false, &raw);

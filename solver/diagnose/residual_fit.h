@@ -27,6 +27,8 @@ struct ResidualFit {
   double train_before = 0, train_after = 0;  // squared-error sums after the nuisance
   double held_before = 0, held_after = 0;
   double z = 0;  // held-out gain / its standard error over cells
+  // FitBeyond: the fit of the base columns alone ("before"), padded with zeros to k.
+  Eigen::VectorXd base_coef;
   double Gain() const { return held_before > 0 ? 1 - held_after / held_before : 0; }
 };
 
@@ -63,13 +65,23 @@ class ResidualFitter {
         k, basis, [](const PixelRecord&, int) { return 0.0; }, nuisance_);
   }
 
+  // A fit credited only with what it explains beyond its first `k_base` columns: "before" (the
+  // scores and the significance's blocks) is the fit of those columns alone, "after" the fit of
+  // all k. For an effect whose model contains another's (per-photo scales contain a scale per
+  // lighting, which is the lights' intensity): what the other explains is not its.
+  template <class F>
+  ResidualFit FitBeyond(int k, int k_base, F basis) const {
+    return FitImpl(
+        k, basis, [](const PixelRecord&, int) { return 0.0; }, false, k_base);
+  }
+
   const std::vector<PixelRecord>& records() const { return records_; }
   bool nuisance() const { return nuisance_; }
 
  private:
   template <class F, class G>
-  ResidualFit FitImpl(int k, F basis, G offset, bool noise_free) const;
-  ResidualFit Solve(int k, const std::vector<double>& stats, bool noise_free) const;
+  ResidualFit FitImpl(int k, F basis, G offset, bool noise_free, int k_base = 0) const;
+  ResidualFit Solve(int k, const std::vector<double>& stats, bool noise_free, int k_base = 0) const;
   // Σ s y / Σ s² of the held-out set per (cell, channel), before and after the fit (with the
   // variance correction when noise_free).
   double NuisanceCoef(const std::vector<double>& stats, int k, size_t cell, int c,
@@ -137,7 +149,7 @@ int SearchStride(const std::vector<PixelRecord>& records, int target);
 // sim): [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ,
 // then Σ var(s), Σ s·y0 and Σ y0².
 template <class F, class G>
-ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) const {
+ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, int k_base) const {
   const int stride = Stride(k);
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
   std::vector<double> b(k);
@@ -168,8 +180,9 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) c
       }
     }
   }
-  ResidualFit fit = Solve(k, stats, noise_free);
+  ResidualFit fit = Solve(k, stats, noise_free, k_base);
   if (fit.coef.size() == 0) return fit;
+  const Eigen::VectorXd& before_coef = fit.base_coef;  // empty: the plain residual
   // Held-out gain per block (photo, block_px square) for its standard error.
   // Relative gain per block (gain / the block's error before), so that a few bright blocks
   // cannot carry the significance on their own.
@@ -186,14 +199,16 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free) c
       basis(r, c, b.data());
       const double s = r.sim[c], y0 = double(r.recorded[c]) - s, y = y0 - offset(r, c);
       support |= y != y0 || std::any_of(b.begin(), b.end(), [](double v) { return v != 0; });
-      double cb = 0;
+      double cb = 0, cb0 = 0;
       for (int a = 0; a < k; ++a) cb += fit.coef[a] * b[a];
-      const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, Eigen::VectorXd(), noise_free);
+      for (int a = 0; a < before_coef.size(); ++a) cb0 += before_coef[a] * b[a];
+      const double a0 = NuisanceCoef(stats, k, size_t(cell_[i]), c, before_coef, noise_free);
       const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef, noise_free);
-      g += (y0 - a0 * s) * (y0 - a0 * s) - (y - cb - a1 * s) * (y - cb - a1 * s);
+      const double r0 = y0 - cb0 - a0 * s;
+      g += r0 * r0 - (y - cb - a1 * s) * (y - cb - a1 * s);
       // The render's noise in the residual, (1 + a)² var: its change is not the candidate's gain.
       if (noise_free) g -= ((1 + a0) * (1 + a0) - (1 + a1) * (1 + a1)) * double(r.sim_var[c]);
-      e += (y0 - a0 * s) * (y0 - a0 * s);
+      e += r0 * r0;
     }
     if (!support) continue;
     auto& acc =

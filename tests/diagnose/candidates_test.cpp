@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "solver/diagnose/residual_fit.h"
 #include "solver/photo_model.h"
@@ -128,6 +130,172 @@ TEST(EmissionProfileTest, SearchOnASubsampleScoresOnEveryRecord) {
   EXPECT_DOUBLE_EQ(sub.held_before, all.held_before);
   EXPECT_DOUBLE_EQ(sub.train_before, all.train_before);
   EXPECT_NEAR(sub.Gain(), all.Gain(), 0.02);
+}
+
+// With the materials solved and a second lighting photographed, the albedos (the fit's nuisance,
+// a free scale per cell) are shared by both lightings. The lamp truly is a cos² spot straight
+// down: its direct light falls off with the angle, and the light it sends after a bounce, most
+// of what the wall shows, drops in its own photos by a share that differs between surfaces
+// (the wall loses more than the floor). lamp2's photos agree with the model. The profile's axis
+// and power are searched on the lamp's photos alone, with their own albedo nuisance, and scored
+// on every record. Measured: axis 0.3° from −z, power 2.25; searched on every record with the
+// shared albedos (before session 20) the power came out 2.53, which fails here. (A mild form of
+// the suite's seed-107 capture, where the search on every record gave cos^14 about an axis
+// pointing up, and on the lamp's photos alone cos^1.43 about one 6.8° from the true one.)
+TEST(EmissionProfileTest, SearchedOnItsOwnPhotosWhenAnotherLightingSharesTheAlbedos) {
+  Scene model = RoomModel();
+  Light lamp2 = model.lights[0];
+  lamp2.name = "lamp2";
+  const Vector3d at2(-1, 1, 2.2);
+  lamp2.position = at2;
+  model.lights.push_back(lamp2);
+  model.lightings.push_back(Lighting{"L1", {1}});
+  for (int j = 0; j < 8; ++j) {
+    Photo ph;
+    ph.lighting = j < 4 ? 0 : 1;
+    model.photos.push_back(ph);
+  }
+  const Json declared = {
+      {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  const double bounce = 0.02;  // the model's bounced light, the same everywhere
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = (i / 2) % 2 == 1;
+    const int lighting = i % 2;
+    const Vector3d p = wall ? Vector3d(3, 6 * u(rng) - 3, 2.5 * u(rng))
+                            : Vector3d(6 * u(rng) - 3, 6 * u(rng) - 3, 0);
+    const Vector3d n = wall ? Vector3d(-1, 0, 0) : Vector3d(0, 0, 1);
+    const Vector3d from = lighting == 0 ? kLamp : at2;
+    const double d = (from - p).norm();
+    const Vector3d wi = (from - p) / d;
+    const double e = kIntensity * std::max(0.0, wi.dot(n)) / (d * d);
+    const double direct = kRho / kPi * e;
+    const int photo = 4 * lighting + (i / 4) % 4;
+    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, p,
+                                         n, n, Vector3f::Constant(float(kRho)), wi, e, d);
+    r.lights[0].light = lighting;
+    const double truth =
+        lighting == 0 ? direct * std::pow(std::max(0.0, wi.z()), 2.0) + bounce * (wall ? 0.35 : 0.7)
+                      : direct + bounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(direct + bounce);
+      r.recorded[c] = float(truth * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, true, 8);
+  const CandidateResult c = EmissionProfile({model, declared, true}, f, 0);
+  ASSERT_TRUE(c.valid) << c.note;
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  std::printf("axis %.1f deg from -z, power %.2f, predicted gain %.3f, z %.1f\n",
+              std::acos(std::min(1.0, -axis[2])) * 180 / kPi, c.params["cos_power"].get<double>(),
+              c.Gain(), c.z);
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.3);
+}
+
+// ---------------------------------------------------------------- exposure_scale
+// Materials solved, photos under two lightings (the albedos shared by both): 4 photos under the
+// lamp, 4 under lamp2, on the floor and the wall. The photos under lamp2 record 0.6x the model
+// (lamp2 is dimmer than declared: a scale common to its lighting, another effect's), and photo
+// `off` (under lamp2; -1: none) records a further `off_scale`.
+CandidateResult ExposureWithTwoLightings(int off, double off_scale) {
+  Scene model = RoomModel();
+  Light lamp2 = model.lights[0];
+  lamp2.name = "lamp2";
+  lamp2.position = Vector3d(-1, 1, 2.2);
+  model.lights.push_back(lamp2);
+  model.lightings.push_back(Lighting{"L1", {1}});
+  for (int j = 0; j < 8; ++j) {
+    Photo ph;
+    ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
+    ph.lighting = j / 4;
+    model.photos.push_back(ph);
+  }
+  const Json declared = {
+      {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = (i / 8) % 2 == 1;
+    const int photo = i % 8;
+    const Vector3d p = wall ? Vector3d(3, 6 * u(rng) - 3, 2.5 * u(rng))
+                            : Vector3d(6 * u(rng) - 3, 6 * u(rng) - 3, 0);
+    const Vector3d n = wall ? Vector3d(-1, 0, 0) : Vector3d(0, 0, 1);
+    const Vector3d from = photo < 4 ? kLamp : lamp2.position;
+    const double d = (from - p).norm();
+    const Vector3d wi = (from - p) / d;
+    const double e = kIntensity * std::max(0.0, wi.dot(n)) / (d * d);
+    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, p,
+                                         n, n, Vector3f::Constant(float(kRho)), wi, e, d);
+    r.lights[0].light = photo < 4 ? 0 : 1;
+    const double sim = kRho / kPi * e + kBounce;
+    const double scale = (photo < 4 ? 1.0 : 0.6) * (photo == off ? off_scale : 1.0);
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(sim);
+      r.recorded[c] = float(sim * scale * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  std::vector<std::string> excluded;
+  for (const char* e : {"vignetting", "camera_response", "ambient_light"}) excluded.push_back(e);
+  for (const char* l : {"lamp", "lamp2"}) {
+    for (const char* e : {"light_emission_profile:", "light_intensity:", "light_source_extent:"}) {
+      excluded.push_back(std::string(e) + l);
+    }
+  }
+  for (const char* r : {"floor", "wall"}) {
+    for (const char* e :
+         {"specular_lobe_shape:", "fresnel:", "anisotropic_reflection:", "specular_reflection:"}) {
+      excluded.push_back(std::string(e) + r);
+    }
+  }
+  const std::vector<CandidateResult> cands =
+      EvaluateCandidates({model, declared, true}, records, excluded);
+  for (const CandidateResult& c : cands) {
+    if (c.effect == "exposure_scale") return c;
+  }
+  ADD_FAILURE() << "no exposure_scale candidate among " << cands.size();
+  return {};
+}
+
+// A scale common to one lighting's photos is not credited to per-photo scales (it is the
+// lighting's lights': light_intensity, light_emission_profile): fitted free, the 8 photos'
+// scales (0.6 under lamp2, relative to the median photo) explained nearly all the residual, and
+// the suite's seed-107 emission-profile capture applied them in the profile's place.
+TEST(ExposureScaleTest, ALightingsCommonScaleIsNotThePhotos) {
+  const CandidateResult c = ExposureWithTwoLightings(-1, 1.0);
+  if (c.valid) {
+    std::printf("exposure_scale: predicted held-out gain %.4f, z %.1f, %s\n", c.Gain(), c.z,
+                c.params.dump().c_str());
+    EXPECT_LT(c.Gain(), 0.02);
+    for (const auto& [file, v] : c.params["scale"].items()) {
+      EXPECT_NEAR(v.get<double>(), 1.0, 0.01) << file;
+    }
+  } else {
+    EXPECT_FALSE(c.note.empty());
+  }
+}
+
+// One photo off within its lighting is still found, relative to its lighting's other photos.
+TEST(ExposureScaleTest, OnePhotoOffWithinItsLightingIsFound) {
+  const CandidateResult c = ExposureWithTwoLightings(5, 0.8);
+  ASSERT_TRUE(c.valid) << c.note;
+  std::printf("exposure_scale: predicted held-out gain %.4f, z %.1f, %s\n", c.Gain(), c.z,
+              c.params.dump().c_str());
+  EXPECT_EQ(c.num_params, 6);  // 8 photos less one reference per lighting
+  EXPECT_GT(c.Gain(), 0.2);
+  for (const auto& [file, v] : c.params["scale"].items()) {
+    EXPECT_NEAR(v.get<double>(), file == "cam1_L1.exr" ? 0.8 : 1.0, 0.01) << file;
+  }
 }
 
 // RecordSubset: one record in `stride` with no pattern, or one region's records.
