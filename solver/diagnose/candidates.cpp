@@ -351,10 +351,24 @@ double MedianSim(const std::vector<PixelRecord>& records) {
 class ProfileFit {
  public:
   ProfileFit(const CandidateContext& cx, const ResidualFitter& f, int light)
-      : f_(f), num_regions_(int(cx.model.materials.size())), terms_(f.records().size()) {
+      : f_(f),
+        num_regions_(int(cx.model.materials.size())),
+        terms_(f.records().size()),
+        current_(f.records().size(), 1.0f) {
     const std::vector<PixelRecord>& recs = f.records();
+    // A spot with a cos^n profile already (a profile kept earlier, refitted): its direct term
+    // carries the current profile, which the new one replaces.
+    const Light& l = cx.model.lights[light];
+    const bool profiled =
+        l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
+    const Eigen::Vector3f axis0 = l.direction.normalized().cast<float>();
     for (size_t i = 0; i < terms_.size(); ++i) {
       terms_[i] = TermOf(cx.model, recs[i], light);
+      if (profiled && terms_[i].lit) {
+        current_[i] =
+            std::pow(std::max(0.0f, terms_[i].from_light.dot(axis0)), float(l.profile.cos_power));
+        if (!(current_[i] > 1e-3f)) terms_[i].lit = false;  // no light there to rescale
+      }
       lit_ += terms_[i].lit;
     }
     ref_ = MedianSim(recs);
@@ -380,7 +394,9 @@ class ProfileFit {
       if (!t.lit) return 0.0;
       if (&r != last) {
         last = &r;
-        change = std::pow(double(std::max(0.0f, t.from_light.dot(ax))), n) - 1;
+        change = std::pow(double(std::max(0.0f, t.from_light.dot(ax))), n) /
+                     double(current_[size_t(&r - base)]) -
+                 1;
       }
       return double(t.direct[c]) * change;
     };
@@ -405,6 +421,7 @@ class ProfileFit {
   const ResidualFitter& f_;
   int num_regions_;
   std::vector<LightTerm> terms_;
+  std::vector<float> current_;  // per record: the light's current relative intensity toward it
   int lit_ = 0;
   double ref_ = 1;
 };
@@ -470,6 +487,8 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     best = fit, best_axis = axis, best_n = n;
     return true;
   };
+  const bool refit = l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
+  if (refit) consider(l.direction.normalized(), l.profile.cos_power);
   for (const Eigen::Vector3d& axis : SphereDirections(64)) {
     for (double n : {1.0, 3.0}) consider(axis, n);
   }
@@ -505,6 +524,11 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
                 {"cos_power", n}};
+  if (refit) {
+    const Eigen::Vector3d a0 = l.direction.normalized();
+    out.params["refined_from"] = {{"direction", {a0.x(), a0.y(), a0.z()}},
+                                  {"cos_power", l.profile.cos_power}};
+  }
   out.where = {{"light", l.name}, {"frame", "angle from the light"}};
   out.num_params = 3;
   out.evidence = fmt::format(
@@ -512,6 +536,14 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
       "from ({:.2f}, {:.2f}, {:.2f}) are darker in the photos than the model, as cos^{:.2f} of "
       "that angle, whatever their distance, region or image position",
       l.name, best_axis.x(), best_axis.y(), best_axis.z(), n);
+  if (refit) {
+    const Eigen::Vector3d a0 = l.direction.normalized();
+    out.evidence += fmt::format(
+        " (its profile refitted: it was cos^{:.2f} about ({:.2f}, {:.2f}, {:.2f}), {:.1f} deg "
+        "from the new axis)",
+        l.profile.cos_power, a0.x(), a0.y(), a0.z(),
+        std::acos(std::clamp(a0.dot(best_axis), -1.0, 1.0)) * 180 / std::numbers::pi);
+  }
   out.valid = true;
   const std::string name = l.name;
   const Eigen::Vector3d axis = best_axis;
@@ -921,8 +953,11 @@ void FillScores(const ResidualFit& fit, CandidateResult* out) {
 
 std::string CandidateResult::Key() const {
   for (const char* k : {"region", "light", "camera"}) {
-    if (params.contains(k) && params[k].is_string())
-      return effect + ":" + params[k].get<std::string>();
+    if (params.contains(k) && params[k].is_string()) {
+      // A kept emission profile is refitted once (its own key).
+      const std::string refit = params.contains("refined_from") ? ":refit" : "";
+      return effect + ":" + params[k].get<std::string>() + refit;
+    }
   }
   return effect;
 }
@@ -964,6 +999,12 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
         light.type == LightType::kPoint || light.type == LightType::kSphere ||
         (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
     if (point_like && allowed("light_emission_profile:" + light.name))
+      add([&, l] { return EmissionProfile(cx, f, l, sub); });
+    // A profile kept in an earlier step (found while other effects were still unmodelled, or
+    // while the albedos were a compromise of the lightings) is refitted once.
+    const bool cos_spot =
+        light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kCosPower;
+    if (cos_spot && allowed("light_emission_profile:" + light.name + ":refit"))
       add([&, l] { return EmissionProfile(cx, f, l, sub); });
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
       add([&, l] { return LightIntensity(cx, f, l); });
