@@ -48,6 +48,20 @@ bool AloneInEveryPhoto(const Scene& model, int light) {
   return !model.photos.empty();
 }
 
+// Whether photo `photo`'s lighting has light `light`.
+bool LitBy(const Scene& model, int photo, int light) {
+  if (photo < 0 || photo >= int(model.photos.size())) return false;
+  const int g = model.photos[photo].lighting;
+  if (g < 0 || g >= int(model.lightings.size())) return false;
+  const std::vector<int>& ids = model.lightings[g].lights;
+  return std::find(ids.begin(), ids.end(), light) != ids.end();
+}
+
+// Whether `l` is a spot with a cos^n profile (an emission profile kept in an earlier step).
+bool CosProfiled(const Light& l) {
+  return l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
+}
+
 // The light that is alone in every photographed lighting, or -1.
 int LoneLight(const Scene& model) {
   for (int l = 0; l < int(model.lights.size()); ++l) {
@@ -107,7 +121,7 @@ CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& 
     }
     if (ids.size() >= 2) num_groups = int(ids.size());
   }
-  if (cx.materials_solved && num_groups >= 2) {
+  if (num_groups >= 2) {
     std::vector<int> is_ref(n, 0);
     for (int g = 0; g < num_groups; ++g) {
       std::vector<std::pair<double, int>> members;
@@ -359,8 +373,7 @@ class ProfileFit {
     // A spot with a cos^n profile already (a profile kept earlier, refitted): its direct term
     // carries the current profile, which the new one replaces.
     const Light& l = cx.model.lights[light];
-    const bool profiled =
-        l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
+    const bool profiled = CosProfiled(l);
     const Eigen::Vector3f axis0 = l.direction.normalized().cast<float>();
     for (size_t i = 0; i < terms_.size(); ++i) {
       terms_[i] = TermOf(cx.model, recs[i], light);
@@ -455,12 +468,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   std::vector<PixelRecord> own;
   bool others = false;
   for (const PixelRecord& r : pool) {
-    const int p = r.photo;
-    const int g = p >= 0 && p < int(cx.model.photos.size()) ? cx.model.photos[p].lighting : -1;
-    const bool in = g >= 0 && g < int(cx.model.lightings.size()) &&
-                    std::count(cx.model.lightings[g].lights.begin(),
-                               cx.model.lightings[g].lights.end(), light) > 0;
-    if (in) {
+    if (LitBy(cx.model, r.photo, light)) {
       own.push_back(r);
     } else {
       others = true;
@@ -487,8 +495,9 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     best = fit, best_axis = axis, best_n = n;
     return true;
   };
-  const bool refit = l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
-  if (refit) consider(l.direction.normalized(), l.profile.cos_power);
+  const bool refit = CosProfiled(l);
+  const Eigen::Vector3d axis0 = l.direction.normalized();  // the current profile's, if refit
+  if (refit) consider(axis0, l.profile.cos_power);
   for (const Eigen::Vector3d& axis : SphereDirections(64)) {
     for (double n : {1.0, 3.0}) consider(axis, n);
   }
@@ -525,8 +534,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
                 {"cos_power", n}};
   if (refit) {
-    const Eigen::Vector3d a0 = l.direction.normalized();
-    out.params["refined_from"] = {{"direction", {a0.x(), a0.y(), a0.z()}},
+    out.params["refined_from"] = {{"direction", {axis0.x(), axis0.y(), axis0.z()}},
                                   {"cos_power", l.profile.cos_power}};
   }
   out.where = {{"light", l.name}, {"frame", "angle from the light"}};
@@ -537,12 +545,11 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
       "that angle, whatever their distance, region or image position",
       l.name, best_axis.x(), best_axis.y(), best_axis.z(), n);
   if (refit) {
-    const Eigen::Vector3d a0 = l.direction.normalized();
     out.evidence += fmt::format(
         " (its profile refitted: it was cos^{:.2f} about ({:.2f}, {:.2f}, {:.2f}), {:.1f} deg "
         "from the new axis)",
-        l.profile.cos_power, a0.x(), a0.y(), a0.z(),
-        std::acos(std::clamp(a0.dot(best_axis), -1.0, 1.0)) * 180 / std::numbers::pi);
+        l.profile.cos_power, axis0.x(), axis0.y(), axis0.z(),
+        std::acos(std::clamp(axis0.dot(best_axis), -1.0, 1.0)) * 180 / std::numbers::pi);
   }
   out.valid = true;
   const std::string name = l.name;
@@ -1002,9 +1009,7 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
       add([&, l] { return EmissionProfile(cx, f, l, sub); });
     // A profile kept in an earlier step (found while other effects were still unmodelled, or
     // while the albedos were a compromise of the lightings) is refitted once.
-    const bool cos_spot =
-        light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kCosPower;
-    if (cos_spot && allowed("light_emission_profile:" + light.name + ":refit"))
+    if (CosProfiled(light) && allowed("light_emission_profile:" + light.name + ":refit"))
       add([&, l] { return EmissionProfile(cx, f, l, sub); });
     if (light.type != LightType::kAmbient && allowed("light_intensity:" + light.name)) {
       add([&, l] { return LightIntensity(cx, f, l); });
