@@ -1045,8 +1045,12 @@ std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& cx,
   ParallelFor(0, int64_t(tasks.size()), [&](int64_t i) {
     const auto start = std::chrono::steady_clock::now();
     results[size_t(i)] = tasks[size_t(i)].run();
-    spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s", results[size_t(i)].Key(),
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    const CandidateResult& c = results[size_t(i)];
+    spdlog::debug("igi-diagnose: candidate {} evaluated in {:.1f} s: {}", c.Key(),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                  c.valid ? fmt::format("predicted held-out gain {:.2f}%, z {:.1f}, {}",
+                                        100 * c.Gain(), c.z, c.params.dump())
+                          : "not valid" + (c.note.empty() ? std::string() : ": " + c.note));
   });
   std::vector<CandidateResult> out;
   for (size_t i = 0; i < tasks.size(); ++i) {
