@@ -275,21 +275,20 @@ Scene ShadowScene(double radius) {
   return s;
 }
 
-// Floor records seen from a camera above the blocker's side, the photo rendered with a sphere
-// lamp of `true_radius` (0: the declared point) with 1 % noise, the model with the point lamp.
-std::vector<PixelRecord> ShadowRecords(const Scene& model, double true_radius) {
-  const Scene truth = ShadowScene(true_radius);
+// Records of the floor points of an n × n grid over [-1.5, 1.5]² that `eye` sees, the photo
+// path-traced from `truth` (`photo_spp` paths, 1 % noise), the model from `model`.
+std::vector<PixelRecord> FloorGridRecords(const Scene& model, const Scene& truth,
+                                          const Vector3d& eye, int n, int photo_spp, int sim_spp) {
   const Renderer photo(truth, 0), sim(model, 0);
-  const Vector3d eye(0, -3, 3);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g(0, 1);
   std::vector<PixelRecord> out;
-  for (int j = 0; j < 60; ++j) {
-    for (int i = 0; i < 60; ++i) {
-      const Vector3d p(-1.5 + 3.0 * (i + 0.5) / 60, -1.5 + 3.0 * (j + 0.5) / 60, 0);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const Vector3d p(-1.5 + 3.0 * (i + 0.5) / n, -1.5 + 3.0 * (j + 0.5) / n, 0);
       const Vector3d dir = (p - eye).normalized();
       const std::optional<Hit> hit = sim.impl().Intersect(eye, dir);
-      if (!hit || std::abs(hit->t - (p - eye).norm()) > 1e-3) continue;  // behind the blocker
+      if (!hit || std::abs(hit->t - (p - eye).norm()) > 1e-3) continue;  // hidden from the eye
       PixelRecord r;
       r.x = 2 * i;
       r.y = 2 * j;
@@ -299,14 +298,21 @@ std::vector<PixelRecord> ShadowRecords(const Scene& model, double true_radius) {
       r.normal = Vector3f::UnitZ();
       r.view = (-dir).cast<float>();
       r.albedo = model.materials[0].rho_d->cast<float>();
-      const uint64_t seed = uint64_t(j * 60 + i);
-      r.recorded = photo.Radiance(eye, dir, true_radius > 0 ? 256 : 4, seed).cast<float>();
+      const uint64_t seed = uint64_t(j * n + i);
+      r.recorded = photo.Radiance(eye, dir, photo_spp, seed).cast<float>();
       r.recorded *= float(1 + 0.01 * g(rng));  // 1 % photo noise
-      r.sim = sim.Radiance(eye, dir, 4, seed + 7).cast<float>();
+      r.sim = sim.Radiance(eye, dir, sim_spp, seed + 7).cast<float>();
       out.push_back(r);
     }
   }
   return out;
+}
+
+// Floor records seen from a camera above the blocker's side, the photo rendered with a sphere
+// lamp of `true_radius` (0: the declared point) with 1 % noise, the model with the point lamp.
+std::vector<PixelRecord> ShadowRecords(const Scene& model, double true_radius) {
+  return FloorGridRecords(model, ShadowScene(true_radius), Vector3d(0, -3, 3), 60,
+                          true_radius > 0 ? 256 : 4, 4);
 }
 
 TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
@@ -422,31 +428,8 @@ TEST(LightSourceExtentTest, FindsTheSphereFromTheLightItHides) {
   const Scene model = CeilingScene(0);
   const Scene truth = CeilingScene(0.25);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
-  const Renderer photo(truth, 0), sim(model, 0);
-  const Vector3d eye(0, -1.9, 2.3);
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> g(0, 1);
-  std::vector<PixelRecord> records;
-  for (int j = 0; j < 40; ++j) {
-    for (int i = 0; i < 40; ++i) {
-      const Vector3d p(-1.5 + 3.0 * (i + 0.5) / 40, -1.5 + 3.0 * (j + 0.5) / 40, 0);
-      const Vector3d dir = (p - eye).normalized();
-      PixelRecord r;
-      r.x = 2 * i;
-      r.y = 2 * j;
-      r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(0, r.x, r.y);
-      r.region = 0;
-      r.position = p.cast<float>();
-      r.normal = Vector3f::UnitZ();
-      r.view = (-dir).cast<float>();
-      r.albedo = model.materials[0].rho_d->cast<float>();
-      const uint64_t seed = uint64_t(j * 40 + i);
-      r.recorded = photo.Radiance(eye, dir, 256, seed).cast<float>();
-      r.recorded *= float(1 + 0.01 * g(rng));
-      r.sim = sim.Radiance(eye, dir, 256, seed + 7).cast<float>();
-      records.push_back(r);
-    }
-  }
+  const std::vector<PixelRecord> records =
+      FloorGridRecords(model, truth, Vector3d(0, -1.9, 2.3), 40, 256, 256);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
   const CandidateResult c = LightSourceExtent({model, declared, false}, f, 0);
   ASSERT_TRUE(c.valid) << c.note;
