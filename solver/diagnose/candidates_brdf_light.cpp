@@ -489,8 +489,8 @@ class ExtentModel {
     const double cos_h = -hit->n_s.dot(w);
     if (!m.rho_d || !(t > 0) || !(cos_h > 0)) return;
     const Vector3d behind = m.rho_d->cwiseProduct(source_.intensity) * (kInvPi * cos_h / (t * t));
-    hidden_[i] = (r.albedo.cast<double>().cwiseProduct(behind) * (kInvPi * cos_p * Scale(r)))
-                     .cast<float>();
+    hidden_[i] =
+        (r.albedo.cast<double>().cwiseProduct(behind) * (kInvPi * cos_p * Scale(r))).cast<float>();
     hidden_distance_[i] = float(d);
   }
 

@@ -414,9 +414,10 @@ Scene CeilingScene(double radius) {
   s.mesh = TriangleMesh{};
   AddQuad(&s.mesh, {Vector3f(-2, -2, 0), Vector3f(2, -2, 0), Vector3f(2, 2, 0), Vector3f(-2, 2, 0)},
           0);
-  AddQuad(&s.mesh,
-          {Vector3f(-2, -2, 2.6f), Vector3f(-2, 2, 2.6f), Vector3f(2, 2, 2.6f), Vector3f(2, -2, 2.6f)},
-          1);
+  AddQuad(
+      &s.mesh,
+      {Vector3f(-2, -2, 2.6f), Vector3f(-2, 2, 2.6f), Vector3f(2, 2, 2.6f), Vector3f(2, -2, 2.6f)},
+      1);
   s.mesh.region_names = {"floor", "ceiling"};
   s.materials[1].name = "ceiling";
   s.materials[1].brdf = BrdfModel::kLambert;
