@@ -272,6 +272,9 @@ constexpr float kMinChange = 0.15f;
 constexpr int kMinBlockRecords = 4;     // in a 16-pixel block; in proportion to the block's area
 constexpr double kLargestRadius = 0.5;  // m: the largest sphere ExtentFit tries
 
+// 1 − cos θmax of a cone whose half-angle has sine² `sin2`, without cancellation.
+double OneMinusCosMax(double sin2) { return sin2 / (1 + std::sqrt(1 - sin2)); }
+
 // A light as a sphere of `intensity` (W/sr) at `center`.
 struct SphereSource {
   Vector3d center = Vector3d::Zero();
@@ -312,8 +315,8 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
     return EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) *
            (cos_center / (d * d));
   }
-  const double sin2 = radius * radius / (d * d), cos_max = std::sqrt(1 - sin2);
-  const double one_minus = sin2 / (1 + cos_max);  // 1 − cos θmax without cancellation
+  const double sin2 = radius * radius / (d * d);
+  const double one_minus = OneMinusCosMax(sin2);
   const Frame cone = Frame::FromNormal(w);
   const Vector3d radiance = s.intensity / (kPi * radius * radius);
   const Vector3d rho_pi = params.rho_d * kInvPi;
@@ -373,7 +376,10 @@ void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int s
 
 class ExtentModel {
  public:
-  ExtentModel(const CandidateContext& cx, const std::vector<PixelRecord>& records, int light)
+  // With `hidden`, also what Hidden needs (a shadow ray and a ray beyond the light per record);
+  // the callers that ask for the direct term only (the tail's edges, WhereLightSizeShows) skip it.
+  ExtentModel(const CandidateContext& cx, const std::vector<PixelRecord>& records, int light,
+              bool hidden = false)
       : cx_(cx),
         records_(records),
         impls_(cx.model.lightings.size()),
@@ -398,7 +404,7 @@ class ExtentModel {
         impls_[p.lighting] = BuildRenderScene(cx.model, p.lighting);
       }
     }
-    ParallelFor(0, int64_t(records.size()), [&](int64_t i) { Prepare(size_t(i)); });
+    ParallelFor(0, int64_t(records.size()), [&](int64_t i) { Prepare(size_t(i), hidden); });
   }
 
   double declared_radius() const { return declared_radius_; }
@@ -443,7 +449,7 @@ class ExtentModel {
     auto solid_angle = [](double r, double d) {
       if (!(r > 0) || !(d > 0)) return 0.0;
       const double sin2 = std::min(0.95, r * r / (d * d));
-      return 2 * kPi * sin2 / (1 + std::sqrt(1 - sin2));  // 2π(1 − cos θmax)
+      return 2 * kPi * OneMinusCosMax(sin2);
     };
     for (size_t i = 0; i < records_.size(); ++i) {
       const double d = hidden_distance_[i];
@@ -495,11 +501,11 @@ class ExtentModel {
   }
 
   // The record's footprint points and cone samples.
-  void Prepare(size_t i) {
+  void Prepare(size_t i, bool hidden) {
     const PixelRecord& r = records_[i];
     const Photo& photo = cx_.model.photos[r.photo];
     if (target_[photo.lighting] < 0 || r.region < 0) return;
-    PrepareHidden(i);
+    if (hidden) PrepareHidden(i);
     Pcg32 rng = PixelSampleRng(0x5eed, i, 0);
     const bool camera = photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size());
     for (int k = 0; k < kFootprint; ++k) {  // without a camera: the centre kFootprint times
@@ -542,7 +548,7 @@ class ExtentModel {
 class ExtentChange {
  public:
   ExtentChange(const CandidateContext& cx, const ResidualFitter& f, int light, int stride)
-      : cx_(cx), f_(f), model_(cx, f.records(), light), stride_(stride) {
+      : cx_(cx), f_(f), model_(cx, f.records(), light, true), stride_(stride) {
     d0_ = model_.Direct(model_.declared_radius(), &vis0_);
   }
   const ExtentModel& model() const { return model_; }
