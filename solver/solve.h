@@ -59,6 +59,11 @@ struct RegionSolution {
   // from its neighbours (seen by no photo, or outside the region's charts). One channel.
   std::optional<Image> albedo_map_seen;
   bool albedo_map_generated_uvs = false;
+  // With --albedo-maps auto, a region whose fit kept a constant albedo: its albedo's relative
+  // standard deviation from texel to texel beyond the photos' noise (two maps from disjoint
+  // halves of the photos, each less its local mean; NaN: not measured). Above 10 % the region
+  // gets a map anyway: a texture finer than the patches averages out in the fit's per-patch test.
+  double texel_variation = NAN;
   // The map's mean over its seen texels (equal areas: a texel is texel_size_m square on the
   // surface), NaN without a map (report.json's albedo_map.seen_mean). It is the region's final ρd
   // (final_params.rho_d, scene.json's rho_d; rho_d_from_map) where it is positive; stage1/stage2

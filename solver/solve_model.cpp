@@ -17,6 +17,12 @@
 namespace igi {
 namespace {
 
+// A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
+// texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.
+// 0.1: a constant sphere's smooth shading errors read 5 %, the demo's noise-textured box and
+// sphere (42 % standard deviation) 23-25 % (session 22).
+constexpr double kTexelTextureMin = 0.10;
+
 // The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
 TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases) {
   std::vector<const RegionAtlas*> of_region(mesh.region_names.size(), nullptr);
@@ -50,14 +56,17 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 // The albedo map of region r: π(L − ρs·T)/E accumulated per texel over every observation.
 // The specular term T of each observation is noisy (few incident samples carry the reflected
 // room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
+// With photo_parity 0 or 1, only the photos of even or odd index contribute.
 static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
                          const std::vector<Eigen::Vector3d>& obs_t,
-                         const std::vector<Eigen::Vector3d>& obs_e, Image* seen = nullptr) {
+                         const std::vector<Eigen::Vector3d>& obs_e, Image* seen = nullptr,
+                         int photo_parity = -1) {
   AlbedoMapBuilder builder(atlas);
   const MaterialState& m = s.materials[r];
   for (size_t i = 0; i < s.obs.size(); ++i) {
     const Observation& o = s.obs[i];
     if (o.region != r) continue;
+    if (photo_parity >= 0 && o.photo % 2 != photo_parity) continue;
     const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
     const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
     // Highlights tell little about the albedo and much about any error in the fitted lobe:
@@ -80,6 +89,93 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
   if (coverage != nullptr) *coverage = builder.Coverage();
   if (seen != nullptr) *seen = builder.DirectMask();
   return builder.Finish(m.params.rho_d);
+}
+
+namespace {
+
+// Two maps of one region from disjoint halves of the photos (even and odd index), and the texels
+// both estimate directly (indices y·width + x). Each half's noise is independent of the other's,
+// while both see the same texture and, nearly, the same errors of the gathered irradiance.
+struct MapHalves {
+  Image map[2], seen[2];
+  std::vector<int> both;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // per channel, over `both`, both halves
+};
+
+MapHalves HalvesOf(const SolverState& s, int r, const RegionAtlas& atlas,
+                   const std::vector<Eigen::Vector3d>& obs_t,
+                   const std::vector<Eigen::Vector3d>& obs_e) {
+  MapHalves h;
+  for (int k = 0; k < 2; ++k) {
+    h.map[k] = AlbedoMapOf(s, r, atlas, nullptr, obs_t, obs_e, &h.seen[k], k);
+  }
+  for (int y = 0; y < h.seen[0].height; ++y) {
+    for (int x = 0; x < h.seen[0].width; ++x) {
+      if (h.seen[0].at(x, y, 0) > 0.5f && h.seen[1].at(x, y, 0) > 0.5f) {
+        h.both.push_back(y * h.seen[0].width + x);
+      }
+    }
+  }
+  for (int i : h.both) {
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < 2; ++k) h.mean[c] += h.map[k].pixels[size_t(i) * 3 + c];
+    }
+  }
+  if (!h.both.empty()) h.mean /= 2.0 * double(h.both.size());
+  return h;
+}
+
+// Mean of `map`'s channel c over the texels of `mask` in the (2k+1)² window around (x, y).
+double LocalMean(const Image& map, const std::vector<char>& mask, int x, int y, int c, int k) {
+  double sum = 0;
+  int n = 0;
+  for (int yy = std::max(0, y - k); yy <= std::min(map.height - 1, y + k); ++yy) {
+    for (int xx = std::max(0, x - k); xx <= std::min(map.width - 1, x + k); ++xx) {
+      if (!mask[size_t(yy) * map.width + xx]) continue;
+      sum += map.at(xx, yy, c);
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : map.at(x, y, c);
+}
+
+constexpr int kLocalMeanHalfWidth = 3;  // 7×7 texels
+
+// The texture's variance at the texel scale, relative to the mean² and averaged over the
+// channels: the covariance of the two halves' deviations from their local means (over the shared
+// texels). Errors of the gathered irradiance are smooth (patch-sized) and cancel in the local
+// means; a texture finer than the patches does not. NaN when fewer than 64 texels are shared.
+double DetailVariance(const MapHalves& h) {
+  if (h.both.size() < 64 || !(h.mean.minCoeff() > 0)) return std::nan("");
+  const int w = h.map[0].width;
+  std::vector<char> in_both(size_t(w) * h.map[0].height, 0);
+  for (int i : h.both) in_both[i] = 1;
+  double variance = 0;
+  for (int c = 0; c < 3; ++c) {
+    double cov = 0;
+    for (int i : h.both) {
+      const int x = i % w, y = i / w;
+      double d[2];
+      for (int k = 0; k < 2; ++k) {
+        d[k] = h.map[k].at(x, y, c) - LocalMean(h.map[k], in_both, x, y, c, kLocalMeanHalfWidth);
+      }
+      cov += d[0] * d[1];
+    }
+    variance += cov / double(h.both.size()) / (h.mean[c] * h.mean[c]) / 3;
+  }
+  return variance;
+}
+
+}  // namespace
+
+// How much region r's albedo varies from texel to texel beyond the photos' noise: the relative
+// standard deviation of its texture's detail (DetailVariance), NaN when it cannot be told. A
+// texture finer than the patches averages out within each patch, where the fit's per-patch test
+// (AlbedoVaries in region_fit.cpp) cannot see it: the demo's glossy box (a noise texture, 42 %
+// standard deviation) kept a constant albedo +3.1 % off its area mean.
+static double TexelScaleVariation(const MapHalves& h) {
+  const double v = DetailVariance(h);
+  return std::isfinite(v) ? std::sqrt(std::max(0.0, v)) : v;
 }
 
 static RegionAtlas AtlasOf(const SolverState& s, int r) {
@@ -301,15 +397,26 @@ void SolverState::BuildAlbedoMaps() {
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
-    const bool want =
-        options.albedo_maps == "all" || (options.albedo_maps == "auto" && m.last_fit.albedo_varies);
     const std::vector<std::string>& only = options.albedo_map_regions;
-    if (!want || (!only.empty() &&
-                  std::find(only.begin(), only.end(), scene.materials[r].name) == only.end())) {
+    if (options.albedo_maps == "none" ||
+        (!only.empty() &&
+         std::find(only.begin(), only.end(), scene.materials[r].name) == only.end())) {
       continue;
     }
     const RegionAtlas atlas = AtlasOf(*this, int(r));
+    bool want = options.albedo_maps == "all" || m.last_fit.albedo_varies;
     RegionSolution& rs = summary.regions[r];
+    if (!want) {
+      rs.texel_variation = TexelScaleVariation(HalvesOf(*this, int(r), atlas, smooth_t, map_e));
+      want = rs.texel_variation > kTexelTextureMin;
+      if (want) {
+        spdlog::info(
+            "region {}: its albedo varies by {:.0f} % from texel to texel (finer than the "
+            "patches): given a map",
+            rs.name, 100 * rs.texel_variation);
+      }
+    }
+    if (!want) continue;
     Image seen;
     rs.albedo_map =
         AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);

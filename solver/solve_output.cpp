@@ -175,6 +175,15 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
            "(the albedo map scaled by the same factor, texels clipped at 1): the photos are "
            "brighter than the scene's lights can make any passive surface"}};
     }
+    if (std::isfinite(r.texel_variation)) {
+      rj["texel_variation"] = {
+          {"value", r.texel_variation},
+          {"mapped", !r.albedo_map_file.empty()},
+          {"meaning",
+           "the fit kept a constant albedo; the albedo's relative standard deviation from texel to "
+           "texel beyond the photos' noise (covariance of two maps from disjoint halves of the "
+           "photos, each less its local 7x7-texel mean); above 0.1 the region gets a map"}};
+    }
     if (!r.albedo_map_file.empty()) {
       rj["albedo_map"] = {{"file", r.albedo_map_file},
                           {"width", r.albedo_map ? r.albedo_map->width : 0},

@@ -49,18 +49,24 @@ using test::RunTool;
 // textured region's true ρd is its texture's mean over the surface the photos see (pipeline/demo.h
 // SeenTrueAlbedo), not over the whole texture: on the same solve that took wall_x4 from −7.7 % to
 // −5.1 % and the glossy objects from +3.2 / +4.9 % to +1.8 / +0.0 %; every other region within
-// 2.7 % (solve from every third pixel, as the demo now does: the same within 1.5 points). The
-// bounds guard those sizes (the solver issue's 1 %/5 % bars are not met end to end). Regions no
-// photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported
-// by igi-solve and not compared.
-constexpr double kRhoDTolerance = 0.08;  // region-mean albedo after k (seen part)
-// Specular reflectance after k (highlights only): the floor's faint lobe came out −6.3 % and
-// −10.1 % in two "reference" runs of the same capture (COLMAP's poses differ slightly run to run).
-constexpr double kRhoSTolerance = 0.20;
-constexpr double kAlphaTolerance = 0.20;  // lobe width (scale-free); the floor's up to +16.4 %
+// 2.7 % (solve from every third pixel, as the demo now does: the same within 1.5 points). Regions
+// no photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are
+// reported by igi-solve and not compared. Since 2026-11-26 (session 22; bench/RESULTS.md "End to
+// end", sessions 19 and 22), with every photo registered, the truth over the solved maps' seen
+// texels and the glossy box and sphere mapped (their texture is finer than the solver's patches):
+// ρd −0.6..+1.25 % (wall_y4 +1.1 and +1.25 %: half of wall_x4, unseen, is brighter than its seen
+// half), ρs −3.1..+0.2 % and −2.5..−0.5 %, α −0.7..+3.3 % and −0.7..+1.1 %, k 1.001 and 0.999. The
+// bounds keep about twice that: an error several times larger fails.
+constexpr double kRhoDTolerance = 0.03;  // region-mean albedo after k (seen part)
+// Specular reflectance after k and lobe width (scale-free): COLMAP's poses differ slightly run to
+// run, which moves the floor's narrow highlight by about a pixel between views (measured up to
+// +4.5 % on the floor's α with another solve of the same capture).
+constexpr double kRhoSTolerance = 0.08;
+constexpr double kAlphaTolerance = 0.08;
 // The ceiling, seen by the 2 cameras that look up (measured −0.9 % after k with "reference",
-// −1.0 % with "measured"; 40 % low when no photo saw it and it kept a placeholder).
-constexpr double kCeilingRhoDTolerance = 0.05;
+// −1.0 % with "measured", +0.0 % and +0.3 % in sessions 19 and 22; 40 % low when no photo saw it
+// and it kept a placeholder).
+constexpr double kCeilingRhoDTolerance = 0.03;
 // Registration against the true cameras: issue 6's bars, 0.1° and 0.5 % of the scene's size (the
 // room's 6.4 m diagonal: 32 mm; held here to 0.2 %, 12.8 mm). Measured with exact control points:
 // COLMAP's poses within 0.011° and 0.6 mm, the ceiling cameras within 1e-4°; with the demo's
@@ -117,15 +123,6 @@ TEST(RunDemoE2eTest, RecoversTruthResumesAndReportLoads) {
     auto check = [&](const char* key, double tol) {
       if (!region.contains(key)) return;
       if (status[name] == "no_highlight" && std::string(key) != "rho_d") return;
-      // wall_y4's highlight is shown only at the edge of the close-up cam3, which COLMAP does not
-      // register and the control points pose: measured rho_s +87..+102 %, alpha -26..-33 % with
-      // a small reported sigma (the solver's sigma understates a lobe seen at a photo's edge).
-      // Printed, not held to the bounds.
-      if (name == "wall_y4" && std::string(key) != "rho_d") {
-        std::printf("not compared: wall_y4 %s (%+.1f %%)\n", key,
-                    100 * region[key]["relative_error"].get<double>());
-        return;
-      }
       // A lobe the solver itself reports as undetermined (relative sigma over 10 %; measured:
       // wall_y4's highlight at a photo's edge, rho_s +102 %) is printed, not held to the bounds.
       const std::string sigma_key = std::string("sigma_") + key;

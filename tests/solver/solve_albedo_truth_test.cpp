@@ -7,6 +7,7 @@
 // albedo_map_seen), and over those away from unseen texels and the room's walls.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -131,6 +132,97 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
       EXPECT_LT(RelErr(r.stage1.rho_d[c], t["rho_d"][c].get<double>()), 0.01)
           << r.name << " rho_d[" << c << "]";
     }
+  }
+}
+
+// igi-synth's room under a point lamp (no validation lighting) as `so` sets it otherwise, solved
+// by the paper's method alone (no refinement round).
+struct SolvedRoom {
+  fs::path capture;
+  Scene scene;
+  SolveOptions options;
+  SolveSummary summary;
+};
+SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
+  SolvedRoom room;
+  so.out = room.capture = tmp / "capture";
+  so.lamp = "point";
+  so.validation_lightings = {};
+  Synthesize(so);
+  room.scene = LoadScene(so.out / "scene.json");
+  room.options.refine_iterations = 0;
+  room.options.show_progress = false;
+  room.summary = Solve(room.scene, room.options, tmp / "out");
+  return room;
+}
+
+// A texture finer than the solver's patches averages out within each patch, so the fit's
+// per-patch test keeps a constant albedo, and the region's constant ρd weights the texture by
+// where the samples crowd and by the irradiance: the demo's glossy box (igi-synth
+// --textured-walls, a noise texture of 42 % standard deviation) came out +3.1 % off its area
+// mean that way. With --albedo-maps auto such a region gets a map when two maps from disjoint
+// halves of the photos agree on a texel-to-texel variation above 10 % (solver/solve_model.cpp
+// TexelScaleVariation), and its ρd is the map's mean over the texels the photos show.
+TEST(SolveAlbedoTruth, AGlossyRegionsFineTextureGetsAMap) {
+  SynthOptions so;
+  so.textured_walls = true;
+  // The ceiling photographed (an unseen ceiling's placeholder albedo biases every region's
+  // bounced light by several per cent, which would hide what this test looks at).
+  so.cameras = 10;
+  so.ceiling_cameras = 2;
+  const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_fine_texture"), so);
+  const Scene& scene = room.scene;
+  const SolveSummary& s = room.summary;
+  const Json truth = ReadJsonFile(room.capture / "truth.json")["materials"];
+  const Json report = SolveReportJson(s, room.options);
+  for (const char* name : {"glossy_box", "glossy_sphere"}) {
+    const RegionSolution& r = s.regions[scene.FindMaterial(name)];
+    const Image texture = ReadImage(room.capture / truth[name]["rho_d_map"].get<std::string>(), 3);
+    ASSERT_TRUE(r.albedo_map.has_value()) << name << ": texel variation " << r.texel_variation;
+    ASSERT_TRUE(r.albedo_map_seen.has_value());
+    EXPECT_TRUE(r.rho_d_from_map) << name;
+    // The sphere's patches are too coarse for its texture: the texel test gives it its map (the
+    // box's per-patch test sees its texture in this capture).
+    if (std::string(name) == "glossy_sphere") {
+      ASSERT_FALSE(r.stage1.albedo_varies) << name << ": the per-patch test now sees the texture";
+      EXPECT_GT(r.texel_variation, 0.1) << name;
+    }
+    const Eigen::Vector3d want = TextureMeanOverSeenTexels(texture, *r.albedo_map_seen);
+    std::printf(
+        "%s: texel variation %.1f %%; rho_d from the map %+.2f %%, the constant fit's "
+        "%+.2f %% (against the true texture's mean over the map's seen texels)\n",
+        name, 100 * r.texel_variation, 100 * (r.final_params.rho_d.mean() / want.mean() - 1),
+        100 * (r.stage1.rho_d.mean() / want.mean() - 1));
+    // Measured (session 22): the box -0.59 % (its constant fit +0.37 %), the sphere -1.20 %
+    // (its constant fit +3.08 %); this small capture's walls and ceiling are off by up to 5 %
+    // themselves (160 x 120 photos), which the regions' bounced light inherits. The demo's
+    // (480 x 360): box -0.2 %, sphere -0.5 % (constant fits +3.1 %, +1.1 %).
+    EXPECT_LT(RelErr(r.final_params.rho_d.mean(), want.mean()), 0.02) << name;
+    if (std::string(name) != "glossy_sphere") continue;
+    EXPECT_LT(RelErr(r.final_params.rho_d.mean(), want.mean()),
+              RelErr(r.stage1.rho_d.mean(), want.mean()));
+    bool reported = false;
+    for (const Json& rj : report["regions"]) {
+      if (rj["name"] != name) continue;
+      reported = rj.contains("albedo_map") && rj.contains("texel_variation") &&
+                 rj["texel_variation"]["mapped"].get<bool>() &&
+                 rj["rho_d_source"] == "albedo_map_seen_mean";
+    }
+    EXPECT_TRUE(reported) << name << ": report.json's texel_variation and albedo_map";
+  }
+}
+
+// The same room with one albedo per region: the glossy regions' texel-to-texel variation stays
+// below the bar (their albedo constant, the photos' noise and the smooth errors of the gathered
+// irradiance left out by the split halves and the local means), and they get no map.
+TEST(SolveAlbedoTruth, ConstantGlossyRegionsGetNoMap) {
+  const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_no_fine_texture"), SynthOptions{});
+  for (const char* name : {"glossy_box", "glossy_sphere"}) {
+    const RegionSolution& r = room.summary.regions[room.scene.FindMaterial(name)];
+    std::printf("%s: texel variation %.1f %%\n", name, 100 * r.texel_variation);
+    ASSERT_TRUE(std::isfinite(r.texel_variation)) << name;
+    EXPECT_LT(r.texel_variation, 0.1) << name;
+    EXPECT_FALSE(r.albedo_map.has_value()) << name;
   }
 }
 
