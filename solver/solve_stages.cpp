@@ -656,13 +656,10 @@ void SolverState::UpdateIrradiance() {
 // observations' irradiance is linear in its ρd (per channel; through the patches' radiance, the
 // gather's weights and the smoothing, all linear). From the current ρ0 and one evaluation at ρ1
 // each observation's E = a + b·ρ. The evidence: the seen regions without a specular lobe (a
-// glossy region's reflection of the unseen one would also change with ρ), each with one albedo
-// (or its given one) even where the fit gives it one per patch: with a wrong ρ the bounced
-// light's pattern is what makes a plain wall look textured (igi-diagnose's solves, every pixel,
-// found every wall per-patch with the ceiling at 0.5). With each region's ρd profiled out (closed
-// form, ρd = πΣLE/ΣE²) and its own residual variance (a textured region's large residual makes it
-// count for little), −2 × the log-likelihood Σ_r n_r·log RSS_r(ρ) is a function of ρ alone,
-// scanned over [0.02, 0.98]: the spatial pattern of
+// glossy region's reflection of the unseen one would also change with ρ) and of one albedo
+// (a per-patch albedo takes any pattern), or of a given albedo. With each region's ρd profiled
+// out (closed form, ρd = πΣLE/ΣE²) and its own residual variance, −2 × the log-likelihood
+// Σ_r n_r·log RSS_r(ρ) is a function of ρ alone, scanned over [0.02, 0.98]: the spatial pattern of
 // a region's bounced light differs from its direct light's, which is what fixes ρ. The fit is
 // kept when its minimum lies inside the range and its uncertainty (from the curvature) is under
 // 10 % of the value in every channel; otherwise the region keeps its placeholder.
@@ -689,7 +686,9 @@ double SolverState::FitUnobservedAlbedos() {
       const MaterialState& m = materials[o.region];
       if (!m.reflective || m.observations == 0 || m.known_map) continue;
       if (HasSpecularLobe(m.params.model)) continue;
-      if (m.unknown_rho_d && !m.last_fit.fitted) continue;
+      if (m.unknown_rho_d && (!m.last_fit.fitted || m.last_fit.albedo_model == "per_patch")) {
+        continue;
+      }
       const Eigen::Vector3d radiance = o.radiance.cast<double>();
       if (!(radiance.sum() > 0)) continue;
       const Eigen::Vector3d l = kPi * radiance;
