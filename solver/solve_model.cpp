@@ -141,11 +141,17 @@ double LocalMean(const Image& map, const std::vector<char>& mask, int x, int y, 
 
 constexpr int kLocalMeanHalfWidth = 3;  // 7×7 texels
 
-// The texture's variance at the texel scale, relative to the mean² and averaged over the
-// channels: the covariance of the two halves' deviations from their local means (over the shared
-// texels). Errors of the gathered irradiance are smooth (patch-sized) and cancel in the local
-// means; a texture finer than the patches does not. NaN when fewer than 64 texels are shared.
-double DetailVariance(const MapHalves& h) {
+}  // namespace
+
+// How much region r's albedo varies from texel to texel beyond the photos' noise: the relative
+// standard deviation of its texture's detail, NaN when fewer than 64 texels are shared. The
+// detail's variance (relative to the mean², averaged over the channels) is the covariance of the
+// two halves' deviations from their local means over the shared texels: errors of the gathered
+// irradiance are smooth (patch-sized) and cancel in the local means; a texture finer than the
+// patches does not, and averages out within each patch, where the fit's per-patch test
+// (AlbedoVaries in region_fit.cpp) cannot see it: the demo's glossy box (a noise texture, 42 %
+// standard deviation) kept a constant albedo +3.1 % off its area mean.
+static double TexelScaleVariation(const MapHalves& h) {
   if (h.both.size() < 64 || !(h.mean.minCoeff() > 0)) return std::nan("");
   const int w = h.map[0].width;
   std::vector<char> in_both(size_t(w) * h.map[0].height, 0);
@@ -163,19 +169,7 @@ double DetailVariance(const MapHalves& h) {
     }
     variance += cov / double(h.both.size()) / (h.mean[c] * h.mean[c]) / 3;
   }
-  return variance;
-}
-
-}  // namespace
-
-// How much region r's albedo varies from texel to texel beyond the photos' noise: the relative
-// standard deviation of its texture's detail (DetailVariance), NaN when it cannot be told. A
-// texture finer than the patches averages out within each patch, where the fit's per-patch test
-// (AlbedoVaries in region_fit.cpp) cannot see it: the demo's glossy box (a noise texture, 42 %
-// standard deviation) kept a constant albedo +3.1 % off its area mean.
-static double TexelScaleVariation(const MapHalves& h) {
-  const double v = DetailVariance(h);
-  return std::isfinite(v) ? std::sqrt(std::max(0.0, v)) : v;
+  return std::sqrt(std::max(0.0, variance));
 }
 
 static RegionAtlas AtlasOf(const SolverState& s, int r) {
