@@ -20,7 +20,8 @@ namespace {
 // A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
 // texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.
 // 0.1: a constant sphere's smooth shading errors read 5 %, the demo's noise-textured box and
-// sphere (42 % standard deviation) 23-25 % (session 22).
+// sphere (42 % standard deviation) about 20 % (session 22); a constant sphere whose Ward fit has
+// the wrong lobe shape 5 % (10.8 % with the channels' relative variances averaged, session 23).
 constexpr double kTexelTextureMin = 0.10;
 
 // The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
@@ -145,8 +146,10 @@ constexpr int kLocalMeanHalfWidth = 3;  // 7×7 texels
 
 // How much region r's albedo varies from texel to texel beyond the photos' noise: the relative
 // standard deviation of its texture's detail, NaN when fewer than 64 texels are shared. The
-// detail's variance (relative to the mean², averaged over the channels) is the covariance of the
-// two halves' deviations from their local means over the shared texels: errors of the gathered
+// detail's variance is the covariance of the two halves' deviations from their local means over
+// the shared texels, summed over the channels and divided by the channels' summed mean² (an
+// albedo texture multiplies every channel alike, while a lobe's error is grey and would dominate
+// a dark channel's relative variance): errors of the gathered
 // irradiance are smooth (patch-sized) and cancel in the local means; a texture finer than the
 // patches does not, and averages out within each patch, where the fit's per-patch test
 // (AlbedoVaries in region_fit.cpp) cannot see it: the demo's glossy box (a noise texture, 42 %
@@ -156,7 +159,7 @@ static double TexelScaleVariation(const MapHalves& h) {
   const int w = h.map[0].width;
   std::vector<char> in_both(size_t(w) * h.map[0].height, 0);
   for (int i : h.both) in_both[i] = 1;
-  double variance = 0;
+  double covariance = 0;
   for (int c = 0; c < 3; ++c) {
     double cov = 0;
     for (int i : h.both) {
@@ -167,9 +170,9 @@ static double TexelScaleVariation(const MapHalves& h) {
       }
       cov += d[0] * d[1];
     }
-    variance += cov / double(h.both.size()) / (h.mean[c] * h.mean[c]) / 3;
+    covariance += cov / double(h.both.size());
   }
-  return std::sqrt(std::max(0.0, variance));
+  return std::sqrt(std::max(0.0, covariance / h.mean.squaredNorm()));
 }
 
 static RegionAtlas AtlasOf(const SolverState& s, int r) {
