@@ -522,7 +522,13 @@ void SolverState::AnalyseCoverage() {
 void SolverState::FinishRegions() {
   for (size_t r = 0; r < materials.size(); ++r) {
     RegionSolution& rs = summary.regions[r];
-    if (rs.status == "unobserved") {
+    if (rs.status == "unobserved" && materials[r].bounce_fit_sigma.allFinite()) {
+      // Its ρd fitted to the light it bounces onto the seen regions (FitUnobservedAlbedos); its
+      // lobe cannot be known: no gloss.
+      rs.rho_d_from_bounced_light = true;
+      rs.bounce_fit_sigma = materials[r].bounce_fit_sigma;
+      if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
+    } else if (rs.status == "unobserved") {
       // Placeholders so that the scene renders: the observed regions' mean albedo, no gloss.
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       int n = 0;

@@ -36,6 +36,9 @@ struct MaterialState {
   // from its independent refit: the joint update, or a partial step).
   Eigen::Vector3d map_scale = Eigen::Vector3d::Ones();
   int observations = 0;
+  // A region no photo sees whose ρd was fitted to the light it bounces onto the seen regions
+  // (SolverState::FitUnobservedAlbedos): its relative uncertainty per channel (NaN: not fitted).
+  Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
   bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
 };
 
@@ -171,6 +174,12 @@ struct SolverState {
   JointUpdate JointParams(const std::vector<int>& regions,
                           const std::vector<RegionFitResult>& fits) const;
   void RunStage1();
+  // Every active lighting's patch radiances, the observations' indirect irradiance and its
+  // smoothing from the current materials (obs_e).
+  void UpdateIrradiance();
+  // The ρd of regions no photo sees, from the light they bounce onto the regions the photos show
+  // (stage 1, from its second iteration): returns the largest relative change.
+  double FitUnobservedAlbedos();
   // One refinement round: the model as it stands (its albedo maps written under temp_dir),
   // rendered incident light, smoothing, FitAll(2, round), specular terms.
   void RefineRound(int round, const std::filesystem::path& temp_dir);

@@ -164,7 +164,18 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     // scene.json's rho_d and where it comes from: the albedo map's mean over its seen texels
     // where the region has a map, else the fit's region mean (after the bound at 1).
     rj["rho_d"] = Vec(r.final_params.rho_d);
-    rj["rho_d_source"] = r.rho_d_from_map ? "albedo_map_seen_mean" : "fit";
+    rj["rho_d_source"] = r.rho_d_from_map             ? "albedo_map_seen_mean"
+                         : r.rho_d_from_bounced_light ? "bounced_light"
+                         : r.status == "unobserved"   ? "placeholder"
+                                                      : "fit";
+    if (r.rho_d_from_bounced_light) {
+      rj["bounced_light_fit"] = {
+          {"relative_sigma", Vec(r.bounce_fit_sigma)},
+          {"meaning",
+           "no photo sees this region: its rho_d is fitted to the light it bounces onto the "
+           "regions the photos show (their one-albedo regions' residuals, each region's albedo "
+           "profiled out); relative_sigma from the cost's curvature"}};
+    }
     if (r.Bounded()) {
       rj["bounded"] = {
           {"rho_d_fitted", Vec(r.rho_d_fitted)},

@@ -644,16 +644,126 @@ double SolverState::FitAll(int stage, int iteration) {
   return change;
 }
 
+void SolverState::UpdateIrradiance() {
+  for (LightingState& st : lighting_state) {
+    if (st.active) UpdatePatchRadiance(&st);
+  }
+  IncidentFromPatches();
+  SmoothIrradiance();
+}
+
+// A region that no photo sees still lights the ones they show: its patches send ρd·E/π, and the
+// observations' irradiance is linear in its ρd (per channel; through the patches' radiance, the
+// gather's weights and the smoothing, all linear). From the current ρ0 and one evaluation at ρ1
+// each observation's E = a + b·ρ. The evidence: the seen regions without a specular lobe (a
+// glossy region's reflection of the unseen one would also change with ρ), each with one albedo
+// (or its given one) even where the fit gives it one per patch: with a wrong ρ the bounced
+// light's pattern is what makes a plain wall look textured (igi-diagnose's solves, every pixel,
+// found every wall per-patch with the ceiling at 0.5). With each region's ρd profiled out (closed
+// form, ρd = πΣLE/ΣE²) and its own residual variance (a textured region's large residual makes it
+// count for little), −2 × the log-likelihood Σ_r n_r·log RSS_r(ρ) is a function of ρ alone,
+// scanned over [0.02, 0.98]: the spatial pattern of
+// a region's bounced light differs from its direct light's, which is what fixes ρ. The fit is
+// kept when its minimum lies inside the range and its uncertainty (from the curvature) is under
+// 10 % of the value in every channel; otherwise the region keeps its placeholder.
+double SolverState::FitUnobservedAlbedos() {
+  double largest = 0;
+  for (size_t u = 0; u < materials.size(); ++u) {
+    MaterialState& mu = materials[u];
+    if (!mu.reflective || !mu.unknown_rho_d || mu.observations > 0) continue;
+    const Eigen::Vector3d rho0 = mu.params.rho_d;
+    const std::vector<Eigen::Vector3d> e0 = obs_e;
+    const Eigen::Vector3d rho1 =
+        (rho0.array() < 0.5).select(rho0.array() + 0.3, rho0.array() - 0.3);
+    mu.params.rho_d = rho1;
+    UpdateIrradiance();
+    const std::vector<Eigen::Vector3d> e1 = obs_e;
+    // Evidence: per region, the sums of its observations' L² , L·a, L·b, a², a·b, b².
+    struct Sums {
+      Eigen::Vector3d ll = Eigen::Vector3d::Zero(), la = ll, lb = ll, aa = ll, ab = ll, bb = ll;
+      int n = 0;
+    };
+    std::vector<Sums> sums(materials.size());
+    for (size_t i = 0; i < obs.size(); ++i) {
+      const Observation& o = obs[i];
+      const MaterialState& m = materials[o.region];
+      if (!m.reflective || m.observations == 0 || m.known_map) continue;
+      if (HasSpecularLobe(m.params.model)) continue;
+      if (m.unknown_rho_d && !m.last_fit.fitted) continue;
+      const Eigen::Vector3d radiance = o.radiance.cast<double>();
+      if (!(radiance.sum() > 0)) continue;
+      const Eigen::Vector3d l = kPi * radiance;
+      const Eigen::Vector3d b = (e1[i] - e0[i]).cwiseQuotient(rho1 - rho0);
+      const Eigen::Vector3d a = e0[i] - b.cwiseProduct(rho0);
+      if (!l.allFinite() || !a.allFinite() || !b.allFinite()) continue;
+      // A region whose ρd is given: its residual l − ρd·E is linear in ρ, ρd folded in.
+      const Eigen::Vector3d k = m.unknown_rho_d ? Eigen::Vector3d::Ones() : m.params.rho_d;
+      Sums& s = sums[o.region];
+      s.ll += l.cwiseProduct(l);
+      s.la += l.cwiseProduct(k.cwiseProduct(a));
+      s.lb += l.cwiseProduct(k.cwiseProduct(b));
+      s.aa += (k.cwiseProduct(a)).cwiseProduct(k.cwiseProduct(a));
+      s.ab += (k.cwiseProduct(a)).cwiseProduct(k.cwiseProduct(b));
+      s.bb += (k.cwiseProduct(b)).cwiseProduct(k.cwiseProduct(b));
+      ++s.n;
+    }
+    int n = 0, regions = 0;
+    for (size_t r = 0; r < sums.size(); ++r) {
+      n += sums[r].n;
+      regions += sums[r].n > 0 && materials[r].unknown_rho_d;
+    }
+    // −2 × the profile log-likelihood, each region with its own residual variance: regions whose
+    // model fits worse (an unmodelled texture) count for less.
+    auto cost = [&](int c, double rho) {
+      double total = 0;
+      for (size_t r = 0; r < sums.size(); ++r) {
+        const Sums& s = sums[r];
+        if (s.n == 0) continue;
+        const double le = s.la[c] + rho * s.lb[c];
+        const double ee = s.aa[c] + 2 * rho * s.ab[c] + rho * rho * s.bb[c];
+        const double rss = materials[r].unknown_rho_d ? (ee > 0 ? s.ll[c] - le * le / ee : s.ll[c])
+                                                      : s.ll[c] - 2 * le + ee;
+        total += s.n * std::log(std::max(rss, 1e-12 * s.ll[c]));
+      }
+      return total;
+    };
+    Eigen::Vector3d fitted = rho0, sigma = Eigen::Vector3d::Constant(NAN);
+    bool ok = n > 50 * (regions + 1);
+    for (int c = 0; c < 3 && n > 0; ++c) {
+      constexpr double lo = 0.02, hi = 0.98, step = 0.001;
+      double best = lo, best_cost = cost(c, lo);
+      for (double rho = lo + step; rho <= hi + 1e-9; rho += step) {
+        const double v = cost(c, rho);
+        if (v < best_cost) best = rho, best_cost = v;
+      }
+      const double h = 0.01;
+      const double curvature = (cost(c, best + h) - 2 * best_cost + cost(c, best - h)) / (h * h);
+      sigma[c] = curvature > 0 ? std::sqrt(2 / curvature) / best : NAN;
+      ok = ok && best > lo + step && best < hi - step && std::isfinite(sigma[c]) && sigma[c] < 0.1;
+      fitted[c] = best;
+    }
+    mu.params.rho_d = ok ? fitted : rho0;
+    mu.bounce_fit_sigma = ok ? sigma : Eigen::Vector3d::Constant(NAN);
+    spdlog::info(
+        "region {} (no photo sees it): rho_d from the light it bounces {:.3f} {:.3f} {:.3f} "
+        "(relative sigma {:.3f} {:.3f} {:.3f}){}",
+        scene.materials[u].name, fitted[0], fitted[1], fitted[2], sigma[0], sigma[1], sigma[2],
+        ok ? "" : ": not determined, kept");
+    for (int c = 0; c < 3; ++c) {
+      largest = std::max(largest, RelChange(mu.params.rho_d[c], rho0[c], 0.05));
+    }
+    UpdateIrradiance();
+  }
+  return largest;
+}
+
 void SolverState::RunStage1() {
   obs_t.assign(obs.size(), Eigen::Vector3d::Zero());
   summary.converged = false;
   for (int it = 1; it <= options.max_iterations; ++it) {
-    for (LightingState& st : lighting_state) {
-      if (st.active) UpdatePatchRadiance(&st);
-    }
-    IncidentFromPatches();
-    SmoothIrradiance();
-    const double change = FitAll(1, it);
+    UpdateIrradiance();
+    const double unobserved_change = it > 1 ? FitUnobservedAlbedos() : 0.0;
+    const double change = std::max(FitAll(1, it), unobserved_change);
     ComputeSpecularTerms();
     summary.stage1_iterations = it;
     if (it > 1 && change < options.tolerance) {

@@ -89,9 +89,12 @@ int main(int argc, char** argv) {
     std::vector<std::string> failed;
     for (const igi::RegionSolution& r : summary.regions) {
       if (r.status == "unobserved") {
-        failed.push_back(igi::DescribeProblem(scene.file.string(), "materials." + r.name,
-                                              "unknown values",
-                                              "no photo sees the region: placeholders written"));
+        failed.push_back(igi::DescribeProblem(
+            scene.file.string(), "materials." + r.name, "unknown values",
+            r.rho_d_from_bounced_light
+                ? "no photo sees the region: rho_d fitted to the light it bounces onto the seen "
+                  "regions (report.json bounced_light_fit), no gloss"
+                : "no photo sees the region: placeholders written"));
       }
     }
     if (!common.quiet) {

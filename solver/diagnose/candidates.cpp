@@ -902,6 +902,11 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
       // better a reference than the current model.)
       const double gain = fit.Gain();
       const double beyond = std::min(same.held_after, fit.held_before) - fit.held_after;
+      spdlog::debug(
+          "igi-diagnose: {} on {}: held-out {:.5g} -> {:.5g} (alternative, amplitude {:.3f}), "
+          "{:.5g} (same lobe re-fitted, alpha {:.3f}, amplitude {:.3f})",
+          out.effect, m.name, fit.held_before, fit.held_after, fit.coef[0], same.held_after, a,
+          same.coef[0]);
       if (!(beyond > 0)) {
         out.note = fmt::format(
             "region {}: the {} lobe explains no more than the {} lobe with its rho_s and alpha "
