@@ -525,7 +525,6 @@ void SolverState::FinishRegions() {
     if (rs.status == "unobserved" && materials[r].bounce_fit_sigma.allFinite()) {
       // Its ρd fitted to the light it bounces onto the seen regions (FitUnobservedAlbedos); its
       // lobe cannot be known: no gloss.
-      rs.rho_d_from_bounced_light = true;
       rs.bounce_fit_sigma = materials[r].bounce_fit_sigma;
       if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
     } else if (rs.status == "unobserved") {

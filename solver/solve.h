@@ -72,9 +72,9 @@ struct RegionSolution {
   Eigen::Vector3d albedo_map_seen_mean = Eigen::Vector3d::Constant(NAN);
   bool rho_d_from_map = false;
   // An unobserved region whose ρd was fitted to the light it bounces onto the regions the photos
-  // show (stage 1), with its relative uncertainty per channel; otherwise its ρd is a placeholder.
-  bool rho_d_from_bounced_light = false;
+  // show (stage 1): its relative uncertainty per channel; NaN where its ρd is a placeholder.
   Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
+  bool RhoDFromBouncedLight() const { return bounce_fit_sigma.allFinite(); }
   // A reflectance is at most 1 (scene.json's rule). When a fit comes out above it (photos brighter
   // than any passive surface under the declared lights: a light too weak, an exposure_scale too
   // low, light the scene leaves out), the written model holds it at 1 and these say what the fit

@@ -164,11 +164,11 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     // scene.json's rho_d and where it comes from: the albedo map's mean over its seen texels
     // where the region has a map, else the fit's region mean (after the bound at 1).
     rj["rho_d"] = Vec(r.final_params.rho_d);
-    rj["rho_d_source"] = r.rho_d_from_map             ? "albedo_map_seen_mean"
-                         : r.rho_d_from_bounced_light ? "bounced_light"
-                         : r.status == "unobserved"   ? "placeholder"
-                                                      : "fit";
-    if (r.rho_d_from_bounced_light) {
+    rj["rho_d_source"] = r.rho_d_from_map           ? "albedo_map_seen_mean"
+                         : r.RhoDFromBouncedLight() ? "bounced_light"
+                         : r.status == "unobserved" ? "placeholder"
+                                                    : "fit";
+    if (r.RhoDFromBouncedLight()) {
       rj["bounced_light_fit"] = {
           {"relative_sigma", Vec(r.bounce_fit_sigma)},
           {"meaning",

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
       if (r.status == "unobserved") {
         failed.push_back(igi::DescribeProblem(
             scene.file.string(), "materials." + r.name, "unknown values",
-            r.rho_d_from_bounced_light
+            r.RhoDFromBouncedLight()
                 ? "no photo sees the region: rho_d fitted to the light it bounces onto the seen "
                   "regions (report.json bounced_light_fit), no gloss"
                 : "no photo sees the region: placeholders written"));

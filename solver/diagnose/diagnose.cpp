@@ -435,8 +435,8 @@ CandidateResult TextureFirst(const Scene& declared, const ModelState& st, double
     if (!e.textured) continue;
     regions.push_back(e.region);
     shown += fmt::format("{}{} (rank correlation {:.2f}, {:.0f}% of {} cells, {:.0f}%)",
-                         shown.empty() ? "" : ", ", e.region, e.rank_correlation,
-                         100 * e.agreement, e.cells, 100 * e.amplitude);
+                         shown.empty() ? "" : ", ", e.region, e.rank_correlation, 100 * e.agreement,
+                         e.cells, 100 * e.amplitude);
   }
   c.valid = !regions.empty();
   c.params = {{"regions", regions}};
@@ -728,8 +728,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     std::sort(ranked.begin(), ranked.end(), [](const CandidateResult* a, const CandidateResult* b) {
       return a->Gain() > b->Gain();
     });
-    // The two best predictions are both refitted and the better kept; a third is tried only
-    // when neither passes.
+    // The two best predictions are both refitted and the better kept; further ones are tried
+    // only while none passes (up to max_tries).
     std::vector<Trial> trials;
     for (size_t k = 0; k < ranked.size() && int(k) < o.max_tries; ++k) {
       trials.push_back(try_step(*ranked[k], maps));

@@ -274,7 +274,7 @@ TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
   const Json truth = ReadJsonFile(room.capture / "truth.json")["materials"];
   const RegionSolution& ceiling = room.summary.regions[room.scene.FindMaterial("ceiling")];
   ASSERT_EQ(ceiling.status, "unobserved");
-  ASSERT_TRUE(ceiling.rho_d_from_bounced_light);
+  ASSERT_TRUE(ceiling.RhoDFromBouncedLight());
   const Eigen::Vector3d want(truth["ceiling"]["rho_d"][0].get<double>(),
                              truth["ceiling"]["rho_d"][1].get<double>(),
                              truth["ceiling"]["rho_d"][2].get<double>());
