@@ -4,7 +4,8 @@
 //   PROBE_REFINE=N (refinement rounds, default 1), PROBE_BOUNCE=0/1 (specular_bounces),
 //   PROBE_STEP=S (refine_albedo_step), PROBE_UPDATE=joint|independent (refine_update),
 //   PROBE_RAYS=N (refine_rays), PROBE_SEED=N (the solver's seed),
-//   PROBE_REUSE=1 (render OUT_DIR/scene.json without solving again)
+//   PROBE_REUSE=1 (render OUT_DIR/scene.json without solving again), PROBE_TEXEL=M (texel_size_m),
+//   PROBE_STRIDE=N (pixel_stride)
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
   if (const char* e = std::getenv("PROBE_UPDATE")) o.refine_update = e;
   if (const char* e = std::getenv("PROBE_RAYS")) o.refine_rays = std::atoi(e);
   if (const char* e = std::getenv("PROBE_SEED")) o.seed = std::strtoull(e, nullptr, 10);
+  if (const char* e = std::getenv("PROBE_TEXEL")) o.texel_size_m = std::atof(e);
+  if (const char* e = std::getenv("PROBE_STRIDE")) o.pixel_stride = std::atoi(e);
   const bool reuse = std::getenv("PROBE_REUSE") != nullptr && fs::exists(out / "scene.json");
   if (!reuse) {
     const SolveSummary s = Solve(scene, o, out);
