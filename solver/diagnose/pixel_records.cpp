@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 
+#include "solver/gather.h"
 #include "solver/observations.h"
 #include "solver/render.h"
 #include "solver/render_internal.h"
@@ -284,6 +285,31 @@ void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceH
   }
 }
 
+// The room's light reflected onto a glossy record (PixelRecord::room).
+void GatherRoom(const Renderer& renderer, const ShadingMaterial& m, const SurfaceHit& hit,
+                uint64_t seed, Pcg32& rng, PixelRecord* r) {
+  GatherQuery q;
+  q.position = hit.position;
+  q.n_geo = hit.n_geo;
+  q.n_s = hit.n_s;
+  q.view = r->view.cast<double>();
+  q.lobe = true;
+  const double alpha = std::clamp(std::max(m.params.AlphaX(), m.params.AlphaY()), 0.02, 0.5);
+  const double eps = renderer.impl().ray_epsilon;
+  int k = 0;
+  for (const WeightedDirection& d :
+       HemisphereDirections(q, PixelRecord::kRoomSamples, 2 * alpha, rng)) {
+    const Eigen::Vector3d li =
+        renderer.ReflectedRadiance(hit.position + hit.n_geo * eps, d.wi, 1, seed * 64 + k++);
+    if (!li.allFinite() || !(li.maxCoeff() > 0)) continue;
+    RecordLightSample rs;
+    rs.wi = d.wi.cast<float>();
+    rs.irradiance = (li * d.weight).cast<float>();
+    rs.distance = 1e30f;
+    r->room.push_back(rs);
+  }
+}
+
 }  // namespace
 
 std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
@@ -291,6 +317,17 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
                                       const DiagnoseOptions& options,
                                       const std::vector<Image>* variance) {
   const auto scenes = LightingScenes(model);
+  // The room's reflection needs the model's radiance: one renderer per photographed lighting,
+  // built only when some reflective region has a specular lobe.
+  bool glossy = false;
+  for (const Material& m : model.materials) glossy |= HasSpecularLobe(m.brdf);
+  std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
+  if (glossy) {
+    for (const Photo& p : model.photos) {
+      if (!renderers[p.lighting])
+        renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+    }
+  }
   const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
                              options.solve.holdout_seed};
   std::vector<std::vector<PixelRecord>> rows;
@@ -353,6 +390,14 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
             r.sim_gradient(c, 1) = gy / 6;
           }
           GatherLights(model, impl, *hit, options.light_samples, rng, &r);
+          const ShadingMaterial& sm = impl.materials[hit->region];
+          if (renderers[p.lighting] && HasSpecularLobe(sm.model)) {
+            // Its own random stream: the lights' samples stay those of a scene without lobes.
+            const uint64_t stream = uint64_t(k) * 65537 + uint64_t(x);
+            Pcg32 room_rng = PixelSampleRng(options.seed + 29, stream, 1);
+            GatherRoom(*renderers[p.lighting], sm, *hit, options.seed * 1000003 + stream, room_rng,
+                       &r);
+          }
           rows[k].push_back(std::move(r));
         }
       },

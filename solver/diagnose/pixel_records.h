@@ -44,6 +44,13 @@ struct PixelRecord {
   // channel: d sim / dx, d sim / dy.
   Eigen::Matrix<float, 3, 2> sim_gradient = Eigen::Matrix<float, 3, 2>::Zero();
   std::vector<RecordLightSample> lights;  // direct light at the point
+  // On a region with a specular lobe: the light the rest of the scene reflects onto the point,
+  // as kRoomSamples directions about the view's mirror (a mixture of cosine and Ward lobes of the
+  // region's roughness, each weighted by its density: RecordLightSample::irradiance is the model's
+  // reflected radiance along it times cos/(pdf·n), light = -1). A lobe's reflection of the room
+  // is Σ lobe·irradiance over them, as its reflection of the lights is over `lights`.
+  std::vector<RecordLightSample> room;
+  static constexpr int kRoomSamples = 16;
 };
 
 // Recorded photos of a scene (loaded once) and their valid-pixel masks.
