@@ -233,7 +233,15 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
   if (n == 0) return none;
   const int light =
       sampled_lights_[n == 1 ? 0 : std::min(static_cast<int>(rng.UniformDouble() * n), n - 1)];
-  const LightSample ls = impl_.SampleLight(light, p, LightNumbers(impl_.lights[light].type, rng));
+  // A light that rays can hit (sphere, area) is sampled from the point the shadow ray and the
+  // BSDF-sampled ray leave, so that its solid angle is the same for both techniques: a sphere
+  // seen from p and from p + ε·n differs in a thin band at its rim that only the BSDF could
+  // reach, with MIS weight 1 there (fireflies of the light's full radiance). Delta lights keep
+  // the shading point itself (exact falloff).
+  const Eigen::Vector3d origin = p + n_geo * impl_.ray_epsilon;
+  const LightType type = impl_.lights[light].type;
+  const bool hittable = type == LightType::kSphere || type == LightType::kArea;
+  const LightSample ls = impl_.SampleLight(light, hittable ? origin : p, LightNumbers(type, rng));
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return none;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
   if (!(wi_local.z() > 0)) return none;
@@ -246,7 +254,7 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
                               ? ls.distance - std::max(4 * eps, 1e-6 * ls.distance)
                               : ls.distance;
   ++s->rays;
-  if (impl_.Occluded(p + n_geo * eps, ls.wi, distance, light)) return none;
+  if (impl_.Occluded(origin, ls.wi, distance, light)) return none;
   const double light_pdf = light_select_pdf_ * ls.pdf;
   const double w = ls.delta ? 1.0 : PowerHeuristic(1, light_pdf, 1, fe.pdf);
   const Eigen::Vector3d term =
@@ -351,14 +359,14 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
       derivative->PushVertex(ts.material, BrdfShares(params, wo_local, bs.wi, bs.f));
     s.from_camera = false;
     s.bsdf_pdf = bs.pdf;
-    s.last_point = p;
+    s.last_point = p + n_geo * impl_.ray_epsilon;  // where the next ray leaves (MIS pdfs)
     if (bounce + 1 >= options_.max_bounces) break;
     if (bounce + 1 >= options_.rr_start_bounce) {
       const double q = std::min(0.95, s.throughput.maxCoeff());
       if (!(rng.UniformDouble() < q)) break;
       s.throughput /= q;
     }
-    origin = p + n_geo * impl_.ray_epsilon;
+    origin = s.last_point;
     dir = wi;
   }
   *rays += s.rays;

@@ -3,7 +3,7 @@
 // (relative errors, %), and each albedo map's PSNR against the true texture over all texels and
 // over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), rays,
 // step, bounce (0/1), smooth (m), acc (smoothing_accuracy), joint (0/1/2: independent, joint,
-// joint_albedo), dump;
+// joint_albedo), refine_rays (stage 2's path-traced directions per observation), seed, dump;
 // spp is not a key (the capture's). For issue 7's experiments; not a test.
 #include <algorithm>
 #include <chrono>
@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
       o.held_out_albedo = v != 0;
     else if (key == "rays")
       o.indirect_rays = int(v);
+    else if (key == "refine_rays")
+      o.refine_rays = int(v);
+    else if (key == "seed")
+      o.seed = uint64_t(v);
     else if (key == "dump")
       dump = v != 0;
     else if (key == "step")

@@ -2,7 +2,7 @@
 // photos"): where a region's stage-1 albedo bias comes from, against the true scene.
 //   build/bench/ceiling_probe CAPTURE [region=ceiling] [stride=2] [every=4] [ref_rays=1024]
 //       [paths=8] [pixel_paths=256] [spec_rays=32] [smooth=0] [patch=0] [bounce=1]
-//       [stage2=0] [seed2=1]
+//       [stage2=0] [seed2=1] [round=1]
 // Runs stage 1 on an igi-synth capture (2 threads; smooth, patch: SolveOptions' smoothing radius
 // and patch size, 0 = auto; bounce: SolveOptions::specular_bounces) and, for every `every`-th
 // observation of `region`, compares:
@@ -17,8 +17,10 @@
 //      and the irradiance at the centres of the unseen patches the rays meet against a reference;
 //  (d) the photo's pixel against ρd_true·E_ref/π at the pixel centre's point and against a
 //      `pixel_paths`-path render of the true scene through the pixel centre;
-//  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2)
-//      over the true scene and over the stage-1 model, against the same reference.
+//  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2,
+//      refinement round `round`) over the true scene and over the stage-1 model, against the same
+//      reference, with the five observations whose gathered E_ind is the largest multiple of
+//      their reference (a firefly shows as one far above the rest).
 // Prints the ratios and the albedo πΣL/ΣE with each irradiance.
 #include <fmt/format.h>
 #include <unistd.h>
@@ -70,7 +72,8 @@ int main(int argc, char** argv) {
   std::map<std::string, std::string> kv = {
       {"region", "ceiling"}, {"stride", "2"},        {"every", "4"},  {"ref_rays", "1024"},
       {"paths", "8"},        {"pixel_paths", "256"}, {"smooth", "0"}, {"patch", "0"},
-      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"}, {"seed2", "1"}};
+      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"}, {"seed2", "1"},
+      {"round", "1"}};
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     const size_t eq = a.find('=');
@@ -256,11 +259,19 @@ int main(int argc, char** argv) {
     s.options.refine_rays = std::stoi(kv["stage2"]);
     s.options.seed = std::stoull(kv["seed2"]);
     for (int variant = 0; variant < 2; ++variant) {
-      s.IncidentFromRenderer(variant == 0 ? truth_scene : model, 1);
+      s.IncidentFromRenderer(variant == 0 ? truth_scene : model, std::stoull(kv["round"]));
       Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
       for (size_t k = 0; k < rows.size(); ++k) {
         sum += s.obs_e_indirect[subset[k]];
         ref_sum += rows[k].e_ind_ref;
+      }
+      {
+        std::vector<std::pair<double, size_t>> r;
+        for (size_t k = 0; k < rows.size(); ++k)
+          r.emplace_back(s.obs_e_indirect[subset[k]].sum() / rows[k].e_ind_ref.sum(), k);
+        std::sort(r.rbegin(), r.rend());
+        for (int j = 0; j < 5 && j < int(r.size()); ++j)
+          std::printf("  top ratio %.3f obs %d\n", r[j].first, subset[r[j].second]);
       }
       std::printf("stage 2's E_ind over the %s / reference (true scene): %.4f\n",
                   variant == 0 ? "true scene" : "stage-1 model", sum.sum() / ref_sum.sum());

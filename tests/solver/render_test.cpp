@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
+#include "solver/render_internal.h"
 #include "tests/solver/test_scenes.h"
 
 namespace igi {
@@ -101,6 +103,42 @@ TEST(RenderTest, SphereLightIrradianceMatchesClosedForm) {
   // Cone sampling varies little over this sphere: 20000 paths give ~0.05 % noise. 0.3 %
   // catches a shadow ray clipping the light's own sphere (that bias was 1.3 %).
   EXPECT_NEAR(CentreRadiance(scene, 20000).x(), expected, 0.003 * expected);
+}
+
+// A small sphere light close to the floor, at 45°: the next ray leaves from the hit point
+// offset by the ray epsilon along the normal, and light sampling must see the sphere from that
+// same point. Seen from the unshifted point, a band at the sphere's rim (here ~7 % of its
+// cone: the offset's sideways part over the radius) is reachable by BSDF sampling only; its
+// MIS weight is then 1 and the path carries the light's full radiance, thousands of times the
+// mean (the fireflies that moved igi-solve's refined albedos by several per cent).
+TEST(RenderTest, SphereLightRimHasNoFireflies) {
+  const auto dir = TempSceneDir("sphere_rim");
+  WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
+  Json light{{"type", "sphere"}, {"center", {0, 0, 1}}, {"radius", 1}, {"radiance", 100}};
+  const double eps = BuildRenderScene(LoadTestScene(dir, FloorScene(light)), 0)->ray_epsilon;
+  const double r = 10 * eps, d = 40 * r, s = std::sqrt(0.5);
+  light["center"] = {d * s, 0.0, d * s};
+  light["radius"] = r;
+  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  ASSERT_NEAR(BuildRenderScene(scene, 0)->ray_epsilon, eps, 1e-12);
+  const Renderer renderer(scene, 0);
+  const Eigen::Vector3d origin = scene.cameras[0].CenterInWorld();
+  const int n = 100000;
+  double sum = 0, peak = 0;
+  for (int k = 0; k < n; ++k) {
+    const double l = renderer.ReflectedRadiance(origin, Eigen::Vector3d(0, 0, -1), 1, k).x();
+    sum += l;
+    peak = std::max(peak, l);
+  }
+  const double mean = sum / n;
+  // E = pi L (r/d)^2 cos(45°) (the sphere wholly above the horizon), L_floor = 0.5 E / pi.
+  const double expected = 0.5 * 100 * (1.0 / 1600) * s;
+  std::printf("rim: mean %.6g (closed form %.6g), largest path %.3g x the mean\n", mean, expected,
+              peak / mean);
+  // Measured: every path within 1.02x of the mean (light sampling of a small sphere is nearly
+  // constant); before the fix, paths at 2100x the mean, and the mean +6.8 %.
+  EXPECT_LT(peak, 5 * mean);
+  EXPECT_NEAR(mean, expected, 0.005 * expected);
 }
 
 TEST(RenderTest, AreaLightIrradianceMatchesClosedForm) {
