@@ -38,6 +38,8 @@ void SolveOptions::Validate() const {
         std::to_string(refine_iterations), "must be in [0, 20]");
   check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),
         "must be in [1, 4096]");
+  check(refine_final_rays >= 1 && refine_final_rays <= 4096, "--refine-final-rays",
+        std::to_string(refine_final_rays), "must be in [1, 4096]");
   check(refine_albedo_step > 0 && refine_albedo_step <= 1, "--refine-albedo-step",
         std::to_string(refine_albedo_step), "must be in (0, 1]");
   check(

@@ -62,6 +62,10 @@ struct SolveOptions {
   // tracer and refit all parameters, `refine_iterations` times (0 = off).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
+  // The same in the last round, whose gather sets the written values: their Monte Carlo noise
+  // is this round's (igi-synth's 1024-spp room, 2 rounds of 32: wall_x0's written ρd −1.2,
+  // −0.7 and −0.2 % for solver seeds 1–3; last round 128: +0.0..+0.3 %; bench/RESULTS.md).
+  int refine_final_rays = 128;
   // How each refinement round updates the albedos. The rounds gather all indirect light from
   // the model, so its albedos feed back on themselves: a too bright model darkens the next fit.
   // "independent": each region's albedo is refitted alone as πL/E with E rendered at the current

@@ -257,6 +257,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                   {"albedo_maps", o.albedo_maps},
                   {"refine_iterations", o.refine_iterations},
                   {"refine_rays", o.refine_rays},
+                  {"refine_final_rays", o.refine_final_rays},
                   {"seed", o.seed},
                   {"refine_albedo_step", o.refine_albedo_step},
                   {"refine_update", o.refine_update},

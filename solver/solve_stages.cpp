@@ -179,7 +179,9 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           int k = 0;
           // Glossy observations that the fits use get four times the rays: noise in the
           // specular term T would bias ρs low (regression dilution).
-          const int n = options.refine_rays * (glossy && in_fit[i] ? 4 : 1);
+          const int base = int(round) >= options.refine_iterations ? options.refine_final_rays
+                                                                   : options.refine_rays;
+          const int n = base * (glossy && in_fit[i] ? 4 : 1);
           for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
             const Eigen::Vector3d origin = q.position + q.n_geo * eps;
             const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);

@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--refine-rays", o.refine_rays, "path-traced directions per observation")
       ->capture_default_str();
+  app.add_option("--refine-final-rays", o.refine_final_rays,
+                 "path-traced directions per observation in the last refinement round")
+      ->capture_default_str();
   app.add_option("--refine-update", o.refine_update,
                  "stage 2's update: independent (each region refitted with the light the "
                  "current model sends), joint (every region's albedo and ρs at once, with the "
