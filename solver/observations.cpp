@@ -1,6 +1,7 @@
 #include "solver/observations.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <mutex>
 
@@ -67,8 +68,7 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
                                              PhotoObservationStats* stats) {
   const Photo& photo = scene.photos[photo_index];
   const Camera& camera = scene.cameras[photo.camera];
-  const double saturation =
-      options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
+  const double saturation = options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
   const Eigen::Vector3d center = camera.CenterInWorld();
   const int stride = options.pixel_stride;
   const int rows = (camera.height + stride - 1) / stride;
@@ -111,12 +111,14 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
           }
           // The pixel's footprint must lie on one smooth piece of one region.
           bool clean = true;
+          std::array<Eigen::Vector3d, 4> corner_normal;
           for (int k = 0; k < 4 && clean; ++k) {
             const double ox = (k & 1) ? 0.75 : 0.25, oy = (k & 2) ? 0.75 : 0.25;
             const Eigen::Vector3d d = camera.WorldRayFromImg(Eigen::Vector2d(x + ox, yy + oy));
             const std::optional<SurfaceHit> h = TraceSurface(geometry, center, d);
             clean = h && h->region == hit->region && h->n_s.dot(hit->n_s) > cos_edge &&
                     std::abs(hit->n_geo.dot(h->position - hit->position)) < 0.01 * hit->t;
+            if (clean) corner_normal[k] = h->n_s;
           }
           if (!clean) {
             ++st.edge;
@@ -135,6 +137,19 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
           o.normal = hit->n_s.cast<float>();
           o.view = (-dir).cast<float>();
           o.radiance = value;
+          {
+            // The normal's change across the pixel in x and in y (the quarter-pixel samples are
+            // half a pixel apart, two pairs each), tangential part; a box of width w has
+            // variance w²/12 along it.
+            const Eigen::Vector3d n = hit->n_s;
+            Eigen::Vector3d a =
+                corner_normal[1] + corner_normal[3] - corner_normal[0] - corner_normal[2];
+            Eigen::Vector3d b =
+                corner_normal[2] + corner_normal[3] - corner_normal[0] - corner_normal[1];
+            a -= n * n.dot(a);
+            b -= n * n.dot(b);
+            o.lobe_blur2 = float((a.squaredNorm() + b.squaredNorm()) / 12.0);
+          }
           per_row[r].push_back(o);
           ++st.valid;
         }

@@ -19,16 +19,21 @@
 namespace igi {
 
 struct Observation {
-  int photo = -1;      // index into Scene::photos
-  int x = 0, y = 0;    // pixel (column, row), row 0 at the top
-  int triangle = -1;   // index into Scene::mesh.triangles
+  int photo = -1;        // index into Scene::photos
+  int x = 0, y = 0;      // pixel (column, row), row 0 at the top
+  int triangle = -1;     // index into Scene::mesh.triangles
   float b1 = 0, b2 = 0;  // barycentrics of the triangle's vertices 1 and 2 at the hit
-  int region = -1;     // index into Scene::materials
-  int patch = -1;      // index into the solver's PatchSet (solver/patches.h)
+  int region = -1;       // index into Scene::materials
+  int patch = -1;        // index into the solver's PatchSet (solver/patches.h)
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  // hit point, world
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();   // shading normal, on the viewer's side
   Eigen::Vector3f view = Eigen::Vector3f::UnitZ();     // unit, from the surface toward the camera
   Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // the photo's pixel, linear RGB
+  // The spread of the shading normal over the pixel's footprint: the trace of its covariance
+  // (radians², linear change over the pixel, box-averaged). A pixel records a lobe convolved
+  // with that spread; for Ward's near-Gaussian lobe that is α² + lobe_blur2 (the normal
+  // filtering of specular antialiasing). Zero on flat surfaces.
+  float lobe_blur2 = 0;
 };
 
 struct PatchSet;
@@ -41,13 +46,13 @@ struct ObservationOptions {
 
 // What became of a photo's pixels.
 struct PhotoObservationStats {
-  int pixels = 0;      // looked at (after the stride)
-  int valid = 0;       // kept as observations
-  int masked = 0;      // mask = 0
-  int clipped = 0;     // a channel at or above the saturation value
-  int invalid = 0;     // a channel non-finite or negative
-  int background = 0;  // sees no reflective surface (nothing, a light, an emitter or black)
-  int edge = 0;        // footprint straddles regions, creases or depth steps
+  int pixels = 0;         // looked at (after the stride)
+  int valid = 0;          // kept as observations
+  int masked = 0;         // mask = 0
+  int clipped = 0;        // a channel at or above the saturation value
+  int invalid = 0;        // a channel non-finite or negative
+  int background = 0;     // sees no reflective surface (nothing, a light, an emitter or black)
+  int edge = 0;           // footprint straddles regions, creases or depth steps
   double saturation = 0;  // the clipping value used (infinity: none)
 };
 

@@ -90,6 +90,7 @@ class LobeTable {
       const FitSample& s = in.samples[i];
       starts_.push_back(start);
       begin_.push_back(static_cast<int>(qx_.size()));
+      blur2_.push_back(std::max(0.0, s.lobe_blur2));
       const Eigen::Vector3d wo = s.wo.cast<double>();
       row.clear();
       for (int k = s.incident_begin; k < s.incident_end; ++k) {
@@ -132,7 +133,9 @@ class LobeTable {
     using std::exp;
     Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
     if (row < 0) return sum;
-    const T ix = T(1.0) / (ax * ax), iy = T(1.0) / (ay * ay);
+    using std::sqrt;
+    const T ax2 = ax * ax + T(blur2_[row]), ay2 = ay * ay + T(blur2_[row]);
+    const T ix = T(1.0) / ax2, iy = T(1.0) / ay2;
     const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
     for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
       if (imin * double(qs_[k]) >= kMaxExponent) break;
@@ -140,7 +143,7 @@ class LobeTable {
       const T f = exp(-(T(double(qx_[k])) * ix + T(double(qy_[k])) * iy));
       sum[0] += f * double(gr_[k]), sum[1] += f * double(gg_[k]), sum[2] += f * double(gb_[k]);
     }
-    return sum / (ax * ay);
+    return sum / sqrt(ax2 * ay2);
   }
 
   // T_c(α) for every sample of `in` (its rows from Rows(in)), less the held-out albedo's own lobe
@@ -150,14 +153,16 @@ class LobeTable {
                                      double ax, double ay) const {
     std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
     if (!HasSpecularLobe(model_)) return t;
-    const float ix = float(1.0 / (ax * ax)), iy = float(1.0 / (ay * ay));
-    const float cut = float(kMaxExponent / std::min(1.0 / (ax * ax), 1.0 / (ay * ay)));
-    const double scale = 1.0 / (ax * ay);
     std::vector<float> f;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       if (rows[i] >= 0) {
+        // The row's lobe: α² widened by its pixel's spread of normals.
+        const double ax2 = ax * ax + blur2_[rows[i]], ay2 = ay * ay + blur2_[rows[i]];
+        const float ix = float(1.0 / ax2), iy = float(1.0 / ay2);
+        const float cut = float(kMaxExponent * std::max(ax2, ay2));
+        const double scale = 1.0 / std::sqrt(ax2 * ay2);
         const int b = begin_[rows[i]];
         const int e =
             int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[rows[i] + 1], cut) -
@@ -196,8 +201,9 @@ class LobeTable {
     return sum;
   }
   BrdfModel model_;
-  std::vector<int> starts_;  // each row's incident_begin, ascending
-  std::vector<int> begin_;   // each row's first entry (+1: the end)
+  std::vector<int> starts_;    // each row's incident_begin, ascending
+  std::vector<int> begin_;     // each row's first entry (+1: the end)
+  std::vector<double> blur2_;  // each row's addition to α² (FitSample::lobe_blur2)
   // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v.
   std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
 };

@@ -42,7 +42,10 @@ struct FitSample {
   Eigen::Vector3d rho_d_held = Eigen::Vector3d::Constant(NAN);
   Eigen::Vector3d held_lobe = Eigen::Vector3d::Constant(NAN);
   Eigen::Vector3f wo = Eigen::Vector3f::UnitZ();  // local, toward the camera
-  int incident_begin = 0, incident_end = 0;       // into RegionFitInput::incident
+  // Added to α² (αx², αy²) in this sample's lobe: its pixel's spread of normals
+  // (Observation::lobe_blur2).
+  double lobe_blur2 = 0;
+  int incident_begin = 0, incident_end = 0;  // into RegionFitInput::incident
 };
 
 // What a region's fit knows and decides, apart from its samples.

@@ -211,6 +211,9 @@ void SolverState::CollectAllObservations() {
     std::vector<Observation> o = CollectObservations(scene, int(i), photo_images[i], mask,
                                                      *lighting_scenes[scene.photos[i].lighting],
                                                      patches, oo, &summary.photos[i]);
+    if (!options.pixel_footprint) {
+      for (Observation& ob : o) ob.lobe_blur2 = 0;
+    }
     const PhotoObservationStats& st = summary.photos[i];
     if (o.empty()) {
       problems.Add(scene.file.string(), "photos[" + std::to_string(i) + "]",

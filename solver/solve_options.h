@@ -29,7 +29,10 @@ struct SolveOptions {
   bool specular_bounces = true;
   // Sample each observation's direct light over its pixel's footprint on the surface (a pixel
   // records the mean over it; solver/gather.h GatherQuery::Footprint), with footprint_samples
-  // points per delta light. Off (--pixel-footprint false): at the centre ray's point only.
+  // points per delta light, and widen each observation's lobe by the spread of the normals over
+  // that footprint (Observation::lobe_blur2: α² + the spread; on igi-synth's 0.35 m sphere seen
+  // at 3–4 cm per pixel the fit otherwise takes α +4 % and ρd −1.5 %, bench/RESULTS.md). Off
+  // (--pixel-footprint false): at the centre ray's point only, with the centre's normal.
   bool pixel_footprint = true;
   int footprint_samples = 4;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same

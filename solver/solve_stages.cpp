@@ -160,9 +160,10 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           const bool summed = sums != nullptr && in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
           // The lobe's weight of an incident direction (ComputeSpecularTerms' T = Σ S·W·v).
+          const double ax = std::sqrt(m.params.AlphaX() * m.params.AlphaX() + o.lobe_blur2);
+          const double ay = std::sqrt(m.params.AlphaY() * m.params.AlphaY() + o.lobe_blur2);
           auto lobe_weight = [&](const Eigen::Vector3d& wi_local) {
-            const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
-                                            m.params.ior, wo, wi_local);
+            const double w = SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, wi_local);
             return w > 0 ? w : 0.0;
           };
           Eigen::Vector3d t = Eigen::Vector3d::Zero();
@@ -301,9 +302,12 @@ void SolverState::ComputeSpecularTerms() {
         if (HasSpecularLobe(m.params.model)) {
           const Eigen::Vector3d wo = LocalFrame(obs[i].region, obs[i].normal.cast<double>())
                                          .ToLocal(obs[i].view.cast<double>());
+          const double b2 = obs[i].lobe_blur2;
+          const double ax = std::sqrt(m.params.AlphaX() * m.params.AlphaX() + b2);
+          const double ay = std::sqrt(m.params.AlphaY() * m.params.AlphaY() + b2);
           for (const IncidentLocal& inc : obs_incident[i]) {
-            const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
-                                            m.params.ior, wo, inc.wi.cast<double>());
+            const double w =
+                SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.wi.cast<double>());
             if (w > 0) t += w * inc.value.cast<double>();
           }
         }
@@ -526,6 +530,7 @@ double SolverState::FitAll(int stage, int iteration) {
     s.held_lobe = obs_held_lobe[i];
     s.wo =
         LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+    s.lobe_blur2 = o.lobe_blur2;
     s.incident_begin = static_cast<int>(in.incident.size());
     in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
     s.incident_end = static_cast<int>(in.incident.size());

@@ -68,8 +68,9 @@ int main(int argc, char** argv) {
                  "share of each refinement round's albedo change applied (1 = full step)")
       ->capture_default_str();
   app.add_option("--pixel-footprint", o.pixel_footprint,
-                 "sample each observation's direct light over the surface its pixel covers (true) "
-                 "or at its centre ray's point only (false)")
+                 "sample each observation's direct light over the surface its pixel covers and "
+                 "widen its lobe by the normals' spread there (true), or use its centre ray's "
+                 "point and normal only (false)")
       ->capture_default_str();
   app.add_option("--specular-bounces", o.specular_bounces,
                  "gathering follows glossy surfaces' reflection of the room (true) or takes only "

@@ -3,11 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "solver/brdf.h"
+#include "solver/observations.h"
 #include "solver/patches.h"
 #include "solver/region_fit.h"
+#include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "tests/solver/test_scenes.h"
+#include "tools/common/image.h"
 
 namespace igi {
 namespace {
@@ -20,6 +26,79 @@ TriangleMesh OneTriangle() {
   m.triangle_region = {0};
   m.region_names = {"r"};
   return m;
+}
+
+// A UV sphere of radius r centred at (0, 0, r) with its vertex normals (smooth shading).
+std::string SphereObj(double r, int rings, int segments) {
+  std::string s = "usemtl ball\n";
+  for (int i = 0; i <= rings; ++i) {
+    const double th = kPi * i / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double ph = 2 * kPi * j / segments;
+      const Eigen::Vector3d n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph),
+                              std::cos(th));
+      s += "v " + std::to_string(r * n.x()) + " " + std::to_string(r * n.y()) + " " +
+           std::to_string(r + r * n.z()) + "\n";
+      s += "vn " + std::to_string(n.x()) + " " + std::to_string(n.y()) + " " +
+           std::to_string(n.z()) + "\n";
+    }
+  }
+  auto id = [&](int i, int j) { return std::to_string(i * segments + (j % segments) + 1); };
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const std::string a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      s += "f " + a + "//" + a + " " + b + "//" + b + " " + c + "//" + c + "\n";
+      s += "f " + a + "//" + a + " " + c + "//" + c + " " + d + "//" + d + "\n";
+    }
+  }
+  return s;
+}
+
+// Observation::lobe_blur2, the spread of the shading normal over a pixel's footprint: on a
+// sphere of radius R seen face-on from distance D through a focal length of f pixels, a pixel
+// spans D/f of surface and the normal turns by D/(f·R) along each image axis: spread
+// 2·(D/(f·R))²/12. Zero on a flat floor.
+TEST(Observations, APixelsSpreadOfNormalsFollowsTheSurfacesCurvature) {
+  const auto dir = test::TempSceneDir("obs_blur");
+  test::WriteText(dir / "ball.obj", SphereObj(0.5, 96, 192));
+  test::WriteText(dir / "floor.obj", test::SquareObj("floor", 3.0));
+  const double f = 100;  // pixels; the camera 4 m above the floor, 3 m above the ball's top
+  const Json doc{
+      {"format", "igi-scene"},
+      {"version", 1},
+      {"geometry", {{{"file", "ball.obj"}}, {{"file", "floor.obj"}}}},
+      {"materials",
+       {{"ball", {{"brdf", "ward"}, {"rho_d", 0.5}, {"rho_s", 0.05}, {"alpha", 0.1}}},
+        {"floor", {{"brdf", "lambert"}, {"rho_d", 0.5}}}}},
+      {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 3}}, {"intensity", 10}}}}},
+      {"lightings", {{"L", {"l"}}}},
+      {"cameras", {{"top", test::DownCamera(0, 0, 4, 81, 81, f)}}},
+      {"photos", {{{"file", "top.exr"}, {"camera", "top"}, {"lighting", "L"}}}}};
+  const Image radiance(81, 81, 3, 0.5f);
+  WriteImage(dir / "top.exr", radiance);
+  const Scene scene = test::LoadTestScene(dir, doc);
+  const auto impl = BuildRenderScene(scene, 0);
+  const PatchSet patches = BuildPatches(scene.mesh, 0.1);
+  ObservationOptions oo;
+  oo.pixel_stride = 1;
+  oo.saturation = 100;  // a constant image would read as clipped
+  const std::vector<Observation> obs =
+      CollectObservations(scene, 0, radiance, nullptr, *impl, patches, oo, nullptr);
+  const double step = 3.0 / (f * 0.5);  // the normal's turn across one pixel at the top
+  bool top = false, floor = false;
+  for (const Observation& o : obs) {
+    if (o.x == 40 && o.y == 40) {  // the ball's top
+      top = true;
+      std::printf("top: lobe_blur2 %.4g, expected %.4g\n", o.lobe_blur2, step * step / 6);
+      EXPECT_NEAR(o.lobe_blur2, step * step / 6, 0.05 * step * step / 6);
+    }
+    if (o.x == 2 && o.y == 2) {  // the floor
+      floor = true;
+      EXPECT_EQ(o.lobe_blur2, 0.0f);
+    }
+  }
+  EXPECT_TRUE(top);
+  EXPECT_TRUE(floor);
 }
 
 TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
@@ -55,7 +134,7 @@ TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
 // a few random incident directions, with L generated from the model.
 RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& slot_rho_d,
                            double rho_s, double alpha, double noise, uint64_t seed,
-                           double alpha_y = 0) {
+                           double alpha_y = 0, double max_blur2 = 0) {
   if (alpha_y <= 0) alpha_y = alpha;
   RegionFitInput in;
   in.name = "test";
@@ -77,12 +156,16 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
     Eigen::Vector3d wo = (mirror + Eigen::Vector3d(jitter.x(), jitter.y(), 0)).normalized();
     if (wo.z() < 0.05) wo = Eigen::Vector3d(wo.x(), wo.y(), 0.05).normalized();
     s.wo = wo.cast<float>();
+    // A pixel whose footprint spans a spread of normals sees the lobe widened (α² + spread).
+    if (max_blur2 > 0) s.lobe_blur2 = max_blur2 * rng.UniformDouble();
+    const double ax = std::sqrt(alpha * alpha + s.lobe_blur2);
+    const double ay = std::sqrt(alpha_y * alpha_y + s.lobe_blur2);
     s.incident_begin = static_cast<int>(in.incident.size());
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), spec = Eigen::Vector3d::Zero();
     auto add = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& value) {
       in.incident.push_back({wi.cast<float>(), value.cast<float>()});
       e += value;
-      spec += SpecularWeight(model, alpha, alpha_y, 1.5, wo, wi) * value;
+      spec += SpecularWeight(model, ax, ay, 1.5, wo, wi) * value;
     };
     for (int k = 0; k < 4; ++k) {  // an extended light: four directions close together
       const Eigen::Vector3d wi =
@@ -99,7 +182,8 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
         slot_rho_d[s.slot].cwiseProduct(e) / kPi + truth.rho_s.cwiseProduct(spec);
     // Shot-like noise: standard deviation noise·√(L·0.3), i.e. `noise` relative at L = 0.3.
     for (int c = 0; c < 3; ++c) {
-      s.observed[c] = l[c] + noise * std::sqrt(l[c] * 0.3) * (2 * rng.UniformDouble() - 1) * std::sqrt(3.0);
+      s.observed[c] =
+          l[c] + noise * std::sqrt(l[c] * 0.3) * (2 * rng.UniformDouble() - 1) * std::sqrt(3.0);
     }
     in.samples.push_back(s);
   }
@@ -118,6 +202,24 @@ TEST(RegionFit, RecoversWardParametersExactlyFromNoiseFreeSamples) {
     EXPECT_NEAR(r.alpha, 0.08, 1e-4 * 0.08);
     EXPECT_LT(r.relative_rms, 1e-5);
   }
+}
+
+// Samples whose pixels span normals up to 0.1 rad apart (lobe_blur2 up to 0.008, as on a 0.35 m
+// sphere seen at 3–4 cm per pixel): the fit recovers the surface's own α with each sample's
+// lobe widened by its spread; taken as sharp samples (spread ignored), the lobe comes out wider.
+TEST(RegionFit, APixelsSpreadOfNormalsWidensItsLobeNotTheSurfaces) {
+  const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
+  RegionFitInput in = MakeSamples(BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.0, 1, 0, 0.008);
+  const RegionFitResult r = FitRegion(in, {});
+  ASSERT_TRUE(r.fitted);
+  EXPECT_NEAR(r.alpha, 0.08, 1e-4 * 0.08);
+  EXPECT_NEAR(r.rho_s.mean(), 0.06, 1e-4 * 0.06);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.rho_d[c], rho_d[c], 1e-4 * rho_d[c]);
+  for (FitSample& s : in.samples) s.lobe_blur2 = 0;
+  const RegionFitResult ignored = FitRegion(in, {});
+  std::printf("alpha 0.08: fitted %.5f with each pixel's spread, %.5f without\n", r.alpha,
+              ignored.alpha);
+  EXPECT_GT(ignored.alpha, 1.05 * 0.08);
 }
 
 TEST(RegionFit, RecoversAnisotropicRoughnessAlongTheTangentAndAcrossIt) {
@@ -142,7 +244,8 @@ TEST(RegionFit, NoisySamplesStayWithinTheirStatedUncertainty) {
   EXPECT_LT(std::abs(r.alpha - 0.08), 4 * r.sigma_alpha);
   EXPECT_LT(r.sigma_rho_s, 0.05 * 0.06);
   EXPECT_LT(r.sigma_alpha, 0.05 * 0.08);
-  for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(r.rho_d[c] - rho_d[c]), 4 * r.sigma_rho_d[c] + 1e-4);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_LT(std::abs(r.rho_d[c] - rho_d[c]), 4 * r.sigma_rho_d[c] + 1e-4);
 }
 
 TEST(RegionFit, VaryingAlbedoIsFittedPerPatchAndKeepsTheLobe) {
@@ -162,7 +265,8 @@ TEST(RegionFit, VaryingAlbedoIsFittedPerPatchAndKeepsTheLobe) {
 }
 
 TEST(RegionFit, LambertRegionsGetTheirAlbedoAndKnownValuesAreHeld) {
-  RegionFitInput in = MakeSamples(BrdfModel::kLambert, {Eigen::Vector3d(0.7, 0.6, 0.5)}, 0, 0.1, 0, 4);
+  RegionFitInput in =
+      MakeSamples(BrdfModel::kLambert, {Eigen::Vector3d(0.7, 0.6, 0.5)}, 0, 0.1, 0, 4);
   RegionFitResult r = FitRegion(in, {});
   EXPECT_NEAR(r.rho_d[0], 0.7, 1e-6);
   EXPECT_NEAR(r.rho_d[2], 0.5, 1e-6);
