@@ -60,6 +60,16 @@ double AutoSaturation(const Image& image) {
   return at_max >= 3 ? double(max_value) : std::numeric_limits<double>::infinity();
 }
 
+double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Eigen::Vector3d& n) {
+  // The normal's change across the pixel in x and in y (the quarter-pixel samples are half a
+  // pixel apart, two pairs each), tangential part; a box of width w has variance w²/12 along it.
+  Eigen::Vector3d a = quarter[1] + quarter[3] - quarter[0] - quarter[2];
+  Eigen::Vector3d b = quarter[2] + quarter[3] - quarter[0] - quarter[1];
+  a -= n * n.dot(a);
+  b -= n * n.dot(b);
+  return (a.squaredNorm() + b.squaredNorm()) / 12.0;
+}
+
 std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
                                              const Image& radiance, const Image* mask,
                                              const Renderer::Impl& geometry,
@@ -137,19 +147,7 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
           o.normal = hit->n_s.cast<float>();
           o.view = (-dir).cast<float>();
           o.radiance = value;
-          {
-            // The normal's change across the pixel in x and in y (the quarter-pixel samples are
-            // half a pixel apart, two pairs each), tangential part; a box of width w has
-            // variance w²/12 along it.
-            const Eigen::Vector3d n = hit->n_s;
-            Eigen::Vector3d a =
-                corner_normal[1] + corner_normal[3] - corner_normal[0] - corner_normal[2];
-            Eigen::Vector3d b =
-                corner_normal[2] + corner_normal[3] - corner_normal[0] - corner_normal[1];
-            a -= n * n.dot(a);
-            b -= n * n.dot(b);
-            o.lobe_blur2 = float((a.squaredNorm() + b.squaredNorm()) / 12.0);
-          }
+          o.lobe_blur2 = float(PixelNormalSpread(corner_normal, hit->n_s));
           per_row[r].push_back(o);
           ++st.valid;
         }

@@ -8,6 +8,7 @@
 // Frames and units: world frame, metres; radiance linear in the scene's units.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -55,6 +56,10 @@ struct PhotoObservationStats {
   int edge = 0;           // footprint straddles regions, creases or depth steps
   double saturation = 0;  // the clipping value used (infinity: none)
 };
+
+// Observation::lobe_blur2 from the shading normals of a pixel's four quarter-pixel rays (at
+// (0.25|0.75, 0.25|0.75), index bit 0: x, bit 1: y) and its centre's normal n.
+double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Eigen::Vector3d& n);
 
 // The clipping value of a photo: its maximum when 3 or more pixels share it exactly (a sensor's
 // clipped highlight), else infinity.

@@ -695,8 +695,9 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
     const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
+      const double a = std::sqrt(alpha * alpha + r.lobe_blur2);
       for (const RecordLightSample& ls : r.lights) {
-        s += WardLobe(r.normal, ls.wi, r.view, alpha) * ls.irradiance[c];
+        s += WardLobe(r.normal, ls.wi, r.view, a) * ls.irradiance[c];
       }
       b[0] = s;
       if (k == 2) b[1] = r.sim[c];
@@ -783,7 +784,9 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   const double rho_s = m.rho_s->mean(), alpha = *m.alpha;
   if (!(rho_s > 0)) return out;
   // The lobe term ρs·Σ lobe·E at a record, of the current model or the alternative at (ior, a).
-  auto lobe_term = [&](const PixelRecord& r, int c, bool alternative, double ior, double a) {
+  auto lobe_term = [&](const PixelRecord& r, int c, bool alternative, double ior, double a0) {
+    // The pixel sees the lobe widened by its spread of normals.
+    const double a = std::sqrt(a0 * a0 + r.lobe_blur2);
     double d = 0;
     auto add = [&](const RecordLightSample& ls) {
       const double plain =
