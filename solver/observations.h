@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +61,11 @@ struct PhotoObservationStats {
 // Observation::lobe_blur2 from the shading normals of a pixel's four quarter-pixel rays (at
 // (0.25|0.75, 0.25|0.75), index bit 0: x, bit 1: y) and its centre's normal n.
 double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Eigen::Vector3d& n);
+
+// The roughness a pixel sees: α widened by its spread of normals (√(α² + spread)).
+inline double WidenedAlpha(double alpha, double spread) {
+  return std::sqrt(alpha * alpha + spread);
+}
 
 // The clipping value of a photo: its maximum when 3 or more pixels share it exactly (a sensor's
 // clipped highlight), else infinity.

@@ -160,8 +160,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           const bool summed = sums != nullptr && in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
           // The lobe's weight of an incident direction (ComputeSpecularTerms' T = Σ S·W·v).
-          const double ax = std::sqrt(m.params.AlphaX() * m.params.AlphaX() + o.lobe_blur2);
-          const double ay = std::sqrt(m.params.AlphaY() * m.params.AlphaY() + o.lobe_blur2);
+          const double ax = WidenedAlpha(m.params.AlphaX(), o.lobe_blur2);
+          const double ay = WidenedAlpha(m.params.AlphaY(), o.lobe_blur2);
           auto lobe_weight = [&](const Eigen::Vector3d& wi_local) {
             const double w = SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, wi_local);
             return w > 0 ? w : 0.0;
@@ -302,9 +302,8 @@ void SolverState::ComputeSpecularTerms() {
         if (HasSpecularLobe(m.params.model)) {
           const Eigen::Vector3d wo = LocalFrame(obs[i].region, obs[i].normal.cast<double>())
                                          .ToLocal(obs[i].view.cast<double>());
-          const double b2 = obs[i].lobe_blur2;
-          const double ax = std::sqrt(m.params.AlphaX() * m.params.AlphaX() + b2);
-          const double ay = std::sqrt(m.params.AlphaY() * m.params.AlphaY() + b2);
+          const double ax = WidenedAlpha(m.params.AlphaX(), obs[i].lobe_blur2);
+          const double ay = WidenedAlpha(m.params.AlphaY(), obs[i].lobe_blur2);
           for (const IncidentLocal& inc : obs_incident[i]) {
             const double w =
                 SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.wi.cast<double>());

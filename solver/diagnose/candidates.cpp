@@ -21,6 +21,7 @@
 #include "solver/diagnose/candidates_brdf_light.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
+#include "solver/observations.h"
 #include "solver/sampling.h"
 #include "tools/common/parallel.h"
 
@@ -695,7 +696,7 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
     const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
-      const double a = std::sqrt(alpha * alpha + r.lobe_blur2);
+      const double a = WidenedAlpha(alpha, r.lobe_blur2);
       for (const RecordLightSample& ls : r.lights) {
         s += WardLobe(r.normal, ls.wi, r.view, a) * ls.irradiance[c];
       }
@@ -786,7 +787,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   // The lobe term ρs·Σ lobe·E at a record, of the current model or the alternative at (ior, a).
   auto lobe_term = [&](const PixelRecord& r, int c, bool alternative, double ior, double a0) {
     // The pixel sees the lobe widened by its spread of normals.
-    const double a = std::sqrt(a0 * a0 + r.lobe_blur2);
+    const double a = WidenedAlpha(a0, r.lobe_blur2);
     double d = 0;
     auto add = [&](const RecordLightSample& ls) {
       const double plain =
