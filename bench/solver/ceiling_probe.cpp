@@ -15,8 +15,10 @@
 //      region and by how many observations the hit patch has; "+spec_ind": with the glossy hit's
 //      true specular reflection of the indirect light added (`spec_rays` lobe rays, 0 = off);
 //      and the irradiance at the centres of the unseen patches the rays meet against a reference;
-//  (d) the photo's pixel against ρd_true·E_ref/π at the pixel centre's point and against a
-//      `pixel_paths`-path render of the true scene through the pixel centre;
+//  (d) the photo's pixel against ρd_true·E_ref/π at the pixel centre's point, against a
+//      `pixel_paths`-path render of the true scene through the pixel centre, and against one
+//      box-filtered over the pixel (4×4 strata, as a photo records; per channel, with the
+//      standard error of the ratio from the rows' scatter);
 //  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2,
 //      refinement round `round`) over the true scene and over the stage-1 model, against the same
 //      reference, with the five observations whose gathered E_ind is the largest multiple of
@@ -52,7 +54,7 @@ struct Sum {
 };
 
 struct Row {
-  Eigen::Vector3d e_dir, e_ind_raw, e_ind_smooth, e_ind_ref, l_photo, l_pixel_ref;
+  Eigen::Vector3d e_dir, e_ind_raw, e_ind_smooth, e_ind_ref, l_photo, l_pixel_ref, l_pixel_box;
   std::map<std::string, Sum> by;  // key -> (Σ w·L_model, Σ w·L_true) on the gather's own rays
 };
 
@@ -202,12 +204,21 @@ int main(int argc, char** argv) {
         row.l_pixel_ref = ref.Radiance(cam.CenterInWorld(),
                                        cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5)),
                                        pixel_paths, uint64_t(i) * 31 + 3);
+        // The same paths spread over the pixel (4×4 strata): the box filter a photo records.
+        row.l_pixel_box.setZero();
+        for (int k = 0; k < 16; ++k) {
+          const Eigen::Vector2d px(o.x + (k % 4 + 0.5) / 4, o.y + (k / 4 + 0.5) / 4);
+          row.l_pixel_box += ref.Radiance(cam.CenterInWorld(), cam.WorldRayFromImg(px),
+                                          std::max(1, pixel_paths / 16),
+                                          uint64_t(i) * 31 + 5 + uint64_t(k) * 7919) /
+                             16.0;
+        }
       },
       2, 1);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Totals, per photo and overall.
-  std::map<std::string, std::array<Eigen::Vector3d, 6>> tot;
+  std::map<std::string, std::array<Eigen::Vector3d, 7>> tot;
   std::map<std::string, Sum> rays;
   for (size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
@@ -215,14 +226,15 @@ int main(int argc, char** argv) {
          {std::string("all"), fmt::format("photo {}", s.obs[subset[k]].photo)}) {
       auto it = tot.find(key);
       if (it == tot.end()) {
-        std::array<Eigen::Vector3d, 6> zero;
+        std::array<Eigen::Vector3d, 7> zero;
         zero.fill(Eigen::Vector3d::Zero());
         it = tot.emplace(key, zero).first;
       }
       auto& t = it->second;
-      const std::array<Eigen::Vector3d, 6> v = {r.e_dir,     r.e_ind_raw, r.e_ind_smooth,
-                                                r.e_ind_ref, r.l_photo,   r.l_pixel_ref};
-      for (int c = 0; c < 6; ++c) t[c] += v[c];
+      const std::array<Eigen::Vector3d, 7> v = {r.e_dir,   r.e_ind_raw,   r.e_ind_smooth,
+                                                r.e_ind_ref, r.l_photo,   r.l_pixel_ref,
+                                                r.l_pixel_box};
+      for (int c = 0; c < 7; ++c) t[c] += v[c];
     }
     for (const auto& [key, sum] : r.by) {
       Sum& a = rays[key];
@@ -246,6 +258,22 @@ int main(int argc, char** argv) {
         t[4].sum() / (rho_true.cwiseProduct(e_ref) / kPi).sum(),
         100 * (rho_g.mean() / rho_true.mean() - 1), 100 * (rho_r.mean() / rho_true.mean() - 1),
         100 * (rho_pix.mean() / rho_true.mean() - 1));
+    // The standard error of L_photo/L_pixel_box (both noisy renders) from the rows' scatter.
+    Eigen::Vector3d se = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < rows.size(); ++k) {
+      if (key != "all" && key != fmt::format("photo {}", s.obs[subset[k]].photo)) continue;
+      const Eigen::Vector3d ratio = t[4].cwiseQuotient(t[6]);
+      const Eigen::Vector3d d = rows[k].l_photo - ratio.cwiseProduct(rows[k].l_pixel_box);
+      se += d.cwiseProduct(d);
+    }
+    se = se.cwiseSqrt().cwiseQuotient(t[6]);
+    std::printf("         L_photo/L_pixel_box standard error %.4f %.4f %.4f\n", se[0], se[1],
+                se[2]);
+    std::printf(
+        "         per channel: L_photo/L_pixel_box %.4f %.4f %.4f | L_pixel_box/L_pixel_ref %.4f "
+        "%.4f %.4f\n",
+        t[4][0] / t[6][0], t[4][1] / t[6][1], t[4][2] / t[6][2], t[6][0] / t[5][0],
+        t[6][1] / t[5][1], t[6][2] / t[5][2]);
   }
   if (kv["stage2"] != "0") {
     // (e) stage 2's gathering (the path tracer over a scene, SolverState::IncidentFromRenderer)
