@@ -2,9 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "tools/common/error.h"
 
 namespace igi {
+
+int FinalRoundRays(int refine_final_rays, int observations) {
+  const double scale = double(kFinalRoundRegionObservations) / std::max(1, observations);
+  const double rays = refine_final_rays * std::clamp(scale, 1.0, 8.0);
+  return int(std::min(4096.0, std::ceil(rays)));
+}
 
 void SolveOptions::Validate() const {
   ProblemList problems;

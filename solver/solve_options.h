@@ -68,6 +68,10 @@ struct SolveOptions {
   // The same in the last round, whose gather sets the written values: their Monte Carlo noise
   // is this round's (igi-synth's 1024-spp room, 2 rounds of 32: wall_x0's written ρd −1.2,
   // −0.7 and −0.2 % for solver seeds 1–3; last round 128: +0.0..+0.3 %; bench/RESULTS.md).
+  // A region with fewer than kFinalRoundRegionObservations observations gets proportionally
+  // more (FinalRoundRays, up to 8×), so that every region's written values rest on as many
+  // gathered directions as a region of that many observations (the 1024-spp room's ceiling,
+  // 149 observations: +1.26 % for solver seed 3 at 128, +0.55 % at 512).
   int refine_final_rays = 128;
   // How each refinement round updates the albedos. The rounds gather all indirect light from
   // the model, so its albedos feed back on themselves: a too bright model darkens the next fit.
@@ -109,5 +113,14 @@ struct SolveOptions {
   // Throws InputError naming the flag and the rule.
   void Validate() const;
 };
+
+// The observation count from which a region's last refinement round gathers
+// SolveOptions::refine_final_rays directions per observation.
+inline constexpr int kFinalRoundRegionObservations = 1024;
+
+// Directions per observation in the last refinement round for a region of `observations`
+// observations: refine_final_rays × 1024 / observations, at least refine_final_rays and at most
+// 8 times it (and 4096).
+int FinalRoundRays(int refine_final_rays, int observations);
 
 }  // namespace igi

@@ -77,6 +77,8 @@ int main(int argc, char** argv) {
       o.indirect_rays = int(v);
     else if (key == "refine_rays")
       o.refine_rays = int(v);
+    else if (key == "final_rays")
+      o.refine_final_rays = int(v);
     else if (key == "seed")
       o.seed = uint64_t(v);
     else if (key == "dump")
@@ -122,7 +124,9 @@ int main(int argc, char** argv) {
       } else {
         std::printf(" %7s %7s", "", "");
       }
-      std::printf("  %s\n", f.albedo_model.c_str());
+      std::printf("  %s", f.albedo_model.c_str());
+      if (stage == 2) std::printf("  %d obs", r.observations);
+      std::printf("\n");
     }
     if (r.albedo_map && t.contains("rho_d_map")) {
       const igi::Image want = igi::ReadImage(capture / t["rho_d_map"].get<std::string>(), 3);

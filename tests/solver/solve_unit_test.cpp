@@ -12,6 +12,7 @@
 #include "solver/region_fit.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "solver/solve_options.h"
 #include "tests/solver/test_scenes.h"
 #include "tools/common/image.h"
 
@@ -99,6 +100,19 @@ TEST(Observations, APixelsSpreadOfNormalsFollowsTheSurfacesCurvature) {
   }
   EXPECT_TRUE(top);
   EXPECT_TRUE(floor);
+}
+
+// The last refinement round's directions per observation: a region of few observations gets
+// proportionally more (its written values rest on as many directions as a 1024-observation
+// region's), at most 8 times the option and 4096.
+TEST(SolveOptions, TheLastRoundGivesRegionsWithFewObservationsMoreRays) {
+  EXPECT_EQ(FinalRoundRays(128, 1024), 128);
+  EXPECT_EQ(FinalRoundRays(128, 20000), 128);  // never fewer than the option
+  EXPECT_EQ(FinalRoundRays(128, 149), 880);    // the 1024-spp room's ceiling: ⌈128·1024/149⌉
+  EXPECT_EQ(FinalRoundRays(128, 512), 256);
+  EXPECT_EQ(FinalRoundRays(128, 10), 1024);    // at most 8×
+  EXPECT_EQ(FinalRoundRays(128, 0), 1024);
+  EXPECT_EQ(FinalRoundRays(1024, 10), 4096);   // and 4096
 }
 
 TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
