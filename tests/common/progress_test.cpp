@@ -9,14 +9,20 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 namespace igi {
 namespace {
 
-// Runs `fn` with stderr sent to a file and returns what it wrote.
+// Runs `fn` with stderr sent to a file of this process's own (ctest runs the tests of this file
+// as parallel processes: a shared name let one test read the other's progress bar) and returns
+// what it wrote.
 template <typename Fn>
 std::string CaptureStderr(Fn fn) {
-  const auto path = std::filesystem::temp_directory_path() / "igi_progress_stderr.txt";
+  static int calls = 0;
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("igi_progress_stderr_" + std::to_string(getpid()) + "_" +
+                     std::to_string(calls++) + ".txt");
   std::fflush(stderr);
   const int saved = dup(STDERR_FILENO);
   const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
