@@ -70,6 +70,26 @@ double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Ei
   return (a.squaredNorm() + b.squaredNorm()) / 12.0;
 }
 
+std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer::Impl& geometry,
+                                                                  const Camera& camera, int x,
+                                                                  int y, const SurfaceHit& centre,
+                                                                  double cos_min,
+                                                                  double max_offset) {
+  const Eigen::Vector3d eye = camera.CenterInWorld();
+  std::array<Eigen::Vector3d, 4> normals;
+  for (int k = 0; k < 4; ++k) {
+    const double ox = (k & 1) ? 0.75 : 0.25, oy = (k & 2) ? 0.75 : 0.25;
+    const std::optional<SurfaceHit> h =
+        TraceSurface(geometry, eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
+    if (!(h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_min &&
+          std::abs(centre.n_geo.dot(h->position - centre.position)) < max_offset * centre.t)) {
+      return std::nullopt;
+    }
+    normals[k] = h->n_s;
+  }
+  return normals;
+}
+
 std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
                                              const Image& radiance, const Image* mask,
                                              const Renderer::Impl& geometry,
@@ -120,17 +140,9 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
             continue;
           }
           // The pixel's footprint must lie on one smooth piece of one region.
-          bool clean = true;
-          std::array<Eigen::Vector3d, 4> corner_normal;
-          for (int k = 0; k < 4 && clean; ++k) {
-            const double ox = (k & 1) ? 0.75 : 0.25, oy = (k & 2) ? 0.75 : 0.25;
-            const Eigen::Vector3d d = camera.WorldRayFromImg(Eigen::Vector2d(x + ox, yy + oy));
-            const std::optional<SurfaceHit> h = TraceSurface(geometry, center, d);
-            clean = h && h->region == hit->region && h->n_s.dot(hit->n_s) > cos_edge &&
-                    std::abs(hit->n_geo.dot(h->position - hit->position)) < 0.01 * hit->t;
-            if (clean) corner_normal[k] = h->n_s;
-          }
-          if (!clean) {
+          const auto corner_normal =
+              QuarterPixelNormals(geometry, camera, x, yy, *hit, cos_edge, 0.01);
+          if (!corner_normal) {
             ++st.edge;
             continue;
           }
@@ -147,7 +159,7 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
           o.normal = hit->n_s.cast<float>();
           o.view = (-dir).cast<float>();
           o.radiance = value;
-          o.lobe_blur2 = float(PixelNormalSpread(corner_normal, hit->n_s));
+          o.lobe_blur2 = float(PixelNormalSpread(*corner_normal, hit->n_s));
           per_row[r].push_back(o);
           ++st.valid;
         }

@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +63,16 @@ struct PhotoObservationStats {
 // Observation::lobe_blur2 from the shading normals of a pixel's four quarter-pixel rays (at
 // (0.25|0.75, 0.25|0.75), index bit 0: x, bit 1: y) and its centre's normal n.
 double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Eigen::Vector3d& n);
+
+struct SurfaceHit;
+
+// The shading normals at the four quarter-pixel points of pixel (x, y) of `camera` (the order of
+// PixelNormalSpread), traced through `geometry`; none when a ray misses `centre`'s region, turns
+// its normal to a cosine of `cos_min` or less from the centre's, or meets a point off the
+// centre's face plane by `max_offset`·centre.t or more.
+std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(
+    const Renderer::Impl& geometry, const Camera& camera, int x, int y, const SurfaceHit& centre,
+    double cos_min, double max_offset = std::numeric_limits<double>::infinity());
 
 // The roughness a pixel sees: α widened by its spread of normals (√(α² + spread)).
 inline double WidenedAlpha(double alpha, double spread) {

@@ -132,17 +132,7 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   const int64_t num_chunks = std::clamp<int64_t>((num_obs + 255) / 256, 1, 64);
   const int64_t chunk_size = (num_obs + num_chunks - 1) / num_chunks;
   std::vector<JointSums> chunk_sums(joint ? num_chunks : 0);
-  // The last round's directions per observation, per region (FinalRoundRays: a region with few
-  // observations gets more, so that its written values are no noisier than a large one's).
   const bool final_round = int(round) >= options.refine_iterations;
-  std::vector<int> region_rays(materials.size(), options.refine_rays);
-  if (final_round) {
-    std::vector<int> count(materials.size(), 0);
-    for (const Observation& o : obs) ++count[o.region];
-    for (size_t r = 0; r < materials.size(); ++r) {
-      region_rays[r] = FinalRoundRays(options.refine_final_rays, count[r]);
-    }
-  }
   ParallelFor(
       0, num_chunks,
       [&](int64_t chunk) {
@@ -191,7 +181,11 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           int k = 0;
           // Glossy observations that the fits use get four times the rays: noise in the
           // specular term T would bias ρs low (regression dilution).
-          const int n = region_rays[o.region] * (glossy && in_fit[i] ? 4 : 1);
+          // The last round's: more where a region has few observations (FinalRoundRays), so that
+          // its written values are no noisier than a large region's.
+          const int base = final_round ? FinalRoundRays(options.refine_final_rays, m.observations)
+                                       : options.refine_rays;
+          const int n = base * (glossy && in_fit[i] ? 4 : 1);
           for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
             const Eigen::Vector3d origin = q.position + q.n_geo * eps;
             const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);

@@ -206,11 +206,11 @@ int main(int argc, char** argv) {
                                        pixel_paths, uint64_t(i) * 31 + 3);
         // The same paths spread over the pixel (4×4 strata): the box filter a photo records.
         row.l_pixel_box.setZero();
-        for (int k = 0; k < 16; ++k) {
-          const Eigen::Vector2d px(o.x + (k % 4 + 0.5) / 4, o.y + (k / 4 + 0.5) / 4);
+        for (int cell = 0; cell < 16; ++cell) {
+          const Eigen::Vector2d px(o.x + (cell % 4 + 0.5) / 4, o.y + (cell / 4 + 0.5) / 4);
           row.l_pixel_box += ref.Radiance(cam.CenterInWorld(), cam.WorldRayFromImg(px),
                                           std::max(1, pixel_paths / 16),
-                                          uint64_t(i) * 31 + 5 + uint64_t(k) * 7919) /
+                                          uint64_t(i) * 31 + 5 + uint64_t(cell) * 7919) /
                              16.0;
         }
       },
@@ -231,8 +231,8 @@ int main(int argc, char** argv) {
         it = tot.emplace(key, zero).first;
       }
       auto& t = it->second;
-      const std::array<Eigen::Vector3d, 7> v = {r.e_dir,   r.e_ind_raw,   r.e_ind_smooth,
-                                                r.e_ind_ref, r.l_photo,   r.l_pixel_ref,
+      const std::array<Eigen::Vector3d, 7> v = {r.e_dir,      r.e_ind_raw, r.e_ind_smooth,
+                                                r.e_ind_ref,  r.l_photo,   r.l_pixel_ref,
                                                 r.l_pixel_box};
       for (int c = 0; c < 7; ++c) t[c] += v[c];
     }
@@ -260,9 +260,9 @@ int main(int argc, char** argv) {
         100 * (rho_pix.mean() / rho_true.mean() - 1));
     // The standard error of L_photo/L_pixel_box (both noisy renders) from the rows' scatter.
     Eigen::Vector3d se = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d ratio = t[4].cwiseQuotient(t[6]);
     for (size_t k = 0; k < rows.size(); ++k) {
       if (key != "all" && key != fmt::format("photo {}", s.obs[subset[k]].photo)) continue;
-      const Eigen::Vector3d ratio = t[4].cwiseQuotient(t[6]);
       const Eigen::Vector3d d = rows[k].l_photo - ratio.cwiseProduct(rows[k].l_pixel_box);
       se += d.cwiseProduct(d);
     }

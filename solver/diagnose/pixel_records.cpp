@@ -1,7 +1,6 @@
 #include "solver/diagnose/pixel_records.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -374,16 +373,8 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
           r.normal = hit->n_s.cast<float>();
           r.view = (-dir).cast<float>();
           if (HasSpecularLobe(model.materials[hit->region].brdf)) {
-            std::array<Eigen::Vector3d, 4> quarter;
-            bool same = true;
-            for (int q = 0; q < 4 && same; ++q) {
-              const double ox = (q & 1) ? 0.75 : 0.25, oy = (q & 2) ? 0.75 : 0.25;
-              const std::optional<SurfaceHit> h =
-                  TraceSurface(impl, center, cam.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
-              same = h && h->region == hit->region && h->n_s.dot(hit->n_s) > 0.98;
-              if (same) quarter[q] = h->n_s;
-            }
-            if (same) r.lobe_blur2 = float(PixelNormalSpread(quarter, hit->n_s));
+            const auto quarter = QuarterPixelNormals(impl, cam, x, y, *hit, 0.98);
+            if (quarter) r.lobe_blur2 = float(PixelNormalSpread(*quarter, hit->n_s));
           }
           const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
           r.r2 = float((dx * dx + dy * dy) / half_diag2);

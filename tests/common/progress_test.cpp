@@ -20,9 +20,9 @@ namespace {
 template <typename Fn>
 std::string CaptureStderr(Fn fn) {
   static int calls = 0;
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("igi_progress_stderr_" + std::to_string(getpid()) + "_" +
-                     std::to_string(calls++) + ".txt");
+  const auto path =
+      std::filesystem::temp_directory_path() /
+      ("igi_progress_stderr_" + std::to_string(getpid()) + "_" + std::to_string(calls++) + ".txt");
   std::fflush(stderr);
   const int saved = dup(STDERR_FILENO);
   const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);

@@ -140,9 +140,10 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // (solver/held_out_albedo.h), rho_s through that albedo's own lobe: rho_s -4.14 % (clean),
       // -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos, session 18:
       // -2.19 %, -1.69 %, -1.54 %, -1.37 %); since session 14 rho_s and alpha also join stage
-      // 2's joint update. Issue 7's 5 % guards them. History: rho_s -10.3 % / -8.1 % before session 14 (the photos' Monte Carlo noise
-      // in the held-out albedos: the lobe is 14 % of the highlight samples' radiance, so 0.07 %
-      // of albedo error is 1 % of rho_s; bench/solver/floor_probe, bench/RESULTS.md).
+      // 2's joint update. Issue 7's 5 % guards them. History: rho_s -10.3 % / -8.1 % before session
+      // 14 (the photos' Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
+      // highlight samples' radiance, so 0.07 % of albedo error is 1 % of rho_s;
+      // bench/solver/floor_probe, bench/RESULTS.md).
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05);
@@ -315,7 +316,8 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
-                         ::testing::Values(SynthCase{"clean", false, 256}, SynthCase{"noisy", true, 256}),
+                         ::testing::Values(SynthCase{"clean", false, 256},
+                                           SynthCase{"noisy", true, 256}),
                          [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace

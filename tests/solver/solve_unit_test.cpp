@@ -110,9 +110,9 @@ TEST(SolveOptions, TheLastRoundGivesRegionsWithFewObservationsMoreRays) {
   EXPECT_EQ(FinalRoundRays(128, 20000), 128);  // never fewer than the option
   EXPECT_EQ(FinalRoundRays(128, 149), 880);    // the 1024-spp room's ceiling: ⌈128·1024/149⌉
   EXPECT_EQ(FinalRoundRays(128, 512), 256);
-  EXPECT_EQ(FinalRoundRays(128, 10), 1024);    // at most 8×
+  EXPECT_EQ(FinalRoundRays(128, 10), 1024);  // at most 8×
   EXPECT_EQ(FinalRoundRays(128, 0), 1024);
-  EXPECT_EQ(FinalRoundRays(1024, 10), 4096);   // and 4096
+  EXPECT_EQ(FinalRoundRays(1024, 10), 4096);  // and 4096
 }
 
 TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
