@@ -1,16 +1,29 @@
 #include "solver/photo_model.h"
 
+#include <algorithm>
+
 namespace igi {
 
 bool PixelHoldout::HeldOut(int photo, int x, int y) const {
-  if (!(fraction > 0)) return false;
+  return fraction > 0 && Draw(photo, x, y) < fraction;
+}
+
+int PixelHoldout::Fold(int photo, int x, int y, int folds) const {
+  const double u = Draw(photo, x, y);
+  if (fraction > 0 && u < fraction) return 0;
+  const double f = std::max(fraction, 0.0);
+  return 1 + std::clamp(int((u - f) / (1 - f) * (folds - 1)), 0, std::max(folds - 2, 0));
+}
+
+double PixelHoldout::Draw(int photo, int x, int y) const {
   // SplitMix64 of the block's coordinates: an even, reproducible choice of blocks.
   uint64_t z = seed * 0x9E3779B97F4A7C15ull + uint64_t(photo) * 0xBF58476D1CE4E5B9ull +
-               uint64_t(x / block_px) * 0x94D049BB133111EBull + uint64_t(y / block_px) * 0x2545F4914F6CDD1Dull;
+               uint64_t(x / block_px) * 0x94D049BB133111EBull +
+               uint64_t(y / block_px) * 0x2545F4914F6CDD1Dull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
-  return double(z >> 11) * 0x1.0p-53 < fraction;
+  return double(z >> 11) * 0x1.0p-53;
 }
 
 bool HasPhotoModel(const Photo& photo, const Camera& camera) {

@@ -22,6 +22,12 @@ struct PixelHoldout {
   uint64_t seed = 1;
 
   bool HeldOut(int photo, int x, int y) const;
+  // The block's uniform draw in [0, 1): held out below `fraction`. The fitted blocks split
+  // further by it (cross-fitting's folds).
+  double Draw(int photo, int x, int y) const;
+  // Fold of a pixel among `folds` (>= 2): 0 = held out, 1..folds-1 = equal shares of the fitted
+  // blocks. With folds < 2 the fitted blocks are all fold 1.
+  int Fold(int photo, int x, int y, int folds) const;
 };
 
 // True when the photo's values are not plain radiance (a response, a scale or vignetting).

@@ -26,12 +26,13 @@ Scene TwoPhotoScene(const std::filesystem::path& dir) {
       {"format", "igi-scene"},
       {"version", 1},
       {"geometry", {{{"file", "floor.obj"}}}},
-      {"materials", {{"floor", {{"brdf", "ward_gmd"}, {"rho_d", 0.4}, {"rho_s", 0.1},
-                                {"alpha", 0.15}}}}},
-      {"lights", {{"l", {{"type", "sphere"}, {"center", {0.3, 0, 1}}, {"radius", 0.3},
-                         {"radiance", 30}}}}},
+      {"materials",
+       {{"floor", {{"brdf", "ward_gmd"}, {"rho_d", 0.4}, {"rho_s", 0.1}, {"alpha", 0.15}}}}},
+      {"lights",
+       {{"l", {{"type", "sphere"}, {"center", {0.3, 0, 1}}, {"radius", 0.3}, {"radiance", 30}}}}},
       {"lightings", {{"L", {"l"}}}},
-      {"cameras", {{"a", DownCamera(0, 0, 3, 37, 29, 30)}, {"b", DownCamera(0.2, 0, 2, 40, 24, 25)}}}};
+      {"cameras",
+       {{"a", DownCamera(0, 0, 3, 37, 29, 30)}, {"b", DownCamera(0.2, 0, 2, 40, 24, 25)}}}};
   Scene scene = LoadTestScene(dir, doc);
   for (int c = 0; c < 2; ++c) {
     Photo p;
@@ -78,6 +79,34 @@ TEST(SimulatePhotosTest, HeldOutTestMasksCoverTheBlocksTheirWindowAndTheGrid) {
     EXPECT_GT(held, 0u);
     EXPECT_LT(marked, masks[i].size());  // not everything: the point of the masks
   }
+}
+
+// Cross-fitting's folds: fold 0 is exactly the held-out blocks, the fitted blocks split into
+// near-equal shares, a block is one fold, and a single fold leaves every fitted block in fold 1.
+TEST(SimulatePhotosTest, FoldsAreTheHeldOutBlocksAndSharesOfTheOthers) {
+  const PixelHoldout h{0.25, 8, 7};
+  std::vector<int> count(4, 0);
+  for (int photo = 0; photo < 4; ++photo) {
+    for (int y = 0; y < 400; y += 8) {
+      for (int x = 0; x < 400; x += 8) {
+        const int f = h.Fold(photo, x, y, 4);
+        ASSERT_GE(f, 0);
+        ASSERT_LT(f, 4);
+        EXPECT_EQ(f == 0, h.HeldOut(photo, x, y));
+        EXPECT_EQ(h.Fold(photo, x + 7, y + 5, 4), f);  // the same block
+        EXPECT_EQ(h.Fold(photo, x, y, 1), f == 0 ? 0 : 1);
+        ++count[size_t(f)];
+      }
+    }
+  }
+  for (int f = 0; f < 4; ++f) EXPECT_NEAR(count[size_t(f)], 2500, 150) << "fold " << f;
+  // No held-out blocks: every block in a fitted fold, still split evenly.
+  const PixelHoldout none{0, 8, 7};
+  std::vector<int> split(3, 0);
+  for (int y = 0; y < 800; y += 8) {
+    for (int x = 0; x < 800; x += 8) ++split[size_t(none.Fold(0, x, y, 4) - 1)];
+  }
+  for (int n : split) EXPECT_NEAR(n, 10000 / 3.0, 250);
 }
 
 TEST(SimulatePhotosTest, PartsRenderedSeparatelyEqualOneRender) {
