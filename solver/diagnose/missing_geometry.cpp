@@ -512,17 +512,20 @@ void AddTouchedBlobs(const Image& state, int r, Image* excluded) {
 }
 
 // The pixels of one view that the object's voxels and its shadow's cover, dilated by r, with the
-// blobs they touch; the pixel counts of the object and of the shadow alone.
+// blobs they touch; the pixel counts of the object and of the shadow alone, when asked.
 Image Exclusion(const CarveView& view, const VoxelGrid& grid, const std::vector<int64_t>& object,
-                const std::vector<int64_t>& shadow, int r, int* n_object, int* n_shadow) {
+                const std::vector<int64_t>& shadow, int r, int* n_object = nullptr,
+                int* n_shadow = nullptr) {
   const Image object_px = ProjectVoxels(view, grid, object, r);
   Image excluded = ProjectVoxels(view, grid, shadow, r);
-  *n_object = *n_shadow = 0;
+  int objects = 0, shadows = 0;
   for (size_t k = 0; k < excluded.pixels.size(); ++k) {
-    *n_object += object_px.pixels[k] > 0.5f;
-    *n_shadow += excluded.pixels[k] > 0.5f && !(object_px.pixels[k] > 0.5f);
+    objects += object_px.pixels[k] > 0.5f;
+    shadows += excluded.pixels[k] > 0.5f && !(object_px.pixels[k] > 0.5f);
     excluded.pixels[k] = std::max(excluded.pixels[k], object_px.pixels[k]);
   }
+  if (n_object) *n_object = objects;
+  if (n_shadow) *n_shadow = shadows;
   AddTouchedBlobs(view.state, r, &excluded);
   return excluded;
 }
@@ -645,6 +648,20 @@ Carving Carve(const std::vector<CarveView>& views, const VoxelGrid& grid,
   return c;
 }
 
+// The carving's exclusions in every view, undilated (what the significance test scores), and
+// when asked each view's pixel counts of the object and of its shadow.
+std::vector<Image> CoreExclusions(const std::vector<CarveView>& views, const VoxelGrid& grid,
+                                  const Carving& c,
+                                  std::vector<std::pair<int, int>>* counts = nullptr) {
+  std::vector<Image> core;
+  for (const CarveView& v : views) {
+    int n_object = 0, n_shadow = 0;
+    core.push_back(Exclusion(v, grid, c.voxels, c.shadow, 0, &n_object, &n_shadow));
+    if (counts) counts->emplace_back(n_object, n_shadow);
+  }
+  return core;
+}
+
 Json Vec(const Eigen::Vector3d& v, double unit = 1e-3) {
   auto r = [unit](double x) { return std::round(x / unit) * unit; };
   return Json::array({r(v.x()), r(v.y()), r(v.z())});
@@ -691,17 +708,36 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
     out.note = "no residual blob is seen by two photos in one place off the modelled surfaces";
     return res;
   }
-  const std::vector<int64_t>& voxels = carving.voxels;
-  const std::vector<int64_t>& shadow = carving.shadow;
   const CarvedObject& largest = objects[0];
+  // Its significance: each fold scored with masks carved without it (see the header).
+  std::vector<std::pair<int, int>> counts;  // per view: the object's pixels, its shadow's
+  Contrast contrast = InsideContrast(photos, sims, CoreExclusions(views, grid, carving, &counts),
+                                     holdout, 0, folds);
+  for (int fold = 1; fold < folds; ++fold) {
+    std::vector<CarveView> fold_views = views;
+    FindBlobsWithoutFold(photos, sims, holdout, fold, folds, o, &fold_views);
+    const std::vector<Image> core =
+        CoreExclusions(fold_views, grid, Carve(fold_views, grid, near, o));
+    contrast.Add(InsideContrast(photos, sims, core, holdout, fold, folds));
+  }
+  const double ratio = contrast.Ratio();
+  out.z = contrast.Z();
+  if (!(ratio >= o.min_contrast)) {
+    // Ranks alone let blocks a little above the median everywhere outweigh a heavy tail outside
+    // (a phantom of 12 voxels over a grazing floor's highlights: z 3.8 at 0.5x the level).
+    out.note = fmt::format(
+        "residual blobs carve to an object of {} voxels, but the residual² per pixel inside its "
+        "masks is {:.1f}x the level outside them (an object the geometry lacks: at least {:.1f}x)",
+        largest.core_voxels, ratio, o.min_contrast);
+    return res;
+  }
   Json photo_files = Json::array(), pixels = Json::object(), shadow_pixels = Json::object();
   fs::create_directories(mask_dir);
   std::vector<std::pair<size_t, std::string>> mask_files;
-  std::vector<Image> core;  // the exclusions undilated: what the significance test scores
   for (size_t i = 0; i < views.size(); ++i) {
-    int n_object = 0, n_shadow = 0;
-    Image excluded = Exclusion(views[i], grid, voxels, shadow, o.dilate_px, &n_object, &n_shadow);
-    core.push_back(Exclusion(views[i], grid, voxels, shadow, 0, &n_object, &n_shadow));
+    // The pixels counted are the undilated object's and shadow's; the masks add their margin.
+    const auto [n_object, n_shadow] = counts[i];
+    Image excluded = Exclusion(views[i], grid, carving.voxels, carving.shadow, o.dilate_px);
     const std::string file = model.photos[i].file.filename().string();
     if (n_object > 0) {
       photo_files.push_back(file);
@@ -732,22 +768,6 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
     if (!in) (r.held_out ? out.held_after : out.train_after) += e;
     if (r.held_out) out.held_photo += double(r.recorded.squaredNorm());
   }
-  // Its significance: each fold scored with masks carved without it (see the header).
-  Contrast contrast = InsideContrast(photos, sims, core, holdout, 0, folds);
-  for (int fold = 1; fold < folds; ++fold) {
-    std::vector<CarveView> fold_views = views;
-    FindBlobsWithoutFold(photos, sims, holdout, fold, folds, o, &fold_views);
-    const Carving c = Carve(fold_views, grid, near, o);
-    std::vector<Image> fold_core;
-    for (const CarveView& v : fold_views) {
-      int n_object = 0, n_shadow = 0;
-      fold_core.push_back(Exclusion(v, grid, c.voxels, c.shadow, 0, &n_object, &n_shadow));
-    }
-    const Contrast fc = InsideContrast(photos, sims, fold_core, holdout, fold, folds);
-    contrast.Add(fc);
-  }
-  const double ratio = contrast.Ratio();
-  out.z = contrast.Z();
   out.params = {{"center", Vec(largest.center)},
                 {"size_m", Vec(largest.size_m)},
                 {"box_min", Vec(largest.box_min)},
@@ -773,15 +793,6 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
       largest.center.x(), largest.center.y(), largest.center.z(), largest.core_voxels, voxel,
       largest.shadow_voxels.size(), 100 * out.Gain(), folds, ratio, contrast.n_in);
   spdlog::info("igi-diagnose: missing geometry: {}", out.evidence);
-  if (!(ratio >= o.min_contrast)) {
-    // Ranks alone let blocks a little above the median everywhere outweigh a heavy tail outside
-    // (a phantom of 12 voxels over a grazing floor's highlights: z 3.8 at 0.5x the level).
-    out.note = fmt::format(
-        "residual blobs carve to an object of {} voxels, but the residual² per pixel inside its "
-        "masks is {:.1f}x the level outside them (an object the geometry lacks: at least {:.1f}x)",
-        largest.core_voxels, ratio, o.min_contrast);
-    return res;
-  }
   out.valid = true;
   out.apply = [mask_files](Json* doc) {
     for (const auto& [i, path] : mask_files) (*doc)["photos"][i]["mask"] = path;
