@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 void MissingGeometryOptions::Validate() const {
   if (!(voxels_per_extent >= 4) || !(min_relative > 0) || !(median_factor > 0) ||
       !(min_area_fraction >= 0) || min_area_px < 1 || min_views < 2 || min_core_voxels < 1 ||
-      dilate_px < 0 || folds < 1 || !(min_contrast >= 0)) {
+      dilate_px < 0 || folds < 1 || !(min_contrast >= 0) || !(max_surface_slope > 0) ||
+      min_agreement_pairs < 0) {
     throw Error("missing geometry: invalid options");
   }
 }
@@ -126,20 +127,25 @@ bool Sees(const CarveView& view, const Eigen::Vector3d& x, double margin_m, int*
   return dist < double(view.depth_m.at(*u, *v)) + margin_m;
 }
 
+// The photo's mean value per channel over the pixels `usable` marks.
+double MeanLevel(const Image& recorded, const Image& usable) {
+  double level = 0;
+  int n = 0;
+  for (int y = 0; y < recorded.height; ++y) {
+    for (int x = 0; x < recorded.width; ++x) {
+      if (usable.at(x, y) > 0.5f)
+        level += recorded.at(x, y, 0) + recorded.at(x, y, 1) + recorded.at(x, y, 2), ++n;
+    }
+  }
+  return n ? level / (3 * n) : 0;
+}
+
 }  // namespace
 
 Image FindResidualBlobs(const Image& recorded, const Image& sim, const Image& usable,
                         const MissingGeometryOptions& o, const Image* infer, int infer_px) {
   const int w = recorded.width, h = recorded.height;
-  double level = 0;
-  int n_level = 0;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (usable.at(x, y) > 0.5f)
-        level += recorded.at(x, y, 0) + recorded.at(x, y, 1) + recorded.at(x, y, 2), ++n_level;
-    }
-  }
-  level = n_level ? level / (3 * n_level) : 0;
+  const double level = MeanLevel(recorded, usable);
   // 3×3 means over usable pixels of the photo and the model; their relative difference.
   std::vector<float> t(size_t(w) * h, -1.0f);
   std::vector<float> values;
@@ -662,6 +668,126 @@ std::vector<Image> CoreExclusions(const std::vector<CarveView>& views, const Vox
   return core;
 }
 
+// Whether the segment from x toward a light of `lighting` passes through one of the objects'
+// boxes (x lies in their shadow); ambient light has no direction and casts none.
+bool ShadowedByObjects(const Scene& model, int lighting, const Eigen::Vector3d& x,
+                       const std::vector<CarvedObject>& objects) {
+  for (int li : model.lightings[size_t(lighting)].lights) {
+    const Light& light = model.lights[size_t(li)];
+    Eigen::Vector3d to;
+    double reach = std::numeric_limits<double>::infinity();
+    if (light.type == LightType::kPoint || light.type == LightType::kSpot) {
+      to = light.position - x;
+    } else if (light.type == LightType::kSphere) {
+      to = light.center - x;
+    } else if (light.type == LightType::kArea && !light.mesh.positions.empty()) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (const Eigen::Vector3f& p : light.mesh.positions) c += p.cast<double>();
+      to = c / double(light.mesh.positions.size()) - x;
+    } else if (light.type == LightType::kDirectional) {
+      to = -light.direction;
+    } else {
+      continue;
+    }
+    if (light.type != LightType::kDirectional) reach = to.norm();
+    const Eigen::Vector3d d = to.normalized();
+    for (const CarvedObject& obj : objects) {
+      // Slab test of the ray x + t d, 0 < t < reach, against the box.
+      double t0 = 1e-6, t1 = reach;
+      for (int k = 0; k < 3 && t0 <= t1; ++k) {
+        if (std::abs(d[k]) < 1e-12) {
+          if (x[k] < obj.box_min[k] || x[k] > obj.box_max[k]) t0 = t1 + 1;
+          continue;
+        }
+        double a = (obj.box_min[k] - x[k]) / d[k], b = (obj.box_max[k] - x[k]) / d[k];
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a), t1 = std::min(t1, b);
+      }
+      if (t0 <= t1) return true;
+    }
+  }
+  return false;
+}
+
+// 3×3 means over valid pixels of the relative residual (model − photo, channels summed) over the
+// model plus 5% of the photo's mean level (as the blobs'); NaN where the pixel is not valid.
+Image SmoothedRelativeResidual(const Image& rec, const Image& sim, const Image& valid) {
+  const int w = rec.width, h = rec.height;
+  const double level = MeanLevel(rec, valid);
+  Image out(w, h, 1, std::numeric_limits<float>::quiet_NaN());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (valid.at(x, y) < 0.5f) continue;
+      double r = 0, s = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= w || yy >= h || valid.at(xx, yy) < 0.5f) continue;
+          for (int c = 0; c < 3; ++c) r += rec.at(xx, yy, c), s += sim.at(xx, yy, c);
+        }
+      }
+      const double den = std::abs(s) + 0.05 * 27 * level;
+      if (std::isfinite(s - r) && den > 0) out.at(x, y) = float((s - r) / den);
+    }
+  }
+  return out;
+}
+
+// How far the other photos reproduce, on the modelled surface behind the object, the residual
+// inside its projection: pairs of (the residual at a pixel of the object's projection in one
+// photo, the residual where another photo sees the modelled surface point behind it, unoccluded
+// by the object, outside its shadow from that photo's lights). A change on the surface (a
+// texture, a stain) shows alike from every side: slope and agreement near 1; an object hides the
+// surface from one photo only: near 0.
+struct SurfaceAgreement {
+  double ab = 0, aa = 0, bb = 0;
+  int pairs = 0;
+  double Slope() const { return aa > 0 ? ab / aa : 0; }
+  double Agreement() const { return aa > 0 && bb > 0 ? ab / std::sqrt(aa * bb) : 0; }
+};
+
+SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
+                                 const std::vector<Image>& sims,
+                                 const std::vector<CarveView>& views, const VoxelGrid& grid,
+                                 const Carving& c) {
+  std::vector<Image> rel, object, hidden;
+  for (size_t i = 0; i < views.size(); ++i) {
+    rel.push_back(SmoothedRelativeResidual(photos.recorded[i], sims[i], photos.valid[i]));
+    object.push_back(ProjectVoxels(views[i], grid, c.voxels, 0));
+    // Where a photo's view of the surface is the object's or its shadow's (with a margin).
+    Image h = ProjectVoxels(views[i], grid, c.voxels, 1);
+    const Image s = ProjectVoxels(views[i], grid, c.shadow, 1);
+    for (size_t k = 0; k < h.pixels.size(); ++k) h.pixels[k] = std::max(h.pixels[k], s.pixels[k]);
+    hidden.push_back(std::move(h));
+  }
+  SurfaceAgreement out;
+  for (size_t a = 0; a < views.size(); ++a) {
+    const CarveView& va = views[a];
+    const Eigen::Vector3d center = va.camera.CenterInWorld();
+    for (int y = 0; y < va.state.height; ++y) {
+      for (int x = 0; x < va.state.width; ++x) {
+        const float ra = rel[a].at(x, y), depth = va.depth_m.at(x, y);
+        if (!(object[a].at(x, y) > 0.5f) || !std::isfinite(ra) || !std::isfinite(depth)) continue;
+        const Eigen::Vector3d p =
+            center + double(depth) * va.camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+        for (size_t b = 0; b < views.size(); ++b) {
+          const CarveView& vb = views[b];
+          int u = 0, v = 0;
+          if (vb.camera_id == va.camera_id || !Sees(vb, p, grid.voxel_m, &u, &v)) continue;
+          const float rb = rel[b].at(u, v);
+          if (!std::isfinite(rb) || hidden[b].at(u, v) > 0.5f ||
+              ShadowedByObjects(model, model.photos[b].lighting, p, c.objects)) {
+            continue;
+          }
+          out.ab += double(ra) * rb, out.aa += double(ra) * ra, out.bb += double(rb) * rb;
+          ++out.pairs;
+        }
+      }
+    }
+  }
+  return out;
+}
+
 Json Vec(const Eigen::Vector3d& v, double unit = 1e-3) {
   auto r = [unit](double x) { return std::round(x / unit) * unit; };
   return Json::array({r(v.x()), r(v.y()), r(v.z())});
@@ -731,6 +857,19 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
         largest.core_voxels, ratio, o.min_contrast);
     return res;
   }
+  const SurfaceAgreement behind = AgreementBehind(model, photos, sims, views, grid, carving);
+  const bool judged = behind.pairs >= o.min_agreement_pairs;
+  if (judged && behind.Slope() >= o.max_surface_slope) {
+    // A change on a surface (an unmodelled texture's tiles) whose blobs in a few photos happen to
+    // carve together off the surface: the other photos show the same residual on the surface.
+    out.note = fmt::format(
+        "residual blobs carve to an object of {} voxels, but where other photos see the modelled "
+        "surface behind it they show {:.0f}% of the residual inside its projections ({} pairs of "
+        "pixels): a change on the surface, not an object (which hides the surface from one side "
+        "only: at most {:.0f}%)",
+        largest.core_voxels, 100 * behind.Slope(), behind.pairs, 100 * o.max_surface_slope);
+    return res;
+  }
   Json photo_files = Json::array(), pixels = Json::object(), shadow_pixels = Json::object();
   fs::create_directories(mask_dir);
   std::vector<std::pair<size_t, std::string>> mask_files;
@@ -788,10 +927,17 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
       "lacks ({} voxels of {:.3f} m), with {} voxels of its shadow on the modelled surfaces; "
       "fitted on the fitted pixels, its masks hold {:.1f}% of the held-out residual²; over {} "
       "folds of pixels, each scored by masks carved without it, the residual² per pixel inside "
-      "is {:.1f}x the level outside ({} blocks inside)",
+      "is {:.1f}x the level outside ({} blocks inside); {}",
       photo_files.size(), largest.size_m.x(), largest.size_m.y(), largest.size_m.z(),
       largest.center.x(), largest.center.y(), largest.center.z(), largest.core_voxels, voxel,
-      largest.shadow_voxels.size(), 100 * out.Gain(), folds, ratio, contrast.n_in);
+      largest.shadow_voxels.size(), 100 * out.Gain(), folds, ratio, contrast.n_in,
+      judged
+          ? fmt::format("where other photos see the modelled surface behind it they show {:.0f}% "
+                        "of the residual inside its projections ({} pairs of pixels)",
+                        100 * behind.Slope(), behind.pairs)
+          : fmt::format("too few other photos see the modelled surface behind it ({} pairs of "
+                        "pixels) to tell it from a change on the surface",
+                        behind.pairs));
   spdlog::info("igi-diagnose: missing geometry: {}", out.evidence);
   out.valid = true;
   out.apply = [mask_files](Json* doc) {

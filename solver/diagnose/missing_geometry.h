@@ -27,6 +27,13 @@
 // held-out blocks with the masks above, and each share of the fitted blocks with masks carved
 // again without it (cross-fitting). The held-out blocks alone hold a quarter of a small object's
 // pixels: an object seen small by two photos left a handful of blocks to rank.
+//
+// Last, the surface behind it: an object hides the modelled surface from the photos that see it
+// in front, while other photos see that surface as modelled; a change on the surface (a texture's
+// tiles, whose blobs in a few photos can carve together off the floor by chance) shows alike
+// from every side. The residual where other photos see the surface point behind each pixel of
+// the object's projection (not through the object, outside its shadow from their lights),
+// regressed on the residual at that pixel, must stay below max_surface_slope.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -61,6 +68,12 @@ struct MissingGeometryOptions {
   // noise (18x and 11x on igi-synth's objects at the CI and the full size); a phantom carved
   // from a few blobs on a grazing floor's highlights does not (0.5x, with a rank z of 3.8).
   double min_contrast = 2;
+  // Where other photos see the modelled surface behind the object (unoccluded by it, outside its
+  // shadow), their residual regressed on the residual inside its projections: a slope of at least
+  // this is a change on the surface, not an object (a tiled floor's blobs carved to a phantom:
+  // 0.94; igi-synth's objects −0.11..0.01). Judged over at least min_agreement_pairs pixel pairs.
+  double max_surface_slope = 0.5;
+  int min_agreement_pairs = 30;
 
   void Validate() const;
 };
