@@ -469,8 +469,10 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   }
   if (fit_a) {
     for (int c = 0; c < na; ++c) {
+      // scene.json's range for α is (0, 1] (igi-render and the loader refuse more): a fit that
+      // wants a broader lobe is held at 1, as the search's grid is.
       problem.SetParameterLowerBound(al, c, 0.002);
-      problem.SetParameterUpperBound(al, c, 2.0);
+      problem.SetParameterUpperBound(al, c, 1.0);
     }
   }
   ceres::Solver::Options so;

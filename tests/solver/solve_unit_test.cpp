@@ -236,6 +236,22 @@ TEST(RegionFit, APixelsSpreadOfNormalsWidensItsLobeNotTheSurfaces) {
   EXPECT_GT(ignored.alpha, 1.05 * 0.08);
 }
 
+// A lobe broader than scene.json allows (α in (0, 1]): the fit holds α at 1, so that the solved
+// scene loads (a degenerate solve under an unmodelled light profile and response once wrote the
+// floor's α 2.0, and igi-diagnose refused its own baseline).
+TEST(RegionFit, RoughnessStaysInTheScenesRange) {
+  const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
+  for (BrdfModel model : {BrdfModel::kWard, BrdfModel::kWardAniso}) {
+    const RegionFitInput in = MakeSamples(model, {rho_d}, 0.5, 1.8, 0.0, 3);
+    const RegionFitResult r = FitRegion(in, {});
+    ASSERT_TRUE(r.fitted);
+    EXPECT_GT(r.alpha_x, 0.0);
+    EXPECT_LE(r.alpha_x, 1.0);
+    EXPECT_LE(r.alpha_y, 1.0);
+    EXPECT_LE(r.alpha, 1.0);
+  }
+}
+
 TEST(RegionFit, RecoversAnisotropicRoughnessAlongTheTangentAndAcrossIt) {
   // ward_aniso with its tangent known (the local frame's x): αx and αy both recovered.
   const Eigen::Vector3d rho_d(0.3, 0.3, 0.3);
