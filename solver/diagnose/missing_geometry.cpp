@@ -736,14 +736,13 @@ Image SmoothedRelativeResidual(const Image& rec, const Image& sim, const Image& 
 // How far the other photos reproduce, on the modelled surface behind the object, the residual
 // inside its projection: pairs of (the residual at a pixel of the object's projection in one
 // photo, the residual where another photo sees the modelled surface point behind it, unoccluded
-// by the object, outside its shadow from that photo's lights). A change on the surface (a
-// texture, a stain) shows alike from every side: slope and agreement near 1; an object hides the
-// surface from one photo only: near 0.
+// by the object, outside its shadow from that photo's lights), and the regression slope of the
+// second on the first. A change on the surface (a texture, a stain) shows alike from every side:
+// a slope near 1; an object hides the surface from one side only: near 0.
 struct SurfaceAgreement {
-  double ab = 0, aa = 0, bb = 0;
+  double ab = 0, aa = 0;
   int pairs = 0;
   double Slope() const { return aa > 0 ? ab / aa : 0; }
-  double Agreement() const { return aa > 0 && bb > 0 ? ab / std::sqrt(aa * bb) : 0; }
 };
 
 SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
@@ -779,7 +778,7 @@ SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
               ShadowedByObjects(model, model.photos[b].lighting, p, c.objects)) {
             continue;
           }
-          out.ab += double(ra) * rb, out.aa += double(ra) * ra, out.bb += double(rb) * rb;
+          out.ab += double(ra) * rb, out.aa += double(ra) * ra;
           ++out.pairs;
         }
       }
