@@ -668,28 +668,40 @@ std::vector<Image> CoreExclusions(const std::vector<CarveView>& views, const Vox
   return core;
 }
 
-// Whether the segment from x toward a light of `lighting` passes through one of the objects'
-// boxes (x lies in their shadow); ambient light has no direction and casts none.
-bool ShadowedByObjects(const Scene& model, int lighting, const Eigen::Vector3d& x,
-                       const std::vector<CarvedObject>& objects) {
+// Where a light of a lighting lies as seen from the scene, for a shadow test: a point (point,
+// spot and sphere lights, an area light's centroid) or, for a directional light, the direction
+// toward it. Ambient light has no direction and casts no shadow.
+struct LightAnchor {
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();
+  bool directional = false;
+};
+
+std::vector<LightAnchor> LightAnchors(const Scene& model, int lighting) {
+  std::vector<LightAnchor> out;
   for (int li : model.lightings[size_t(lighting)].lights) {
     const Light& light = model.lights[size_t(li)];
-    Eigen::Vector3d to;
-    double reach = std::numeric_limits<double>::infinity();
     if (light.type == LightType::kPoint || light.type == LightType::kSpot) {
-      to = light.position - x;
+      out.push_back({light.position, false});
     } else if (light.type == LightType::kSphere) {
-      to = light.center - x;
+      out.push_back({light.center, false});
     } else if (light.type == LightType::kArea && !light.mesh.positions.empty()) {
       Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (const Eigen::Vector3f& p : light.mesh.positions) c += p.cast<double>();
-      to = c / double(light.mesh.positions.size()) - x;
+      out.push_back({c / double(light.mesh.positions.size()), false});
     } else if (light.type == LightType::kDirectional) {
-      to = -light.direction;
-    } else {
-      continue;
+      out.push_back({-light.direction.normalized(), true});
     }
-    if (light.type != LightType::kDirectional) reach = to.norm();
+  }
+  return out;
+}
+
+// Whether the segment from x toward one of the lights passes through one of the objects' boxes
+// (x lies in their shadow).
+bool ShadowedByObjects(const std::vector<LightAnchor>& lights, const Eigen::Vector3d& x,
+                       const std::vector<CarvedObject>& objects) {
+  for (const LightAnchor& light : lights) {
+    const Eigen::Vector3d to = light.directional ? light.at : Eigen::Vector3d(light.at - x);
+    const double reach = light.directional ? std::numeric_limits<double>::infinity() : to.norm();
     const Eigen::Vector3d d = to.normalized();
     for (const CarvedObject& obj : objects) {
       // Slab test of the ray x + t d, 0 < t < reach, against the box.
@@ -749,15 +761,16 @@ SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
                                  const std::vector<Image>& sims,
                                  const std::vector<CarveView>& views, const VoxelGrid& grid,
                                  const Carving& c) {
+  std::vector<int64_t> object_and_shadow = c.voxels;
+  object_and_shadow.insert(object_and_shadow.end(), c.shadow.begin(), c.shadow.end());
   std::vector<Image> rel, object, hidden;
+  std::vector<std::vector<LightAnchor>> lights;  // per photo
   for (size_t i = 0; i < views.size(); ++i) {
     rel.push_back(SmoothedRelativeResidual(photos.recorded[i], sims[i], photos.valid[i]));
     object.push_back(ProjectVoxels(views[i], grid, c.voxels, 0));
     // Where a photo's view of the surface is the object's or its shadow's (with a margin).
-    Image h = ProjectVoxels(views[i], grid, c.voxels, 1);
-    const Image s = ProjectVoxels(views[i], grid, c.shadow, 1);
-    for (size_t k = 0; k < h.pixels.size(); ++k) h.pixels[k] = std::max(h.pixels[k], s.pixels[k]);
-    hidden.push_back(std::move(h));
+    hidden.push_back(ProjectVoxels(views[i], grid, object_and_shadow, 1));
+    lights.push_back(LightAnchors(model, model.photos[i].lighting));
   }
   SurfaceAgreement out;
   for (size_t a = 0; a < views.size(); ++a) {
@@ -775,7 +788,7 @@ SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
           if (vb.camera_id == va.camera_id || !Sees(vb, p, grid.voxel_m, &u, &v)) continue;
           const float rb = rel[b].at(u, v);
           if (!std::isfinite(rb) || hidden[b].at(u, v) > 0.5f ||
-              ShadowedByObjects(model, model.photos[b].lighting, p, c.objects)) {
+              ShadowedByObjects(lights[b], p, c.objects)) {
             continue;
           }
           out.ab += double(ra) * rb, out.aa += double(ra) * ra;
