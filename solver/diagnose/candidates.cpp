@@ -233,6 +233,8 @@ CandidateResult Vignetting(const CandidateContext& cx, const ResidualFitter& f) 
   return out;
 }
 
+}  // namespace
+
 // ---------------------------------------------------------------- camera_response
 CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
@@ -259,8 +261,23 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
       if (k == 2) b[1] = m;
     };
   };
+  // The basis is a curve of the render's noisy value: its fits are corrected for that noise
+  // (ResidualFitter::FitNoisyBasis) with m'(s) = e (|s|/r)^(e−1) and m''(s) = sign(s) e (e − 1)
+  // (|s|/r)^(e−2) / r, where the noise is small beside the value (a second-order expansion; on
+  // darker pixels the power is too curved for it, and their share of the sums is small).
+  auto derivatives_at = [&](double e) {
+    return [&, e](const PixelRecord& r, int c, double* d1, double* d2) {
+      const double s = r.sim[c], u = std::abs(s) / ref;
+      if (!(double(r.sim_var[c]) < 0.09 * s * s)) return false;
+      const double m1 = e * std::pow(u, e - 1), m2 = e * (e - 1) * std::pow(u, e - 2) / ref;
+      d1[0] = m1 - 1;
+      d2[0] = s < 0 ? -m2 : m2;
+      if (k == 2) d1[1] = m1, d2[1] = d2[0];
+      return true;
+    };
+  };
   for (double e : {0.5, 0.6, 0.7, 0.8, 0.9, 1.1, 1.25, 1.4, 1.6, 1.8, 2.0}) {
-    const ResidualFit fit = f.Fit(k, basis_at(e));
+    const ResidualFit fit = f.FitNoisyBasis(k, basis_at(e), derivatives_at(e));
     if (fit.coef.size() && (best.coef.size() == 0 || fit.train_after < best.train_after)) {
       best = fit, best_e = e;
     }
@@ -270,11 +287,17 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   double lo = best_e * 0.85, hi = best_e * 1.15;
   for (int it = 0; it < 14; ++it) {
     const double m1 = lo + (hi - lo) * 0.382, m2 = lo + (hi - lo) * 0.618;
-    auto err = [&](double e) { return f.Fit(k, basis_at(e)).train_after; };
-    (err(m1) < err(m2) ? hi : lo) = (err(m1) < err(m2) ? m2 : m1);
+    auto err = [&](double e) {
+      return f.FitNoisyBasis(k, basis_at(e), derivatives_at(e)).train_after;
+    };
+    if (err(m1) < err(m2)) {
+      hi = m2;
+    } else {
+      lo = m1;
+    }
   }
   const double e_grid = 0.5 * (lo + hi);
-  best = f.Fit(k, basis_at(e_grid));
+  best = f.FitNoisyBasis(k, basis_at(e_grid), derivatives_at(e_grid));
   if (best.coef.size() == 0) return out;
   FillScores(best, &out);
   // photo ≈ sim + c·(model_e − sim) (+ s·model_e): for c near 1 the exponent is e; in general
@@ -303,6 +326,8 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   };
   return out;
 }
+
+namespace {
 
 // The direct light of one light at a record toward the camera, Σ f(wi, view)·irradiance with the
 // region's BRDF (ρd from the record; an anisotropic lobe, whose tangent the records lack, counts

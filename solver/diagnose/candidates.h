@@ -72,6 +72,11 @@ class RecordSubset;
 CandidateResult SpecularReflection(const CandidateContext& context, const ResidualFitter& fitter,
                                    int region);
 
+// camera_response: the photos follow the model's value through a power about a reference,
+// ref·(v/ref)^e (photo_model.h). The exponent is searched on the residual with a fit corrected
+// for the renders' noise in the model's value (ResidualFitter::FitNoisyBasis).
+CandidateResult Response(const CandidateContext& context, const ResidualFitter& fitter);
+
 // light_emission_profile for light `light` (index into model.lights): the light's direct term
 // becomes cos^n of the angle from an axis (a "spot" with a cos_power profile). The axis and n are
 // searched with a camera response as a nuisance (so that a response the photos also hide does not

@@ -65,6 +65,22 @@ class ResidualFitter {
         k, basis, [](const PixelRecord&, int) { return 0.0; }, nuisance_);
   }
 
+  // Fit for a basis computed from the noisy simulation itself, b(s) (a response curve of the
+  // model's value): b and the residual y = photo − s both carry the render's noise ε (variance
+  // V = PixelRecord::sim_var), so a plain fit reads that noise as part of the curve (the photo's
+  // slope on the noisy model value is diluted: a response's exponent comes out low, 0.718 for
+  // 0.791 at 10 % render noise in candidates_test's ResponseTest). To second order in ε, with
+  // b' = ∂b/∂s and b'' = ∂²b/∂s², the sums' expectations exceed their noise-free values by
+  //   Σ s·b: V (b' + s b''/2),  Σ b·y: V (y b''/2 − b'),  Σ b·bᵀ: V (b' b'ᵀ + (b b''ᵀ + b'' bᵀ)/2);
+  // they are subtracted (with the nuisance's correction of FitNoiseFreeBasis), and the held-out
+  // gain counts the residual's noise as (1 + a + c·b')² V. derivatives(record, channel, d1, d2)
+  // writes b' and b'' (K values each, zeroed before each call).
+  template <class F, class D>
+  ResidualFit FitNoisyBasis(int k, F basis, D derivatives) const {
+    return FitImpl(
+        k, basis, [](const PixelRecord&, int) { return 0.0; }, true, 0, derivatives);
+  }
+
   // A fit credited only with what it explains beyond its first `k_base` columns: "before" (the
   // scores and the significance's blocks) is the fit of those columns alone, "after" the fit of
   // all k. For an effect whose model contains another's (per-photo scales contain a scale per
@@ -79,8 +95,13 @@ class ResidualFitter {
   bool nuisance() const { return nuisance_; }
 
  private:
-  template <class F, class G>
-  ResidualFit FitImpl(int k, F basis, G offset, bool noise_free, int k_base = 0) const;
+  // No basis derivatives: the basis carries none of the simulation's noise.
+  struct NoDerivatives {
+    bool operator()(const PixelRecord&, int, double*, double*) const { return false; }
+  };
+  template <class F, class G, class D = NoDerivatives>
+  ResidualFit FitImpl(int k, F basis, G offset, bool noise_free, int k_base = 0,
+                      D derivatives = D()) const;
   ResidualFit Solve(int k, const std::vector<double>& stats, bool noise_free, int k_base = 0) const;
   // Σ s y / Σ s² of the held-out set per (cell, channel), before and after the fit (with the
   // variance correction when noise_free).
@@ -148,11 +169,23 @@ int SearchStride(const std::vector<PixelRecord>& records, int target);
 // Per (cell, channel, set) the statistics are laid out as (y = photo − sim − offset, y0 = photo −
 // sim): [0] Σ s², [1] Σ s·y, [2] Σ y², [3..3+k) Σ s·b, [3+k..3+2k) Σ b·y, then k×k Σ b·bᵀ,
 // then Σ var(s), Σ s·y0 and Σ y0².
-template <class F, class G>
-ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, int k_base) const {
+// With derivatives (FitNoisyBasis), the sums are corrected for the basis's own noise as they are
+// accumulated; derivatives returns false for a basis without noise.
+template <class F, class G, class D>
+ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, int k_base,
+                                    D derivatives) const {
   const int stride = Stride(k);
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
-  std::vector<double> b(k);
+  std::vector<double> b(k), d1(k), d2(k);
+  // Σ c·b' of the record's channel (zero for a basis without noise).
+  auto slope = [&](const PixelRecord& r, int c, const Eigen::VectorXd& coef) {
+    std::fill(d1.begin(), d1.end(), 0.0);
+    std::fill(d2.begin(), d2.end(), 0.0);
+    if (coef.size() == 0 || !derivatives(r, c, d1.data(), d2.data())) return 0.0;
+    double v = 0;
+    for (int a = 0; a < coef.size(); ++a) v += coef[a] * d1[a];
+    return v;
+  };
   // A basis is mostly zeros (one column per region, of which a record has one): only its
   // nonzero entries are accumulated (the sums are the same: adding a zero product changes none).
   std::vector<int> nz(k);
@@ -177,6 +210,19 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, i
         st[3 + k + a] += b[a] * y;
         double* row = st + 3 + 2 * k + a * k;
         for (int ie = 0; ie < n; ++ie) row[nz[ie]] += b[a] * b[nz[ie]];
+      }
+      std::fill(d1.begin(), d1.end(), 0.0);
+      std::fill(d2.begin(), d2.end(), 0.0);
+      const double v = r.sim_var[c];
+      if (v > 0 && derivatives(r, c, d1.data(), d2.data())) {
+        for (int a = 0; a < k; ++a) {
+          st[3 + a] -= v * (d1[a] + 0.5 * s * d2[a]);
+          st[3 + k + a] -= v * (0.5 * y * d2[a] - d1[a]);
+          double* row = st + 3 + 2 * k + a * k;
+          for (int e = 0; e < k; ++e) {
+            row[e] -= v * (d1[a] * d1[e] + 0.5 * (b[a] * d2[e] + d2[a] * b[e]));
+          }
+        }
       }
     }
   }
@@ -206,8 +252,12 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, i
       const double a1 = NuisanceCoef(stats, k, size_t(cell_[i]), c, fit.coef, noise_free);
       const double r0 = y0 - cb0 - a0 * s;
       g += r0 * r0 - (y - cb - a1 * s) * (y - cb - a1 * s);
-      // The render's noise in the residual, (1 + a)² var: its change is not the candidate's gain.
-      if (noise_free) g -= ((1 + a0) * (1 + a0) - (1 + a1) * (1 + a1)) * double(r.sim_var[c]);
+      // The render's noise in the residual, (1 + a + c·b')² var: its change is not the
+      // candidate's gain.
+      if (noise_free) {
+        const double n0 = 1 + a0 + slope(r, c, before_coef), n1 = 1 + a1 + slope(r, c, fit.coef);
+        g -= (n0 * n0 - n1 * n1) * double(r.sim_var[c]);
+      }
       e += r0 * r0;
     }
     if (!support) continue;
