@@ -422,32 +422,34 @@ CandidateResult TextureFirst(const Scene& declared, const ModelState& st, double
   for (const TextureEvidence& e : FindTexturedRegions(st.model, st.records, solved, to)) {
     tests.push_back({{"region", e.region},
                      {"cells", e.cells},
+                     {"cell_m", e.cell_m},
                      {"sign_agreement", e.agreement},
                      {"rank_correlation", e.rank_correlation},
                      {"z", e.z},
                      {"amplitude", e.amplitude},
                      {"textured", e.textured}});
     spdlog::info(
-        "igi-diagnose: texture test of {}: {} cells, rank correlation {:.2f} (z {:.1f}), signs "
-        "agree in {:.0f}% (z {:.1f}), amplitude {:.1f}%{}",
-        e.region, e.cells, e.rank_correlation, e.z, 100 * e.agreement, e.sign_z, 100 * e.amplitude,
-        e.textured ? ": textured" : "");
+        "igi-diagnose: texture test of {}: {} cells of {:.0f} cm, rank correlation {:.2f} (z "
+        "{:.1f}), signs agree in {:.0f}% (z {:.1f}), amplitude {:.1f}%{}",
+        e.region, e.cells, 100 * e.cell_m, e.rank_correlation, e.z, 100 * e.agreement, e.sign_z,
+        100 * e.amplitude, e.textured ? ": textured" : "");
     if (!e.textured) continue;
     regions.push_back(e.region);
-    shown += fmt::format("{}{} (rank correlation {:.2f}, {:.0f}% of {} cells, {:.0f}%)",
-                         shown.empty() ? "" : ", ", e.region, e.rank_correlation, 100 * e.agreement,
-                         e.cells, 100 * e.amplitude);
+    shown +=
+        fmt::format("{}{} (rank correlation {:.2f}, {:.0f}% of {} cells of {:.0f} cm, {:.0f}%)",
+                    shown.empty() ? "" : ", ", e.region, e.rank_correlation, 100 * e.agreement,
+                    e.cells, 100 * e.cell_m, 100 * e.amplitude);
   }
   c.valid = !regions.empty();
   c.params = {{"regions", regions}};
   c.where = {{"regions", regions}, {"frame", "position on the surfaces"}, {"texture_tests", tests}};
   c.evidence = fmt::format(
-      "the photos' ratio to the constant-albedo model changes from one {:.0f} cm surface cell to "
-      "the next, alike in the even and the odd photos (region: the two sets' rank correlation over "
+      "the photos' ratio to the constant-albedo model changes from one surface cell to the "
+      "next, alike in the even and the odd photos (region: the two sets' rank correlation over "
       "the cells, share of cells whose high-pass signs agree, cells, reproducible amplitude): "
-      "{}. A texture: fitted before any other "
-      "candidate is judged, so that no smooth effect can pass for it",
-      100 * cell_m, shown);
+      "{}. A texture: fitted before any other candidate is judged, so that no smooth effect can "
+      "pass for it",
+      shown);
   return c;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 
 namespace igi {
@@ -81,6 +82,22 @@ double RankCorrelation(const std::vector<double>& a, const std::vector<double>& 
   return aa > 0 && bb > 0 ? ab / std::sqrt(aa * bb) : 0.0;
 }
 
+// The median over the cells either photo set holds of the smaller set's record count.
+double MedianRecords(const CellGrid& a, const CellGrid& b) {
+  std::vector<int> n;
+  auto count = [](const CellGrid& g, CellKey key) {
+    const auto it = g.cells.find(key);
+    return it == g.cells.end() ? 0 : it->second.n;
+  };
+  for (const auto& [key, c] : a.cells) n.push_back(std::min(c.n, count(b, key)));
+  for (const auto& [key, c] : b.cells) {
+    if (!a.cells.count(key)) n.push_back(0);
+  }
+  if (n.empty()) return 0;
+  std::nth_element(n.begin(), n.begin() + n.size() / 2, n.end());
+  return n[n.size() / 2];
+}
+
 TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellGrid& b,
                          const TextureEvidenceOptions& o) {
   TextureEvidence e;
@@ -130,27 +147,40 @@ std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
                                                  const std::vector<bool>& solved,
                                                  const TextureEvidenceOptions& options) {
   const int regions = int(model.materials.size());
-  std::vector<CellGrid> grids(2 * size_t(regions));  // [region * 2 + photo parity]
-  for (const PixelRecord& r : records) {
-    if (r.held_out || r.outlier || r.region < 0 || r.region >= regions) continue;
-    if (r.region >= int(solved.size()) || !solved[r.region]) continue;
-    const double q = Ratio(r);
-    if (!std::isfinite(q)) continue;
-    const Eigen::Vector3i c =
-        (r.position.cast<double>() / options.cell_m).array().floor().cast<int>();
-    CellGrid& g = grids[size_t(r.region) * 2 + (r.photo & 1)];
-    const CellKey key = KeyOf(c.x(), c.y(), c.z());
-    CellSum& s = g.cells[key];
-    s.cell = c;
-    s.sum += q;
-    ++s.n;
+  std::vector<std::optional<TextureEvidence>> best{size_t(regions)};
+  const std::vector<double> scales =
+      options.scales.empty() ? std::vector<double>{1.0} : options.scales;
+  std::vector<bool> dense(size_t(regions), false);  // the scales so far had records enough
+  for (const double scale : scales) {
+    const double cell_m = options.cell_m * scale;
+    std::vector<CellGrid> grids(2 * size_t(regions));  // [region * 2 + photo parity]
+    for (const PixelRecord& r : records) {
+      if (r.held_out || r.outlier || r.region < 0 || r.region >= regions) continue;
+      if (r.region >= int(solved.size()) || !solved[r.region]) continue;
+      const double q = Ratio(r);
+      if (!std::isfinite(q)) continue;
+      const Eigen::Vector3i c = (r.position.cast<double>() / cell_m).array().floor().cast<int>();
+      CellGrid& g = grids[size_t(r.region) * 2 + (r.photo & 1)];
+      const CellKey key = KeyOf(c.x(), c.y(), c.z());
+      CellSum& s = g.cells[key];
+      s.cell = c;
+      s.sum += q;
+      ++s.n;
+    }
+    for (int r = 0; r < regions; ++r) {
+      const CellGrid& a = grids[size_t(r) * 2];
+      const CellGrid& b = grids[size_t(r) * 2 + 1];
+      if (a.cells.empty() || b.cells.empty() || dense[size_t(r)]) continue;
+      dense[size_t(r)] = MedianRecords(a, b) >= options.dense_records;
+      TextureEvidence e = Evaluate(model.materials[r].name, a, b, options);
+      e.cell_m = cell_m;
+      std::optional<TextureEvidence>& kept = best[size_t(r)];
+      if (!kept || (!kept->textured && (e.textured || e.z > kept->z))) kept = e;
+    }
   }
   std::vector<TextureEvidence> out;
-  for (int r = 0; r < regions; ++r) {
-    const CellGrid& a = grids[size_t(r) * 2];
-    const CellGrid& b = grids[size_t(r) * 2 + 1];
-    if (a.cells.empty() || b.cells.empty()) continue;
-    out.push_back(Evaluate(model.materials[r].name, a, b, options));
+  for (const std::optional<TextureEvidence>& e : best) {
+    if (e) out.push_back(*e);
   }
   return out;
 }
