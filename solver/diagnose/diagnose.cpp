@@ -17,6 +17,7 @@
 
 #include "solver/diagnose/missing_geometry.h"
 #include "solver/diagnose/pose_error.h"
+#include "solver/diagnose/residual_fit.h"
 #include "solver/diagnose/texture_evidence.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
@@ -453,6 +454,64 @@ CandidateResult TextureFirst(const Scene& declared, const ModelState& st, double
   return c;
 }
 
+// A response's exponent fitted on a model whose albedos were solved without it comes out
+// attenuated: the albedos (and maps) had absorbed part of the curve, and the refit's albedos
+// absorb less of the rest. The seed-103 capture with the materials unknown: 0.868 for 0.8 on the
+// baseline, 0.943 after the floor's maps, whose refit then lost to an ambient term (−8.9 %
+// against −12.8 % held out) that the true exponent beats (session 29). The candidate is fitted
+// again on the refit's own residual (its records where the trial is rendered): in log e, the
+// second fit g1 at x1 (the first step, g0 from 0) gives the attenuation κ = (g0 − g1) / x1 and the
+// fixed point x1 + g1 / κ (a secant), refitted once more. Kept only when the second fit moves the
+// same way as the first and κ is in [0.1, 1] (a fit that absorbs nothing, or overshoots, is left
+// as it was); the held-out test judges the last refit as any other.
+void RefineResponse(const PhotoSet& photos, const DiagnoseOptions& o, const fs::path& dir,
+                    const MapMode& maps, const PixelMasks* test_masks, CandidateResult* c,
+                    Json* next, ModelState* state) {
+  const double e1 = c->params.value("exponent", 1.0);
+  if (!(e1 > 0) || std::abs(std::log(e1)) < 1e-3) return;
+  const std::vector<PixelRecord> records =
+      BuildRecords(state->model, photos, state->sim.sims, o, &state->sim.variance);
+  int num_cells = 0;
+  std::vector<int> cells = RecordCells(state->model, records, CellSize(state->model), &num_cells);
+  const ResidualFitter f(records, std::move(cells), num_cells, true, o.holdout_block_px);
+  const CandidateResult again =
+      Response({state->model, *next, true, CellSize(state->model), o.holdout_block_px}, f);
+  if (!again.valid) return;
+  const double x1 = std::log(e1), g0 = x1, g1 = std::log(again.params.value("exponent", 1.0));
+  const double kappa = (g0 - g1) / x1;
+  spdlog::info(
+      "igi-diagnose: camera_response refitted on its own residual: exponent {:.4f} more "
+      "(attenuation {:.2f})",
+      std::exp(g1), kappa);
+  if (!(g1 * g0 > 0) || !(kappa >= 0.1 && kappa <= 1)) return;
+  const double x = x1 + g1 / kappa, e = std::exp(x);
+  const double reference = again.params.value("reference", c->params.value("reference", 1.0));
+  Json doc = *next;
+  for (Json& p : doc["photos"]) {
+    const double declared = p.contains("response") && p["response"].contains("exponent") &&
+                                    p["response"]["exponent"].is_number()
+                                ? p["response"]["exponent"].get<double>() / e1
+                                : 1.0;
+    p["response"] = {{"exponent", declared * e}, {"reference", reference}};
+  }
+  ModelState refined;
+  try {
+    refined = FitModel(doc, true, maps, dir / "refined", o, photos, false, test_masks);
+  } catch (const Error& err) {
+    spdlog::warn("igi-diagnose: camera_response's refined refit failed: {}", err.what());
+    return;
+  }
+  c->params["first_exponent"] = e1;
+  c->params["exponent"] = e;
+  c->params["reference"] = reference;
+  c->evidence += fmt::format(
+      "; fitted again on the refit's residual (a further {:.3f}: the albedos had absorbed a "
+      "share {:.2f} of the curve), the exponent's fixed point is {:.3f}",
+      std::exp(g1), 1 - kappa, e);
+  *next = std::move(doc);
+  *state = std::move(refined);
+}
+
 // The photo whose held-out residual the step reduced most (for the report's images).
 size_t MostImprovedPhoto(const PhotoSet& photos, const std::vector<Image>& before,
                          const std::vector<Image>& after) {
@@ -559,6 +618,10 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
       return t;
+    }
+    if (c.effect == "camera_response" && solve) {
+      RefineResponse(photos, o, ds.model_dir, next_maps, &test_masks, &c, &t.next, &t.state);
+      ds.model_dir = t.state.dir;
     }
     // Until the step is applied (settle), the fitted pixels' residual is over the grid of
     // HeldOutTestMasks only, before and after alike.
@@ -694,6 +757,19 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   // region are then not tried again as a last candidate of each round.
   bool texture_judged = false;
   if (solve && o.max_steps > 0) {
+    // An object the model lacks is located before the maps: fitted with the object's pixels in
+    // them, the maps of the surfaces around and under it take up part of its image and its
+    // shadow, and its blobs fall below the locator's tests (the full-size missing_geometry
+    // capture of seed 115, session 29: named first before the maps, not at all after them). A
+    // texture's blobs are not taken for an object (the surface-behind test, missing_geometry.h).
+    missing = LocateMissingGeometry(st.model, photos, st.sim.sims, st.records, holdout,
+                                    out_dir / "masks");
+    if (missing.candidate.valid && missing.candidate.Gain() >= o.candidate_min_gain &&
+        missing.candidate.z >= o.candidate_min_z) {
+      std::vector<Trial> one;
+      one.push_back(try_step(missing.candidate, maps));
+      settle(one, maps);
+    }
     CandidateResult texture = TextureFirst(scene, st, CellSize(st.model));
     texture_judged = texture.valid;
     if (texture.valid) {
