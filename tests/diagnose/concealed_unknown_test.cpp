@@ -30,7 +30,11 @@ TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
                                                " --photo-lightings L0,L1", false);
   const Json& d = o.diagnosis;
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
-  const Json& first = d["steps"][0];
+  // igi-synth's floor is textured: since session 29 its maps come first here (the texture test's
+  // coarser cells), and the hidden effect is the first step after them.
+  size_t k = 0;
+  while (k + 1 < d["steps"].size() && d["steps"][k]["effect"] == "albedo_texture") ++k;
+  const Json& first = d["steps"][k];
   EXPECT_EQ(first["effect"], "ambient_light") << d.dump(1);
   if (first["effect"] == "ambient_light") {
     for (int c = 0; c < 3; ++c) {
