@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <memory>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -178,7 +179,10 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, i
   std::vector<double> stats(size_t(num_cells_) * 3 * 2 * stride, 0.0);
   std::vector<double> b(k), d1(k), d2(k);
   // Σ c·b' of the record's channel (zero for a basis without noise).
+  // A basis without noise (every fit but FitNoisyBasis's) skips the derivatives' work.
+  constexpr bool kNoisy = !std::is_same_v<D, NoDerivatives>;
   auto slope = [&](const PixelRecord& r, int c, const Eigen::VectorXd& coef) {
+    if constexpr (!kNoisy) return 0.0;
     std::fill(d1.begin(), d1.end(), 0.0);
     std::fill(d2.begin(), d2.end(), 0.0);
     if (coef.size() == 0 || !derivatives(r, c, d1.data(), d2.data())) return 0.0;
@@ -211,6 +215,7 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, i
         double* row = st + 3 + 2 * k + a * k;
         for (int ie = 0; ie < n; ++ie) row[nz[ie]] += b[a] * b[nz[ie]];
       }
+      if constexpr (!kNoisy) continue;
       std::fill(d1.begin(), d1.end(), 0.0);
       std::fill(d2.begin(), d2.end(), 0.0);
       const double v = r.sim_var[c];
