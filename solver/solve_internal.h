@@ -186,6 +186,10 @@ struct SolverState {
   void RunStage2();
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir) const;
+  // The model's residual rendered at the observed pixels (report.json's render_residual, and
+  // stage 2's acceptance test), of the model as scene.json will have it: the per-patch albedo
+  // maps CompleteScene gives the regions fitted per patch are dropped where the options write
+  // none (--albedo-maps none, or a region outside albedo_map_regions), which keep one albedo.
   void RenderResiduals(const Scene& model, int stage);
   // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
   // observation (gathered from the photographed patches: less noisy than the rounds' few

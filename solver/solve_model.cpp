@@ -235,8 +235,22 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
   return model;
 }
 
-void SolverState::RenderResiduals(const Scene& model, int stage) {
+void SolverState::RenderResiduals(const Scene& complete, int stage) {
   const auto start = std::chrono::steady_clock::now();
+  // The model as written: without it the report measured a model the user never gets (a
+  // two-lighting capture whose lightings disagree, solved with --albedo-maps none: reported 0.153
+  // with four regions' per-patch maps, 0.48 as written; bench/RESULTS.md, Diagnosis, session 30).
+  Scene model = complete;
+  const std::vector<std::string>& only = options.albedo_map_regions;
+  for (size_t r = 0; r < materials.size() && r < model.materials.size(); ++r) {
+    Material& m = model.materials[r];
+    const bool writes = options.albedo_maps != "none" &&
+                        (only.empty() || std::find(only.begin(), only.end(), m.name) != only.end());
+    if (!writes && materials[r].unknown_rho_d && m.rho_d_map && !scene.materials[r].rho_d_map) {
+      m.rho_d_map.reset();
+      m.rho_d = materials[r].params.rho_d;
+    }
+  }
   // Two independent renders of kSpp/2 paths: Σ(r1 − p)(r2 − p) estimates Σ(r − p)² of the
   // noise-free render r without the render's own Monte Carlo variance (whose size at a few
   // paths per pixel would otherwise swamp the model's error).

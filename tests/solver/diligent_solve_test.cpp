@@ -121,11 +121,13 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   return fit;
 }
 
-// Measured (Release, 2 threads, shared 2-core machine under load ~5; the whole test 12 s):
-//   ward:    rho_d (0.487 0.411 0.268), rho_s 0.0081, alpha 0.032; fit render residual 0.067,
-//            region rms 0.072, held-out residual 0.098
-//   lambert: rho_d (0.476 0.400 0.264);               fit render residual 0.126,
-//            region rms 0.115, held-out residual 0.155
+// Measured (Release, 2 threads, shared 2-core machine; the whole test 3 s), session 30:
+//   ward:    rho_d (0.517 0.437 0.286), rho_s 0.0090, alpha 0.026; fit render residual 0.096,
+//            region rms 0.096, held-out residual 0.097
+//   lambert: rho_d (0.499 0.423 0.279);               fit render residual 0.154,
+//            region rms 0.210, held-out residual 0.141
+// (Before session 30 the fit render residual was of the ball with its per-patch albedo map,
+// which --albedo-maps none does not write: ward 0.067, lambert 0.126.)
 TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   const fs::path out = test::UniqueTempDir("igi_diligent_solve");
   const BallFit ward = FitBall(BrdfModel::kWard, "ward", out);
@@ -140,10 +142,10 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   EXPECT_GT(ward.region.final_params.alpha, 0.01);
   EXPECT_LT(ward.region.final_params.alpha, 0.5);
   // Clearly below: at least 20 % lower residual on the fitted photos, by both measures
-  // (measured: 0.53 and 0.62 of Lambert's).
+  // (measured: 0.62 and 0.46 of Lambert's).
   EXPECT_LT(ward.fit_residual, 0.8 * lambert.fit_residual);
   EXPECT_LT(ward.region_rms, 0.8 * lambert.region_rms);
-  // Photos under lights neither fit saw (measured 0.63 of Lambert's).
+  // Photos under lights neither fit saw (measured 0.69 of Lambert's).
   EXPECT_LE(ward.held_out, lambert.held_out);
 }
 
