@@ -94,8 +94,8 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
 }
 
 // The residual the report states ("rendered at the observed pixels") is of the model as written:
-// with --albedo-maps none a region the fit treats per patch (the tiled glossy floor, whose albedo
-// varies) is written with one albedo, and the report had rendered it with its per-patch map (on
+// with --albedo-maps none a region the fit treats per patch (its albedo varies from patch to
+// patch) is written with one albedo, and the report had rendered it with its per-patch map (on
 // session 30's two-lighting capture: reported 0.153, 0.48 as written). The written scene.json
 // is rendered here twice per photo (independent seeds, 128 paths each) and Σ(r1 − p)(r2 − p)
 // over the observed pixels estimates its residual without the renders' own noise, as the
