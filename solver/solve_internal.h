@@ -186,11 +186,14 @@ struct SolverState {
   void RunStage2();
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir) const;
+  // Whether the options let region r have an albedo map in scene.json (not --albedo-maps none,
+  // and among albedo_map_regions when those are listed).
+  bool MapAllowed(size_t r) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and
   // stage 2's acceptance test), of the model as scene.json will have it: the per-patch albedo
-  // maps CompleteScene gives the regions fitted per patch are dropped where the options write
-  // none (--albedo-maps none, or a region outside albedo_map_regions), which keep one albedo.
-  void RenderResiduals(const Scene& model, int stage);
+  // maps CompleteScene gives the regions fitted per patch are dropped where !MapAllowed, which
+  // keep one albedo.
+  void RenderResiduals(Scene model, int stage);
   // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
   // observation (gathered from the photographed patches: less noisy than the rounds' few
   // path-traced directions) times the ratio of the rounds' to stage 1's irradiance averaged over

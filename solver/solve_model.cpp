@@ -235,18 +235,22 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
   return model;
 }
 
-void SolverState::RenderResiduals(const Scene& complete, int stage) {
+bool SolverState::MapAllowed(size_t r) const {
+  const std::vector<std::string>& only = options.albedo_map_regions;
+  return options.albedo_maps != "none" &&
+         (only.empty() ||
+          std::find(only.begin(), only.end(), scene.materials[r].name) != only.end());
+}
+
+void SolverState::RenderResiduals(Scene model, int stage) {
   const auto start = std::chrono::steady_clock::now();
   // The model as written: without it the report measured a model the user never gets (a
   // two-lighting capture whose lightings disagree, solved with --albedo-maps none: reported 0.153
   // with four regions' per-patch maps, 0.48 as written; bench/RESULTS.md, Diagnosis, session 30).
-  Scene model = complete;
-  const std::vector<std::string>& only = options.albedo_map_regions;
   for (size_t r = 0; r < materials.size() && r < model.materials.size(); ++r) {
     Material& m = model.materials[r];
-    const bool writes = options.albedo_maps != "none" &&
-                        (only.empty() || std::find(only.begin(), only.end(), m.name) != only.end());
-    if (!writes && materials[r].unknown_rho_d && m.rho_d_map && !scene.materials[r].rho_d_map) {
+    if (!MapAllowed(r) && materials[r].unknown_rho_d && m.rho_d_map &&
+        !scene.materials[r].rho_d_map) {
       m.rho_d_map.reset();
       m.rho_d = materials[r].params.rho_d;
     }
@@ -366,18 +370,14 @@ void SolverState::RunStage2() {
   std::vector<RegionAtlas> atlases;
   std::vector<Image> maps;
   const std::vector<MaterialState> stage1 = materials;
-  {
-    const Scene model = CompleteScene(&atlases, &maps, temp / "s1");
-    RenderResiduals(model, 1);
-  }
+  RenderResiduals(CompleteScene(&atlases, &maps, temp / "s1"), 1);
   for (int round = 1; round <= options.refine_iterations; ++round) {
     RefineRound(round, temp / std::to_string(round));
   }
   for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
   if (options.refine_iterations > 0) {
     std::filesystem::create_directories(temp / "final");
-    const Scene model = CompleteScene(&atlases, &maps, temp / "final");
-    RenderResiduals(model, 2);
+    RenderResiduals(CompleteScene(&atlases, &maps, temp / "final"), 2);
     // The refinement's parameters are kept only if the photos are not explained worse than by
     // the paper's (beyond twice the standard error of the comparison).
     const double r1 = summary.stage1_render_residual, r2 = summary.stage2_render_residual;
@@ -408,12 +408,7 @@ void SolverState::BuildAlbedoMaps() {
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
-    const std::vector<std::string>& only = options.albedo_map_regions;
-    if (options.albedo_maps == "none" ||
-        (!only.empty() &&
-         std::find(only.begin(), only.end(), scene.materials[r].name) == only.end())) {
-      continue;
-    }
+    if (!MapAllowed(r)) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     bool want = options.albedo_maps == "all" || m.last_fit.albedo_varies;
     RegionSolution& rs = summary.regions[r];
