@@ -557,6 +557,23 @@ void SolverState::FinishRegions() {
   }
 }
 
+int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map) {
+  int clipped = 0;
+  for (int y = 0; y < map->height; ++y) {
+    for (int x = 0; x < map->width; ++x) {
+      for (int c = 0; c < std::min(map->channels, 3); ++c) {
+        float& v = map->at(x, y, c);
+        v = float(v * factor[c]);
+        if (v > 1.0f) {
+          v = 1.0f;
+          ++clipped;
+        }
+      }
+    }
+  }
+  return clipped;
+}
+
 // scene.json refuses a reflectance above 1, and no passive surface has one: a fitted ρd or ρs
 // above 1 is held at 1 (the fit's value goes to the report), the albedo map is scaled by the same
 // factor per channel and its texels clipped at 1. The photos' excess stays in the residual, where
@@ -574,21 +591,7 @@ void SolverState::BoundReflectances(size_t r) {
   }
   p.rho_d = p.rho_d.cwiseMin(1.0);
   p.rho_s = p.rho_s.cwiseMin(1.0);
-  if (rs.albedo_map) {
-    Image& map = *rs.albedo_map;
-    for (int y = 0; y < map.height; ++y) {
-      for (int x = 0; x < map.width; ++x) {
-        for (int c = 0; c < std::min(map.channels, 3); ++c) {
-          float& v = map.at(x, y, c);
-          v = float(v * map_factor[c]);
-          if (v > 1.0f) {
-            v = 1.0f;
-            ++rs.albedo_texels_clipped;
-          }
-        }
-      }
-    }
-  }
+  if (rs.albedo_map) rs.albedo_texels_clipped += ScaleMapHeldAtOne(map_factor, &*rs.albedo_map);
   if (rs.albedo_map && rs.albedo_map_seen &&
       (map_factor != Eigen::Vector3d::Ones() || rs.albedo_texels_clipped > 0)) {
     rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, *rs.albedo_map_seen);

@@ -99,6 +99,11 @@ inline bool IsJointUpdate(const std::string& update) {
   return update == "joint" || update == "joint_albedo";
 }
 
+// An albedo map as scene.json holds it when its region's fitted ρd exceeds 1 in some channel
+// (BoundReflectances): scaled by `factor` per channel (1/ρd where ρd > 1, else 1) and its texels
+// clipped at 1. Returns how many texel channels were clipped.
+int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map);
+
 struct SolverState {
   const Scene& scene;
   SolveOptions options;
@@ -184,15 +189,23 @@ struct SolverState {
   // rendered incident light, smoothing, FitAll(2, round), specular terms.
   void RefineRound(int round, const std::filesystem::path& temp_dir);
   void RunStage2();
+  // The model as it stands. Per-patch albedo maps (written under temp_dir) go to the regions
+  // fitted per patch, or, as_written, to exactly the regions BuildAlbedoMaps gives a map
+  // (WritesMap): the refinement's rounds model the bounced light with the per-patch albedos
+  // whatever the options write, the report renders the model scene.json will hold.
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
-                      const std::filesystem::path& temp_dir) const;
+                      const std::filesystem::path& temp_dir, bool as_written = false) const;
   // Whether the options let region r have an albedo map in scene.json (not --albedo-maps none,
   // and among albedo_map_regions when those are listed).
   bool MapAllowed(size_t r) const;
+  // Whether scene.json gives region r an albedo map: an observed region of unknown ρd the options
+  // allow one, with --albedo-maps all, an albedo fitted per patch, or (auto) an albedo that
+  // varies from texel to texel beyond the photos' noise (its variation in *texel_variation when
+  // that test ran).
+  bool WritesMap(size_t r, const RegionAtlas& atlas, const std::vector<Eigen::Vector3d>& smooth_t,
+                 const std::vector<Eigen::Vector3d>& map_e, double* texel_variation) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and
-  // stage 2's acceptance test), of the model as scene.json will have it: the per-patch albedo
-  // maps CompleteScene gives the regions fitted per patch are dropped where !MapAllowed, which
-  // keep one albedo.
+  // stage 2's acceptance test); `model` is CompleteScene's as_written.
   void RenderResiduals(Scene model, int stage);
   // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
   // observation (gathered from the photographed patches: less noisy than the rounds' few

@@ -199,7 +199,7 @@ std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
 }
 
 Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
-                                 const std::filesystem::path& temp_dir) const {
+                                 const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
   const std::vector<Eigen::Vector3d> smooth_t =
       NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
@@ -220,9 +220,19 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
         out.alpha_y = m.params.alpha_y;
       }
     }
-    if (m.unknown_rho_d && m.last_fit.albedo_model == "per_patch") {
-      atlases->push_back(AtlasOf(*this, int(r)));
+    if (as_written) {  // reflectances above 1 held at 1, as BoundReflectances writes them
+      if (out.rho_d) out.rho_d = out.rho_d->cwiseMin(1.0);
+      if (out.rho_s) out.rho_s = out.rho_s->cwiseMin(1.0);
+    }
+    if (!m.unknown_rho_d || (!as_written && m.last_fit.albedo_model != "per_patch")) continue;
+    RegionAtlas atlas = AtlasOf(*this, int(r));
+    if (!as_written || WritesMap(r, atlas, smooth_t, map_e, nullptr)) {
+      atlases->push_back(std::move(atlas));
       maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr, smooth_t, map_e));
+      if (as_written) {
+        const Eigen::Vector3d rho = m.params.rho_d;
+        ScaleMapHeldAtOne((rho.array() > 1).select(rho.cwiseInverse(), 1.0), &maps->back());
+      }
       const std::filesystem::path file = temp_dir / (out.name + ".exr");
       WriteImage(file, maps->back());
       out.rho_d_map = file;
@@ -242,19 +252,20 @@ bool SolverState::MapAllowed(size_t r) const {
           std::find(only.begin(), only.end(), scene.materials[r].name) != only.end());
 }
 
+bool SolverState::WritesMap(size_t r, const RegionAtlas& atlas,
+                            const std::vector<Eigen::Vector3d>& smooth_t,
+                            const std::vector<Eigen::Vector3d>& map_e,
+                            double* texel_variation) const {
+  const MaterialState& m = materials[r];
+  if (!m.reflective || !m.unknown_rho_d || m.observations == 0 || !MapAllowed(r)) return false;
+  if (options.albedo_maps == "all" || m.last_fit.albedo_varies) return true;
+  const double v = TexelScaleVariation(HalvesOf(*this, int(r), atlas, smooth_t, map_e));
+  if (texel_variation) *texel_variation = v;
+  return v > kTexelTextureMin;
+}
+
 void SolverState::RenderResiduals(Scene model, int stage) {
   const auto start = std::chrono::steady_clock::now();
-  // The model as written: without it the report measured a model the user never gets (a
-  // two-lighting capture whose lightings disagree, solved with --albedo-maps none: reported 0.153
-  // with four regions' per-patch maps, 0.48 as written; bench/RESULTS.md, Diagnosis, session 30).
-  for (size_t r = 0; r < materials.size() && r < model.materials.size(); ++r) {
-    Material& m = model.materials[r];
-    if (!MapAllowed(r) && materials[r].unknown_rho_d && m.rho_d_map &&
-        !scene.materials[r].rho_d_map) {
-      m.rho_d_map.reset();
-      m.rho_d = materials[r].params.rho_d;
-    }
-  }
   // Two independent renders of kSpp/2 paths: Σ(r1 − p)(r2 − p) estimates Σ(r − p)² of the
   // noise-free render r without the render's own Monte Carlo variance (whose size at a few
   // paths per pixel would otherwise swamp the model's error).
@@ -370,14 +381,14 @@ void SolverState::RunStage2() {
   std::vector<RegionAtlas> atlases;
   std::vector<Image> maps;
   const std::vector<MaterialState> stage1 = materials;
-  RenderResiduals(CompleteScene(&atlases, &maps, temp / "s1"), 1);
+  RenderResiduals(CompleteScene(&atlases, &maps, temp / "s1", true), 1);
   for (int round = 1; round <= options.refine_iterations; ++round) {
     RefineRound(round, temp / std::to_string(round));
   }
   for (size_t r = 0; r < materials.size(); ++r) summary.regions[r].stage2 = materials[r].last_fit;
   if (options.refine_iterations > 0) {
     std::filesystem::create_directories(temp / "final");
-    RenderResiduals(CompleteScene(&atlases, &maps, temp / "final"), 2);
+    RenderResiduals(CompleteScene(&atlases, &maps, temp / "final", true), 2);
     // The refinement's parameters are kept only if the photos are not explained worse than by
     // the paper's (beyond twice the standard error of the comparison).
     const double r1 = summary.stage1_render_residual, r2 = summary.stage2_render_residual;
@@ -410,19 +421,14 @@ void SolverState::BuildAlbedoMaps() {
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
     if (!MapAllowed(r)) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
-    bool want = options.albedo_maps == "all" || m.last_fit.albedo_varies;
     RegionSolution& rs = summary.regions[r];
-    if (!want) {
-      rs.texel_variation = TexelScaleVariation(HalvesOf(*this, int(r), atlas, smooth_t, map_e));
-      want = rs.texel_variation > kTexelTextureMin;
-      if (want) {
-        spdlog::info(
-            "region {}: its albedo varies by {:.0f} % from texel to texel (finer than the "
-            "patches): given a map",
-            rs.name, 100 * rs.texel_variation);
-      }
+    if (!WritesMap(r, atlas, smooth_t, map_e, &rs.texel_variation)) continue;
+    if (!m.last_fit.albedo_varies && options.albedo_maps != "all") {
+      spdlog::info(
+          "region {}: its albedo varies by {:.0f} % from texel to texel (finer than the "
+          "patches): given a map",
+          rs.name, 100 * rs.texel_variation);
     }
-    if (!want) continue;
     Image seen;
     rs.albedo_map =
         AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);

@@ -93,29 +93,51 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
   EXPECT_TRUE(s.coverage[0].observed);
 }
 
-// The residual the report states ("rendered at the observed pixels") is of the model as written:
-// with --albedo-maps none a region the fit treats per patch (its albedo varies from patch to
-// patch) is written with one albedo, and the report had rendered it with its per-patch map (on
-// session 30's two-lighting capture: reported 0.153, 0.48 as written). The written scene.json
-// is rendered here twice per photo (independent seeds, 128 paths each) and Σ(r1 − p)(r2 − p)
-// over the observed pixels estimates its residual without the renders' own noise, as the
-// report's two halves do; the two must agree. Measured: reported 0.160, rendered here 0.185
-// (the rest: the two renders' pixel sampling differs); before session 30, 0.108 reported.
-TEST(SolveTruth, ReportedRenderResidualIsOfTheWrittenModel) {
+// The residual the report states ("rendered at the observed pixels") is of the model as written.
+// The written scene.json is rendered here twice per photo (independent seeds, 128 paths each) and
+// Σ(r1 − p)(r2 − p) over the observed pixels estimates its residual without the renders' own
+// noise, as the report's two halves do; the two must agree.
+// - "no_maps": with --albedo-maps none a region the fit treats per patch (its albedo varies from
+//   patch to patch) is written with one albedo, and the report had rendered it with its
+//   per-patch map (on session 30's two-lighting capture: reported 0.153, 0.48 as written).
+//   Measured: reported 0.1604, the written model 0.1608; before session 30, 0.108 reported.
+// - "texel_maps": every region textured finer than the patches, --albedo-maps auto: three
+//   regions whose fit keeps one albedo get a map from the texel test (BuildAlbedoMaps), which the
+//   report had rendered with that one albedo. Measured: reported 0.1766, the written model
+//   0.1708 (1.034); before session 31, 0.1844 reported (1.080).
+struct WrittenCase {
+  std::string name;
+  std::string albedo_maps;
+  bool textured_walls;
+};
+
+void PrintTo(const WrittenCase& c, std::ostream* os) { *os << c.name; }
+
+class SolveWritten : public ::testing::TestWithParam<WrittenCase> {};
+
+TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
   const fs::path tmp = test::UniqueTempDir("solve_written");
   SynthOptions so;
   so.out = tmp / "capture";
   so.cameras = 4;
   so.spp = 64;
+  so.textured_walls = GetParam().textured_walls;
   Synthesize(so);
   const Scene scene = LoadScene(so.out / "scene.json");
   SolveOptions o;
-  o.albedo_maps = "none";
+  o.albedo_maps = GetParam().albedo_maps;
   o.refine_iterations = 0;
   const SolveSummary s = Solve(scene, o, tmp / "out");
   WriteSolveOutputs(s, o, tmp / "out");
   const Scene written = LoadScene(tmp / "out" / "scene.json");
-  for (const Material& m : written.materials) EXPECT_FALSE(m.rho_d_map) << m.name;
+  int mapped = 0;
+  for (size_t r = 0; r < written.materials.size(); ++r) {
+    const Material& m = written.materials[r];
+    if (o.albedo_maps == "none") EXPECT_FALSE(m.rho_d_map) << m.name;
+    if (m.rho_d_map && s.regions[r].stage1.albedo_model == "constant") ++mapped;
+  }
+  // The case's point: regions fitted with one albedo and written with a map.
+  if (o.albedo_maps != "none") EXPECT_GE(mapped, 2);
   double num = 0, den = 0;
   for (size_t k = 0; k < written.photos.size(); ++k) {
     const Photo& ph = written.photos[k];
@@ -134,18 +156,27 @@ TEST(SolveTruth, ReportedRenderResidualIsOfTheWrittenModel) {
         if (pr.photo.at(x, y, 0) == 0 && pr.photo.at(x, y, 1) == 0) continue;  // not observed
         for (int c = 0; c < 3; ++c) {
           const double p = pr.photo.at(x, y, c);
-          num += (r1.at(x * stride, y * stride, c) - p) * (r2.at(x * stride, y * stride, c) - p);
+          // The observation's pixel (solver/observations.cpp: the middle of each stride cell).
+          const int px = x * stride + stride / 2;
+          const int py = std::min(y * stride + stride / 2, r1.height - 1);
+          num += (r1.at(px, py, c) - p) * (r2.at(px, py, c) - p);
           den += p * p;
         }
       }
     }
   }
   const double measured = std::sqrt(std::max(0.0, num) / den);
-  std::printf("reported %.4f, the written model rendered %.4f\n", s.stage1_render_residual,
-              measured);
-  EXPECT_GT(s.stage1_render_residual, 0.8 * measured);
-  EXPECT_LT(s.stage1_render_residual, 1.05 * measured);
+  std::printf("reported %.4f (standard error %.4f), the written model rendered %.4f\n",
+              s.stage1_render_residual,
+              s.stage1_render_residual_sq_se / (2 * s.stage1_render_residual), measured);
+  EXPECT_GT(s.stage1_render_residual, 0.93 * measured);
+  EXPECT_LT(s.stage1_render_residual, 1.06 * measured);
 }
+
+INSTANTIATE_TEST_SUITE_P(Cases, SolveWritten,
+                         ::testing::Values(WrittenCase{"no_maps", "none", false},
+                                           WrittenCase{"texel_maps", "auto", true}),
+                         [](const auto& info) { return info.param.name; });
 
 struct SynthCase {
   std::string name;
@@ -265,8 +296,10 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // than a box-filtered 1024-path render of the true scene (bench/solver/ceiling_probe);
       // from 1024-spp photos (0.1 % off) the sphere comes to -0.5..-0.9 % and from another
       // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md, session 26). The sphere
-      // is guarded at 2 %. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
-      const double bar = r.name == "glossy_sphere" ? 0.02 : 0.01;
+      // is guarded at 2 % from 256-spp photos. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
+      // The "converged" case's 1024-spp photos are within 0.1 % of the true scene's radiance
+      // (issue 7's noise-free capture): there the sphere too has the issue's 1 %.
+      const double bar = r.name == "glossy_sphere" && GetParam().spp < 1024 ? 0.02 : 0.01;
       EXPECT_LT(RelErr(r.final_params.rho_d[c], t["rho_d"][c].get<double>()), bar)
           << r.name << " final rho_d[" << c << "]";
     }
@@ -371,7 +404,8 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
                          ::testing::Values(SynthCase{"clean", false, 256},
-                                           SynthCase{"noisy", true, 256}),
+                                           SynthCase{"noisy", true, 256},
+                                           SynthCase{"converged", false, 1024}),
                          [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace
