@@ -297,8 +297,12 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // from 1024-spp photos (0.1 % off) the sphere comes to -0.5..-0.9 % and from another
       // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md, session 26). The sphere
       // is guarded at 2 % from 256-spp photos. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
-      // The "converged" case's 1024-spp photos are within 0.1 % of the true scene's radiance
-      // (issue 7's noise-free capture): there the sphere too has the issue's 1 %.
+      // The "converged" cases' 1024-spp photos are within 0.1 % of the true scene's radiance
+      // (issue 7's noise-free capture; "converged_noisy" adds the realistic sensor noise): there
+      // the sphere too has the issue's 1 %. Measured (session 31), the worst written rho_d:
+      // converged the sphere -0.80 %, the ceiling +0.60 %, the rest within 0.46 %;
+      // converged_noisy the sphere -0.79 %, the glossy box +0.62 %, the rest within 0.40 %.
+      // (The "noisy" case at 256 spp, sessions 26-30, was replaced by converged_noisy.)
       const double bar = r.name == "glossy_sphere" && GetParam().spp < 1024 ? 0.02 : 0.01;
       EXPECT_LT(RelErr(r.final_params.rho_d[c], t["rho_d"][c].get<double>()), bar)
           << r.name << " final rho_d[" << c << "]";
@@ -404,8 +408,8 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
 
 INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
                          ::testing::Values(SynthCase{"clean", false, 256},
-                                           SynthCase{"noisy", true, 256},
-                                           SynthCase{"converged", false, 1024}),
+                                           SynthCase{"converged", false, 1024},
+                                           SynthCase{"converged_noisy", true, 1024}),
                          [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace
