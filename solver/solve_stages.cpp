@@ -787,6 +787,10 @@ void SolverState::RunStage1() {
         "not converged after {} iterations (largest relative change "
         "{:.2e}, tolerance {})",
         options.max_iterations, summary.history.back().max_change, options.tolerance);
+    spdlog::warn(
+        "the paper's stage {}: its parameters are written as they stand (report.json "
+        "converged false)",
+        summary.message);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
   obs_e_stage1 = obs_e;

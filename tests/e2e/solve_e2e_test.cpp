@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "tests/e2e/box_room.h"
@@ -196,6 +197,34 @@ TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {
     }
   }
   EXPECT_TRUE(found_hidden);
+  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
+                                                " --camera cam0 --lighting L0 --spp 2 --quiet "
+                                                "--out " +
+                                                Quote((dir_ / "check.exr").string()));
+  EXPECT_EQ(render.exit_code, 0) << render.err;
+}
+
+// A solve that does not converge (here: one iteration of the paper's alternation, which needs two
+// to measure a change) is reported, not a crash: exit 0, one warning line, report.json
+// converged false with the reason, report.html's warning, and a scene.json that renders.
+TEST_F(SolveE2E, NonConvergenceIsReportedNotACrash) {
+  const fs::path scene = LambertRoomAlbedosUnknown();
+  std::string not_quiet = kFast;
+  not_quiet.erase(not_quiet.find(" --quiet"), 8);
+  const auto r = RunTool("igi-solve", Quote(scene.string()) + " --out " + Quote(Out().string()) +
+                                          not_quiet + " --max-iterations 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("not converged after 1 iterations"), std::string::npos) << r.err;
+  const Json report = ReadJsonFile(Out() / "report.json");
+  EXPECT_FALSE(report.at("converged").get<bool>());
+  EXPECT_NE(report.at("message").get<std::string>().find("not converged after 1 iterations"),
+            std::string::npos)
+      << report.at("message");
+  std::ifstream html(Out() / "report.html");
+  std::stringstream page_text;
+  page_text << html.rdbuf();
+  const std::string page = page_text.str();
+  EXPECT_NE(page.find("Stage 1 did not converge"), std::string::npos);
   const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
                                                 " --camera cam0 --lighting L0 --spp 2 --quiet "
                                                 "--out " +
