@@ -43,11 +43,13 @@ Image Eroded(const Image& mask, int radius) {
 
 double RelErr(double a, double b) { return std::abs(a - b) / std::abs(b); }
 
-TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
+// The floor's map from photos of `spp` paths per pixel, its PSNR over the seen texels and over
+// those two texels inside them held above the bars.
+void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar_db) {
   const fs::path tmp = test::UniqueTempDir("solve_albedo_truth");
   SynthOptions so;
   so.out = tmp / "capture";
-  so.spp = 256;
+  so.spp = spp;
   so.lamp = "point";
   so.floor_texture = "smooth";
   so.validation_lightings = {};
@@ -78,9 +80,9 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
       all.psnr_db, seen.psnr_db, 100 * seen.compared, interior.psnr_db, 100 * interior.compared);
   // About three quarters of the floor is seen (the boxes and the sphere hide the rest).
   EXPECT_GT(seen.compared, 0.65);
-  // Issue 7 asks 35 dB (noise-free). Measured 33.1 dB over the seen texels and 34.9 dB two
-  // texels (9 cm) inside them (32.9 / 34.4 dB before the specular bounces; 33.8 and 35.3 dB with
-  // 512-spp photos then, bench/RESULTS.md): the rest is the photos' Monte Carlo noise (about
+  // Issue 7 asks 35 dB (noise-free). At 256 spp: measured 33.1 dB over the seen texels and 34.9 dB
+  // two texels (9 cm) inside them (32.9 / 34.4 dB before the specular bounces; 33.8 and 35.3 dB
+  // with 512-spp photos then, bench/RESULTS.md): the rest is the photos' Monte Carlo noise (about
   // 7 % per pixel at 256 spp), the gathered indirect irradiance's noise, and its bias near the
   // walls and the boxes' and sphere's contacts. Session 12's adaptive smoothing of the indirect
   // irradiance (SolveOptions::smoothing_accuracy: a radius from the harmonic mean distance of
@@ -88,8 +90,8 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
   // 35.01); the same capture at 2048 spp (nearly noise-free; 212 s to render, too slow for CI)
   // 35.49 and 39.81 dB (fixed radius 35.01, 37.43; bench/RESULTS.md, session 12). Guarded 1 dB
   // below the measured values: the interior bound fails with the fixed radius.
-  EXPECT_GT(seen.psnr_db, 32.5);
-  EXPECT_GT(interior.psnr_db, 35.3);
+  EXPECT_GT(seen.psnr_db, seen_bar_db);
+  EXPECT_GT(interior.psnr_db, interior_bar_db);
   std::printf("floor: rho_s %+.2f %%, alpha %+.2f %%\n",
               100 * (floor.stage1.rho_s.mean() / truth["floor"]["rho_s"].get<double>() - 1),
               100 * (floor.stage1.alpha / truth["floor"]["alpha"].get<double>() - 1));
@@ -133,6 +135,17 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
           << r.name << " rho_d[" << c << "]";
     }
   }
+}
+
+TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
+  CheckMapOfAResolvedTexture(256, 32.5, 35.3);
+}
+
+// Issue 7's 35 dB is for noise-free photos: the same capture at 2048 paths per pixel (123 s alone
+// on 2 threads; labelled slow, run with IGI_SLOW=1). Measured (session 31, as in session 12):
+// 35.49 dB over the seen texels, 39.81 dB two texels inside; every region's rho_d within 0.57 %.
+TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolveNoiseFree) {
+  CheckMapOfAResolvedTexture(2048, 35.0, 37.0);
 }
 
 // igi-synth's room under a point lamp (no validation lighting) as `so` sets it otherwise, solved
