@@ -198,10 +198,11 @@ struct SolverState {
   // Whether the options let region r have an albedo map in scene.json (not --albedo-maps none,
   // and among albedo_map_regions when those are listed).
   bool MapAllowed(size_t r) const;
-  // Whether scene.json gives region r an albedo map: an observed region of unknown ρd the options
-  // allow one, with --albedo-maps all, an albedo fitted per patch, or (auto) an albedo that
-  // varies from texel to texel beyond the photos' noise (its variation in *texel_variation when
-  // that test ran).
+  // Whether region r may have an albedo map in scene.json: observed, of unknown ρd, MapAllowed.
+  bool MapCandidate(size_t r) const;
+  // Whether scene.json gives region r an albedo map: a MapCandidate with --albedo-maps all, an
+  // albedo fitted per patch, or (auto) an albedo that varies from texel to texel beyond the photos'
+  // noise (its variation in *texel_variation when that test ran).
   bool WritesMap(size_t r, const RegionAtlas& atlas, const std::vector<Eigen::Vector3d>& smooth_t,
                  const std::vector<Eigen::Vector3d>& map_e, double* texel_variation) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and

@@ -224,7 +224,10 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
       if (out.rho_d) out.rho_d = out.rho_d->cwiseMin(1.0);
       if (out.rho_s) out.rho_s = out.rho_s->cwiseMin(1.0);
     }
-    if (!m.unknown_rho_d || (!as_written && m.last_fit.albedo_model != "per_patch")) continue;
+    if (as_written ? !MapCandidate(r)
+                   : !m.unknown_rho_d || m.last_fit.albedo_model != "per_patch") {
+      continue;
+    }
     RegionAtlas atlas = AtlasOf(*this, int(r));
     if (!as_written || WritesMap(r, atlas, smooth_t, map_e, nullptr)) {
       atlases->push_back(std::move(atlas));
@@ -252,12 +255,17 @@ bool SolverState::MapAllowed(size_t r) const {
           std::find(only.begin(), only.end(), scene.materials[r].name) != only.end());
 }
 
+bool SolverState::MapCandidate(size_t r) const {
+  const MaterialState& m = materials[r];
+  return m.reflective && m.unknown_rho_d && m.observations > 0 && MapAllowed(r);
+}
+
 bool SolverState::WritesMap(size_t r, const RegionAtlas& atlas,
                             const std::vector<Eigen::Vector3d>& smooth_t,
                             const std::vector<Eigen::Vector3d>& map_e,
                             double* texel_variation) const {
   const MaterialState& m = materials[r];
-  if (!m.reflective || !m.unknown_rho_d || m.observations == 0 || !MapAllowed(r)) return false;
+  if (!MapCandidate(r)) return false;
   if (options.albedo_maps == "all" || m.last_fit.albedo_varies) return true;
   const double v = TexelScaleVariation(HalvesOf(*this, int(r), atlas, smooth_t, map_e));
   if (texel_variation) *texel_variation = v;
@@ -418,8 +426,7 @@ void SolverState::BuildAlbedoMaps() {
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
-    if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
-    if (!MapAllowed(r)) continue;
+    if (!MapCandidate(r)) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
     if (!WritesMap(r, atlas, smooth_t, map_e, &rs.texel_variation)) continue;

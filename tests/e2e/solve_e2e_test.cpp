@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "tests/e2e/box_room.h"
@@ -88,6 +87,21 @@ class SolveE2E : public ::testing::Test {
                         const std::string& extra = "") const {
     return RunTool("igi-solve",
                    Quote(scene.string()) + " --out " + Quote(out.string()) + kFast + extra);
+  }
+
+  // Solve with igi-solve's log on stderr (kFast without --quiet).
+  test::RunResult SolveLogged(const fs::path& scene, const std::string& extra) const {
+    std::string logged = kFast;
+    logged.erase(logged.find(" --quiet"), 8);
+    return RunTool("igi-solve",
+                   Quote(scene.string()) + " --out " + Quote(Out().string()) + logged + extra);
+  }
+
+  // igi-render of the solved scene (Out()/scene.json) from `camera` under L0, at 2 spp.
+  test::RunResult RenderSolved(const std::string& camera) const {
+    return RunTool("igi-render", Quote((Out() / "scene.json").string()) + " --camera " + camera +
+                                     " --lighting L0 --spp 2 --quiet --out " +
+                                     Quote((dir_ / "check.exr").string()));
   }
 
   // Both cameras' photos of the Lambertian room, every albedo stripped from its scene.json.
@@ -197,10 +211,7 @@ TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {
     }
   }
   EXPECT_TRUE(found_hidden);
-  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
-                                                " --camera cam0 --lighting L0 --spp 2 --quiet "
-                                                "--out " +
-                                                Quote((dir_ / "check.exr").string()));
+  const auto render = RenderSolved("cam0");
   EXPECT_EQ(render.exit_code, 0) << render.err;
 }
 
@@ -209,10 +220,7 @@ TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {
 // converged false with the reason, report.html's warning, and a scene.json that renders.
 TEST_F(SolveE2E, NonConvergenceIsReportedNotACrash) {
   const fs::path scene = LambertRoomAlbedosUnknown();
-  std::string not_quiet = kFast;
-  not_quiet.erase(not_quiet.find(" --quiet"), 8);
-  const auto r = RunTool("igi-solve", Quote(scene.string()) + " --out " + Quote(Out().string()) +
-                                          not_quiet + " --max-iterations 1");
+  const auto r = SolveLogged(scene, " --max-iterations 1");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("not converged after 1 iterations"), std::string::npos) << r.err;
   const Json report = ReadJsonFile(Out() / "report.json");
@@ -220,15 +228,9 @@ TEST_F(SolveE2E, NonConvergenceIsReportedNotACrash) {
   EXPECT_NE(report.at("message").get<std::string>().find("not converged after 1 iterations"),
             std::string::npos)
       << report.at("message");
-  std::ifstream html(Out() / "report.html");
-  std::stringstream page_text;
-  page_text << html.rdbuf();
-  const std::string page = page_text.str();
-  EXPECT_NE(page.find("Stage 1 did not converge"), std::string::npos);
-  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
-                                                " --camera cam0 --lighting L0 --spp 2 --quiet "
-                                                "--out " +
-                                                Quote((dir_ / "check.exr").string()));
+  EXPECT_NE(ReadFileToString(Out() / "report.html").find("Stage 1 did not converge"),
+            std::string::npos);
+  const auto render = RenderSolved("cam0");
   EXPECT_EQ(render.exit_code, 0) << render.err;
 }
 
@@ -295,10 +297,7 @@ TEST_F(SolveE2E, RecoversLambertAlbedosOfARenderedRoom) {
   EXPECT_EQ(report.at("format"), "igi-solve-report");
   for (const Json& region : report.at("regions")) EXPECT_EQ(region.at("status"), "solved");
   EXPECT_NE(ReadFileToString(Out() / "report.html").find("<img"), std::string::npos);
-  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
-                                                " --camera cam1 --lighting L0 --spp 2 --quiet "
-                                                "--out " +
-                                                Quote((dir_ / "check.exr").string()));
+  const auto render = RenderSolved("cam1");
   EXPECT_EQ(render.exit_code, 0) << render.err;
   EXPECT_EQ(ReadImageInfo(dir_ / "check.exr").width, kWidth);
 }
@@ -365,10 +364,7 @@ TEST_F(SolveE2E, AlbedosAboveOneAreHeldAtOneAndReported) {
                                       PhotoEntry("photos/cam1_L0.exr", "cam1", "L0")}));
   doc["lights"]["lamp"]["intensity"] = {0.1, 0.1, 0.1};
   const fs::path scene = WriteScene(doc);
-  std::string not_quiet = kFast;
-  not_quiet.erase(not_quiet.find(" --quiet"), 8);
-  const auto r = RunTool("igi-solve", Quote(scene.string()) + " --out " + Quote(Out().string()) +
-                                          not_quiet + " --albedo-maps all");
+  const auto r = SolveLogged(scene, " --albedo-maps all");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("region walls: the fit wants a reflectance above 1"), std::string::npos)
       << r.err;
@@ -411,10 +407,7 @@ TEST_F(SolveE2E, AlbedosAboveOneAreHeldAtOneAndReported) {
   EXPECT_LE(highest, 1.0f);
   EXPECT_GT(highest, 0.9f);
   // It loads as a complete scene and renders.
-  const auto render = RunTool("igi-render", Quote((Out() / "scene.json").string()) +
-                                                " --camera cam0 --lighting L0 --spp 2 --quiet "
-                                                "--out " +
-                                                Quote((dir_ / "check.exr").string()));
+  const auto render = RenderSolved("cam0");
   EXPECT_EQ(render.exit_code, 0) << render.err;
 }
 

@@ -87,7 +87,7 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   // walls and the boxes' and sphere's contacts. Session 12's adaptive smoothing of the indirect
   // irradiance (SolveOptions::smoothing_accuracy: a radius from the harmonic mean distance of
   // each observation's indirect hits) gives 33.50 and 36.33 dB (with a fixed radius 33.13 and
-  // 35.01); the same capture at 2048 spp (nearly noise-free; 212 s to render, too slow for CI)
+  // 35.01); the same capture at 2048 spp (nearly noise-free: the slow NoiseFree case below)
   // 35.49 and 39.81 dB (fixed radius 35.01, 37.43; bench/RESULTS.md, session 12). Guarded 1 dB
   // below the measured values: the interior bound fails with the fixed radius.
   EXPECT_GT(seen.psnr_db, seen_bar_db);
