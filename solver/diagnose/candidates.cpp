@@ -997,6 +997,24 @@ void FillScores(const ResidualFit& fit, CandidateResult* out) {
   out->z = fit.z;
 }
 
+std::vector<CandidateResult*> RankForTrials(std::vector<CandidateResult>& candidates,
+                                            double min_gain, double min_z) {
+  std::vector<CandidateResult*> ranked;
+  for (CandidateResult& c : candidates) {
+    if (c.valid && c.Gain() >= min_gain && c.z >= min_z) ranked.push_back(&c);
+  }
+  std::stable_sort(
+      ranked.begin(), ranked.end(),
+      [](const CandidateResult* a, const CandidateResult* b) { return a->Gain() > b->Gain(); });
+  if (ranked.size() > 2 && ranked[0]->effect == ranked[1]->effect) {
+    const auto other =
+        std::find_if(ranked.begin() + 2, ranked.end(),
+                     [&](const CandidateResult* c) { return c->effect != ranked[0]->effect; });
+    if (other != ranked.end()) std::rotate(ranked.begin() + 1, other, other + 1);
+  }
+  return ranked;
+}
+
 std::string CandidateResult::Key() const {
   for (const char* k : {"region", "light", "camera"}) {
     if (params.contains(k) && params[k].is_string()) {

@@ -57,6 +57,15 @@ struct CandidateResult {
   std::string Key() const;
 };
 
+// The candidates a step refits, in the order it tries them: the valid ones whose predicted
+// held-out gain reaches `min_gain` and whose z reaches `min_z`, best predicted first, except that
+// when the two best are of one effect the best of another effect moves up to second. A step
+// refits the first two and keeps the better; the rest only while none passes. Two of one effect
+// are rival fits of one explanation (two lights' intensities standing in for the lightings'
+// balance); the best other explanation is the real alternative.
+std::vector<CandidateResult*> RankForTrials(std::vector<CandidateResult>& candidates,
+                                            double min_gain, double min_z);
+
 // The photos' file names (a candidate's "where" for effects of every photo).
 std::vector<std::string> PhotoFiles(const Scene& model);
 

@@ -8,9 +8,9 @@
 namespace igi {
 
 struct DiagnoseOptions {
-  int spp = 32;            // paths per pixel of the re-renders
-  int pixel_stride = 2;    // every Nth pixel of each photo is a residual sample
-  int max_steps = 4;       // effects modelled at most
+  int spp = 32;          // paths per pixel of the re-renders
+  int pixel_stride = 2;  // every Nth pixel of each photo is a residual sample
+  int max_steps = 4;     // effects modelled at most
   // Held-out pixels: square blocks, left out of every fit (the solver's and the effects').
   double holdout_fraction = 0.25;
   int holdout_block_px = 16;
@@ -19,15 +19,16 @@ struct DiagnoseOptions {
   double min_gain = 0.02;
   double min_z = 2.5;
   // A candidate is refitted (the real test above) when its predicted held-out gain reaches
-  // these; at most `max_tries` candidates per step, best predicted first (the two best are both
-  // refitted, further ones only while none passes). 5: the predictions come from direct-light
-  // records and can be far off where a region's reflected room dominates (a sphere lit by a
-  // bright ceiling: its lobe-shape change predicted 2.3 %, measured 59 %); with 3, a floor's two
-  // rival lobe changes and a false missing-geometry blob took every try (session 23).
+  // these; at most `max_tries` candidates per step, best predicted first (the two best of
+  // different effects are both refitted, further ones only while none passes: RankForTrials). 5:
+  // the predictions come from direct-light records and can be far off where a region's reflected
+  // room dominates (a sphere lit by a bright ceiling: its lobe-shape change predicted 2.3 %,
+  // measured 59 %); with 3, a floor's two rival lobe changes and a false missing-geometry blob took
+  // every try (session 23).
   double candidate_min_gain = 0.01;
   double candidate_min_z = 1.5;
   int max_tries = 5;
-  int light_samples = 8;   // per extended light, for the direct-light features
+  int light_samples = 8;  // per extended light, for the direct-light features
   uint64_t seed = 1;
   int num_threads = 0;
   bool show_progress = true;

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "solver/brdf.h"
 #include "solver/diagnose/residual_fit.h"
@@ -617,6 +618,60 @@ TEST(LobeChangeTest, TheRoomsReflectionCounts) {
   EXPECT_GT(c.Gain(), 0.5);
   for (PixelRecord& r : records) r.room.clear();
   EXPECT_FALSE(PlateCandidate(false, records, rho_s, alpha, false).valid);
+}
+
+// The order a step refits its candidates in (RankForTrials): the seed-117 baseline's three best
+// predictions (two lights' intensities at 74 %, the lamp's profile at 30 %) refit the profile
+// second; otherwise best predicted first, and the weak, insignificant or invalid left out.
+CandidateResult Predicted(const std::string& effect, double gain, double z,
+                          const std::string& light = "") {
+  CandidateResult c;
+  c.effect = effect;
+  c.valid = true;
+  c.held_before = 1.0;
+  c.held_after = 1.0 - gain;
+  c.z = z;
+  if (!light.empty()) c.params["light"] = light;
+  return c;
+}
+
+std::vector<std::string> Order(std::vector<CandidateResult>& cands) {
+  std::vector<std::string> out;
+  for (const CandidateResult* c : RankForTrials(cands, 0.01, 1.5)) out.push_back(c->Key());
+  return out;
+}
+
+TEST(RankForTrialsTest, TheBestOfAnotherEffectIsRefittedSecond) {
+  std::vector<CandidateResult> cands = {Predicted("ambient_light", 0.12, 3.0),
+                                        Predicted("light_intensity", 0.741, 14.0, "lamp"),
+                                        Predicted("light_emission_profile", 0.30, 9.0, "lamp"),
+                                        Predicted("light_intensity", 0.739, 13.0, "lamp2")};
+  EXPECT_EQ(Order(cands),
+            (std::vector<std::string>{"light_intensity:lamp", "light_emission_profile:lamp",
+                                      "light_intensity:lamp2", "ambient_light"}));
+}
+
+TEST(RankForTrialsTest, OtherwiseBestPredictedFirst) {
+  std::vector<CandidateResult> cands = {
+      Predicted("vignetting", 0.2, 3.0), Predicted("light_intensity", 0.5, 9.0, "lamp"),
+      Predicted("light_intensity", 0.1, 2.0, "lamp2"), Predicted("ambient_light", 0.3, 4.0)};
+  EXPECT_EQ(Order(cands), (std::vector<std::string>{"light_intensity:lamp", "ambient_light",
+                                                    "vignetting", "light_intensity:lamp2"}));
+  // All of one effect: nothing to move up.
+  std::vector<CandidateResult> same = {Predicted("specular_lobe_shape", 0.2, 3.0),
+                                       Predicted("specular_lobe_shape", 0.4, 3.0)};
+  same[0].params["region"] = "floor";
+  same[1].params["region"] = "glossy_box";
+  EXPECT_EQ(Order(same), (std::vector<std::string>{"specular_lobe_shape:glossy_box",
+                                                   "specular_lobe_shape:floor"}));
+}
+
+TEST(RankForTrialsTest, WeakInsignificantAndInvalidAreLeftOut) {
+  std::vector<CandidateResult> cands = {
+      Predicted("vignetting", 0.005, 3.0), Predicted("ambient_light", 0.3, 1.0),
+      Predicted("camera_response", 0.2, 2.0), Predicted("exposure_scale", 0.4, 5.0)};
+  cands[3].valid = false;
+  EXPECT_EQ(Order(cands), (std::vector<std::string>{"camera_response"}));
 }
 
 }  // namespace
