@@ -23,7 +23,7 @@ BUILD="$(cd "${2:-build}" && pwd)"
 WORK="${3:-/tmp/igi_demo_split}"
 mkdir -p "$WORK"
 python3 - "$DEMO" "$WORK" <<'PY'
-import copy, json, os, sys
+import copy, json, os, shutil, sys
 demo, work = sys.argv[1], sys.argv[2]
 reg = json.load(open(os.path.join(demo, "03-register", "scene.json")))
 true_cams = json.load(open(os.path.join(demo, "00-capture", "synth", "truth", "scene.json")))["cameras"]
@@ -54,7 +54,7 @@ for variant in ("registered", "true_poses", "true_radiance"):
             p.pop("mask", None)
     json.dump(s, open(os.path.join(d, "scene.json"), "w"), indent=1)
     truth = os.path.join(demo, "00-capture", "synth", "truth.json")
-    json.dump(json.load(open(truth)), open(os.path.join(d, "truth.json"), "w"))
+    shutil.copyfile(truth, os.path.join(d, "truth.json"))
     link = os.path.join(d, "truth")  # truth.json's texture paths are relative to the capture
     if os.path.lexists(link):
         os.remove(link)

@@ -796,13 +796,9 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     // By the predicted relative gain: a candidate scored over the records less those where it
     // cannot be fitted (light_intensity leaves out the penumbrae and highlights) has a smaller
     // base, and its absolute fall ranked it under weaker rivals (the CI-size light_intensity
-    // capture: 60 % predicted, never tried, ambient_light's 52 % kept first). The two best of
-    // different effects are both refitted and the better kept; the rest only while none passes
-    // (up to max_tries). The profile + response pair (seed 117): light_intensity of the lamp and
-    // of lamp2 both predicted 74 %, the lamp's emission profile 30 %; with the two best refitted
-    // the profile was never tried at the baseline, lamp2's ×1.97 was kept (held out 0.504 →
-    // 0.313) and the run ended 2.64× the floor; refitted second the profile is kept (→ 0.187),
-    // then the response, and the run ends 1.12× (bench/RESULTS.md, session 32).
+    // capture: 60 % predicted, never tried, ambient_light's 52 % kept first); the two best of
+    // different effects first (RankForTrials; the profile + response pair, bench/RESULTS.md
+    // session 32).
     std::vector<CandidateResult*> ranked =
         RankForTrials(cands, o.candidate_min_gain, o.candidate_min_z);
     for (const CandidateResult* c : ranked) {
