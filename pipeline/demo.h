@@ -39,8 +39,13 @@ struct DemoOptions {
   // ceiling no photo sees keeps a placeholder albedo, which removes light the rest of the room
   // receives (measured without them: the walls' rho_d -7.5..+14.4 %). COLMAP matches no feature
   // of theirs with the downward views; igi-register poses them from the surveyed targets on the
-  // ceiling and upper walls (markers.json, see demo.cpp SurveyedTargets).
-  int ceiling_cameras = 2;
+  // ceiling and upper walls (markers.json, see demo.cpp SurveyedTargets). Four, not two (since
+  // session 33): with two, the upper half of wall_x4 and most of the ceiling went unseen and took
+  // their seen parts' albedo, and the light they bounce left wall_y4 +1.2 % (the solver's own on
+  // that capture: +1.4 % from the true radiance); with four every ρd came within 0.8 % after k,
+  // the poses within 0.071 deg / 2.5 mm (two runs; with two 0.087 deg / 5.5 mm), for 12 s more
+  // (bench/RESULTS.md, End to end, sessions 32 and 33).
+  int ceiling_cameras = 4;
   // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
   // which weakens every bounce; measured: rho_s/k -27..-29 %):
   //  - "reference": the capture holds a reference of known reflectance (the matte box, its
@@ -65,8 +70,8 @@ struct DemoOptions {
   double marker_noise_px = 0.1;
   // igi-register weighs the control points by the same sigma (its default, 1 px, is for
   // hand-clicked points). At most 1024 SIFT keypoints per photo (COLMAP's default 8192): the
-  // exhaustive matching of the 18 photos 51.9 s -> 22.0 s, the poses as accurate (measured
-  // 2026-11-23: every photo registered, worst 0.089 deg / 5.7 mm either way).
+  // exhaustive matching of the 18 photos (2 ceiling cameras then) 51.9 s -> 22.0 s, the poses as
+  // accurate (measured 2026-11-23: every photo registered, worst 0.089 deg / 5.7 mm either way).
   std::vector<std::string> register_args = {"--marker-sigma", "0.1", "--max-features", "1024"};
   // Every third pixel: 344 k observations, 92 s of CPU with the scale solved (every second
   // pixel: 773 k, 358 s; the same errors within the run-to-run spread; measured 2026-11-22).

@@ -29,24 +29,24 @@ double Since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Fit samples per region and stage (SolverState::SelectFitSamples).
-// Observations near a highlight carry a faint lobe's ρs and α: up to kMaxHighlightSamples of
-// them. igi-synth's textured floor (ρs 0.04, α 0.15, ~60 000 such observations in the demo):
-// with 4000 drawn its ρs came out anywhere in −11..+4 % over sub-pixel pose changes (session 10),
-// with all of them within −4..0 %; on the demo's registered capture α −10.7 % with 4000, −5.5 %
-// with 16 000, −2.1 % with all, at a solve of 57, 66 and 103 s (bench/RESULTS.md). The rest
-// carry the albedo: kMaxFitSamples less the highlight samples, never under a third of it.
-constexpr size_t kMaxHighlightSamples = 16000;
-constexpr size_t kMaxFitSamples = 6000;
-constexpr size_t kMinRestSamples = kMaxFitSamples / 3;
+// Fit samples per region and stage (SolverState::SelectFitSamples; the counts are
+// SolveOptions::max_highlight_samples and max_fit_samples). The rest carry the albedo:
+// max_fit_samples less the highlight samples, never under a third of it.
 
-// Marks about `count` of `indices` in `chosen` (all when there are no more), each drawn with the
-// same probability by a hash of its value; returns how many it marked.
-size_t DrawSubset(const std::vector<int>& indices, size_t count, std::vector<char>* chosen) {
+// Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
+// drawn with the same probability by a hash of its photo and pixel; returns how many it marked.
+// Not by the observation's index: a change to one photo's observations (its pose, its mask, a
+// pixel that passes an edge test or not) shifts every later photo's indices and redraws them
+// all, and a faint lobe's ρs moved by up to 11 points with the draw alone (bench/RESULTS.md,
+// session 33).
+size_t DrawSubset(const std::vector<Observation>& obs, const std::vector<int>& indices,
+                  size_t count, std::vector<char>* chosen) {
   size_t marked = 0;
   const double p = indices.empty() ? 0.0 : double(count) / double(indices.size());
   for (int i : indices) {
-    if (InHashedSubset(uint64_t(i), p)) {
+    const Observation& o = obs[i];
+    const uint64_t key = (uint64_t(o.photo) << 42) ^ (uint64_t(o.y) << 21) ^ uint64_t(o.x);
+    if (InHashedSubset(key, p)) {
       (*chosen)[i] = 1;
       ++marked;
     }
@@ -255,15 +255,16 @@ void SolverState::SelectFitSamples() {
     (highlight ? near : rest)[o.region].push_back(int(i));
   }
   // The highlight observations carry ρs and α, the rest mostly the albedo: up to
-  // kMaxHighlightSamples of the first, then the rest (kMaxFitSamples in all, at least
-  // kMinRestSamples of them). Both drawn by a hash of the observation's index: a regular stride
-  // through the photos' pixel rows aliased with a texture's period (the SolveSynth room's
-  // textured floor, ρs 0.04: −10.3 % with the stride, +2.1 % drawn by hash).
+  // max_highlight_samples of the first, then the rest (max_fit_samples in all, at least a third
+  // of it). Both drawn by a hash of the observation's photo and pixel: a regular stride through
+  // the photos' pixel rows aliased with a texture's period (the SolveSynth room's textured floor,
+  // ρs 0.04: −10.3 % with the stride, +2.1 % drawn by hash).
+  const size_t max_fit = size_t(options.max_fit_samples);
+  const size_t min_rest = max_fit / 3;
   for (size_t r = 0; r < materials.size(); ++r) {
-    const size_t taken = DrawSubset(near[r], kMaxHighlightSamples, &in_fit);
-    const size_t budget =
-        std::max(kMinRestSamples, kMaxFitSamples - std::min(taken, kMaxFitSamples));
-    DrawSubset(rest[r], budget, &in_fit);
+    const size_t taken = DrawSubset(obs, near[r], size_t(options.max_highlight_samples), &in_fit);
+    const size_t budget = std::max(min_rest, max_fit - std::min(taken, max_fit));
+    DrawSubset(obs, rest[r], budget, &in_fit);
   }
 }
 

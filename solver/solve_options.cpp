@@ -43,6 +43,9 @@ void SolveOptions::Validate() const {
         albedo_maps, "must be auto, all or none");
   check(texel_size_m >= 0, "--texel-size-m", fmt::format("{}", texel_size_m),
         "must be >= 0 (0 = auto)");
+  check(max_highlight_samples >= 1, "--max-highlight-samples",
+        std::to_string(max_highlight_samples), "must be >= 1");
+  check(max_fit_samples >= 3, "--max-fit-samples", std::to_string(max_fit_samples), "must be >= 3");
   check(refine_iterations >= 0 && refine_iterations <= 20, "--refine-iterations",
         std::to_string(refine_iterations), "must be in [0, 20]");
   check(refine_rays >= 1 && refine_rays <= 4096, "--refine-rays", std::to_string(refine_rays),

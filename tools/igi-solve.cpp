@@ -50,6 +50,13 @@ int main(int argc, char** argv) {
   app.add_option("--albedo-maps", o.albedo_maps, "auto, all or none")->capture_default_str();
   app.add_option("--texel-size-m", o.texel_size_m, "albedo texel in metres (0 = auto)")
       ->capture_default_str();
+  app.add_option("--max-highlight-samples", o.max_highlight_samples,
+                 "per region, the observations near a highlight fitted (drawn evenly when there "
+                 "are more; they carry the lobe's rho_s and alpha)")
+      ->capture_default_str();
+  app.add_option("--max-fit-samples", o.max_fit_samples,
+                 "per region, the other observations fitted (they mostly carry the albedo)")
+      ->capture_default_str();
   app.add_option("--refine-iterations", o.refine_iterations,
                  "rounds of the path-traced joint refinement (0 = the paper's method only)")
       ->capture_default_str();

@@ -49,7 +49,8 @@ void DumpComparison(const igi::Image& mine, const igi::Image& seen, const igi::I
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: bench_solve_truth CAPTURE [threads=2 stride=2 texel=0 refine=1 held=1]\n");
+                 "usage: bench_solve_truth CAPTURE [threads=2 stride=2 texel=0 refine=1 held=1 "
+                 "high=100000]\n");
     return 2;
   }
   const fs::path capture = argv[1];
@@ -73,6 +74,8 @@ int main(int argc, char** argv) {
       o.refine_iterations = int(v);
     else if (key == "held")
       o.held_out_albedo = v != 0;
+    else if (key == "high")  // SolveOptions::max_highlight_samples
+      o.max_highlight_samples = int(v);
     else if (key == "rays")
       o.indirect_rays = int(v);
     else if (key == "refine_rays")

@@ -92,6 +92,12 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   options.indirect_rays = 4;  // nothing to inter-reflect on a convex ball
   options.refine_iterations = 0;
   options.albedo_maps = "none";  // compare region-constant models
+  // Every observation fitted (23 423): the fit's choice between one albedo and one per patch
+  // (which, under Lambert, soaks up the highlights) flips with which 6000 are drawn (session 33,
+  // the draw keyed by photo and pixel instead of the observation's index: Lambert per patch,
+  // region rms 0.091; 3000 drawn: Lambert per patch; 12 000: Ward per patch; all: both one
+  // albedo), and the comparison is of the two models, not of a draw.
+  options.max_fit_samples = 100000;
   options.num_threads = 2;
   options.show_progress = false;
   const auto start = std::chrono::steady_clock::now();
@@ -114,18 +120,21 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   fit.held_out = HeldOutResidual(solved, held_out, 2);
   std::printf(
       "%s: %.1f s, %d observations, rho_d (%.4f %.4f %.4f), rho_s %.4f, alpha %.4f; "
-      "fit render residual %.4f, region rms %.4f, held-out residual %.4f\n",
+      "fit render residual %.4f, region rms %.4f (albedo %s), held-out residual %.4f\n",
       brdf_name, fit.seconds, fit.region.observations, m.rho_d->x(), m.rho_d->y(), m.rho_d->z(),
       fit.region.final_params.rho_s.x(), fit.region.final_params.alpha, fit.fit_residual,
-      fit.region_rms, fit.held_out);
+      fit.region_rms, fit.region.stage2.albedo_model.c_str(), fit.held_out);
   return fit;
 }
 
-// Measured (Release, 2 threads, shared 2-core machine; the whole test 3 s), session 30:
-//   ward:    rho_d (0.517 0.437 0.286), rho_s 0.0090, alpha 0.026; fit render residual 0.096,
-//            region rms 0.096, held-out residual 0.097
-//   lambert: rho_d (0.499 0.423 0.279);               fit render residual 0.154,
-//            region rms 0.210, held-out residual 0.141
+// Measured (Release, 2 threads, shared 2-core machine; the whole test 3 s), session 33, every
+// observation fitted, one albedo in both fits:
+//   ward:    rho_d (0.496 0.420 0.275), rho_s 0.0092, alpha 0.027; fit render residual 0.0955,
+//            region rms 0.0947, held-out residual 0.0960
+//   lambert: rho_d (0.498 0.422 0.277);               fit render residual 0.1546,
+//            region rms 0.1542, held-out residual 0.1417
+// (Session 30, 6000 drawn by the observation's index: ward 0.096 / 0.096 / 0.097, lambert
+// 0.154 / 0.210 / 0.141.)
 // (Before session 30 the fit render residual was of the ball with its per-patch albedo map,
 // which --albedo-maps none does not write: ward 0.067, lambert 0.126.)
 TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
@@ -142,10 +151,10 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   EXPECT_GT(ward.region.final_params.alpha, 0.01);
   EXPECT_LT(ward.region.final_params.alpha, 0.5);
   // Clearly below: at least 20 % lower residual on the fitted photos, by both measures
-  // (measured: 0.62 and 0.46 of Lambert's).
+  // (measured: 0.62 and 0.61 of Lambert's).
   EXPECT_LT(ward.fit_residual, 0.8 * lambert.fit_residual);
   EXPECT_LT(ward.region_rms, 0.8 * lambert.region_rms);
-  // Photos under lights neither fit saw (measured 0.69 of Lambert's).
+  // Photos under lights neither fit saw (measured 0.68 of Lambert's).
   EXPECT_LE(ward.held_out, lambert.held_out);
 }
 

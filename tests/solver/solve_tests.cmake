@@ -6,3 +6,6 @@ igi_add_test(solve_gather_test SOURCES solve_gather_test.cpp DEPS igi_solver)
 # Stage 2's joint albedo update against the independent refit: one round from albedos 5 % too
 # high in a bright closed room (SolverState directly; a few seconds).
 igi_add_test(solve_refine_test SOURCES solve_refine_test.cpp DEPS igi_solver)
+# The fit samples' draw is keyed by photo and pixel: one photo's changed pixels leave another
+# photo's draw as it was (SolverState::Prepare twice on the 2 m room; a few seconds).
+igi_add_test(solve_fit_samples_test SOURCES solve_fit_samples_test.cpp DEPS igi_solver)
