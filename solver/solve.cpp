@@ -29,10 +29,6 @@ double Since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Fit samples per region and stage (SolverState::SelectFitSamples; the counts are
-// SolveOptions::max_highlight_samples and max_fit_samples). The rest carry the albedo:
-// max_fit_samples less the highlight samples, never under a third of it.
-
 // Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
 // drawn with the same probability by a hash of its photo and pixel; returns how many it marked.
 // Not by the observation's index: a change to one photo's observations (its pose, its mask, a

@@ -81,10 +81,10 @@ TEST(SolveFitSamples, APhotosDrawDoesNotMoveWithAnotherPhotosPixels) {
   const Scene scene = LoadScene(dir / "scene.json");
   const Camera& cam0 = scene.cameras[scene.FindCamera("cam0")];
   Image photo = ReadImage(dir / "photos" / "cam0.exr");
+  const Eigen::Vector3d c = cam0.CenterInWorld();
   int cleared = 0;
   for (int y = 0; y < photo.height; ++y) {
     for (int x = 0; x < photo.width; ++x) {
-      const Eigen::Vector3d c = cam0.CenterInWorld();
       const Eigen::Vector3d d = cam0.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
       if (!(d.z() < 0)) continue;
       const Eigen::Vector3d p = c - d * (c.z() / d.z());
