@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -135,6 +136,18 @@ inline ConcealedOutcome DiagnoseConcealed(
                             materials_given ? "" : " --refine-iterations 0");
   if (inspect) inspect(dir / "diag");
   o.floor = FloorResidual(WriteTrueModel(capture), dir / "floor");
+  // The figures a reader of the log needs to see how near a bound a run came (the folders are
+  // removed below).
+  if (o.diagnosis.contains("final") && o.floor > 0) {
+    std::string kept;
+    for (const Json& s : o.diagnosis["steps"]) {
+      kept += (kept.empty() ? "" : ", ") + s["effect"].get<std::string>();
+    }
+    const double fin = o.diagnosis["final"]["residual"].get<double>();
+    std::printf("[concealed %s seed %d] kept: %s; baseline %.4f, final %.4f, floor %.4f: %.3fx\n",
+                effect.empty() ? "none" : effect.c_str(), seed, kept.empty() ? "-" : kept.c_str(),
+                o.diagnosis["baseline"]["residual"].get<double>(), fin, o.floor, fin / o.floor);
+  }
   if (const char* keep = std::getenv("IGI_CONCEALED_KEEP"); keep != nullptr && *keep != 0) {
     const std::filesystem::path to = std::filesystem::path(keep) / dir.filename();
     std::filesystem::create_directories(to.parent_path());
