@@ -764,10 +764,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     // texture's blobs are not taken for an object (the surface-behind test, missing_geometry.h).
     missing = LocateMissingGeometry(st.model, photos, st.sim.sims, st.records, holdout,
                                     out_dir / "masks");
-    // Tried at a 1 % share of the held-out residual² at least: this early trial, rejected, keeps
-    // the object out of every later round, and its step is kept only at min_gain's share anyway.
-    if (missing.candidate.valid &&
-        missing.candidate.Gain() >= std::max(o.candidate_min_gain, 0.01) &&
+    if (missing.candidate.valid && missing.candidate.Gain() >= o.missing_geometry_min_gain &&
         missing.candidate.z >= o.candidate_min_z) {
       std::vector<Trial> one;
       one.push_back(try_step(missing.candidate, maps));

@@ -28,6 +28,9 @@ struct DiagnoseOptions {
   // fall short too; the full-size light_source_extent capture (seed 113, session 34) predicted
   // the lamp's extent at 0.64 % (z 1.6), never tried at 1 %, and kept it, tried, at 2.7 % (z 3.9).
   double candidate_min_gain = 0.005;
+  // The same for missing_geometry's trial before the maps: a rejected trial there keeps the
+  // object out of every later round, so it waits for a larger predicted share.
+  double missing_geometry_min_gain = 0.01;
   double candidate_min_z = 1.5;
   int max_tries = 5;
   int light_samples = 8;  // per extended light, for the direct-light features
