@@ -52,11 +52,12 @@ TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
 // profile is refitted once. Before (session 19), the full-size suite's capture applied 11 photo
 // scales first (1.85× the floor) and the profile's search on every record gave cos^14 about an
 // axis pointing up.
-// Measured 2026-11-26 (seed 11, 3.5 min on 2 cores beside other work): the profile first (axis
-// 2.1° off, cos^1.40, held-out residual² −89 %), its refit (4.3° off, cos^1.95, −17 %); the
-// albedo maps (the floor is textured) rejected (−6 %, z 0.1); final 0.1606 against the true
-// model's 0.1322: 1.215×, just over issue 8's 1.2× (the full-size capture, where the maps are
-// kept, reaches 0.97×). The bound here is 1.25× for that reason: a known gap, not the target.
+// Measured 2026-11-28 (seed 11, 4.6 min on 2 cores): the profile first (axis 2.2° off, cos^1.40,
+// held-out residual² −89 %); the texture test, missed at the baseline under the profile's error,
+// run again on that model: the floor alone textured, its maps kept (−23 %); the profile's refit
+// (2.2° off, cos^1.81, −24 %); final 0.1305 against the true model's 0.1322: 0.99× (held out
+// 1.04×). Before the texture test was repeated (sessions 26–34) the maps came only as the last
+// resort, for every region whose albedo varies, were rejected, and the run ended at 1.215×.
 TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings) {
   const ConcealedOutcome o =
       DiagnoseConcealed("light_emission_profile", 11, nullptr, " --photo-lightings L0,L1", false);
@@ -74,8 +75,15 @@ TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings
   EXPECT_NEAR((*last_profile)["params"]["cos_power"].get<double>(), 2.0, 0.3)
       << last_profile->dump(1);
   const double final_residual = d["final"]["residual"];
-  EXPECT_LE(final_residual, 1.25 * o.floor) << "floor " << o.floor;
+  EXPECT_LE(final_residual, 1.2 * o.floor) << "floor " << o.floor;
   EXPECT_LT(final_residual, 0.4 * d["baseline"]["residual"].get<double>());
+  bool floor_map = false;
+  for (const Json& s : d["steps"]) {
+    if (s["effect"] == "albedo_texture" && s["params"].contains("regions")) {
+      for (const Json& r : s["params"]["regions"]) floor_map = floor_map || r == "floor";
+    }
+  }
+  EXPECT_TRUE(floor_map) << d.dump(1);  // the textured floor's maps, once the profile is in
 }
 
 // specular_lobe_shape with the materials unknown (ρs and α solved at every step): at the default
@@ -88,7 +96,10 @@ TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings
 // Measured 2026-11-26 (seed 11, 2.7 min on 2 cores): specular_lobe_shape on glossy_sphere first
 // (held-out residual² −56.7 %, 68.6 standard errors; fresnel on the sphere passed too, −55.3 %,
 // and was not applied), the albedo maps, specular_lobe_shape on the floor (−20.5 %, 3.4); final
-// 0.0611 against the true model's 0.0571 (1.07×; held out 1.23×).
+// 0.0611 against the true model's 0.0571 (1.07×; held out 1.23×). Re-measured 2026-11-28 with
+// the texture test repeated after each kept step (6.4 min for the three slow cases):
+// albedo_texture, specular_lobe_shape, fresnel, specular_lobe_shape; final 0.0639 against 0.0571
+// (1.12×).
 TEST(ConcealedUnknownMaterialsTest, SpecularLobeShapeIsNamedOnAGrazingView) {
   const ConcealedOutcome o = DiagnoseConcealed(
       "specular_lobe_shape", 11, nullptr, " --lamp-position 2,2,0.6 --grazing-cameras 1", false);
