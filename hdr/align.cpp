@@ -11,34 +11,18 @@
 namespace igi::hdr {
 namespace {
 
-// An 8-bit grey image, row-major.
-struct Grey {
-  int width = 0;
-  int height = 0;
-  std::vector<uint8_t> v;
-};
-
-Grey ToGrey(const Image& image) {
-  Grey g{image.width, image.height, std::vector<uint8_t>(size_t(image.width) * image.height)};
-  for (size_t i = 0; i < g.v.size(); ++i) {
-    float sum = 0.0f;
-    const int n = std::min(image.channels, 3);
-    for (int c = 0; c < n; ++c) sum += image.pixels[i * image.channels + c];
-    g.v[i] = uint8_t(std::clamp(sum / float(n) * 255.0f + 0.5f, 0.0f, 255.0f));
-  }
-  return g;
-}
+using Grey = GreyImage;
 
 Grey HalfSize(const Grey& g) {
   Grey h{std::max(g.width / 2, 1), std::max(g.height / 2, 1), {}};
-  h.v.resize(size_t(h.width) * h.height);
+  h.levels.resize(size_t(h.width) * h.height);
   for (int y = 0; y < h.height; ++y) {
     for (int x = 0; x < h.width; ++x) {
       const int x0 = std::min(2 * x, g.width - 1), x1 = std::min(2 * x + 1, g.width - 1);
       const int y0 = std::min(2 * y, g.height - 1), y1 = std::min(2 * y + 1, g.height - 1);
-      const int sum = g.v[size_t(y0) * g.width + x0] + g.v[size_t(y0) * g.width + x1] +
-                      g.v[size_t(y1) * g.width + x0] + g.v[size_t(y1) * g.width + x1];
-      h.v[size_t(y) * h.width + x] = uint8_t((sum + 2) / 4);
+      const int sum = g.levels[size_t(y0) * g.width + x0] + g.levels[size_t(y0) * g.width + x1] +
+                      g.levels[size_t(y1) * g.width + x0] + g.levels[size_t(y1) * g.width + x1];
+      h.levels[size_t(y) * h.width + x] = uint8_t((sum + 2) / 4);
     }
   }
   return h;
@@ -55,11 +39,11 @@ struct Bitmaps {
 // The level below which a fraction `rank` of the pixels lie.
 int Percentile(const Grey& g, double rank) {
   int histogram[256] = {};
-  for (uint8_t v : g.v) ++histogram[v];
+  for (uint8_t v : g.levels) ++histogram[v];
   int level = 0;
   for (size_t seen = 0; level < 255; ++level) {
     seen += size_t(histogram[level]);
-    if (double(seen) >= rank * double(g.v.size())) break;
+    if (double(seen) >= rank * double(g.levels.size())) break;
   }
   return level;
 }
@@ -67,16 +51,17 @@ int Percentile(const Grey& g, double rank) {
 // Fraction of pixels below `level`.
 double RankOf(const Grey& g, int level) {
   size_t below = 0;
-  for (uint8_t v : g.v) below += v < level ? 1 : 0;
-  return double(below) / double(g.v.size());
+  for (uint8_t v : g.levels) below += v < level ? 1 : 0;
+  return double(below) / double(g.levels.size());
 }
 
 Bitmaps MakeBitmaps(const Grey& g, int exclude_range, double rank) {
   const int median = Percentile(g, rank);
-  Bitmaps b{g.width, g.height, std::vector<uint8_t>(g.v.size()), std::vector<uint8_t>(g.v.size())};
-  for (size_t i = 0; i < g.v.size(); ++i) {
-    b.threshold[i] = g.v[i] > median ? 1 : 0;
-    b.keep[i] = std::abs(int(g.v[i]) - median) > exclude_range ? 1 : 0;
+  Bitmaps b{g.width, g.height, std::vector<uint8_t>(g.levels.size()),
+            std::vector<uint8_t>(g.levels.size())};
+  for (size_t i = 0; i < g.levels.size(); ++i) {
+    b.threshold[i] = g.levels[i] > median ? 1 : 0;
+    b.keep[i] = std::abs(int(g.levels[i]) - median) > exclude_range ? 1 : 0;
   }
   return b;
 }
@@ -125,6 +110,21 @@ PixelShift FindShift(const Grey& reference, const Grey& image, int level, double
 
 }  // namespace
 
+void ToGreyLevels(const float* pixels, size_t pixel_count, int channels, uint8_t* out) {
+  const int n = std::min(channels, 3);
+  for (size_t i = 0; i < pixel_count; ++i) {
+    float sum = 0.0f;
+    for (int c = 0; c < n; ++c) sum += pixels[i * size_t(channels) + size_t(c)];
+    out[i] = uint8_t(std::clamp(sum / float(n) * 255.0f + 0.5f, 0.0f, 255.0f));
+  }
+}
+
+GreyImage ToGrey(const Image& image) {
+  GreyImage g{image.width, image.height, std::vector<uint8_t>(size_t(image.width) * image.height)};
+  ToGreyLevels(image.pixels.data(), g.levels.size(), image.channels, g.levels.data());
+  return g;
+}
+
 void AlignOptions::Validate() const {
   if (max_bits < 1 || max_bits > 10 || exclude_range < 0 || exclude_range > 64) {
     throw InputError(DescribeProblem("--align", "", fmt::format("{}/{}", max_bits, exclude_range),
@@ -144,8 +144,8 @@ double PairRank(const Grey& a, const Grey& b) {
 
 double MeanLevel(const Grey& g) {
   double sum = 0.0;
-  for (uint8_t v : g.v) sum += v;
-  return sum / double(g.v.size());
+  for (uint8_t v : g.levels) sum += v;
+  return sum / double(g.levels.size());
 }
 
 }  // namespace
@@ -153,18 +153,36 @@ double MeanLevel(const Grey& g) {
 std::vector<PixelShift> ComputeMtbShifts(const std::vector<Image>& images, int reference,
                                          const AlignOptions& options) {
   options.Validate();
-  std::vector<Grey> grey;
+  std::vector<GreyImage> grey;
   for (const Image& image : images) grey.push_back(ToGrey(image));
+  return ComputeMtbShifts(grey, reference, options);
+}
+
+std::vector<PixelShift> ComputeMtbShifts(const std::vector<GreyImage>& grey, int reference,
+                                         const AlignOptions& options) {
+  options.Validate();
+  for (size_t j = 0; j < grey.size(); ++j) {
+    if (grey[j].width != grey[0].width || grey[j].height != grey[0].height ||
+        grey[j].levels.size() != size_t(grey[j].width) * size_t(grey[j].height)) {
+      throw InputError(DescribeProblem(fmt::format("image {}", j), "size",
+                                       fmt::format("{}x{}", grey[j].width, grey[j].height),
+                                       "every image must have the size of the first"));
+    }
+  }
+  if (!grey.empty() && (reference < 0 || size_t(reference) >= grey.size())) {
+    throw InputError(DescribeProblem("--align", "reference", fmt::format("{}", reference),
+                                     fmt::format("must be an image index below {}", grey.size())));
+  }
   // Chain neighbours in brightness order outwards from the reference: two frames a stop or two
   // apart share many well-exposed pixels, the ends of a long bracket share none.
-  std::vector<int> order(images.size());
+  std::vector<int> order(grey.size());
   for (size_t j = 0; j < order.size(); ++j) order[j] = int(j);
   std::vector<double> mean;
   for (const Grey& g : grey) mean.push_back(MeanLevel(g));
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return mean[size_t(a)] < mean[size_t(b)]; });
   const int at = int(std::find(order.begin(), order.end(), reference) - order.begin());
-  std::vector<PixelShift> shifts(images.size());
+  std::vector<PixelShift> shifts(grey.size());
   for (int step : {-1, 1}) {
     for (int k = at + step; k >= 0 && k < int(order.size()); k += step) {
       const int previous = order[size_t(k - step)], current = order[size_t(k)];

@@ -12,6 +12,8 @@
 // Percentiles do not depend on the response, so the bitmaps of both exposures still correspond.
 // Translation only: rotation between frames is not modelled.
 
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "tools/common/image.h"
@@ -29,9 +31,24 @@ struct PixelShift {
   int dy = 0;
 };
 
+// What alignment sees of an image: 8-bit grey levels, row-major, 1 byte a pixel (a quarter of
+// one float channel), so a bracket too large to hold as float can still be aligned.
+struct GreyImage {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> levels;  // round(255 x mean of the first three channels), clamped
+};
+
+// The grey levels of `pixel_count` pixels of `channels` interleaved normalised levels, to `out`.
+void ToGreyLevels(const float* pixels, size_t pixel_count, int channels, uint8_t* out);
+GreyImage ToGrey(const Image& image);
+
 // Shifts that align each image to images[reference] (whose shift is 0). Images are normalised
 // levels in [0, 1] (any response).
 std::vector<PixelShift> ComputeMtbShifts(const std::vector<Image>& images, int reference,
+                                         const AlignOptions& options = {});
+// The same from the images' grey levels (ToGrey): the same shifts.
+std::vector<PixelShift> ComputeMtbShifts(const std::vector<GreyImage>& grey, int reference,
                                          const AlignOptions& options = {});
 
 // Moves the content of `image` by `shift`; pixels shifted in from outside repeat the border.

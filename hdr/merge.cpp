@@ -105,13 +105,14 @@ void MergeOptions::Validate() const {
 namespace {
 
 // The per-pixel merge over lookup tables; one instance is shared by all threads (read only).
+// `src[j]` points at the values of exposure j that the value indices below address.
 class MergeKernel {
  public:
-  MergeKernel(const std::vector<Image>& images, const std::vector<double>& exposures_s,
+  MergeKernel(int channels, const std::vector<double>& exposures_s,
               const calib::ResponseCurve& response, const MergeOptions& options)
       : options_(options),
         levels_(1 << options.bits),
-        channels_(images[0].channels),
+        channels_(channels),
         scale_(float(levels_ - 1)),
         hat_(options.weighting == "hat") {
     for (int c = 0; c < channels_; ++c) {
@@ -122,34 +123,38 @@ class MergeKernel {
         size_t(std::min_element(exposures_s.begin(), exposures_s.end()) - exposures_s.begin());
     longest_ =
         size_t(std::max_element(exposures_s.begin(), exposures_s.end()) - exposures_s.begin());
-    for (size_t j = 0; j < images.size(); ++j) {
+    for (size_t j = 0; j < exposures_s.size(); ++j) {
       const float t = float(exposures_s[j]);
       t_.push_back(t);
       a_.push_back(hat_ ? 1.0f : t);
       b_.push_back(hat_ ? -float(std::log(exposures_s[j])) : 0.0f);
       c_.push_back(hat_ ? 1.0f : t * t);
-      src_.push_back(images[j].pixels.data());
     }
   }
+
+  size_t exposures() const { return t_.size(); }
+  int channels() const { return channels_; }
+  bool shared_weights() const { return options_.shared_weights; }
+  int num_threads() const { return options_.num_threads; }
 
   // Merges pixel `pixel` into `out` (channels_ values); returns bit 1 = saturated, 2 = black.
   // Every sample adds a_j * (w x) + b_j * w to the numerator and c_j * w to the denominator:
   // noise a = t, b = 0, c = t^2 (then E = num / den); hat a = 1, b = -ln t, c = 1
   // (then E = exp(num / den)). kChannels = 0: any count (runtime).
   template <int kChannels>
-  int Pixel(size_t pixel, float* out) const {
+  int Pixel(const float* const* src, size_t pixel, float* out) const {
     constexpr int kMaxChannels = 8;
     const int channels = kChannels > 0 ? kChannels : channels_;
     float num[kMaxChannels] = {}, den[kMaxChannels] = {};
     const size_t base = pixel * size_t(channels);
-    const size_t p = src_.size();
+    const size_t p = t_.size();
     if (options_.shared_weights) {
-      SharedWeightSums(base, num, den);
+      SharedWeightSums(src, base, num, den);
     } else {
       for (size_t j = 0; j < p; ++j) {
-        const float* src = src_[j] + base;
+        const float* values = src[j] + base;
         for (int c = 0; c < channels; ++c) {
-          const std::array<float, 2>& wx = tables_[size_t(c)].weighted[size_t(Level(src[c]))];
+          const std::array<float, 2>& wx = tables_[size_t(c)].weighted[size_t(Level(values[c]))];
           num[c] += a_[j] * wx[0] + b_[j] * wx[1];
           den[c] += c_[j] * wx[1];
         }
@@ -162,31 +167,30 @@ class MergeKernel {
         continue;
       }
       // No usable value: saturated (judged on the shortest exposure) or black everywhere.
-      const int q_short = Level(src_[shortest_][base + size_t(c)]);
+      const int q_short = Level(src[shortest_][base + size_t(c)]);
       const bool saturated = double(q_short) / (levels_ - 1) >= options_.saturated;
       const size_t j = saturated ? shortest_ : longest_;
-      out[c] = tables_[size_t(c)].lin[size_t(Level(src_[j][base + size_t(c)]))] / t_[j];
+      out[c] = tables_[size_t(c)].lin[size_t(Level(src[j][base + size_t(c)]))] / t_[j];
       flags |= saturated ? 1 : 2;
     }
     return flags;
   }
 
-  int channels() const { return channels_; }
-
   // Merges `count` consecutive values (whole pixels) starting at value index `begin`, image by
   // image so that each image is read as one sequential stream. `num`/`den` are scratch of size
   // `count`. Fills out[begin .. begin + count) and returns per-pixel flags in `flags`.
-  void Span(size_t begin, size_t count, float* num, float* den, float* out, uint8_t* flags) const {
+  void Span(const float* const* src, size_t begin, size_t count, float* num, float* den, float* out,
+            uint8_t* flags) const {
     std::fill(num, num + count, 0.0f);
     std::fill(den, den + count, 0.0f);
     const size_t channels = size_t(channels_);
-    for (size_t j = 0; j < src_.size(); ++j) {
+    for (size_t j = 0; j < t_.size(); ++j) {
       if (channels == 3) {
-        Accumulate<3>(j, begin, count, num, den);
+        Accumulate<3>(src[j], j, begin, count, num, den);
       } else if (channels == 1) {
-        Accumulate<1>(j, begin, count, num, den);
+        Accumulate<1>(src[j], j, begin, count, num, den);
       } else {
-        Accumulate<0>(j, begin, count, num, den);
+        Accumulate<0>(src[j], j, begin, count, num, den);
       }
     }
     for (size_t i = 0; i < count; i += channels) {
@@ -197,10 +201,10 @@ class MergeKernel {
           out[begin + v] = hat_ ? std::exp(num[v] / den[v]) : num[v] / den[v];
           continue;
         }
-        const int q_short = Level(src_[shortest_][begin + v]);
+        const int q_short = Level(src[shortest_][begin + v]);
         const bool saturated = double(q_short) / (levels_ - 1) >= options_.saturated;
         const size_t j = saturated ? shortest_ : longest_;
-        out[begin + v] = tables_[k].lin[size_t(Level(src_[j][begin + v]))] / t_[j];
+        out[begin + v] = tables_[k].lin[size_t(Level(src[j][begin + v]))] / t_[j];
         f |= saturated ? 1 : 2;
       }
       flags[i / channels] = f;
@@ -208,14 +212,16 @@ class MergeKernel {
   }
 
  private:
-  // Adds image j's samples of values [begin, begin + count) to num and den (the hot loop).
+  // Adds image j's samples (at `image`) of values [begin, begin + count) to num and den (the hot
+  // loop).
   template <int kChannels>
-  void Accumulate(size_t j, size_t begin, size_t count, float* num, float* den) const {
+  void Accumulate(const float* image, size_t j, size_t begin, size_t count, float* num,
+                  float* den) const {
     const size_t channels = kChannels > 0 ? size_t(kChannels) : size_t(channels_);
     constexpr int kMaxChannels = 8;
     const std::array<float, 2>* tab[kMaxChannels];
     for (size_t k = 0; k < channels; ++k) tab[k] = tables_[k].weighted.data();
-    const float* src = src_[j] + begin;
+    const float* src = image + begin;
     const float a = a_[j], b = b_[j], c = c_[j];
     const int top = levels_ - 1;
     for (size_t i = 0; i < count; i += channels) {
@@ -229,26 +235,25 @@ class MergeKernel {
   }
 
   // The sums with one weight per sample shared by the channels (their mean), as MergeDebevec.
-  void SharedWeightSums(size_t base, float* num, float* den) const {
-    for (size_t j = 0; j < src_.size(); ++j) {
+  void SharedWeightSums(const float* const* src, size_t base, float* num, float* den) const {
+    for (size_t j = 0; j < t_.size(); ++j) {
       float w = 0.0f;
       for (int c = 0; c < channels_; ++c) {
-        w += tables_[size_t(c)].weight[size_t(Level(src_[j][base + size_t(c)]))];
+        w += tables_[size_t(c)].weight[size_t(Level(src[j][base + size_t(c)]))];
       }
       w /= float(channels_);
       for (int c = 0; c < channels_; ++c) {
         const ChannelTables& tab = tables_[size_t(c)];
-        const size_t q = size_t(Level(src_[j][base + size_t(c)]));
+        const size_t q = size_t(Level(src[j][base + size_t(c)]));
         num[c] += a_[j] * w * (hat_ ? tab.ln[q] : tab.lin[q]) + b_[j] * w;
         den[c] += c_[j] * w;
       }
     }
   }
 
- private:
   int Level(float v) const { return std::clamp(int(v * scale_ + 0.5f), 0, levels_ - 1); }
 
-  const MergeOptions& options_;
+  const MergeOptions options_;
   int levels_;
   int channels_;
   float scale_;
@@ -256,10 +261,77 @@ class MergeKernel {
   std::vector<ChannelTables> tables_;
   size_t shortest_ = 0, longest_ = 0;
   std::vector<float> t_, a_, b_, c_;
-  std::vector<const float*> src_;
 };
 
 }  // namespace
+
+struct BandMerger::Impl {
+  MergeKernel kernel;
+};
+
+BandMerger::BandMerger(int channels, const std::vector<double>& exposures_s,
+                       const calib::ResponseCurve& response, const MergeOptions& options) {
+  options.Validate();
+  if (channels < 1 || channels > 8) {
+    throw InputError(DescribeProblem("bracket", "channels", fmt::format("{}", channels),
+                                     "need 1 to 8 channels"));
+  }
+  if (exposures_s.empty()) {
+    throw InputError(DescribeProblem("bracket", "images", "0", "need at least one exposure"));
+  }
+  if (response.num_channels() != 1 && response.num_channels() != channels) {
+    throw InputError(
+        DescribeProblem("response", "channels", fmt::format("{}", response.num_channels()),
+                        fmt::format("must be 1 or the images' channel count ({})", channels)));
+  }
+  impl_ = std::make_unique<Impl>(Impl{MergeKernel(channels, exposures_s, response, options)});
+}
+
+BandMerger::~BandMerger() = default;
+
+int BandMerger::channels() const { return impl_->kernel.channels(); }
+
+BandMerger::Counts BandMerger::Merge(const std::vector<const float*>& bands, int width, int rows,
+                                     float* radiance, float* mask, Progress* progress) const {
+  const MergeKernel& kernel = impl_->kernel;
+  if (bands.size() != kernel.exposures()) {
+    throw InputError(DescribeProblem("bracket", "images", fmt::format("{}", bands.size()),
+                                     fmt::format("need {} exposures", kernel.exposures())));
+  }
+  const int channels = kernel.channels();
+  const bool shared_weights = impl_->kernel.shared_weights();
+  std::atomic<int64_t> saturated{0}, black{0};
+  ParallelForRange(
+      0, rows,
+      [&](int64_t y0, int64_t y1) {
+        int64_t row_saturated = 0, row_black = 0;
+        const size_t row_values = size_t(width) * channels;
+        std::vector<float> num(row_values), den(row_values);
+        std::vector<uint8_t> flags(static_cast<size_t>(width));
+        for (int64_t y = y0; y < y1; ++y) {
+          const size_t first_pixel = size_t(y) * width;
+          if (shared_weights) {
+            for (int x = 0; x < width; ++x) {
+              flags[size_t(x)] = uint8_t(kernel.Pixel<0>(bands.data(), first_pixel + x,
+                                                         &radiance[(first_pixel + x) * channels]));
+            }
+          } else {
+            kernel.Span(bands.data(), first_pixel * channels, row_values, num.data(), den.data(),
+                        radiance, flags.data());
+          }
+          for (int x = 0; x < width; ++x) {
+            mask[first_pixel + x] = flags[size_t(x)] != 0 ? 0.0f : 1.0f;
+            row_saturated += flags[size_t(x)] & 1;
+            row_black += (flags[size_t(x)] >> 1) & 1;
+          }
+        }
+        saturated += row_saturated;
+        black += row_black;
+        if (progress != nullptr) progress->Add(y1 - y0);
+      },
+      impl_->kernel.num_threads(), 8);
+  return {saturated, black};
+}
 
 MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<double>& exposures_s,
                          const calib::ResponseCurve& response, const MergeOptions& options) {
@@ -271,44 +343,18 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
   }
   const auto start = std::chrono::steady_clock::now();
   const int width = images[0].width, height = images[0].height, channels = images[0].channels;
-  const MergeKernel kernel(images, exposures_s, response, options);
+  const BandMerger merger(channels, exposures_s, response, options);
+  std::vector<const float*> src;
+  for (const Image& image : images) src.push_back(image.pixels.data());
   MergeResult result;
   result.radiance = Image(width, height, channels);
-  result.mask = Image(width, height, 1, 1.0f);
-  std::atomic<int64_t> saturated{0}, black{0};
+  result.mask = Image(width, height, 1);
   Progress progress("merge rows", height);  // on a terminal, for merges longer than ~2 s
-  ParallelForRange(
-      0, height,
-      [&](int64_t y0, int64_t y1) {
-        int64_t row_saturated = 0, row_black = 0;
-        const size_t row_values = size_t(width) * channels;
-        std::vector<float> num(row_values), den(row_values);
-        std::vector<uint8_t> flags(static_cast<size_t>(width));
-        for (int64_t y = y0; y < y1; ++y) {
-          const size_t first_pixel = size_t(y) * width;
-          if (options.shared_weights) {
-            for (int x = 0; x < width; ++x) {
-              flags[size_t(x)] = uint8_t(kernel.Pixel<0>(
-                  first_pixel + x, &result.radiance.pixels[(first_pixel + x) * channels]));
-            }
-          } else {
-            kernel.Span(first_pixel * channels, row_values, num.data(), den.data(),
-                        result.radiance.pixels.data(), flags.data());
-          }
-          for (int x = 0; x < width; ++x) {
-            if (flags[size_t(x)] != 0) result.mask.pixels[first_pixel + x] = 0.0f;
-            row_saturated += flags[size_t(x)] & 1;
-            row_black += (flags[size_t(x)] >> 1) & 1;
-          }
-        }
-        saturated += row_saturated;
-        black += row_black;
-        progress.Add(y1 - y0);
-      },
-      options.num_threads, 8);
+  const BandMerger::Counts counts = merger.Merge(src, width, height, result.radiance.pixels.data(),
+                                                 result.mask.pixels.data(), &progress);
   progress.Finish();
-  result.saturated_pixels = saturated;
-  result.black_pixels = black;
+  result.saturated_pixels = counts.saturated_pixels;
+  result.black_pixels = counts.black_pixels;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::debug("merge: {}x{}x{}, {} images, {} weights, {:.3f} s", width, height, channels,
                 images.size(), options.weighting, result.seconds);

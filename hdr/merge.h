@@ -17,12 +17,17 @@
 // The output is linear radiance in the response's units (exp(g) per second): relative, not
 // absolute. Work is a per-pixel loop over lookup tables, parallel over rows (ParallelFor), with
 // an igi::Progress bar over the rows (drawn on a terminal once a merge runs past ~2 s).
+// Each pixel's result depends only on that pixel's values, so a merge band by band (BandMerger,
+// hdr/merge_stream.h) gives bit-identical values to a merge of the whole images.
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "calib/response_curve.h"
 #include "tools/common/image.h"
+#include "tools/common/progress.h"
 
 namespace igi::hdr {
 
@@ -56,5 +61,35 @@ struct MergeResult {
 // mismatch between images, exposures and response.
 MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<double>& exposures_s,
                          const calib::ResponseCurve& response, const MergeOptions& options);
+
+// The merge of bands of rows: the lookup tables are built once for a bracket, then any number of
+// bands (the same rows of every image) are merged. MergeBracket is one band of the whole height.
+class BandMerger {
+ public:
+  struct Counts {
+    int64_t saturated_pixels = 0;  // pixels saturated in every exposure (in some channel)
+    int64_t black_pixels = 0;      // pixels black in every exposure (in some channel)
+  };
+
+  // Throws InputError on bad options, more than 8 channels, or a response with neither 1 curve
+  // nor `channels` curves.
+  BandMerger(int channels, const std::vector<double>& exposures_s,
+             const calib::ResponseCurve& response, const MergeOptions& options);
+  ~BandMerger();
+  BandMerger(const BandMerger&) = delete;
+  BandMerger& operator=(const BandMerger&) = delete;
+
+  // `bands[j]` holds `rows` rows of `width` pixels of exposure j (normalised levels, channels
+  // interleaved). Writes linear radiance (rows x width x channels values) to `radiance` and the
+  // mask (rows x width values, 1 = good, 0 = bad) to `mask`; `progress` (optional) gets the rows.
+  Counts Merge(const std::vector<const float*>& bands, int width, int rows, float* radiance,
+               float* mask, Progress* progress = nullptr) const;
+
+  int channels() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace igi::hdr

@@ -4,6 +4,9 @@
 //   igi-hdr RAW_FILES… --out radiance.exr          (DNG, CR2, NEF, …: decoded linearly)
 //   igi-hdr --manifest DIR/manifest.jsonl --out radiance.exr   (one output per bracket)
 // Pixels saturated or black in every exposure are counted, printed and masked (mask: 0 = bad).
+// 8/16-bit frames with a known response (--response, --linear, a manifest) are merged band by
+// band (--band-rows rows of every frame in memory, hdr/merge_stream.h); raw files, a response
+// recovered from the bracket and --whole-images load every frame whole.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +17,7 @@
 #include "hdr/hdr_input.h"
 #include "hdr/manifest.h"
 #include "hdr/merge.h"
+#include "hdr/merge_stream.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
@@ -28,9 +32,11 @@ struct Flags {
   std::string out;
   std::string mask_out;  // empty = OUT_mask.png
   bool align = false;
-  bool black_given = false;  // --black on the command line (else raw input uses 0)
+  bool black_given = false;   // --black on the command line (else raw input uses 0)
+  bool whole_images = false;  // load every frame whole instead of merging band by band
   igi::hdr::HdrInputOptions input;
   igi::hdr::MergeOptions merge;
+  igi::hdr::HdrStreamOptions stream;
 };
 
 struct Job {
@@ -47,6 +53,7 @@ fs::path MaskPath(const fs::path& out, const std::string& mask_out, bool single)
 void Validate(const Flags& flags) {
   flags.merge.Validate();
   flags.input.raw.Validate();
+  flags.stream.Validate();
   if (flags.images.empty() == flags.manifest.empty()) {
     throw igi::InputError("give either IMAGES or --manifest (exactly one of them)");
   }
@@ -60,13 +67,14 @@ void Validate(const Flags& flags) {
 // Loads every bracket (all problems found before anything is written).
 std::vector<Job> LoadJobs(const Flags& flags) {
   std::vector<Job> jobs;
+  igi::hdr::HdrInputOptions options = flags.input;
+  options.headers_only = !flags.whole_images;
   if (!flags.images.empty()) {
     std::vector<fs::path> paths(flags.images.begin(), flags.images.end());
-    jobs.push_back({flags.out, igi::hdr::LoadHdrInput(paths, flags.input)});
+    jobs.push_back({flags.out, igi::hdr::LoadHdrInput(paths, options)});
     return jobs;
   }
   const auto brackets = igi::hdr::ReadManifest(flags.manifest);
-  igi::hdr::HdrInputOptions options = flags.input;
   options.linear = options.response.empty();  // machine-vision frames are linear
   igi::ProblemList problems;
   for (const auto& bracket : brackets) {
@@ -90,50 +98,94 @@ std::vector<Job> LoadJobs(const Flags& flags) {
   return jobs;
 }
 
-void AlignJob(igi::hdr::HdrInput* input) {
+// The median exposure: the best-exposed reference for alignment.
+int ReferenceFrame(const std::vector<double>& exposures_s) {
   int reference = 0;
-  for (size_t j = 0; j < input->exposures_s.size(); ++j) {
-    // The median exposure is the best-exposed reference.
+  for (size_t j = 0; j < exposures_s.size(); ++j) {
     int below = 0;
-    for (double t : input->exposures_s) below += t < input->exposures_s[j] ? 1 : 0;
-    if (below == int(input->exposures_s.size()) / 2) reference = int(j);
+    for (double t : exposures_s) below += t < exposures_s[j] ? 1 : 0;
+    if (below == int(exposures_s.size()) / 2) reference = int(j);
   }
-  const auto shifts = igi::hdr::ComputeMtbShifts(input->images, reference);
+  return reference;
+}
+
+void PrintShifts(const igi::hdr::HdrInput& input, const std::vector<igi::hdr::PixelShift>& shifts) {
   for (size_t j = 0; j < shifts.size(); ++j) {
     if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
-    std::printf("%s: aligned by (%d, %d) px\n", input->names[j].c_str(), shifts[j].dx,
-                shifts[j].dy);
+    std::printf("%s: aligned by (%d, %d) px\n", input.names[j].c_str(), shifts[j].dx, shifts[j].dy);
+  }
+}
+
+void AlignJob(igi::hdr::HdrInput* input) {
+  const auto shifts = igi::hdr::ComputeMtbShifts(input->images, ReferenceFrame(input->exposures_s));
+  PrintShifts(*input, shifts);
+  for (size_t j = 0; j < shifts.size(); ++j) {
+    if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
     input->images[j] = igi::hdr::ShiftImage(input->images[j], shifts[j]);
   }
+}
+
+// What a merge found, for the summary line.
+struct MergeCounts {
+  int64_t pixels = 0;
+  int64_t saturated = 0;
+  int64_t black = 0;
+};
+
+MergeCounts MergeWhole(Job& job, const igi::hdr::MergeOptions& merge, const Flags& flags,
+                       const fs::path& mask) {
+  if (flags.align) AlignJob(&job.input);
+  const igi::hdr::MergeResult result =
+      igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
+  igi::Image radiance = result.radiance;
+  radiance.metadata["igi:response"] = job.input.response_source;
+  radiance.metadata["igi:weighting"] = merge.weighting;
+  igi::WriteImage(job.out, radiance);
+  igi::WriteImageOptions mask_options;
+  mask_options.type = igi::PixelType::kUInt8;
+  igi::WriteImage(mask, result.mask, mask_options);
+  return {int64_t(result.radiance.width) * result.radiance.height, result.saturated_pixels,
+          result.black_pixels};
+}
+
+MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, const Flags& flags,
+                          const fs::path& mask) {
+  std::vector<igi::hdr::PixelShift> shifts;
+  if (flags.align) {
+    // Shifts from the frames' 8-bit grey levels (1 byte a pixel), applied while streaming.
+    shifts = igi::hdr::ComputeMtbShifts(igi::hdr::ReadGreyFrames(job.input.paths, flags.stream),
+                                        ReferenceFrame(job.input.exposures_s));
+    PrintShifts(job.input, shifts);
+  }
+  igi::hdr::StreamOutputs outputs;
+  outputs.radiance = job.out;
+  outputs.radiance_metadata["igi:response"] = job.input.response_source;
+  outputs.radiance_metadata["igi:weighting"] = merge.weighting;
+  outputs.mask = mask;
+  const igi::hdr::StreamMergeSummary summary =
+      igi::hdr::MergeBracketStreamed(job.input.paths, job.input.exposures_s, shifts,
+                                     job.input.response, merge, flags.stream, outputs);
+  return {int64_t(summary.width) * summary.height, summary.saturated_pixels, summary.black_pixels};
 }
 
 int Run(const Flags& flags) {
   Validate(flags);
   std::vector<Job> jobs = LoadJobs(flags);
   for (Job& job : jobs) {
-    if (flags.align) AlignJob(&job.input);
     igi::hdr::MergeOptions merge = flags.merge;
     merge.bits = job.input.bits;
     // Raw data has its black level subtracted: only a zero value carries no signal.
     if (job.input.raw && !flags.black_given) merge.black = 0.0;
-    const igi::hdr::MergeResult result =
-        igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
     const fs::path mask = MaskPath(job.out, flags.mask_out, jobs.size() == 1);
-    igi::Image radiance = result.radiance;
-    radiance.metadata["igi:response"] = job.input.response_source;
-    radiance.metadata["igi:weighting"] = merge.weighting;
-    igi::WriteImage(job.out, radiance);
-    igi::WriteImageOptions mask_options;
-    mask_options.type = igi::PixelType::kUInt8;
-    igi::WriteImage(mask, result.mask, mask_options);
-    const double total = double(result.radiance.width) * result.radiance.height;
+    const MergeCounts counts = job.input.headers_only ? MergeStreamed(job, merge, flags, mask)
+                                                      : MergeWhole(job, merge, flags, mask);
+    const double total = double(counts.pixels);
     std::printf(
         "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
         "(%.3f %%), black in every exposure: %lld px (%.3f %%), masked in %s\n",
-        job.out.string().c_str(), int(job.input.images.size()), job.input.response_source.c_str(),
-        merge.weighting.c_str(), (long long)result.saturated_pixels,
-        100.0 * result.saturated_pixels / total, (long long)result.black_pixels,
-        100.0 * result.black_pixels / total, mask.string().c_str());
+        job.out.string().c_str(), int(job.input.names.size()), job.input.response_source.c_str(),
+        merge.weighting.c_str(), (long long)counts.saturated, 100.0 * counts.saturated / total,
+        (long long)counts.black, 100.0 * counts.black / total, mask.string().c_str());
   }
   return 0;
 }
@@ -167,6 +219,10 @@ int main(int argc, char** argv) {
   app.add_option("--raw-white-balance", flags.input.raw.white_balance, "camera or none");
   app.add_option("--raw-color", flags.input.raw.color, "srgb (linear) or raw (camera RGB)");
   app.add_flag("--half-size", flags.input.raw.half_size, "Raw: 2x2 binning, no demosaicing");
+  app.add_option("--band-rows", flags.stream.band_rows,
+                 "Rows of every frame held in memory when merging band by band (default 64)");
+  app.add_flag("--whole-images", flags.whole_images,
+               "Load every frame whole instead of merging band by band");
   return igi::RunMain(app, common, argc, argv, [&]() {
     flags.black_given = black->count() > 0;
     return Run(flags);

@@ -2,13 +2,12 @@
 // naming the image and the rule, outputs written only when the input is good).
 #include <gtest/gtest.h>
 
-#include "tests/e2e/run.h"
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "tests/e2e/run.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
@@ -181,6 +180,58 @@ TEST_F(HdrE2e, BadInputIsExitTwoWithOneLine) {
   EXPECT_NE(r.output.find("corrupt.png"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(dir_ / "bad_mask.png"));
+}
+
+// 8/16-bit frames with a known response are merged band by band: the same radiance map and mask
+// as --whole-images, bit for bit (each pixel's merge reads only that pixel), aligned or not.
+TEST_F(HdrE2e, BandByBandEqualsWholeImages) {
+  for (const std::string extra : {"", " --align --weighting hat"}) {
+    const fs::path streamed = dir_ / "streamed.exr", whole = dir_ / "whole.exr";
+    RunResult r = Run("igi-hdr", Frames() + kTimes + " --linear --band-rows 7" + extra + " --out " +
+                                     streamed.string());
+    ASSERT_EQ(r.code, 0) << r.output;
+    r = Run("igi-hdr",
+            Frames() + kTimes + " --linear --whole-images" + extra + " --out " + whole.string());
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_TRUE(ReadImage(streamed).pixels == ReadImage(whole).pixels) << extra;
+    EXPECT_TRUE(ReadImage(dir_ / "streamed_mask.png").pixels ==
+                ReadImage(dir_ / "whole_mask.png").pixels)
+        << extra;
+  }
+  const RunResult r = Run(
+      "igi-hdr", Frames() + kTimes + " --linear --band-rows 0 --out " + (dir_ / "x.exr").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--band-rows: 0: must be 1 .. 65536"), std::string::npos) << r.output;
+}
+
+// The band-by-band path checks the headers before writing anything, and a frame whose pixel data
+// is cut short (found part way through) leaves no output, not even a temporary file.
+TEST_F(HdrE2e, BandByBandBadInputIsExitTwoAndWritesNothing) {
+  const fs::path out = dir_ / "out" / "bad.exr";
+  const std::string two = kMemorial + "memorial0066.png " + kMemorial + "memorial0067.png ";
+  WriteImage(dir_ / "small.png", Image(10, 10, 3, 0.5f));
+  RunResult r = Run("igi-hdr", two + (dir_ / "small.png").string() +
+                                   " --linear --exposures 1,2,3 --out " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("small.png: size: 10x10x3: every image of a bracket must have the size"),
+            std::string::npos)
+      << r.output;
+  std::ofstream(dir_ / "corrupt.png") << "garbage";
+  r = Run("igi-hdr", two + (dir_ / "corrupt.png").string() + " --linear --exposures 1,2,3 --out " +
+                         out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("corrupt.png"), std::string::npos) << r.output;
+  const fs::path cut = dir_ / "cut.png";
+  fs::copy_file(kMemorial + "memorial0068.png", cut);
+  fs::resize_file(cut, fs::file_size(cut) * 3 / 4);
+  r = Run("igi-hdr", two + cut.string() + " --linear --exposures 1,2,3 --out " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("cut.png: cannot read image data"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "bad_mask.png"));
+  if (fs::exists(dir_ / "out")) {
+    EXPECT_TRUE(fs::is_empty(dir_ / "out"));
+  }
 }
 
 TEST_F(HdrE2e, TooFewUsablePixelsAndUsage) {

@@ -118,38 +118,163 @@ Image ReadImage(const std::filesystem::path& path, int channels) {
   return out;
 }
 
+namespace {
+
+// Creates the writer for `path`'s extension and opens `temp_path` with the spec of an image of
+// the given shape, `metadata` and `options`.
+std::unique_ptr<OIIO::ImageOutput> OpenOutput(const std::filesystem::path& path,
+                                              const std::filesystem::path& temp_path, int width,
+                                              int height, int channels,
+                                              const ImageMetadata& metadata,
+                                              const WriteImageOptions& options) {
+  const std::string ext = Lower(path.extension().string());
+  PixelType type = options.type;
+  if (type == PixelType::kAuto) {
+    if (ext == ".exr" || ext == ".hdr")
+      type = PixelType::kFloat;
+    else if (ext == ".tif" || ext == ".tiff")
+      type = PixelType::kUInt16;
+    else
+      type = PixelType::kUInt8;
+  }
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    throw Error(DescribeProblem(path.string(), "", "",
+                                "no image writer for this extension: " + OIIO::geterror()));
+  }
+  OIIO::ImageSpec spec(width, height, channels, ToOiio(type));
+  MetadataToSpec(metadata, &spec);
+  if (!options.compression.empty()) spec.attribute("compression", options.compression);
+  if (ext == ".jpg" || ext == ".jpeg") spec.attribute("CompressionQuality", options.jpeg_quality);
+  if (!out->open(temp_path.string(), spec)) {
+    throw Error(DescribeProblem(path.string(), "", "", "cannot write image: " + out->geterror()));
+  }
+  return out;
+}
+
+}  // namespace
+
 void WriteImage(const std::filesystem::path& path, const Image& image,
                 const WriteImageOptions& options) {
   if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
       image.pixels.size() != size_t(image.width) * image.height * image.channels) {
-    throw Error(DescribeProblem(path.string(), "", "", "refusing to write an empty or malformed image"));
-  }
-  const std::string ext = Lower(path.extension().string());
-  PixelType type = options.type;
-  if (type == PixelType::kAuto) {
-    if (ext == ".exr" || ext == ".hdr") type = PixelType::kFloat;
-    else if (ext == ".tif" || ext == ".tiff") type = PixelType::kUInt16;
-    else type = PixelType::kUInt8;
+    throw Error(
+        DescribeProblem(path.string(), "", "", "refusing to write an empty or malformed image"));
   }
   AtomicOutput atomic(path);
-  auto out = OIIO::ImageOutput::create(path.string());
-  if (!out) {
-    throw Error(DescribeProblem(path.string(), "", "", "no image writer for this extension: " + OIIO::geterror()));
-  }
-  OIIO::ImageSpec spec(image.width, image.height, image.channels, ToOiio(type));
-  MetadataToSpec(image.metadata, &spec);
-  if (!options.compression.empty()) spec.attribute("compression", options.compression);
-  if (ext == ".jpg" || ext == ".jpeg") spec.attribute("CompressionQuality", options.jpeg_quality);
-  if (!out->open(atomic.temp_path().string(), spec)) {
-    throw Error(DescribeProblem(path.string(), "", "", "cannot write image: " + out->geterror()));
-  }
+  auto out = OpenOutput(path, atomic.temp_path(), image.width, image.height, image.channels,
+                        image.metadata, options);
   if (!out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-    throw Error(DescribeProblem(path.string(), "", "", "cannot write image data: " + out->geterror()));
+    throw Error(
+        DescribeProblem(path.string(), "", "", "cannot write image data: " + out->geterror()));
   }
   if (!out->close()) {
     throw Error(DescribeProblem(path.string(), "", "", "cannot finish image: " + out->geterror()));
   }
   atomic.Commit();
+}
+
+struct ImageRowReader::Impl {
+  std::filesystem::path path;
+  std::unique_ptr<OIIO::ImageInput> in;
+  ImageInfo info;
+};
+
+ImageRowReader::ImageRowReader(const std::filesystem::path& path) : impl_(new Impl) {
+  impl_->path = path;
+  impl_->in = OIIO::ImageInput::open(path.string());
+  if (!impl_->in) {
+    throw InputError(
+        DescribeProblem(path.string(), "", "", "cannot read image: " + OIIO::geterror()));
+  }
+  const OIIO::ImageSpec& spec = impl_->in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    throw InputError(DescribeProblem(path.string(), "", "", "image has no pixels"));
+  }
+  ImageInfo& info = impl_->info;
+  info.width = spec.width;
+  info.height = spec.height;
+  info.channels = spec.nchannels;
+  info.type = FromOiio(spec.format);
+  info.bits_per_sample = spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size() * 8));
+  info.format = impl_->in->format_name();
+  info.metadata = MetadataFromSpec(spec);
+}
+
+ImageRowReader::~ImageRowReader() = default;
+
+const ImageInfo& ImageRowReader::info() const { return impl_->info; }
+
+void ImageRowReader::ReadRows(int y0, int y1, float* out) {
+  const ImageInfo& info = impl_->info;
+  if (y0 < 0 || y1 <= y0 || y1 > info.height) {
+    throw Error(DescribeProblem(impl_->path.string(), "rows",
+                                std::to_string(y0) + ".." + std::to_string(y1),
+                                "outside the image's " + std::to_string(info.height) + " rows"));
+  }
+  const OIIO::ImageSpec& spec = impl_->in->spec();
+  if (!impl_->in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, info.channels,
+                                 OIIO::TypeDesc::FLOAT, out)) {
+    throw InputError(DescribeProblem(impl_->path.string(), "", "",
+                                     "cannot read image data: " + impl_->in->geterror()));
+  }
+}
+
+struct ImageRowWriter::Impl {
+  std::filesystem::path path;
+  std::unique_ptr<AtomicOutput> atomic;
+  std::unique_ptr<OIIO::ImageOutput> out;
+  int width = 0, height = 0, channels = 0;
+  int next_row = 0;
+};
+
+ImageRowWriter::ImageRowWriter(const std::filesystem::path& path, int width, int height,
+                               int channels, const ImageMetadata& metadata,
+                               const WriteImageOptions& options)
+    : impl_(new Impl) {
+  if (width <= 0 || height <= 0 || channels <= 0) {
+    throw Error(
+        DescribeProblem(path.string(), "", "", "refusing to write an empty or malformed image"));
+  }
+  impl_->path = path;
+  impl_->width = width;
+  impl_->height = height;
+  impl_->channels = channels;
+  impl_->atomic = std::make_unique<AtomicOutput>(path);
+  impl_->out =
+      OpenOutput(path, impl_->atomic->temp_path(), width, height, channels, metadata, options);
+}
+
+ImageRowWriter::~ImageRowWriter() {
+  // Uncommitted: close the writer before AtomicOutput removes its temporary file.
+  if (impl_->out) impl_->out->close();
+}
+
+void ImageRowWriter::WriteRows(int y0, int y1, const float* rows) {
+  if (!impl_->out || y0 != impl_->next_row || y1 <= y0 || y1 > impl_->height) {
+    throw Error(DescribeProblem(impl_->path.string(), "rows",
+                                std::to_string(y0) + ".." + std::to_string(y1),
+                                "rows must be written once each, top to bottom"));
+  }
+  if (!impl_->out->write_scanlines(y0, y1, 0, OIIO::TypeDesc::FLOAT, rows)) {
+    throw Error(DescribeProblem(impl_->path.string(), "", "",
+                                "cannot write image data: " + impl_->out->geterror()));
+  }
+  impl_->next_row = y1;
+}
+
+void ImageRowWriter::Commit() {
+  if (!impl_->out || impl_->next_row != impl_->height) {
+    throw Error(DescribeProblem(impl_->path.string(), "rows", std::to_string(impl_->next_row),
+                                "every row must be written before the image is finished"));
+  }
+  const bool closed = impl_->out->close();
+  const std::string error = closed ? "" : impl_->out->geterror();
+  impl_->out.reset();
+  if (!closed) {
+    throw Error(DescribeProblem(impl_->path.string(), "", "", "cannot finish image: " + error));
+  }
+  impl_->atomic->Commit();
 }
 
 }  // namespace igi

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
@@ -70,5 +71,49 @@ struct WriteImageOptions {
 // image or the write fails.
 void WriteImage(const std::filesystem::path& path, const Image& image,
                 const WriteImageOptions& options = {});
+
+// Reads an image a band of rows at a time, so that only those rows are held in memory (scanline
+// files read in order decode only the rows asked for; asking for an earlier row re-reads from the
+// start). Values as ReadImage gives them (all channels; integer files scaled to [0, 1]).
+class ImageRowReader {
+ public:
+  // Opens the file and reads its header; throws InputError "FILE: cannot read image: REASON".
+  explicit ImageRowReader(const std::filesystem::path& path);
+  ~ImageRowReader();
+  ImageRowReader(const ImageRowReader&) = delete;
+  ImageRowReader& operator=(const ImageRowReader&) = delete;
+
+  const ImageInfo& info() const;
+  // Reads rows [y0, y1) (0 <= y0 < y1 <= height) into `out`, which holds
+  // (y1 - y0) x width x channels floats. Throws InputError naming the file on a read error.
+  void ReadRows(int y0, int y1, float* out);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Writes an image a band of rows at a time, top to bottom, to a temporary file beside `path`;
+// Commit() after the last row renames it into place (an uncommitted writer removes it).
+// Integer types clamp to [0, 1] and round, as WriteImage.
+class ImageRowWriter {
+ public:
+  // Throws igi::Error if there is no writer for the extension or the file cannot be opened.
+  ImageRowWriter(const std::filesystem::path& path, int width, int height, int channels,
+                 const ImageMetadata& metadata = {}, const WriteImageOptions& options = {});
+  ~ImageRowWriter();
+  ImageRowWriter(const ImageRowWriter&) = delete;
+  ImageRowWriter& operator=(const ImageRowWriter&) = delete;
+
+  // Writes rows [y0, y1) from `rows` ((y1 - y0) x width x channels floats); y0 must be the row
+  // after the last one written.
+  void WriteRows(int y0, int y1, const float* rows);
+  // Closes the file (every row must have been written) and renames it; throws igi::Error.
+  void Commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace igi
