@@ -10,6 +10,7 @@
 #include "solver/sampling.h"
 #include "solver/surface_hit.h"
 #include "tools/common/parallel.h"
+#include "tools/common/progress.h"
 
 namespace igi {
 namespace {
@@ -252,6 +253,8 @@ GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
   constexpr int64_t kChunk = 256;
   const int64_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<std::vector<PointSamples>> results(chunks);
+  Progress progress(options.progress_label, chunks, 2.0,
+                    !options.progress_label.empty() && ProgressAllowed());
   ParallelFor(
       0, chunks,
       [&](int64_t c) {
@@ -264,24 +267,37 @@ GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
           GatherIndirect(scene, patches, queries[i], options, rng, &ps);
           chunk.push_back(std::move(ps));
         }
+        progress.Add(1);
       },
       options.num_threads);
+  progress.Finish();
+  // The records are moved into one array each, reserved at their final size so that the peak
+  // holds them once besides the chunks (growing by doubling would hold up to three copies).
   GatherSet set;
   set.points.reserve(n);
+  size_t direct = 0, indirect = 0, bounces = 0;
+  for (const auto& chunk : results) {
+    for (const PointSamples& ps : chunk) {
+      direct += ps.direct.size(), indirect += ps.indirect.size(), bounces += ps.bounces.size();
+    }
+  }
+  set.direct.reserve(direct);
+  set.indirect.reserve(indirect);
+  set.bounces.reserve(bounces);
   for (auto& chunk : results) {
     for (PointSamples& ps : chunk) {
       GatherPoint p = ps.point;
-      p.direct_begin = static_cast<int>(set.direct.size());
+      p.direct_begin = int64_t(set.direct.size());
       set.direct.insert(set.direct.end(), ps.direct.begin(), ps.direct.end());
-      p.direct_end = static_cast<int>(set.direct.size());
-      p.indirect_begin = static_cast<int>(set.indirect.size());
+      p.direct_end = int64_t(set.direct.size());
+      p.indirect_begin = int64_t(set.indirect.size());
       const int bounce_base = static_cast<int>(set.bounces.size());
       for (IndirectSample& is : ps.indirect) {
         if (is.bounce >= 0) is.bounce += bounce_base;
       }
       set.bounces.insert(set.bounces.end(), ps.bounces.begin(), ps.bounces.end());
       set.indirect.insert(set.indirect.end(), ps.indirect.begin(), ps.indirect.end());
-      p.indirect_end = static_cast<int>(set.indirect.size());
+      p.indirect_end = int64_t(set.indirect.size());
       set.points.push_back(p);
       set.rays += ps.rays;
     }

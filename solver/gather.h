@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "solver/patches.h"
@@ -79,8 +80,10 @@ struct GatherQuery {
 
 struct GatherPoint {
   Eigen::Vector3f e_direct = Eigen::Vector3f::Zero();  // Σ direct values
-  int direct_begin = 0, direct_end = 0;
-  int indirect_begin = 0, indirect_end = 0;
+  // Ranges in GatherSet::direct and ::indirect: 64-bit, as a lighting's records exceed 2³¹ from
+  // about 33 M observations at 64 hemisphere rays.
+  int64_t direct_begin = 0, direct_end = 0;
+  int64_t indirect_begin = 0, indirect_end = 0;
 };
 
 struct GatherSet {
@@ -102,6 +105,8 @@ struct GatherOptions {
   bool specular_bounces = true;  // trace a specular bounce at each glossy indirect hit
   uint64_t seed = 1;
   int num_threads = 0;
+  // A progress bar with its label (tools/common/progress.h) on a terminal; empty: none.
+  std::string progress_label;
 };
 
 // Hemisphere directions for a query: stratified cosine-weighted, half of them from a Ward lobe

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <mutex>
 
+#include "solver/observation_draw.h"
 #include "solver/patches.h"
 #include "solver/surface_hit.h"
 #include "tools/common/parallel.h"
@@ -90,12 +91,10 @@ std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer
   return normals;
 }
 
-std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
-                                             const Image& radiance, const Image* mask,
-                                             const Renderer::Impl& geometry,
-                                             const PatchSet& patches,
-                                             const ObservationOptions& options,
-                                             PhotoObservationStats* stats) {
+std::vector<Observation> CollectObservations(
+    const Scene& scene, int photo_index, const Image& radiance, const std::vector<uint8_t>* mask,
+    const Renderer::Impl& geometry, const PatchSet& patches, const ObservationOptions& options,
+    PhotoObservationStats* stats) {
   const Photo& photo = scene.photos[photo_index];
   const Camera& camera = scene.cameras[photo.camera];
   const double saturation = options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
@@ -113,7 +112,7 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
         for (int x = stride / 2; x < camera.width; x += stride) {
           const int yy = std::min(y + stride / 2, camera.height - 1);
           ++st.pixels;
-          if (mask != nullptr && !(mask->at(x, yy, 0) > 0)) {
+          if (mask != nullptr && (*mask)[size_t(yy) * camera.width + x] == 0) {
             ++st.masked;
             continue;
           }
@@ -137,6 +136,13 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
           const std::optional<SurfaceHit> hit = TraceSurface(geometry, center, dir);
           if (!hit || !IsReflective(scene.materials[hit->region].brdf)) {
             ++st.background;
+            continue;
+          }
+          if (options.draw != nullptr &&
+              !options.draw->Keeps(photo_index, x, yy, hit->region,
+                                   options.draw->lobe_class[hit->region] &&
+                                       NearHighlight(geometry, hit->position, -dir, hit->n_s))) {
+            ++st.undrawn;
             continue;
           }
           // The pixel's footprint must lie on one smooth piece of one region.
@@ -177,6 +183,7 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
     total.invalid += row_stats[r].invalid;
     total.background += row_stats[r].background;
     total.edge += row_stats[r].edge;
+    total.undrawn += row_stats[r].undrawn;
   }
   if (stats != nullptr) *stats = total;
   return out;

@@ -41,10 +41,14 @@ struct Observation {
 };
 
 struct PatchSet;
+struct ObservationDraw;
 
 struct ObservationOptions {
   int pixel_stride = 2;   // every stride-th pixel in x and y
   double saturation = 0;  // values >= this are clipped; 0 = auto (see AutoSaturation)
+  // Keeps a pixel that sees a reflective surface only where the draw does
+  // (solver/observation_draw.h); null: every such pixel.
+  const ObservationDraw* draw = nullptr;
   int num_threads = 0;
 };
 
@@ -57,6 +61,7 @@ struct PhotoObservationStats {
   int invalid = 0;        // a channel non-finite or negative
   int background = 0;     // sees no reflective surface (nothing, a light, an emitter or black)
   int edge = 0;           // footprint straddles regions, creases or depth steps
+  int undrawn = 0;        // sees a reflective surface, not drawn (ObservationOptions::draw)
   double saturation = 0;  // the clipping value used (infinity: none)
 };
 
@@ -83,10 +88,12 @@ inline double WidenedAlpha(double alpha, double spread) {
 // clipped highlight), else infinity.
 double AutoSaturation(const Image& image);
 
-// The observations of photo `photo` (its linear radiance image and optional mask, 0 = ignore),
-// traced through `geometry`, the Embree scene of the photo's lighting (solver/render_internal.h).
+// The observations of photo `photo` (its linear radiance image and optional 8-bit mask of the
+// photo's size, row by row, 0 = ignore), traced through `geometry`, the Embree scene of the
+// photo's lighting (solver/render_internal.h).
 std::vector<Observation> CollectObservations(const Scene& scene, int photo, const Image& radiance,
-                                             const Image* mask, const Renderer::Impl& geometry,
+                                             const std::vector<uint8_t>* mask,
+                                             const Renderer::Impl& geometry,
                                              const PatchSet& patches,
                                              const ObservationOptions& options,
                                              PhotoObservationStats* stats);

@@ -132,10 +132,7 @@ std::vector<ScaleSample> ReferenceSamples(const SolverState& s, int channel, dou
   return out;
 }
 
-void DividePhotos(SolverState* s, double k) {
-  for (Image& image : s->photo_images) {
-    for (float& v : image.pixels) v = float(v / k);
-  }
+void DivideObservedRadiance(SolverState* s, double k) {
   for (Observation& o : s->obs) o.radiance = (o.radiance.cast<double>() / k).cast<float>();
 }
 
@@ -188,7 +185,7 @@ ScaleMeasurement MeasureScale(const SolverState& s, PhotoScaleEstimate* est) {
 // Divides the photos by `step` and scales the fitted reflectances with them (a warm start for
 // the next stage-1 run).
 void ApplyScale(SolverState* s, double step) {
-  DividePhotos(s, step);
+  DivideObservedRadiance(s, step);
   for (MaterialState& m : s->materials) {
     if (m.unknown_rho_d) {
       m.params.rho_d /= step;

@@ -73,14 +73,20 @@ class LobeTable {
   // variant's) finds its rows by incident range (Rows).
   explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
     if (!HasSpecularLobe(in.model)) return;
-    std::vector<std::pair<int, int>> order;  // (incident_begin, sample)
+    std::vector<std::pair<const IncidentLocal*, int>> order;  // (incident, sample)
     order.reserve(in.samples.size());
+    int64_t entries = 0;
     for (size_t i = 0; i < in.samples.size(); ++i) {
-      order.emplace_back(in.samples[i].incident_begin, int(i));
+      order.emplace_back(in.samples[i].incident, int(i));
+      entries += in.samples[i].incident_count;
     }
     std::sort(order.begin(), order.end());
     starts_.reserve(order.size());
     begin_.reserve(order.size() + 1);
+    // At most one entry per incident sample: reserved once (grown by doubling, the six arrays
+    // held up to twice the region's incident light).
+    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_})
+      v->reserve(in.incident.size());
     struct Entry {
       float qx, qy;
       Eigen::Vector3f gv;
@@ -93,8 +99,8 @@ class LobeTable {
       blur2_.push_back(std::max(0.0, s.lobe_blur2));
       const Eigen::Vector3d wo = s.wo.cast<double>();
       row.clear();
-      for (int k = s.incident_begin; k < s.incident_end; ++k) {
-        const IncidentLocal& inc = in.incident[k];
+      for (int64_t k = 0; k < s.incident_count; ++k) {
+        const IncidentLocal& inc = s.incident[k];
         const Eigen::Vector3d wi = inc.wi.cast<double>();
         double qx = 0, qy = 0, g = 0;
         if (!SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
@@ -117,9 +123,8 @@ class LobeTable {
   std::vector<int> Rows(const RegionFitInput& in) const {
     std::vector<int> rows(in.samples.size(), -1);
     for (size_t i = 0; i < in.samples.size(); ++i) {
-      const auto it =
-          std::lower_bound(starts_.begin(), starts_.end(), in.samples[i].incident_begin);
-      if (it != starts_.end() && *it == in.samples[i].incident_begin) {
+      const auto it = std::lower_bound(starts_.begin(), starts_.end(), in.samples[i].incident);
+      if (it != starts_.end() && *it == in.samples[i].incident) {
         rows[i] = int(it - starts_.begin());
       }
     }
@@ -201,9 +206,9 @@ class LobeTable {
     return sum;
   }
   BrdfModel model_;
-  std::vector<int> starts_;    // each row's incident_begin, ascending
-  std::vector<int> begin_;     // each row's first entry (+1: the end)
-  std::vector<double> blur2_;  // each row's addition to α² (FitSample::lobe_blur2)
+  std::vector<const IncidentLocal*> starts_;  // each row's incident list, ascending
+  std::vector<int> begin_;                    // each row's first entry (+1: the end)
+  std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
   // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v.
   std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
 };

@@ -45,7 +45,11 @@ struct FitSample {
   // Added to α² (αx², αy²) in this sample's lobe: its pixel's spread of normals
   // (Observation::lobe_blur2).
   double lobe_blur2 = 0;
-  int incident_begin = 0, incident_end = 0;  // into RegionFitInput::incident
+  // Its incident samples: `incident_count` of them at `incident` (the solver's list of the
+  // observation, or RegionFitInput::incident's storage), which must outlive the fit; the pointer
+  // also names the sample to the fit's lobe table.
+  const IncidentLocal* incident = nullptr;
+  int64_t incident_count = 0;
 };
 
 // What a region's fit knows and decides, apart from its samples.
@@ -81,6 +85,8 @@ struct RegionFitSettings {
 
 struct RegionFitInput : RegionFitSettings {
   std::vector<FitSample> samples;
+  // Storage the samples' incident pointers may point into (not read by the fit itself): the
+  // solver points them at its per-observation lists instead, so that the fit copies nothing.
   std::vector<IncidentLocal> incident;
 };
 

@@ -19,7 +19,9 @@
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
 #include "tools/common/error.h"
+#include "tools/common/memory.h"
 #include "tools/common/parallel.h"
+#include "tools/common/progress.h"
 
 namespace igi {
 namespace {
@@ -31,18 +33,20 @@ double Since(Clock::time_point t) {
 
 // Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
 // drawn with the same probability by a hash of its photo and pixel; returns how many it marked.
+// The indices were themselves collected with probability `collected` by the same hash
+// (solver/observation_draw.h), so this draw is nested in that one: a pixel is marked when its
+// hash falls under `collected` × count / indices.size().
 // Not by the observation's index: a change to one photo's observations (its pose, its mask, a
 // pixel that passes an edge test or not) shifts every later photo's indices and redraws them
 // all, and a faint lobe's ρs moved by up to 11 points with the draw alone (bench/RESULTS.md,
 // session 33).
 size_t DrawSubset(const std::vector<Observation>& obs, const std::vector<int>& indices,
-                  size_t count, std::vector<char>* chosen) {
+                  size_t count, double collected, std::vector<char>* chosen) {
   size_t marked = 0;
-  const double p = indices.empty() ? 0.0 : double(count) / double(indices.size());
+  const double p = indices.empty() ? 0.0 : collected * (double(count) / double(indices.size()));
   for (int i : indices) {
     const Observation& o = obs[i];
-    const uint64_t key = (uint64_t(o.photo) << 42) ^ (uint64_t(o.y) << 21) ^ uint64_t(o.x);
-    if (InHashedSubset(key, p)) {
+    if (InHashedSubset(PixelKey(o.photo, o.x, o.y), p)) {
       (*chosen)[i] = 1;
       ++marked;
     }
@@ -67,7 +71,7 @@ void SolverState::Prepare() {
   InitMaterials();
   summary.regions.resize(scene.materials.size());
   BuildLightingScenes();
-  LoadPhotos();
+  PlanObservations();
   CollectAllObservations();
   SummariseRegions();
   SelectFitSamples();
@@ -121,56 +125,156 @@ Eigen::Vector3d SolverState::PatchAlbedo(int q) const {
   return v.allFinite() ? v : materials[r].params.rho_d;
 }
 
-// Photos whose values are not plain radiance are linearised (their clipped pixels masked out
-// first, as the clip level is a recorded value); held-out pixels are masked out.
-void SolverState::ApplyPhotoModelAndHoldout(int i) {
+// Photo i as the solver reads it: linear radiance (photos whose values are not plain radiance
+// are linearised, their clipped pixels masked out first, as the clip level is a recorded value),
+// and an 8-bit mask (0 = ignore; empty: every pixel) with the held-out pixels masked out.
+SolverState::LoadedPhoto SolverState::LoadPhoto(int i) const {
   const Photo& p = scene.photos[i];
   const Camera& cam = scene.cameras[p.camera];
-  Image& photo = photo_images[i];
+  LoadedPhoto out;
+  out.radiance = ReadImage(p.file, 3);
+  if (out.radiance.width != cam.width || out.radiance.height != cam.height) {
+    throw InputError(DescribeProblem(scene.file.string(), "photos[" + std::to_string(i) + "].file",
+                                     p.file.string() + " is " + std::to_string(out.radiance.width) +
+                                         "x" + std::to_string(out.radiance.height),
+                                     "must match camera " + cam.name + " (" +
+                                         std::to_string(cam.width) + "x" +
+                                         std::to_string(cam.height) + ")"));
+  }
+  const size_t w = size_t(cam.width), h = size_t(cam.height);
+  if (p.mask) {
+    const Image m = ReadImage(*p.mask, 1);
+    out.mask.resize(w * h);
+    for (size_t k = 0; k < out.mask.size(); ++k) out.mask[k] = m.pixels[k] > 0 ? 1 : 0;
+  }
   const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
                              options.holdout_seed};
   const bool model = HasPhotoModel(p, cam);
-  if (!model && !(holdout.fraction > 0)) return;
+  if (!model && !(holdout.fraction > 0)) return out;
+  Image& photo = out.radiance;
   const double clip = options.saturation > 0 ? options.saturation : AutoSaturation(photo);
-  std::optional<Image>& mask = mask_images[i];
-  if (!mask) {
-    mask = Image(photo.width, photo.height, 1);
-    std::fill(mask->pixels.begin(), mask->pixels.end(), 1.0f);
-  }
+  if (out.mask.empty()) out.mask.assign(w * h, 1);
   for (int y = 0; y < photo.height; ++y) {
     for (int x = 0; x < photo.width; ++x) {
-      bool out = holdout.HeldOut(i, x, y);
-      for (int c = 0; c < photo.channels && model; ++c) out |= photo.at(x, y, c) >= clip;
-      if (out) mask->at(x, y, 0) = 0;
+      bool held = holdout.HeldOut(i, x, y);
+      for (int c = 0; c < photo.channels && model; ++c) held |= photo.at(x, y, c) >= clip;
+      if (held) out.mask[size_t(y) * w + x] = 0;
     }
   }
   if (model) photo = LinearRadianceOfPhoto(p, cam, photo);
+  return out;
 }
 
-void SolverState::LoadPhotos() {
-  ProblemList problems;
-  photo_images.resize(scene.photos.size());
-  mask_images.resize(scene.photos.size());
-  for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Photo& p = scene.photos[i];
-    const Camera& cam = scene.cameras[p.camera];
-    const std::string key = "photos[" + std::to_string(i) + "]";
-    try {
-      photo_images[i] = ReadImage(p.file, 3);
-      if (photo_images[i].width != cam.width || photo_images[i].height != cam.height) {
-        problems.Add(scene.file.string(), key + ".file",
-                     p.file.string() + " is " + std::to_string(photo_images[i].width) + "x" +
-                         std::to_string(photo_images[i].height),
-                     "must match camera " + cam.name + " (" + std::to_string(cam.width) + "x" +
-                         std::to_string(cam.height) + ")");
-      }
-      if (p.mask) mask_images[i] = ReadImage(*p.mask, 1);
-      ApplyPhotoModelAndHoldout(int(i));
-    } catch (const Error& e) {
-      problems.Append(e);
-    }
+namespace {
+
+// The fewest observations a solve is run on (or every available one, where fewer).
+constexpr double kMinObservations = 5000;
+
+std::string GiB(double bytes) { return fmt::format("{:.2f} GiB", bytes / kGiB); }
+
+}  // namespace
+
+void SolverState::PlanObservations() {
+  memory = EstimateSolveMemory(scene, options, patches.size());
+  summary.memory_budget_bytes = memory.budget_bytes;
+  const size_t n = materials.size();
+  std::vector<char> lobe_class(n, 0);
+  for (size_t r = 0; r < n; ++r) {
+    lobe_class[r] = materials[r].NeedsFit() && HasSpecularLobe(materials[r].params.model);
   }
-  problems.ThrowIfAny();
+  const double fixed = memory.fixed_bytes + memory.photo_bytes;
+  if (fixed > memory.budget_bytes) {
+    size_t largest = 0;
+    for (size_t i = 0; i < scene.photos.size(); ++i) {
+      const Camera& a = scene.cameras[scene.photos[i].camera];
+      const Camera& b = scene.cameras[scene.photos[largest].camera];
+      if (double(a.width) * a.height > double(b.width) * b.height) largest = i;
+    }
+    const Camera& cam = scene.cameras[scene.photos[largest].camera];
+    throw InputError(DescribeProblem(
+        scene.file.string(), "photos[" + std::to_string(largest) + "].file",
+        fmt::format("{} ({}x{})", scene.photos[largest].file.string(), cam.width, cam.height),
+        "reading it with the scene takes " + GiB(fixed) + " before any observation, over the " +
+            GiB(memory.budget_bytes) + " memory budget (--memory-budget)"));
+  }
+  // The observations k that fit, each costing `per` bytes on average, of which at most
+  // min(k, fitted_lobe) are fitted on regions with a lobe (fitted_lobe_bytes more each).
+  auto fitting = [&](double per, double fitted_lobe) {
+    const double room = memory.budget_bytes - fixed;
+    double k = (room - memory.fitted_lobe_bytes * fitted_lobe) / per;
+    if (k < fitted_lobe) k = room / (per + memory.fitted_lobe_bytes);
+    return std::max(0.0, k);
+  };
+  auto capped = [&](double k) {
+    return options.max_observations > 0 ? std::min(k, double(options.max_observations)) : k;
+  };
+  spdlog::debug(
+      "memory plan: budget {}, fixed {}, largest photo {}, per observation {:.0f} B ({:.0f} B "
+      "with a lobe, {:.0f} B more fitted there)",
+      GiB(memory.budget_bytes), GiB(memory.fixed_bytes), GiB(memory.photo_bytes),
+      memory.observation_bytes, memory.lobe_observation_bytes, memory.fitted_lobe_bytes);
+  const double pixels = PixelsAtStride(scene, options.pixel_stride);
+  double lobe_fit = 0;  // the lobe regions' fit samples at most
+  bool any_lobe = false;
+  for (size_t r = 0; r < n; ++r) {
+    if (!lobe_class[r]) continue;
+    any_lobe = true;
+    lobe_fit += double(options.max_highlight_samples) + options.max_fit_samples;
+  }
+  lobe_fit = std::min(lobe_fit, pixels);
+  summary.observation_budget = capped(
+      fitting(any_lobe ? memory.lobe_observation_bytes : memory.observation_bytes, lobe_fit));
+  if (pixels <= summary.observation_budget) {
+    summary.memory_estimate_bytes = memory.BytesFor(pixels, any_lobe ? pixels : 0, lobe_fit);
+    return;
+  }
+  ObservationDrawOptions d;
+  d.pixel_stride = options.pixel_stride;
+  d.max_highlight_samples = options.max_highlight_samples;
+  d.max_fit_samples = options.max_fit_samples;
+  d.num_threads = options.num_threads;
+  std::vector<const Renderer::Impl*> geometry(lighting_scenes.size(), nullptr);
+  for (size_t l = 0; l < lighting_scenes.size(); ++l) geometry[l] = lighting_scenes[l].get();
+  const std::vector<RegionPixelCensus> census = CensusPixels(scene, geometry, lobe_class, d);
+  // The census's share of pixels on regions with a lobe, and their fit samples.
+  double total = 0, lobe = 0;
+  lobe_fit = 0;
+  for (size_t r = 0; r < n; ++r) {
+    total += census[r].near + census[r].rest;
+    if (!lobe_class[r]) continue;
+    lobe += census[r].near + census[r].rest;
+    lobe_fit += std::min(census[r].near, double(options.max_highlight_samples)) +
+                std::min(census[r].rest, double(options.max_fit_samples));
+  }
+  const double share = total > 0 ? lobe / total : 0.0;
+  const double in_memory = fitting(
+      memory.observation_bytes + share * (memory.lobe_observation_bytes - memory.observation_bytes),
+      lobe_fit);
+  d.budget = summary.observation_budget = capped(in_memory);
+  const double fewest = std::min(total, kMinObservations);
+  if (in_memory < fewest) {
+    const double needed = memory.BytesFor(fewest, share * fewest, std::min(lobe_fit, fewest));
+    throw InputError(DescribeProblem(
+        scene.file.string(), "--memory-budget", GiB(memory.budget_bytes),
+        "the solve needs at least " + GiB(needed) + " (" + std::to_string(int(fewest)) +
+            " observations with the scene, the patches and the largest photo); raise the budget "
+            "or lower --indirect-rays, --refine-final-rays or --max-highlight-samples"));
+  }
+  draw = PlanObservationDraw(census, lobe_class, d);
+  draw.census = draw.expected < draw.available;
+  summary.observations_thinned = draw.census;
+  summary.memory_estimate_bytes =
+      memory.BytesFor(draw.expected, share * draw.expected, std::min(lobe_fit, draw.expected));
+  if (draw.census) {
+    spdlog::warn(
+        "the photos offer about {:.0f} observations at pixel stride {}; drawing about {:.0f} to "
+        "fit {} of memory ({} budget{}): every region keeps its highlight candidates and fit "
+        "samples, the rest is drawn evenly",
+        draw.available, options.pixel_stride, draw.expected, GiB(summary.memory_estimate_bytes),
+        GiB(memory.budget_bytes),
+        options.max_observations > 0 ? fmt::format(", at most {}", options.max_observations)
+                                     : std::string());
+  }
 }
 
 void SolverState::BuildLightingScenes() {
@@ -195,18 +299,32 @@ void SolverState::BuildLightingScenes() {
   problems.ThrowIfAny();
 }
 
+// The photos are streamed: each is read, linearised, turned into observations and released
+// before the next, so that only one photo is in memory at a time (its observations are drawn to
+// the budget as they are collected: solver/observation_draw.h).
 void SolverState::CollectAllObservations() {
   ProblemList problems;
   ObservationOptions oo;
   oo.pixel_stride = options.pixel_stride;
   oo.saturation = options.saturation;
   oo.num_threads = options.num_threads;
+  oo.draw = draw.census ? &draw : nullptr;
   summary.photos.resize(scene.photos.size());
+  Progress progress("igi-solve: observations", int64_t(scene.photos.size()), 2.0,
+                    options.show_progress && ProgressAllowed());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Image* mask = mask_images[i] ? &*mask_images[i] : nullptr;
-    std::vector<Observation> o = CollectObservations(scene, int(i), photo_images[i], mask,
-                                                     *lighting_scenes[scene.photos[i].lighting],
-                                                     patches, oo, &summary.photos[i]);
+    std::vector<Observation> o;
+    try {
+      const LoadedPhoto photo = LoadPhoto(int(i));
+      o = CollectObservations(
+          scene, int(i), photo.radiance, photo.mask.empty() ? nullptr : &photo.mask,
+          *lighting_scenes[scene.photos[i].lighting], patches, oo, &summary.photos[i]);
+    } catch (const Error& e) {
+      problems.Append(e);
+      progress.Add(1);
+      continue;
+    }
+    progress.Add(1);
     if (!options.pixel_footprint) {
       for (Observation& ob : o) ob.lobe_blur2 = 0;
     }
@@ -222,8 +340,13 @@ void SolverState::CollectAllObservations() {
     }
     obs.insert(obs.end(), o.begin(), o.end());
   }
+  progress.Finish();
   problems.ThrowIfAny();
+  obs.shrink_to_fit();
   summary.observations = static_cast<int>(obs.size());
+  for (const PhotoObservationStats& st : summary.photos) {
+    summary.observations_available += st.valid + st.undrawn;
+  }
   for (const Observation& o : obs) ++materials[o.region].observations;
 }
 
@@ -236,18 +359,10 @@ void SolverState::SelectFitSamples() {
     const Observation& o = obs[i];
     const MaterialState& m = materials[o.region];
     if (!m.NeedsFit()) continue;
-    bool highlight = false;
-    if (HasSpecularLobe(m.params.model)) {
-      const Renderer::Impl& ls = *lighting_scenes[scene.photos[o.photo].lighting];
-      for (int l = 0; l < int(ls.lights.size()) && !highlight; ++l) {
-        if (ls.lights[l].type == LightType::kAmbient) continue;
-        const LightSample s =
-            ls.SampleLight(l, o.position.cast<double>(), Eigen::Vector3d(0.5, 0.5, 0.5));
-        const Eigen::Vector3d h = (s.wi + o.view.cast<double>()).normalized();
-        const double c = h.dot(o.normal.cast<double>());
-        highlight = c > 0 && (1 - c * c) < 0.36 * c * c;
-      }
-    }
+    const bool highlight =
+        HasSpecularLobe(m.params.model) &&
+        NearHighlight(*lighting_scenes[scene.photos[o.photo].lighting], o.position.cast<double>(),
+                      o.view.cast<double>(), o.normal.cast<double>());
     (highlight ? near : rest)[o.region].push_back(int(i));
   }
   // The highlight observations carry ρs and α, the rest mostly the albedo: up to
@@ -258,9 +373,10 @@ void SolverState::SelectFitSamples() {
   const size_t max_fit = size_t(options.max_fit_samples);
   const size_t min_rest = max_fit / 3;
   for (size_t r = 0; r < materials.size(); ++r) {
-    const size_t taken = DrawSubset(obs, near[r], size_t(options.max_highlight_samples), &in_fit);
+    const size_t taken = DrawSubset(obs, near[r], size_t(options.max_highlight_samples),
+                                    DrawnShare(int(r), true), &in_fit);
     const size_t budget = std::max(min_rest, max_fit - std::min(taken, max_fit));
-    DrawSubset(obs, rest[r], budget, &in_fit);
+    DrawSubset(obs, rest[r], budget, DrawnShare(int(r), false), &in_fit);
   }
 }
 
@@ -294,6 +410,8 @@ void SolverState::GatherAll() {
   go.seed = options.seed;
   go.num_threads = options.num_threads;
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
+    if (options.show_progress)
+      go.progress_label = "igi-solve: gathering " + scene.lightings[l].name;
     if (!lighting_scenes[l]) continue;
     LightingState& st = lighting_state[l];
     st.active = true;
@@ -341,15 +459,15 @@ void SolverState::BuildPatchLobes(LightingState* st) const {
   for (int p = 0; p < patches.size(); ++p) {
     st->lobe_begin[p] = static_cast<int>(st->lobes.size());
     const GatherPoint& gp = st->gather.points[st->first_patch_point + p];
-    const int n = gp.direct_end - gp.direct_begin;
+    const int n = int(gp.direct_end - gp.direct_begin);
     if (n > 0 && HasSpecularLobe(materials[patches.patch_region[p]].params.model)) {
       const int groups = std::min(4, n);
       for (int g = 0; g < groups; ++g) {
         DirectSample rep;
         rep.value.setZero();
         Eigen::Vector3f dir = Eigen::Vector3f::Zero();
-        for (int k = gp.direct_begin + g * n / groups; k < gp.direct_begin + (g + 1) * n / groups;
-             ++k) {
+        for (int64_t k = gp.direct_begin + g * n / groups;
+             k < gp.direct_begin + (g + 1) * n / groups; ++k) {
           const DirectSample& d = st->gather.direct[k];
           rep.value += d.value;
           dir += d.wi * d.value.sum();
@@ -440,7 +558,7 @@ void SolverState::UpdatePatchRadiance(LightingState* st) {
         [&](int64_t q) {
           const GatherPoint& gp = st->gather.points[st->first_patch_point + q];
           Eigen::Vector3d e = gp.e_direct.cast<double>();
-          for (int k = gp.indirect_begin; k < gp.indirect_end; ++k) {
+          for (int64_t k = gp.indirect_begin; k < gp.indirect_end; ++k) {
             const IndirectSample& s = st->gather.indirect[k];
             if (s.patch < 0) continue;
             e += s.weight * IndirectRadiance(*st, s);
@@ -491,7 +609,9 @@ void SolverState::ChooseTexelSize() {
     const Observation& o = obs[i];
     const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
     const double d = (cam.CenterInWorld() - o.position.cast<double>()).norm();
-    footprints.push_back(d / cam.params[0] * options.pixel_stride);
+    // The observations' spacing on the photo: the stride, widened where they were drawn.
+    footprints.push_back(d / cam.params[0] * options.pixel_stride /
+                         std::sqrt(DrawnShare(o.region, false)));
   }
   if (footprints.empty()) {
     summary.texel_size_m = 0.01;
@@ -552,6 +672,11 @@ void SolverState::FinishRegions() {
     BoundReflectances(r);
     rs.final_params = materials[r].params;
   }
+}
+
+int ReportStride(int width, int height, int pixel_stride) {
+  const int side = std::max(width, height);
+  return std::max(pixel_stride, (side + kReportMaxSide - 1) / kReportMaxSide);
 }
 
 int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map) {

@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "recon/scene.h"
@@ -135,6 +136,14 @@ struct SolveSummary {
   double patch_size_m = 0, texel_size_m = 0;
   double scene_diagonal_m = 0;  // of the geometry's bounding box
   int patches = 0, observations = 0;
+  // Pixels at the stride that saw a reflective surface (observations plus those not drawn), the
+  // observation budget (infinity: none), whether the draw thinned the photos, and the memory:
+  // the budget, the estimated peak for the observations drawn, the process's measured peak.
+  double observations_available = 0;
+  double observation_budget = 0;
+  bool observations_thinned = false;
+  double memory_budget_bytes = 0, memory_estimate_bytes = 0, peak_memory_bytes = 0;
+  std::vector<std::pair<std::string, double>> peak_after;  // per stage: the peak so far, bytes
   uint64_t rays = 0;
   double seconds_total = 0, seconds_rays = 0, seconds_fit = 0;
   // The solved scene.json document (paths relative to the output folder) and any mesh with

@@ -11,12 +11,14 @@
 
 #include "solver/brdf.h"
 #include "solver/gather.h"
+#include "solver/observation_draw.h"
 #include "solver/observations.h"
 #include "solver/patches.h"
 #include "solver/region_fit.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
 #include "solver/solve.h"
+#include "solver/solve_memory.h"
 #include "solver/uv_charts.h"
 
 namespace igi {
@@ -104,6 +106,13 @@ inline bool IsJointUpdate(const std::string& update) {
 // clipped at 1. Returns how many texel channels were clipped.
 int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map);
 
+// The report's images of a photo (PhotoResidual) are at most this many pixels on a side: one
+// report pixel per ReportStride pixels of the photo.
+inline constexpr int kReportMaxSide = 640;
+// The photo pixels per report pixel: the pixel stride, or more where the photo's longer side at
+// the stride exceeds kReportMaxSide.
+int ReportStride(int width, int height, int pixel_stride);
+
 struct SolverState {
   const Scene& scene;
   SolveOptions options;
@@ -112,8 +121,10 @@ struct SolverState {
   std::vector<MaterialState> materials;
   std::vector<std::vector<int>> region_patches;  // per region: its patches (slot order)
   std::vector<int> patch_slot;                   // per patch: index within its region
-  std::vector<Image> photo_images;
-  std::vector<std::optional<Image>> mask_images;
+  // The memory estimate and the observations' draw (solver/observation_draw.h), planned before
+  // any photo is read.
+  SolveMemoryEstimate memory;
+  ObservationDraw draw;
   std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
   std::vector<Observation> obs;
   std::vector<char> in_fit;    // per observation: used by the region fits
@@ -140,9 +151,23 @@ struct SolverState {
   // solve.cpp
   void Prepare();  // everything before the rays (Solve() then gathers and fits)
   void InitMaterials();
-  void LoadPhotos();
-  void ApplyPhotoModelAndHoldout(int photo);
+  // A photo as the solver reads it: linear radiance and its 8-bit mask (0 = ignore; empty:
+  // every pixel), the held-out and (for photos that are not plain radiance) clipped pixels
+  // masked out.
+  struct LoadedPhoto {
+    Image radiance;
+    std::vector<uint8_t> mask;
+  };
+  LoadedPhoto LoadPhoto(int photo) const;
   void BuildLightingScenes();
+  // The memory estimate and the observations' draw: every pixel at the stride when they fit the
+  // budget, else a census and the draw's probabilities; throws InputError when not even the
+  // largest photo and the fits' fewest observations fit.
+  void PlanObservations();
+  // The probability with which region r's observations (near a highlight or not) were drawn.
+  double DrawnShare(int region, bool near) const {
+    return draw.census ? draw.Probability(region, near) : 1.0;
+  }
   void CollectAllObservations();
   void SelectFitSamples();
   void GatherAll();

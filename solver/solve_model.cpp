@@ -12,7 +12,9 @@
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "tools/common/error.h"
+#include "tools/common/memory.h"
 #include "tools/common/parallel.h"
+#include "tools/common/progress.h"
 
 namespace igi {
 namespace {
@@ -284,9 +286,12 @@ void SolverState::RenderResiduals(Scene model, int stage) {
     if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
   std::vector<Eigen::Vector3d> pred(obs.size()), pred1(obs.size()), pred2(obs.size());
+  Progress progress(fmt::format("igi-solve: rendering the stage-{} model", stage),
+                    int64_t(obs.size()), 2.0, options.show_progress && ProgressAllowed());
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
+        progress.Add(1);
         const Observation& o = obs[i];
         const Photo& p = scene.photos[o.photo];
         const Camera& cam = scene.cameras[p.camera];
@@ -308,14 +313,15 @@ void SolverState::RenderResiduals(Scene model, int stage) {
         pred[i] = 0.5 * (pred1[i] + pred2[i]);
       },
       options.num_threads);
-  const int stride = options.pixel_stride;
   summary.residuals.resize(scene.photos.size());
+  std::vector<int> report_stride(scene.photos.size());
   std::vector<double> num(scene.photos.size(), 0), den(scene.photos.size(), 0);
   double all_num = 0, all_den = 0;
   for (size_t k = 0; k < scene.photos.size(); ++k) {
     const Camera& cam = scene.cameras[scene.photos[k].camera];
     PhotoResidual& pr = summary.residuals[k];
     pr.file = scene.photos[k].file.filename().string();
+    const int stride = report_stride[k] = ReportStride(cam.width, cam.height, options.pixel_stride);
     const int w = (cam.width + stride - 1) / stride, h = (cam.height + stride - 1) / stride;
     pr.photo = Image(w, h, 3);
     pr.render = Image(w, h, 3);
@@ -324,6 +330,7 @@ void SolverState::RenderResiduals(Scene model, int stage) {
   for (size_t i = 0; i < obs.size(); ++i) {
     const Observation& o = obs[i];
     PhotoResidual& pr = summary.residuals[o.photo];
+    const int stride = report_stride[o.photo];
     const int x = std::min(o.x / stride, pr.photo.width - 1),
               y = std::min(o.y / stride, pr.photo.height - 1);
     for (int c = 0; c < 3; ++c) {
@@ -368,6 +375,12 @@ void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) 
   std::filesystem::create_directories(temp_dir);
   const Scene model = CompleteScene(&atlases, &maps, temp_dir);
   IncidentFromRenderer(model, uint64_t(round));
+  if (spdlog::should_log(spdlog::level::debug)) {
+    size_t entries = 0, lists = 0;
+    for (const auto& inc : obs_incident) entries += inc.capacity(), lists += !inc.empty();
+    spdlog::debug("round {}: {} incident lists, {:.2f} GiB; peak so far {:.2f} GiB", round, lists,
+                  entries * sizeof(IncidentLocal) / kGiB, PeakResidentBytes() / kGiB);
+  }
   SmoothIrradiance();
   FitAll(2, round);
   ComputeSpecularTerms();
@@ -457,19 +470,31 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
     throw InputError(DescribeProblem(scene.file.string(), "photos", "[]",
                                      "the solver needs at least one photo"));
   }
+  // The process's peak resident memory after each stage (report.json memory.peak_after).
+  auto stage_done = [&](const char* stage) {
+    s.summary.peak_after.emplace_back(stage, double(PeakResidentBytes()));
+    spdlog::debug("peak memory after {}: {:.2f} GiB", stage,
+                  s.summary.peak_after.back().second / kGiB);
+  };
   s.Prepare();
+  stage_done("observations");
   if (options.photo_scale == "solve") PhotoScaleReferenceRegions(s);  // before the rays
   s.GatherAll();
+  stage_done("gather");
   if (options.photo_scale == "solve") {
     s.summary.photo_scale = RunStage1WithPhotoScale(&s);
   } else {
     s.RunStage1();
   }
+  stage_done("paper");
   s.RunStage2();
+  stage_done("refined");
   s.BuildAlbedoMaps();
   s.FinishRegions();
+  stage_done("albedo_maps");
   s.summary.seconds_total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  s.summary.peak_memory_bytes = double(PeakResidentBytes());
   s.summary.scene_document = SolvedSceneDocument(scene, s.summary, out_dir);
   return std::move(s.summary);
 }

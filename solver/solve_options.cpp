@@ -22,6 +22,10 @@ void SolveOptions::Validate() const {
   };
   check(pixel_stride >= 1 && pixel_stride <= 64, "--pixel-stride", std::to_string(pixel_stride),
         "must be in [1, 64]");
+  check(memory_budget >= 0, "--memory-budget", fmt::format("{}", memory_budget),
+        "must be >= 0 GiB (0 = the machine's memory less a margin)");
+  check(max_observations >= 0, "--max-observations", std::to_string(max_observations),
+        "must be >= 0 (0 = as the memory budget allows)");
   check(saturation >= 0, "--saturation", fmt::format("{}", saturation), "must be >= 0 (0 = auto)");
   check(patch_size_m >= 0, "--patch-size-m", fmt::format("{}", patch_size_m),
         "must be >= 0 (0 = auto)");

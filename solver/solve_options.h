@@ -12,6 +12,14 @@ namespace igi {
 struct SolveOptions {
   // Observations: every pixel_stride-th pixel of each photo in x and y (>= 1).
   int pixel_stride = 2;
+  // Memory budget in GiB (0 = the machine's memory less an eighth, at least 1 GiB less): the
+  // solver estimates its peak before reading any photo and draws fewer observations to fit it
+  // (solver/solve_memory.h), or stops with one line when even the fewest do not fit.
+  double memory_budget = 0;
+  // At most this many observations in all (0 = as many as the memory budget allows): where the
+  // photos offer more, each region keeps its highlight candidates and fit samples (below) and
+  // the rest is drawn evenly by a hash of photo and pixel (solver/observation_draw.h).
+  int64_t max_observations = 0;
   // Pixel values at or above this are clipped and ignored (scene radiance units); 0 = auto: a
   // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
   double saturation = 0;

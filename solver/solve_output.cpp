@@ -211,10 +211,9 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   Json photos = Json::array();
   for (size_t k = 0; k < s.photos.size(); ++k) {
     const PhotoObservationStats& p = s.photos[k];
-    Json pj = {{"pixels", p.pixels},   {"valid", p.valid},
-               {"masked", p.masked},   {"clipped", p.clipped},
-               {"invalid", p.invalid}, {"background", p.background},
-               {"edge", p.edge},       {"saturation", Num(p.saturation)}};
+    Json pj = {{"pixels", p.pixels},   {"valid", p.valid},     {"masked", p.masked},
+               {"clipped", p.clipped}, {"invalid", p.invalid}, {"background", p.background},
+               {"edge", p.edge},       {"undrawn", p.undrawn}, {"saturation", Num(p.saturation)}};
     if (k < s.residuals.size()) {
       pj["file"] = s.residuals[k].file;
       pj["residual_paper"] = Num(s.residuals[k].stage1);
@@ -247,7 +246,19 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["patch_size_m"] = s.patch_size_m;
   j["texel_size_m"] = s.texel_size_m;
   j["observations"] = s.observations;
+  // The observation budget and the draw (solver/observation_draw.h), and the memory: the budget,
+  // the estimate it was planned with (solver/solve_memory.h) and the measured peak.
+  j["observation_draw"] = {{"budget", Num(s.observation_budget)},
+                           {"available", Num(s.observations_available)},
+                           {"drawn", s.observations},
+                           {"thinned", s.observations_thinned}};
+  j["memory"] = {{"budget_bytes", Num(s.memory_budget_bytes)},
+                 {"estimate_bytes", Num(s.memory_estimate_bytes)},
+                 {"peak_bytes", Num(s.peak_memory_bytes)}};
+  for (const auto& [stage, bytes] : s.peak_after) j["memory"]["peak_after"][stage] = Num(bytes);
   j["options"] = {{"pixel_stride", o.pixel_stride},
+                  {"memory_budget", o.memory_budget},
+                  {"max_observations", o.max_observations},
                   {"smoothing_accuracy", o.smoothing_accuracy},
                   {"light_samples", o.light_samples},
                   {"indirect_rays", o.indirect_rays},

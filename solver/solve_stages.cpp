@@ -16,6 +16,7 @@
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
 #include "tools/common/parallel.h"
+#include "tools/common/progress.h"
 
 namespace igi {
 namespace {
@@ -47,11 +48,14 @@ Json ParamsJson(const MaterialState& m) {
   return j;
 }
 
-// A gather point's direct samples in the local shading frame (for the specular term).
+// A gather point's direct samples in the local shading frame (for the specular term), with room
+// reserved for `more` samples to follow: the list is allocated once at its final size (grown by
+// doubling, a glossy observation's 16 + 512 directions took 1024 slots).
 std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
-                                          const Frame& frame) {
+                                          const Frame& frame, int64_t more) {
   std::vector<IncidentLocal> inc;
-  for (int d = gp.direct_begin; d < gp.direct_end; ++d) {
+  inc.reserve(size_t(gp.direct_end - gp.direct_begin + more));
+  for (int64_t d = gp.direct_begin; d < gp.direct_end; ++d) {
     const DirectSample& ds = st.gather.direct[d];
     inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
   }
@@ -92,9 +96,9 @@ void SolverState::IncidentFromPatches() {
           const bool glossy = HasSpecularLobe(materials[o.region].params.model);
           const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
-          if (glossy) inc = DirectIncident(st, gp, frame);
+          if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
-          for (int d = gp.indirect_begin; d < gp.indirect_end; ++d) {
+          for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
             const IndirectSample& s = st.gather.indirect[d];
             if (s.patch < 0) continue;
             const Eigen::Vector3d l = IndirectRadiance(st, s);
@@ -133,6 +137,8 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   const int64_t chunk_size = (num_obs + num_chunks - 1) / num_chunks;
   std::vector<JointSums> chunk_sums(joint ? num_chunks : 0);
   const bool final_round = int(round) >= options.refine_iterations;
+  Progress progress(fmt::format("igi-solve: path tracing, round {}", round), num_chunks, 2.0,
+                    options.show_progress && ProgressAllowed());
   ParallelFor(
       0, num_chunks,
       [&](int64_t chunk) {
@@ -155,8 +161,15 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           q.n_s = o.normal.cast<double>();
           q.lobe = glossy;
           Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
+          // Glossy observations that the fits use get four times the rays: noise in the
+          // specular term T would bias ρs low (regression dilution).
+          // The last round's: more where a region has few observations (FinalRoundRays), so that
+          // its written values are no noisier than a large region's.
+          const int base = final_round ? FinalRoundRays(options.refine_final_rays, m.observations)
+                                       : options.refine_rays;
+          const int n = base * (glossy && in_fit[i] ? 4 : 1);
           std::vector<IncidentLocal> inc;
-          if (glossy) inc = DirectIncident(st, gp, frame);
+          if (glossy) inc = DirectIncident(st, gp, frame, n);
           const double eps = lighting_scenes[l]->ray_epsilon;
           const bool summed = sums != nullptr && in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
@@ -179,13 +192,6 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           }
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
           int k = 0;
-          // Glossy observations that the fits use get four times the rays: noise in the
-          // specular term T would bias ρs low (regression dilution).
-          // The last round's: more where a region has few observations (FinalRoundRays), so that
-          // its written values are no noisier than a large region's.
-          const int base = final_round ? FinalRoundRays(options.refine_final_rays, m.observations)
-                                       : options.refine_rays;
-          const int n = base * (glossy && in_fit[i] ? 4 : 1);
           for (const WeightedDirection& d : HemisphereDirections(q, n, 0.2, rng)) {
             const Eigen::Vector3d origin = q.position + q.n_geo * eps;
             const uint64_t seed = Mix(Mix(options.seed, round), i * 4096 + k++);
@@ -210,8 +216,10 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           obs_e_indirect[i] = e;
           obs_incident[i] = std::move(inc);
         }
+        progress.Add(1);
       },
       options.num_threads);
+  progress.Finish();
   joint_sums = JointSums();
   if (joint) {
     joint_sums.Resize(num_regions);
@@ -279,10 +287,10 @@ void SolverState::ComputeSmoothingRadii(double radius) {
     if (!st.active) continue;
     for (int i : st.obs) {
       const GatherPoint& gp = st.gather.points[obs_point[i]];
-      const int n = gp.indirect_end - gp.indirect_begin;
+      const int n = int(gp.indirect_end - gp.indirect_begin);
       if (n <= 0) continue;
       double inv = 0;
-      for (int d = gp.indirect_begin; d < gp.indirect_end; ++d) {
+      for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
         const IndirectSample& s = st.gather.indirect[d];
         if (s.patch < 0) continue;
         const double dist = double((patches.center[s.patch] - obs[i].position).norm());
@@ -519,6 +527,11 @@ double SolverState::FitAll(int stage, int iteration) {
   }
   std::vector<int> index_of(materials.size(), -1);
   for (size_t k = 0; k < regions.size(); ++k) index_of[regions[k]] = int(k);
+  std::vector<size_t> samples(regions.size(), 0);
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (in_fit[i] && index_of[obs[i].region] >= 0) ++samples[index_of[obs[i].region]];
+  }
+  for (size_t k = 0; k < regions.size(); ++k) inputs[k].samples.reserve(samples[k]);
   for (size_t i = 0; i < obs.size(); ++i) {
     const Observation& o = obs[i];
     if (!in_fit[i] || index_of[o.region] < 0) continue;
@@ -533,9 +546,8 @@ double SolverState::FitAll(int stage, int iteration) {
     s.wo =
         LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.lobe_blur2 = o.lobe_blur2;
-    s.incident_begin = static_cast<int>(in.incident.size());
-    in.incident.insert(in.incident.end(), obs_incident[i].begin(), obs_incident[i].end());
-    s.incident_end = static_cast<int>(in.incident.size());
+    s.incident = obs_incident[i].data();  // read in place: the fit copies nothing
+    s.incident_count = int64_t(obs_incident[i].size());
     in.samples.push_back(s);
   }
   for (size_t k = 0; k < regions.size(); ++k) {

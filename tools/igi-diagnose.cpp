@@ -13,16 +13,18 @@
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  CLI::App app{"igi-diagnose: locate where the simulation and the photos differ, name the "
-               "physics left out, model it, refit and keep it only if held-out pixels improve",
-               "igi-diagnose"};
+  CLI::App app{
+      "igi-diagnose: locate where the simulation and the photos differ, name the "
+      "physics left out, model it, refit and keep it only if held-out pixels improve",
+      "igi-diagnose"};
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
   igi::DiagnoseOptions o;
   app.add_option("scene", scene_path, "scene.json (unknown materials are solved first)")
       ->required();
-  app.add_option("--out", out_dir, "output folder (diagnosis.json, scene.json, report.html, steps/)")
+  app.add_option("--out", out_dir,
+                 "output folder (diagnosis.json, scene.json, report.html, steps/)")
       ->required();
   app.add_option("--spp", o.spp, "paths per pixel of the re-renders")->capture_default_str();
   app.add_option("--pixel-stride", o.pixel_stride, "residual samples: every Nth pixel")
@@ -40,10 +42,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--solve-stride", o.solve.pixel_stride, "igi-solve --pixel-stride")
       ->capture_default_str();
+  app.add_option("--memory-budget", o.solve.memory_budget,
+                 "igi-solve --memory-budget for its solves, GiB (0 = the machine's memory less a "
+                 "margin)")
+      ->capture_default_str();
+  app.add_option("--max-observations", o.solve.max_observations,
+                 "igi-solve --max-observations for its solves (0 = as the memory budget allows)")
+      ->capture_default_str();
   app.add_option("--solve-iterations", o.solve.max_iterations, "igi-solve --max-iterations")
       ->capture_default_str();
-  app.add_option("--refine-iterations", o.solve.refine_iterations,
-                 "igi-solve --refine-iterations")
+  app.add_option("--refine-iterations", o.solve.refine_iterations, "igi-solve --refine-iterations")
       ->capture_default_str();
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();
   return igi::RunMain(app, common, argc, argv, [&]() {
@@ -62,8 +70,7 @@ int main(int argc, char** argv) {
       std::cout << "baseline residual " << s.baseline_residual << " (held out "
                 << s.baseline_held_out << ")\n";
       for (const igi::DiagnosisStep& d : s.steps) {
-        std::cout << (d.kept ? "  + " : "  - ") << d.candidate.effect << ": " << d.verdict
-                  << "\n";
+        std::cout << (d.kept ? "  + " : "  - ") << d.candidate.effect << ": " << d.verdict << "\n";
       }
       std::cout << "final residual " << s.final_residual << " (held out " << s.final_held_out
                 << "), noise floor estimate " << s.noise_floor << "\n";

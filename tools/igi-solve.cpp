@@ -26,6 +26,14 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("--pixel-stride", o.pixel_stride, "use every Nth pixel in x and y")
       ->capture_default_str();
+  app.add_option("--memory-budget", o.memory_budget,
+                 "memory budget in GiB (0 = the machine's memory less a margin): fewer "
+                 "observations are drawn to fit it, or the solve stops with one line")
+      ->capture_default_str();
+  app.add_option("--max-observations", o.max_observations,
+                 "at most this many observations (0 = as the memory budget allows); each region "
+                 "keeps its highlight candidates and fit samples, the rest is drawn evenly")
+      ->capture_default_str();
   app.add_option("--saturation", o.saturation, "clipping value of the photos (0 = auto)")
       ->capture_default_str();
   app.add_option("--patch-size-m", o.patch_size_m, "patch size in metres (0 = auto)")

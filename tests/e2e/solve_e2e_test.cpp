@@ -184,6 +184,25 @@ TEST_F(SolveE2E, PhotoSizeDifferentFromCameraIsBadInput) {
   ExpectBadInput(r, Out(), "photos[0].file", "small.exr");
 }
 
+TEST_F(SolveE2E, MaskOfAnotherSizeIsBadInput) {
+  WriteGeometry(false);
+  Json doc = ConstantPhotoScene(SceneDir(),
+                                PhotoEntry("photos/cam0_L0.exr", "cam0", "L0", "photos/mask.png"));
+  WriteImage(SceneDir() / "photos" / "mask.png", Constant(kWidth / 2, kHeight, 1, 1.0f));
+  const auto r = Solve(WriteScene(doc), Out());
+  ExpectBadInput(r, Out(), "photos[0].mask", "scene.json");
+}
+
+// A memory budget too small for even one photo and the scene: refused before any work, naming
+// the photo and the flag (solver/solve_memory.h).
+TEST_F(SolveE2E, MemoryBudgetBelowOnePhotoIsBadInput) {
+  WriteGeometry(false);
+  Json doc = ConstantPhotoScene(SceneDir(), PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"));
+  const auto r = Solve(WriteScene(doc), Out(), " --memory-budget 0.01");
+  ExpectBadInput(r, Out(), "photos[0].file", "cam0_L0.exr");
+  EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
+}
+
 // A region that no photo sees (a quad behind the wall, its albedo unknown): exit 3, the region
 // named on stderr, every output written, the solved scene complete enough to render.
 TEST_F(SolveE2E, UnobservedRegionIsPartialAndOutputsStillRender) {

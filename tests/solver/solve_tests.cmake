@@ -9,3 +9,6 @@ igi_add_test(solve_refine_test SOURCES solve_refine_test.cpp DEPS igi_solver)
 # The fit samples' draw is keyed by photo and pixel: one photo's changed pixels leave another
 # photo's draw as it was (SolverState::Prepare twice on the 2 m room; a few seconds).
 igi_add_test(solve_fit_samples_test SOURCES solve_fit_samples_test.cpp DEPS igi_solver)
+# Observations drawn to a budget at collection, and the memory plan's refusal (the 2 m room with a
+# glossy floor, three Prepares; a few seconds).
+igi_add_test(observation_draw_test SOURCES observation_draw_test.cpp DEPS igi_solver)

@@ -161,6 +161,7 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
   truth.alpha = alpha;
   Pcg32 rng(seed, 7);
   const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.1, 1).normalized();
+  std::vector<size_t> begins;  // each sample's first entry in in.incident
   for (int i = 0; i < 3000; ++i) {
     FitSample s;
     s.slot = i % in.num_slots;
@@ -174,7 +175,7 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
     if (max_blur2 > 0) s.lobe_blur2 = max_blur2 * rng.UniformDouble();
     const double ax = std::sqrt(alpha * alpha + s.lobe_blur2);
     const double ay = std::sqrt(alpha_y * alpha_y + s.lobe_blur2);
-    s.incident_begin = static_cast<int>(in.incident.size());
+    const size_t begin = in.incident.size();
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), spec = Eigen::Vector3d::Zero();
     auto add = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& value) {
       in.incident.push_back({wi.cast<float>(), value.cast<float>()});
@@ -190,7 +191,8 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
       const Eigen::Vector3d wi = SampleCosineHemisphere(rng.Uniform2D());
       add(wi, Eigen::Vector3d(0.1, 0.1, 0.12));
     }
-    s.incident_end = static_cast<int>(in.incident.size());
+    s.incident_count = int64_t(in.incident.size() - begin);
+    begins.push_back(begin);
     s.irradiance = e;
     const Eigen::Vector3d l =
         slot_rho_d[s.slot].cwiseProduct(e) / kPi + truth.rho_s.cwiseProduct(spec);
@@ -201,6 +203,8 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
     }
     in.samples.push_back(s);
   }
+  // The samples point into in.incident once it no longer grows.
+  for (size_t i = 0; i < in.samples.size(); ++i) in.samples[i].incident = &in.incident[begins[i]];
   return in;
 }
 

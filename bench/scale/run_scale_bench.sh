@@ -1,0 +1,163 @@
+#!/usr/bin/env bash
+# Scale benchmark: igi-solve's wall time, CPU time and peak memory as the photos grow in size and
+# number, and the recovered parameters against the truth at each size.
+#
+# Captures: igi-synth rooms (the default room: glossy floor with a texture, glossy and matte
+# boxes, a sphere, one lamp) of N photos at M megapixels (4:3), rendered once at SPP paths per
+# pixel and cached outside the repository ($IGI_SCALE_CACHE, default ~/.cache/igi-scale). Each is
+# solved with default flags (--threads $THREADS), and beside it the same capture downscaled to
+# 0.5 MP (oiiotool --resize, intrinsics scaled): the user's alternative to a full-size solve,
+# and the peer of each row (same machine, same run).
+#
+# Usage: bench/scale/run_scale_bench.sh [BUILD_DIR] [-- EXTRA igi-solve FLAGS]
+#   PHOTOS="8 30" MEGAPIXELS="0.5 3 12 24" SPP=16 THREADS=2
+# Prints one markdown table (for bench/RESULTS.md) and the growth exponents of wall time and
+# peak memory in pixels per photo (at each photo count) and in photos (at each size).
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+BUILD="${1:-$ROOT/build}"
+[[ $# -gt 0 ]] && shift
+[[ "${1:-}" == "--" ]] && shift
+EXTRA=("$@")
+PHOTOS="${PHOTOS:-8 30}"
+MEGAPIXELS="${MEGAPIXELS:-0.5 3 12 24}"
+SPP="${SPP:-16}"
+THREADS="${THREADS:-2}"
+CACHE="${IGI_SCALE_CACHE:-$HOME/.cache/igi-scale}"
+SYNTH="$BUILD/bin/igi-synth"
+SOLVE="$BUILD/bin/igi-solve"
+PY=/usr/bin/python3
+for t in "$SYNTH" "$SOLVE"; do
+  [[ -x "$t" ]] || { echo "no $t: ninja -C $BUILD igi-synth igi-solve" >&2; exit 2; }
+done
+command -v oiiotool >/dev/null || { echo "no oiiotool (Debian openimageio-tools)" >&2; exit 2; }
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/igi_scale_bench.XXXXXX")"
+trap 'rm -rf "$WORK"' EXIT
+mkdir -p "$CACHE"
+
+# Width and height of M megapixels at 4:3, even.
+size_of() { $PY -c "import math,sys; m=float(sys.argv[1]); w=int(round(math.sqrt(m*1e6*4/3)/2))*2; print(w, int(round(w*3/4/2))*2)" "$1"; }
+
+# capture N M: the cached capture's folder (rendered on first use).
+capture() {
+  local n=$1 mp=$2 dir="$CACHE/room_n$1_mp$2_spp$SPP"
+  if [[ ! -f "$dir/truth.json" ]]; then
+    read -r w h < <(size_of "$mp")
+    rm -rf "$dir.tmp"
+    "$SYNTH" --out "$dir.tmp" --cameras "$n" --width "$w" --height "$h" --spp "$SPP" --seed 1 \
+      --threads "$THREADS" --quiet >&2
+    mv "$dir.tmp" "$dir"
+  fi
+  echo "$dir"
+}
+
+# downscaled SRC DST MP: SRC's capture with every photo resized to MP megapixels.
+downscaled() {
+  local src=$1 dst=$2 mp=$3
+  read -r w h < <(size_of "$mp")
+  mkdir -p "$dst"
+  $PY - "$src" "$dst" "$w" "$h" <<'PYEOF'
+import json, os, subprocess, sys
+src, dst, w, h = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+doc = json.load(open(os.path.join(src, "scene.json")))
+for g in doc.get("geometry", []):
+    g["file"] = os.path.join(src, g["file"])
+for cam in doc["cameras"].values():
+    sx, sy = w / cam["width"], h / cam["height"]
+    p = cam["params"]
+    p[0] *= sx; p[1] *= sy; p[2] *= sx; p[3] *= sy
+    cam["width"], cam["height"] = w, h
+os.makedirs(os.path.join(dst, "photos"), exist_ok=True)
+for ph in doc["photos"]:
+    out = os.path.join(dst, "photos", os.path.basename(ph["file"]))
+    subprocess.run(["oiiotool", os.path.join(src, ph["file"]), "--resize", f"{w}x{h}", "-o", out],
+                   check=True)
+    ph["file"] = out
+    if ph.get("mask"):
+        raise SystemExit("masks are not downscaled")
+json.dump(doc, open(os.path.join(dst, "scene.json"), "w"), indent=1)
+PYEOF
+}
+
+# solve SCENE OUT: "wall_s cpu_s peak_gib" of igi-solve, its output in OUT.
+solve() {
+  local scene=$1 out=$2
+  /usr/bin/time -f "%e %U %S %M" -o "$out.time" \
+    "$SOLVE" "$scene" --out "$out" --threads "$THREADS" --quiet "${EXTRA[@]}" >/dev/null 2>"$out.log" || {
+    local rc=$?
+    [[ $rc -eq 3 ]] || { echo "igi-solve failed ($rc): $(tail -1 "$out.log")" >&2; echo "nan nan nan"; return; }
+  }
+  awk '{printf "%s %.1f %.2f\n", $1, $2 + $3, $4 / 1048576}' "$out.time"
+}
+
+# errors OUT TRUTH: "rho_d_max% rho_s_max% alpha_max% observations drawn_of_available".
+errors() {
+  $PY - "$1" "$2" <<'PYEOF'
+import json, sys
+out, truth = sys.argv[1], sys.argv[2]
+try:
+    solved = json.load(open(out + "/scene.json"))["materials"]
+    report = json.load(open(out + "/report.json"))
+except Exception:
+    print("nan nan nan nan nan"); raise SystemExit
+true = json.load(open(truth))["materials"]
+def rel(a, b):
+    a = a if isinstance(a, list) else [a] * 3
+    b = b if isinstance(b, list) else [b] * 3
+    return max(abs(x - y) / abs(y) for x, y in zip(a, b) if y)
+worst = {"rho_d": 0.0, "rho_s": 0.0, "alpha": 0.0}
+for name, t in true.items():
+    s = solved.get(name, {})
+    for k in worst:
+        if k in t and k in s and isinstance(t[k], (list, float, int)):
+            worst[k] = max(worst[k], rel(s[k], t[k]))
+d = report.get("observation_draw", {})
+print(f"{100*worst['rho_d']:.2f} {100*worst['rho_s']:.2f} {100*worst['alpha']:.2f} "
+      f"{report['observations']} {d.get('available', 'nan')}")
+PYEOF
+}
+
+echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "commit: $(git -C "$ROOT" rev-parse --short HEAD), igi-solve --threads $THREADS ${EXTRA[*]}"
+echo
+echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / 0.5 MP | peak / 0.5 MP |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+ROWS="$WORK/rows.txt"
+: > "$ROWS"
+for n in $PHOTOS; do
+  for mp in $MEGAPIXELS; do
+    dir=$(capture "$n" "$mp")
+    small="$WORK/small_n${n}_mp${mp}"
+    downscaled "$dir" "$small" 0.5
+    read -r sw sc sp < <(solve "$small/scene.json" "$small/out")
+    read -r sd ss sa so savail < <(errors "$small/out" "$dir/truth.json")
+    read -r fw fc fp < <(solve "$dir/scene.json" "$WORK/full_n${n}_mp${mp}")
+    read -r fd fs fa fo favail < <(errors "$WORK/full_n${n}_mp${mp}" "$dir/truth.json")
+    echo "| $n | $mp | full | $fw | $fc | $fp | $fo | $favail | $fd | $fs | $fa | $($PY -c "print(f'{$fw/$sw:.2f}')") | $($PY -c "print(f'{$fp/$sp:.2f}')") |"
+    echo "| $n | $mp | 0.5 MP | $sw | $sc | $sp | $so | $savail | $sd | $ss | $sa | 1 | 1 |"
+    echo "$n $mp $fw $fp" >> "$ROWS"
+  done
+done
+echo
+# Growth exponents: least-squares slope of log(cost) against log(pixels per photo) per photo
+# count, and against log(photos) per size.
+$PY - "$ROWS" <<'PYEOF'
+import math, sys
+rows = [l.split() for l in open(sys.argv[1]) if l.strip()]
+rows = [(int(n), float(mp), float(w), float(p)) for n, mp, w, p in rows]
+def slope(xs, ys):
+    if len(xs) < 2: return float("nan")
+    lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    den = sum((x - mx) ** 2 for x in lx)
+    return sum((x - mx) * (y - my) for x, y in zip(lx, ly)) / den if den else float("nan")
+for n in sorted({r[0] for r in rows}):
+    sub = [r for r in rows if r[0] == n]
+    print(f"photos {n}: growth in pixels per photo: wall {slope([r[1] for r in sub], [r[2] for r in sub]):.2f}, "
+          f"peak memory {slope([r[1] for r in sub], [r[3] for r in sub]):.2f}")
+for mp in sorted({r[1] for r in rows}):
+    sub = [r for r in rows if r[1] == mp]
+    print(f"{mp} MP: growth in photos: wall {slope([r[0] for r in sub], [r[2] for r in sub]):.2f}, "
+          f"peak memory {slope([r[0] for r in sub], [r[3] for r in sub]):.2f}")
+PYEOF

@@ -1,0 +1,188 @@
+// Drawing the observations to a budget as they are collected (solver/observation_draw.h) and the
+// memory plan behind it (solver/solve_memory.h): the probabilities keep each region's highlight
+// candidates and fit samples and share the rest of the budget; a thinned collection keeps a
+// subset of the very pixels a full one keeps, every highlight candidate among them; a budget that
+// cannot hold one photo is refused before any work.
+//
+// Scene: tests/e2e/box_room.h's 2 m room with a Ward floor of unknown lobe, cam0 looking down at
+// the lamp's highlight on the floor, cam1 up; photos path-traced at 16 paths, every pixel
+// (stride 1: 6144 pixels).
+#include "solver/observation_draw.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <tuple>
+
+#include "recon/scene.h"
+#include "solver/solve.h"
+#include "solver/solve_internal.h"
+#include "tests/e2e/box_room.h"
+#include "tests/solver/box_room_photos.h"
+#include "tests/temp_dir.h"
+#include "tools/common/error.h"
+#include "tools/common/json.h"
+
+namespace igi {
+namespace {
+namespace fs = std::filesystem;
+namespace room = test::box_room;
+
+TEST(PlanObservationDraw, EveryPixelWhenTheyFitTheBudget) {
+  const std::vector<RegionPixelCensus> census = {{1000, 5000}, {0, 3000}};
+  ObservationDrawOptions o;
+  o.budget = 9000;
+  const ObservationDraw d = PlanObservationDraw(census, {1, 0}, o);
+  EXPECT_DOUBLE_EQ(d.available, 9000);
+  EXPECT_DOUBLE_EQ(d.expected, 9000);
+  for (double p : {d.p_near[0], d.p_rest[0], d.p_near[1], d.p_rest[1]}) EXPECT_EQ(p, 1.0);
+}
+
+TEST(PlanObservationDraw, KeepsEachRegionsNeedsAndSharesTheRest) {
+  // Region 0 has a fitted lobe: 50 000 highlight candidates, 200 000 others; region 1 has none
+  // (its 1000 pixels near a highlight count with its others); region 2 is small.
+  const std::vector<RegionPixelCensus> census = {{50000, 200000}, {1000, 500000}, {0, 3000}};
+  ObservationDrawOptions o;
+  o.budget = 100000;
+  o.max_highlight_samples = 30000;
+  o.max_fit_samples = 6000;
+  const ObservationDraw d = PlanObservationDraw(census, {1, 0, 0}, o);
+  EXPECT_DOUBLE_EQ(d.available, 754000);
+  // The budget is met (the bisection's precision), never exceeded.
+  EXPECT_LE(d.expected, 100000);
+  EXPECT_GT(d.expected, 100000 - 1);
+  EXPECT_NEAR(d.p_near[0] * 50000, 30000, 1);  // the highlight candidates the fit needs
+  EXPECT_EQ(d.p_rest[2], 1.0);                 // a region smaller than its fit samples: all
+  // The rest shares one probability: region 0's and region 1's other pixels alike.
+  EXPECT_NEAR(d.p_rest[0], d.p_rest[1], 1e-9);
+  EXPECT_NEAR(d.p_rest[0] * (200000 + 501000) + 30000 + 3000, 100000, 1);
+  EXPECT_EQ(d.Probability(1, true), d.p_rest[1]);  // no lobe class: near counts as rest
+}
+
+TEST(PlanObservationDraw, NeedsBeyondTheBudgetAreScaledTogether) {
+  const std::vector<RegionPixelCensus> census = {{50000, 200000}, {0, 500000}};
+  ObservationDrawOptions o;
+  o.budget = 18000;  // the needs: 30 000 + 6000 + 6000 = 42 000
+  o.max_highlight_samples = 30000;
+  o.max_fit_samples = 6000;
+  const ObservationDraw d = PlanObservationDraw(census, {1, 0}, o);
+  EXPECT_NEAR(d.expected, 18000, 1e-6);
+  const double s = 18000.0 / 42000;
+  EXPECT_NEAR(d.p_near[0] * 50000, s * 30000, 1e-6);
+  EXPECT_NEAR(d.p_rest[0] * 200000, s * 6000, 1e-6);
+  EXPECT_NEAR(d.p_rest[1] * 500000, s * 6000, 1e-6);
+}
+
+class ObservationDrawRoom : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(test::UniqueTempDir("observation_draw"));
+    room::WriteRoomFolder(*dir_);
+    Json photos = Json::array();
+    for (const char* cam : {"cam0", "cam1"}) {
+      photos.push_back(room::PhotoEntry(std::string("photos/") + cam + ".exr", cam, "L0"));
+    }
+    Json unknown = room::TrueMaterials(false);
+    for (auto& [name, m] : unknown.items()) m.erase("rho_d");
+    unknown["floor"] = {{"brdf", "ward"}};  // ρd, ρs and α unknown: a fitted lobe
+    WriteJsonFile(*dir_ / "truth.json", room::SceneDoc(room::TrueMaterials(false), Json::array()));
+    WriteJsonFile(*dir_ / "scene.json", room::SceneDoc(unknown, photos));
+    room::RenderTruthPhotos(*dir_, {"cam0", "cam1"}, 16, 5);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static SolveOptions Options() {
+    SolveOptions o;
+    o.pixel_stride = 1;
+    o.num_threads = 2;
+    o.show_progress = false;
+    return o;
+  }
+  static fs::path* dir_;
+};
+fs::path* ObservationDrawRoom::dir_ = nullptr;
+
+using Pixel = std::tuple<int, int, int>;  // photo, x, y
+
+TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSamePixels) {
+  const Scene scene = LoadScene(*dir_ / "scene.json");
+  SolveOptions o = Options();
+  o.max_fit_samples = 200;  // the regions' needs (their highlight candidates and 200 others)
+                            // well inside the budget below
+  SolverState full(scene, o);
+  full.Prepare();
+  o.max_observations = 2000;
+  SolverState thin(scene, o);
+  thin.Prepare();
+  ASSERT_GT(full.obs.size(), 4000u);
+  EXPECT_FALSE(full.summary.observations_thinned);
+  EXPECT_TRUE(thin.summary.observations_thinned);
+
+  const int floor = scene.FindMaterial("floor");
+  auto near = [&](const SolverState& s, const Observation& ob) {
+    const Renderer::Impl& g = *s.lighting_scenes[scene.photos[ob.photo].lighting];
+    return NearHighlight(g, ob.position.cast<double>(), ob.view.cast<double>(),
+                         ob.normal.cast<double>());
+  };
+  std::map<Pixel, const Observation*> full_pixels;
+  int full_near = 0;
+  for (const Observation& ob : full.obs) {
+    full_pixels[{ob.photo, ob.x, ob.y}] = &ob;
+    full_near += ob.region == floor && near(full, ob);
+  }
+  int thin_near = 0, undrawn = 0;
+  for (const Observation& ob : thin.obs) {
+    const auto it = full_pixels.find({ob.photo, ob.x, ob.y});
+    ASSERT_NE(it, full_pixels.end()) << "a thinned observation the full collection lacks";
+    EXPECT_EQ(it->second->position, ob.position);
+    EXPECT_EQ(it->second->radiance, ob.radiance);
+    thin_near += ob.region == floor && near(thin, ob);
+  }
+  for (const PhotoObservationStats& st : thin.summary.photos) undrawn += st.undrawn;
+  // Within the budget (the census's estimate has the hash's spread: ±3σ of a binomial draw).
+  EXPECT_LE(double(thin.obs.size()), 2000 + 3 * std::sqrt(2000.0));
+  EXPECT_LT(thin.obs.size(), full.obs.size() / 2);
+  EXPECT_GT(undrawn, 2000);
+  // Available: every pixel that saw a reflective surface, drawn or not (the undrawn ones skip the
+  // edge test, so the two collections' edge counts differ by the undrawn edge pixels).
+  auto edges = [](const SolverState& s) {
+    return s.summary.photos[0].edge + s.summary.photos[1].edge;
+  };
+  EXPECT_EQ(thin.summary.observations_available + edges(thin),
+            double(full.obs.size()) + edges(full));
+  // Every highlight candidate of the floor is kept (fewer than max_highlight_samples).
+  ASSERT_GT(full_near, 50);
+  EXPECT_EQ(thin_near, full_near);
+  // The fit's subset is drawn inside the collection's: still at most max_fit_samples-ish per
+  // region, and only of collected observations.
+  int walls_fit = 0;
+  const int walls = scene.FindMaterial("walls");
+  for (size_t i = 0; i < thin.obs.size(); ++i)
+    walls_fit += thin.obs[i].region == walls && thin.in_fit[i];
+  EXPECT_GT(walls_fit, 0);
+}
+
+TEST_F(ObservationDrawRoom, ABudgetThatCannotHoldAPhotoIsRefusedBeforeAnyWork) {
+  const Scene scene = LoadScene(*dir_ / "scene.json");
+  SolveOptions o = Options();
+  o.memory_budget = 0.01;  // 10 MiB: less than the process itself
+  SolverState s(scene, o);
+  try {
+    s.Prepare();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("photos["), std::string::npos) << what;
+    EXPECT_NE(what.find("--memory-budget"), std::string::npos) << what;
+  }
+  EXPECT_TRUE(s.obs.empty());
+}
+
+}  // namespace
+}  // namespace igi
