@@ -166,6 +166,19 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
   }
 }
 
+}  // namespace
+
+Eigen::Vector3f GatherDirectAt(const Renderer::Impl& scene, const GatherQuery& query,
+                               int light_samples, int footprint_samples, Pcg32& rng,
+                               std::vector<DirectSample>* samples) {
+  PointSamples ps;
+  GatherDirect(scene, query, light_samples, footprint_samples, rng, &ps);
+  samples->insert(samples->end(), ps.direct.begin(), ps.direct.end());
+  return ps.point.e_direct;
+}
+
+namespace {
+
 void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const GatherQuery& q,
                     const GatherOptions& options, Pcg32& rng, PointSamples* out) {
   const double eps = scene.ray_epsilon;

@@ -122,4 +122,10 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
 GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
                  const std::vector<GatherQuery>& queries, const GatherOptions& options);
 
+// The direct light at one query point alone (Gather's direct samples for it): appends its
+// samples to *samples and returns their sum, the direct irradiance.
+Eigen::Vector3f GatherDirectAt(const Renderer::Impl& scene, const GatherQuery& query,
+                               int light_samples, int footprint_samples, Pcg32& rng,
+                               std::vector<DirectSample>* samples);
+
 }  // namespace igi

@@ -91,6 +91,20 @@ std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer
   return normals;
 }
 
+PixelUse CheckPixel(const Image& radiance, const std::vector<uint8_t>* mask, int x, int y,
+                    double saturation, Eigen::Vector3f* value) {
+  if (mask != nullptr && (*mask)[size_t(y) * radiance.width + x] == 0) return PixelUse::kMasked;
+  bool finite = true, clipped = false;
+  for (int c = 0; c < 3; ++c) {
+    const float v = radiance.at(x, y, std::min(c, radiance.channels - 1));
+    (*value)[c] = v;
+    if (!std::isfinite(v) || v < 0) finite = false;
+    if (v >= saturation) clipped = true;
+  }
+  if (!finite) return PixelUse::kInvalid;
+  return clipped ? PixelUse::kClipped : PixelUse::kUsable;
+}
+
 std::vector<Observation> CollectObservations(
     const Scene& scene, int photo_index, const Image& radiance, const std::vector<uint8_t>* mask,
     const Renderer::Impl& geometry, const PatchSet& patches, const ObservationOptions& options,
@@ -112,24 +126,12 @@ std::vector<Observation> CollectObservations(
         for (int x = stride / 2; x < camera.width; x += stride) {
           const int yy = std::min(y + stride / 2, camera.height - 1);
           ++st.pixels;
-          if (mask != nullptr && (*mask)[size_t(yy) * camera.width + x] == 0) {
-            ++st.masked;
-            continue;
-          }
           Eigen::Vector3f value;
-          bool finite = true, clipped = false;
-          for (int c = 0; c < 3; ++c) {
-            const float v = radiance.at(x, yy, std::min(c, radiance.channels - 1));
-            value[c] = v;
-            if (!std::isfinite(v) || v < 0) finite = false;
-            if (v >= saturation) clipped = true;
-          }
-          if (!finite) {
-            ++st.invalid;
-            continue;
-          }
-          if (clipped) {
-            ++st.clipped;
+          const PixelUse use = CheckPixel(radiance, mask, x, yy, saturation, &value);
+          if (use != PixelUse::kUsable) {
+            ++(use == PixelUse::kMasked    ? st.masked
+               : use == PixelUse::kInvalid ? st.invalid
+                                           : st.clipped);
             continue;
           }
           const Eigen::Vector3d dir = camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, yy + 0.5));

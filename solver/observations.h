@@ -84,6 +84,13 @@ inline double WidenedAlpha(double alpha, double spread) {
   return std::sqrt(alpha * alpha + spread);
 }
 
+// Whether pixel (x, y) of a linear radiance image can be an observation's: masked out (mask 0),
+// invalid (a channel non-finite or negative), clipped (a channel at or above `saturation`), or
+// usable, its RGB in *value.
+enum class PixelUse { kUsable, kMasked, kInvalid, kClipped };
+PixelUse CheckPixel(const Image& radiance, const std::vector<uint8_t>* mask, int x, int y,
+                    double saturation, Eigen::Vector3f* value);
+
 // The clipping value of a photo: its maximum when 3 or more pixels share it exactly (a sensor's
 // clipped highlight), else infinity.
 double AutoSaturation(const Image& image);

@@ -601,25 +601,28 @@ void SolverState::SummariseRegions() {
 // photo.
 void SolverState::ChooseTexelSize() {
   if (options.texel_size_m > 0) {
-    summary.texel_size_m = options.texel_size_m;
+    summary.texel_size_m = summary.map_texel_size_m = options.texel_size_m;
     return;
   }
-  std::vector<double> footprints;
+  std::vector<double> footprints, photo_footprints;
   for (size_t i = 0; i < obs.size(); i += 7) {
     const Observation& o = obs[i];
     const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
     const double d = (cam.CenterInWorld() - o.position.cast<double>()).norm();
     // The observations' spacing on the photo: the stride, widened where they were drawn.
-    footprints.push_back(d / cam.params[0] * options.pixel_stride /
-                         std::sqrt(DrawnShare(o.region, false)));
+    photo_footprints.push_back(d / cam.params[0] * options.pixel_stride);
+    footprints.push_back(photo_footprints.back() / std::sqrt(DrawnShare(o.region, false)));
   }
   if (footprints.empty()) {
-    summary.texel_size_m = 0.01;
+    summary.texel_size_m = summary.map_texel_size_m = 0.01;
     return;
   }
-  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
-                   footprints.end());
-  summary.texel_size_m = std::max(1e-4, footprints[footprints.size() / 2]);
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return std::max(1e-4, v[v.size() / 2]);
+  };
+  summary.texel_size_m = median(footprints);
+  summary.map_texel_size_m = median(photo_footprints);
 }
 
 void SolverState::AnalyseCoverage() {

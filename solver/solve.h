@@ -134,6 +134,10 @@ struct SolveSummary {
   // SolveOptions::photo_scale is "solve" (solver/photometric_scale.h); nullopt: given.
   std::optional<PhotoScaleEstimate> photo_scale;
   double patch_size_m = 0, texel_size_m = 0;
+  // The photos' own pixel footprint at the stride (texel_size_m where given): the texel of maps
+  // from their own pass over the photos (SolveOptions::albedo_map_pass), where texel_size_m, the
+  // drawn observations' spacing, serves the fits and stage 2's model.
+  double map_texel_size_m = 0;
   double scene_diagonal_m = 0;  // of the geometry's bounding box
   int patches = 0, observations = 0;
   // Pixels at the stride that saw a reflective surface (observations plus those not drawn), the

@@ -240,6 +240,15 @@ struct SolverState {
   // follows the path tracer; otherwise obs_e (stage 1's after a rejected refinement).
   std::vector<Eigen::Vector3d> MapIrradiance() const;
   void BuildAlbedoMaps();
+  // The albedo maps of `regions` on `atlases` (one each) from every photo read again, every pixel
+  // at the stride (solver/albedo_stream.cpp): for observations drawn to a budget, whose own
+  // spacing is coarser than the photos'. Also each map's seen texels and coverage.
+  std::vector<Image> StreamAlbedoMaps(const std::vector<int>& regions,
+                                      const std::vector<RegionAtlas>& atlases,
+                                      const std::vector<Eigen::Vector3d>& smooth_t,
+                                      const std::vector<Eigen::Vector3d>& map_e,
+                                      std::vector<Image>* seen,
+                                      std::vector<double>* coverage) const;
   Eigen::Vector3d KnownAlbedo(const Observation& o) const;
 
   // solve.cpp

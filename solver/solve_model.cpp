@@ -437,6 +437,10 @@ void SolverState::BuildAlbedoMaps() {
   const std::vector<Eigen::Vector3d> smooth_t =
       NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
+  // Regions whose maps come from their own pass over the photos (observations drawn to a
+  // budget), on atlases at the photos' footprint.
+  std::vector<int> streamed;
+  std::vector<RegionAtlas> fine;
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!MapCandidate(r)) continue;
@@ -449,14 +453,35 @@ void SolverState::BuildAlbedoMaps() {
           "patches): given a map",
           rs.name, 100 * rs.texel_variation);
     }
+    rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
+    if (options.albedo_map_pass == "always" || (options.albedo_map_pass == "auto" && draw.census)) {
+      AtlasOptions ao;
+      ao.texel_size_m = summary.map_texel_size_m;
+      streamed.push_back(int(r));
+      fine.push_back(BuildRegionAtlas(scene.mesh, int(r), ao));
+      continue;
+    }
     Image seen;
     rs.albedo_map =
         AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);
     rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, seen);
     rs.albedo_map_seen = std::move(seen);
-    rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     rs.albedo_map_generated_uvs = atlas.generated;
     if (atlas.generated) generated.push_back(atlas);
+  }
+  if (!streamed.empty()) {
+    std::vector<Image> seen;
+    std::vector<double> coverage;
+    std::vector<Image> maps = StreamAlbedoMaps(streamed, fine, smooth_t, map_e, &seen, &coverage);
+    for (size_t k = 0; k < streamed.size(); ++k) {
+      RegionSolution& rs = summary.regions[streamed[k]];
+      rs.albedo_map_seen_mean = SeenTexelMean(maps[k], seen[k]);
+      rs.albedo_map = std::move(maps[k]);
+      rs.albedo_map_seen = std::move(seen[k]);
+      rs.albedo_map_coverage = coverage[k];
+      rs.albedo_map_generated_uvs = fine[k].generated;
+      if (fine[k].generated) generated.push_back(fine[k]);
+    }
   }
   if (!generated.empty()) summary.charted_mesh = ApplyAtlases(scene.mesh, generated);
 }

@@ -45,6 +45,8 @@ void SolveOptions::Validate() const {
         "must be grey or rgb");
   check(albedo_maps == "auto" || albedo_maps == "all" || albedo_maps == "none", "--albedo-maps",
         albedo_maps, "must be auto, all or none");
+  check(albedo_map_pass == "auto" || albedo_map_pass == "always" || albedo_map_pass == "never",
+        "--albedo-map-pass", albedo_map_pass, "must be auto, always or never");
   check(texel_size_m >= 0, "--texel-size-m", fmt::format("{}", texel_size_m),
         "must be >= 0 (0 = auto)");
   check(max_highlight_samples >= 1, "--max-highlight-samples",

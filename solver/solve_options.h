@@ -66,6 +66,10 @@ struct SolveOptions {
   // library option, used by igi-diagnose to give maps to the regions it found textured first.)
   std::vector<std::string> albedo_map_regions;
   double texel_size_m = 0;  // albedo map texel, metres; 0 = auto (the median pixel footprint)
+  // Where the written albedo maps come from: "auto" (their own pass over the photos, every pixel
+  // at the stride, when the observations were drawn to a budget and are spaced more coarsely than
+  // the photos' pixels; else the observations), "always" (the pass) or "never" (the observations).
+  std::string albedo_map_pass = "auto";
   // A textured glossy region's ρs and α are fitted with each sample's albedo as the other photos
   // see that texel off their highlights (false: its patch's off-highlight albedo).
   bool held_out_albedo = true;

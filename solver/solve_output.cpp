@@ -245,6 +245,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["patches"] = s.patches;
   j["patch_size_m"] = s.patch_size_m;
   j["texel_size_m"] = s.texel_size_m;
+  j["map_texel_size_m"] = s.map_texel_size_m;
   j["observations"] = s.observations;
   // The observation budget and the draw (solver/observation_draw.h), and the memory: the budget,
   // the estimate it was planned with (solver/solve_memory.h) and the measured peak.
@@ -266,6 +267,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                   {"tolerance", o.tolerance},
                   {"specular_colour", o.specular_colour},
                   {"albedo_maps", o.albedo_maps},
+                  {"albedo_map_pass", o.albedo_map_pass},
                   {"refine_iterations", o.refine_iterations},
                   {"refine_rays", o.refine_rays},
                   {"refine_final_rays", o.refine_final_rays},

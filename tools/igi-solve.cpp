@@ -56,6 +56,10 @@ int main(int argc, char** argv) {
   app.add_option("--specular-colour", o.specular_colour, "grey or rgb specular reflectance")
       ->capture_default_str();
   app.add_option("--albedo-maps", o.albedo_maps, "auto, all or none")->capture_default_str();
+  app.add_option("--albedo-map-pass", o.albedo_map_pass,
+                 "albedo maps from their own pass over the photos at every pixel of the stride: "
+                 "auto (when the observations were drawn to a budget), always or never")
+      ->capture_default_str();
   app.add_option("--texel-size-m", o.texel_size_m, "albedo texel in metres (0 = auto)")
       ->capture_default_str();
   app.add_option("--max-highlight-samples", o.max_highlight_samples,

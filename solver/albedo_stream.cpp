@@ -1,0 +1,229 @@
+// The albedo maps' own pass over the photos (SolverState::StreamAlbedoMaps): when the
+// observations were drawn to a budget (solver/observation_draw.h), a map built from them alone
+// would have texels as coarse as the drawn observations' spacing. Instead every photo is read
+// again, one at a time, and every pixel at the stride that sees a mapped region cleanly adds its
+// albedo estimate π(L − ρs·T)/E to the region's map at the photos' own resolution.
+//
+// The light at such a pixel: its direct part is gathered there (shadow rays toward the lights,
+// as at an observation), so that shadow edges and highlights are the pixel's own; the rest (the
+// light from other surfaces, smooth on the scale of the drawn observations' spacing) comes from
+// the nearest observation of the same region under the same lighting (normals within ~25°):
+//   E = E_map(o) · (E_direct(p) + E_indirect(o)) / (E_direct(o) + E_indirect(o)),
+//   T = T_direct(p) + (T(o) − T_direct(o)),
+// E_map(o) being the irradiance the maps divide by at the observation (MapIrradiance) and T the
+// lobe term of the written ρs (smoothed, as the maps from the observations use it).
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "solver/albedo_map.h"
+#include "solver/brdf.h"
+#include "solver/gather.h"
+#include "solver/sampling.h"
+#include "solver/solve_internal.h"
+#include "solver/surface_hit.h"
+#include "tools/common/parallel.h"
+#include "tools/common/progress.h"
+
+namespace igi {
+namespace {
+
+// The observations of the mapped regions, by lighting, region and cell of a uniform grid.
+class ObservationGrid {
+ public:
+  ObservationGrid(const SolverState& s, const std::vector<char>& mapped, double cell)
+      : s_(s), cell_(cell) {
+    for (size_t i = 0; i < s.obs.size(); ++i) {
+      const Observation& o = s.obs[i];
+      if (!mapped[o.region]) continue;
+      const int l = s.scene.photos[o.photo].lighting;
+      cells_[Key(l, o.region, CellOf(o.position.cast<double>()))].push_back(int(i));
+    }
+  }
+
+  // The nearest observation of `region` under lighting `l` to `p` with its normal within ~25° of
+  // n (dot >= 0.9), within the 27 cells around p's; -1 when none.
+  int Nearest(int l, int region, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+    const Eigen::Vector3i c = CellOf(p);
+    int best = -1;
+    double best_d2 = INFINITY;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = cells_.find(Key(l, region, c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (int i : it->second) {
+            const Observation& o = s_.obs[i];
+            if (o.normal.cast<double>().dot(n) < 0.9) continue;
+            const double d2 = (o.position.cast<double>() - p).squaredNorm();
+            if (d2 < best_d2) best_d2 = d2, best = i;
+          }
+        }
+      }
+    }
+    return best;
+  }
+
+ private:
+  Eigen::Vector3i CellOf(const Eigen::Vector3d& p) const {
+    return (p / cell_).array().floor().cast<int>();
+  }
+  static uint64_t Key(int l, int region, const Eigen::Vector3i& c) {
+    const auto u = [](int v) { return uint64_t(uint32_t(v) & 0xfffff); };
+    return (uint64_t(l & 0xff) << 56) ^ (uint64_t(region & 0xfff) << 44) ^
+           (u(c.x()) << 24 | u(c.y()) << 4) ^ (u(c.z()) * 0x9e3779b1ULL);
+  }
+  const SolverState& s_;
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<int>> cells_;
+};
+
+// One pixel's contribution to its region's map.
+struct MapSample {
+  int map = -1;  // index into the pass's regions
+  int triangle = -1;
+  double b1 = 0, b2 = 0;
+  Eigen::Vector3d numerator = Eigen::Vector3d::Zero(), denominator = Eigen::Vector3d::Zero();
+};
+
+// Σ W(wo, wi)·v over direct samples, in the frame `frame`, at the widened roughness (ax, ay):
+// the direct part of an observation's lobe term T.
+Eigen::Vector3d DirectLobe(const BrdfParams& p, double ax, double ay, const Frame& frame,
+                           const Eigen::Vector3d& view, const DirectSample* d, int64_t n) {
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d wo = frame.ToLocal(view);
+  for (int64_t k = 0; k < n; ++k) {
+    const double w =
+        SpecularWeight(p.model, ax, ay, p.ior, wo, frame.ToLocal(d[k].wi.cast<double>()));
+    if (w > 0) t += w * d[k].value.cast<double>();
+  }
+  return t;
+}
+
+}  // namespace
+
+std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions,
+                                                 const std::vector<RegionAtlas>& atlases,
+                                                 const std::vector<Eigen::Vector3d>& smooth_t,
+                                                 const std::vector<Eigen::Vector3d>& map_e,
+                                                 std::vector<Image>* seen,
+                                                 std::vector<double>* coverage) const {
+  std::vector<char> mapped(materials.size(), 0);
+  std::vector<int> map_of(materials.size(), -1);
+  for (size_t k = 0; k < regions.size(); ++k) mapped[regions[k]] = 1, map_of[regions[k]] = int(k);
+  // Cells of the smoothing radius: the indirect light is averaged over about that already.
+  const double radius =
+      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
+  const ObservationGrid grid(*this, mapped, radius);
+  std::vector<AlbedoMapBuilder> builders;
+  for (const RegionAtlas& atlas : atlases) builders.emplace_back(atlas);
+  const double cos_edge = std::cos(10.0 * kPi / 180.0);
+  const int stride = options.pixel_stride;
+  Progress progress("igi-solve: albedo maps", int64_t(scene.photos.size()), 2.0,
+                    options.show_progress && ProgressAllowed());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const Photo& photo = scene.photos[i];
+    const Camera& cam = scene.cameras[photo.camera];
+    const int l = photo.lighting;
+    const Renderer::Impl& geometry = *lighting_scenes[l];
+    const LightingState& st = lighting_state[l];
+    const LoadedPhoto loaded = LoadPhoto(int(i));
+    const std::vector<uint8_t>* mask = loaded.mask.empty() ? nullptr : &loaded.mask;
+    const double saturation =
+        options.saturation > 0 ? options.saturation : AutoSaturation(loaded.radiance);
+    const Eigen::Vector3d eye = cam.CenterInWorld();
+    const int rows = (cam.height + stride - 1) / stride;
+    std::vector<std::vector<MapSample>> per_row(rows);
+    ParallelFor(
+        0, rows,
+        [&](int64_t row) {
+          const int y = std::min(int(row) * stride + stride / 2, cam.height - 1);
+          for (int x = stride / 2; x < cam.width; x += stride) {
+            Eigen::Vector3f value;
+            if (CheckPixel(loaded.radiance, mask, x, y, saturation, &value) != PixelUse::kUsable) {
+              continue;
+            }
+            const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
+            const std::optional<SurfaceHit> hit = TraceSurface(geometry, eye, dir);
+            if (!hit || !mapped[hit->region]) continue;
+            const auto quarter = QuarterPixelNormals(geometry, cam, x, y, *hit, cos_edge, 0.01);
+            if (!quarter) continue;
+            const int j = grid.Nearest(l, hit->region, hit->position, hit->n_s);
+            if (j < 0 || !(map_e[j].minCoeff() > 0)) continue;
+            const MaterialState& m = materials[hit->region];
+            Observation o;  // the pixel as an observation, for its footprint and frame
+            o.photo = int(i), o.x = x, o.y = y;
+            GatherQuery q;
+            q.position = hit->position;
+            q.n_geo = hit->n_geo;
+            q.n_s = hit->n_s;
+            q.view = -dir;
+            if (options.pixel_footprint) q.footprint = PixelFootprint(o);
+            Pcg32 rng = PixelSampleRng(options.seed ^ 0xa1bed0, PixelKey(int(i), x, y), 0);
+            std::vector<DirectSample> direct;
+            const Eigen::Vector3d e_direct = GatherDirectAt(geometry, q, options.light_samples,
+                                                            options.footprint_samples, rng, &direct)
+                                                 .cast<double>();
+            const Eigen::Vector3d e_indirect = obs_e[j] - obs_e_direct[j];
+            const Eigen::Vector3d ratio =
+                (e_direct + e_indirect).cwiseQuotient((obs_e[j]).cwiseMax(1e-300));
+            const Eigen::Vector3d e = map_e[j].cwiseProduct(ratio);
+            Eigen::Vector3d t = Eigen::Vector3d::Zero();
+            if (HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
+              // The pixel's direct lobe, and the observation's other light from its T.
+              const Observation& oj = obs[j];
+              const GatherPoint& gp = st.gather.points[obs_point[j]];
+              const double spread =
+                  options.pixel_footprint ? PixelNormalSpread(*quarter, hit->n_s) : 0.0;
+              auto widened = [&](double spread2) {
+                return std::make_pair(WidenedAlpha(m.params.AlphaX(), spread2),
+                                      WidenedAlpha(m.params.AlphaY(), spread2));
+              };
+              const auto [ax, ay] = widened(spread);
+              const auto [axj, ayj] = widened(oj.lobe_blur2);
+              const Eigen::Vector3d t_direct_j =
+                  DirectLobe(m.params, axj, ayj, LocalFrame(oj.region, oj.normal.cast<double>()),
+                             oj.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
+                             gp.direct_end - gp.direct_begin);
+              t = DirectLobe(m.params, ax, ay, LocalFrame(hit->region, hit->n_s), -dir,
+                             direct.data(), int64_t(direct.size())) +
+                  (smooth_t[j] - t_direct_j).cwiseMax(0.0);
+            }
+            const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t);
+            const Eigen::Vector3d diffuse = value.cast<double>() - spec;
+            // As the maps from the observations (AlbedoMapOf): each weighted by its diffuse share.
+            const int patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
+            const double diffuse_pred = (PatchAlbedo(patch).cwiseProduct(e) / kPi).sum();
+            const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
+            const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
+            if (!(w > 0) || !(e.minCoeff() > 0)) continue;
+            per_row[row].push_back({map_of[hit->region], hit->triangle, hit->b1, hit->b2,
+                                    w * kPi * diffuse.cwiseProduct(m.map_scale), w * e});
+          }
+        },
+        options.num_threads);
+    for (const std::vector<MapSample>& samples : per_row) {
+      for (const MapSample& s : samples) {
+        builders[s.map].Add(s.triangle, s.b1, s.b2, s.numerator, s.denominator);
+      }
+    }
+    progress.Add(1);
+  }
+  progress.Finish();
+  std::vector<Image> maps;
+  seen->clear();
+  coverage->clear();
+  for (size_t k = 0; k < regions.size(); ++k) {
+    maps.push_back(builders[k].Finish(materials[regions[k]].params.rho_d));
+    seen->push_back(builders[k].DirectMask());
+    coverage->push_back(builders[k].Coverage());
+    spdlog::debug("region {}: albedo map of {}x{} texels from {} pixels (every photo re-read)",
+                  scene.materials[regions[k]].name, maps.back().width, maps.back().height,
+                  builders[k].num_samples());
+  }
+  return maps;
+}
+
+}  // namespace igi
