@@ -41,7 +41,8 @@ void CheckSameShape(const std::vector<Image>& images, const std::vector<std::str
   problems.ThrowIfAny();
 }
 
-Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const ExposureSource& source) {
+Bracket LoadBracketHeaders(const std::vector<std::filesystem::path>& paths,
+                           const ExposureSource& source, int* channels) {
   Bracket bracket;
   if (paths.size() < 2) {
     throw InputError(DescribeProblem(paths.empty() ? "" : paths[0].string(), "images",
@@ -50,11 +51,12 @@ Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const Expos
   }
   ProblemList problems;
   std::vector<ImageMetadata> metadata;
-  for (size_t i = 0; i < paths.size(); ++i) {
-    const std::string name = paths[i].string();
+  std::vector<ImageInfo> infos;
+  for (const auto& path : paths) {
+    const std::string name = path.string();
     bracket.names.push_back(name);
     try {
-      const ImageInfo info = ReadImageInfo(paths[i]);
+      const ImageInfo info = ReadImageInfo(path);
       const int bits = info.type == PixelType::kUInt8    ? 8
                        : info.type == PixelType::kUInt16 ? 16
                                                          : 0;
@@ -63,7 +65,7 @@ Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const Expos
                      "bracket images must be 8- or 16-bit integer levels");
         continue;
       }
-      if (i == 0) bracket.bits_per_sample = bits;
+      if (infos.empty()) bracket.bits_per_sample = bits;
       if (bits != bracket.bits_per_sample) {
         problems.Add(
             name, "pixel type", fmt::format("{} bits", bits),
@@ -71,14 +73,41 @@ Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const Expos
         continue;
       }
       metadata.push_back(info.metadata);
-      bracket.images.push_back(ReadImage(paths[i]));
+      infos.push_back(info);
     } catch (const Error& e) {
       problems.Append(e);
     }
   }
   problems.ThrowIfAny();
-  CheckSameShape(bracket.images, bracket.names);
+  for (size_t i = 1; i < infos.size(); ++i) {
+    if (infos[i].width != infos[0].width || infos[i].height != infos[0].height ||
+        infos[i].channels != infos[0].channels) {
+      problems.Add(
+          bracket.names[i], "size",
+          fmt::format("{}x{}x{}", infos[i].width, infos[i].height, infos[i].channels),
+          fmt::format("every image of a bracket must have the size of {} ({}x{}x{})",
+                      bracket.names[0], infos[0].width, infos[0].height, infos[0].channels));
+    }
+  }
+  problems.ThrowIfAny();
   bracket.exposures_s = ResolveExposures(source, bracket.names, metadata);
+  *channels = infos[0].channels;
+  return bracket;
+}
+
+Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const ExposureSource& source) {
+  int channels = 0;
+  Bracket bracket = LoadBracketHeaders(paths, source, &channels);
+  ProblemList problems;
+  for (const auto& path : paths) {
+    try {
+      bracket.images.push_back(ReadImage(path));
+    } catch (const Error& e) {
+      problems.Append(e);
+    }
+  }
+  problems.ThrowIfAny();
+  CheckSameShape(bracket.images, bracket.names);  // the pixels as read, against the headers'
   return bracket;
 }
 

@@ -41,6 +41,12 @@ std::vector<double> ResolveExposures(const ExposureSource& source,
 void CheckSameShape(const std::vector<Image>& images, const std::vector<std::string>& names);
 
 // Loads 8- or 16-bit images (PNG, TIFF, JPEG, …) with their exposure times.
+// LoadBracket's checks on the files' headers alone (pixel types, sizes and channels, exposure
+// times), without reading their pixels: a Bracket without images; *channels gets the frames'
+// channel count. For merges that stream the frames (hdr/merge_stream.h).
+Bracket LoadBracketHeaders(const std::vector<std::filesystem::path>& paths,
+                           const ExposureSource& source, int* channels);
+
 Bracket LoadBracket(const std::vector<std::filesystem::path>& paths, const ExposureSource& source);
 
 }  // namespace igi::calib

@@ -51,62 +51,6 @@ HdrInput LoadRaw(const std::vector<std::filesystem::path>& paths, const HdrInput
   return input;
 }
 
-// calib::LoadBracket's checks on the files' headers, without reading their pixels; `channels`
-// gets the frames' channel count.
-calib::Bracket LoadBracketHeaders(const std::vector<std::filesystem::path>& paths,
-                                  const calib::ExposureSource& source, int* channels) {
-  calib::Bracket bracket;
-  if (paths.size() < 2) {
-    throw InputError(DescribeProblem(paths.empty() ? "" : paths[0].string(), "images",
-                                     fmt::format("{}", paths.size()),
-                                     "a bracket needs at least 2 images"));
-  }
-  ProblemList problems;
-  std::vector<ImageMetadata> metadata;
-  std::vector<ImageInfo> infos;
-  for (const auto& path : paths) {
-    const std::string name = path.string();
-    bracket.names.push_back(name);
-    try {
-      const ImageInfo info = ReadImageInfo(path);
-      const int bits = info.type == PixelType::kUInt8    ? 8
-                       : info.type == PixelType::kUInt16 ? 16
-                                                         : 0;
-      if (bits == 0) {
-        problems.Add(name, "pixel type", fmt::format("{} bits", info.bits_per_sample),
-                     "bracket images must be 8- or 16-bit integer levels");
-        continue;
-      }
-      if (infos.empty()) bracket.bits_per_sample = bits;
-      if (bits != bracket.bits_per_sample) {
-        problems.Add(
-            name, "pixel type", fmt::format("{} bits", bits),
-            fmt::format("must match {} ({} bits)", bracket.names[0], bracket.bits_per_sample));
-        continue;
-      }
-      metadata.push_back(info.metadata);
-      infos.push_back(info);
-    } catch (const Error& e) {
-      problems.Append(e);
-    }
-  }
-  problems.ThrowIfAny();
-  for (size_t i = 1; i < infos.size(); ++i) {
-    if (infos[i].width != infos[0].width || infos[i].height != infos[0].height ||
-        infos[i].channels != infos[0].channels) {
-      problems.Add(
-          bracket.names[i], "size",
-          fmt::format("{}x{}x{}", infos[i].width, infos[i].height, infos[i].channels),
-          fmt::format("every image of a bracket must have the size of {} ({}x{}x{})",
-                      bracket.names[0], infos[0].width, infos[0].height, infos[0].channels));
-    }
-  }
-  problems.ThrowIfAny();
-  bracket.exposures_s = calib::ResolveExposures(source, bracket.names, metadata);
-  *channels = infos[0].channels;
-  return bracket;
-}
-
 }  // namespace
 
 HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
@@ -130,7 +74,7 @@ HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
   // Recovering a response samples the whole images: only a known response leaves them unread.
   const bool headers_only = options.headers_only && (!options.response.empty() || options.linear);
   int channels = 0;
-  calib::Bracket bracket = headers_only ? LoadBracketHeaders(paths, source, &channels)
+  calib::Bracket bracket = headers_only ? calib::LoadBracketHeaders(paths, source, &channels)
                                         : calib::LoadBracket(paths, source);
   if (!headers_only) channels = bracket.channels();
   HdrInput input;
