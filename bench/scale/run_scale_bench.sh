@@ -121,7 +121,7 @@ PYEOF
 echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB, load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "commit: $(git -C "$ROOT" rev-parse --short HEAD), igi-solve --threads $THREADS ${EXTRA[*]}"
 echo
-echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / 0.5 MP | peak / 0.5 MP |"
+echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / peer | peak / peer |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 ROWS="$WORK/rows.txt"
 : > "$ROWS"
@@ -134,8 +134,8 @@ for n in $PHOTOS; do
     read -r sd ss sa so savail < <(errors "$small/out" "$dir/truth.json")
     read -r fw fc fp < <(solve "$dir/scene.json" "$WORK/full_n${n}_mp${mp}")
     read -r fd fs fa fo favail < <(errors "$WORK/full_n${n}_mp${mp}" "$dir/truth.json")
-    echo "| $n | $mp | full | $fw | $fc | $fp | $fo | $favail | $fd | $fs | $fa | $($PY -c "print(f'{$fw/$sw:.2f}')") | $($PY -c "print(f'{$fp/$sp:.2f}')") |"
-    echo "| $n | $mp | 0.5 MP | $sw | $sc | $sp | $so | $savail | $sd | $ss | $sa | 1 | 1 |"
+    echo "| $n | $mp | capture | $fw | $fc | $fp | $fo | $favail | $fd | $fs | $fa | $($PY -c "print(f'{$fw/$sw:.2f}')") | $($PY -c "print(f'{$fp/$sp:.2f}')") |"
+    echo "| $n | $mp | peer (0.5 MP) | $sw | $sc | $sp | $so | $savail | $sd | $ss | $sa | 1 | 1 |"
     echo "$n $mp $fw $fp" >> "$ROWS"
   done
 done
