@@ -23,8 +23,17 @@ bool NearHighlight(const Renderer::Impl& lighting, const Eigen::Vector3d& positi
   return false;
 }
 
-bool ObservationDraw::Keeps(int photo, int x, int y, int region, bool near) const {
-  return InHashedSubset(PixelKey(photo, x, y), Probability(region, near));
+bool ObservationDraw::Draws(int photo, int x, int y, int stride, int region, bool near, int* x0,
+                            int* y0, int* size) const {
+  const int b = Block(region, near);
+  if (b <= 1) {
+    *x0 = x, *y0 = y, *size = 1;
+  } else {
+    const int cx = x / stride, cy = y / stride;
+    if (cx % b != b / 2 || cy % b != b / 2) return false;  // not the centre of its block
+    *x0 = (cx - b / 2) * stride, *y0 = (cy - b / 2) * stride, *size = b * stride;
+  }
+  return InHashedSubset(PixelKey(photo, *x0, *y0), Threshold(region, near));
 }
 
 double PixelsAtStride(const Scene& scene, int pixel_stride) {
@@ -93,6 +102,20 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
   d.lobe_class.resize(regions, 0);
   d.p_near.assign(regions, 1.0);
   d.p_rest.assign(regions, 1.0);
+  d.block_near.assign(regions, 1);
+  d.block_rest.assign(regions, 1);
+  // Each class's block side: ⌊1/√p⌋ stride cells, within [1, max_block].
+  auto blocks = [&] {
+    auto side = [&](double p) {
+      return p > 0 ? std::clamp(int(std::floor(1.0 / std::sqrt(p) + 1e-9)), 1,
+                                std::max(1, options.max_block))
+                   : 1;
+    };
+    for (size_t r = 0; r < regions; ++r) {
+      d.block_near[r] = side(d.p_near[r]);
+      d.block_rest[r] = side(d.p_rest[r]);
+    }
+  };
   d.budget = options.budget > 0 ? options.budget : std::numeric_limits<double>::infinity();
   // Per region and class: the pixels, and how many the region's fit needs.
   std::vector<double> n_near(regions), n_rest(regions), need_near(regions), need_rest(regions);
@@ -116,6 +139,7 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
       d.p_rest[r] = share(s * need_rest[r], n_rest[r]);
     }
     d.expected = d.budget;
+    blocks();
     return d;
   }
   // One probability q for every pixel beyond the needs: the total kept is increasing in q.
@@ -136,6 +160,7 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
     d.p_rest[r] = share(std::max(need_rest[r], lo * n_rest[r]), n_rest[r]);
   }
   d.expected = kept(lo);
+  blocks();
   return d;
 }
 

@@ -17,8 +17,18 @@
 // (SolverState::SelectFitSamples) is drawn with the same hash, nested inside this draw.
 // When every photo's pixels at the stride fit the budget, every probability is 1 and nothing is
 // traced for the census: small captures are collected exactly as without a budget.
+//
+// Blocks: a class kept with probability p keeps one pixel in about 1/p, spaced 1/√p stride cells
+// apart. Rather than one pixel there, each such observation is the mean of a block of b × b
+// stride cells (b = ⌊1/√p⌋, at most max_block), every pixel of the block counted, and blocks are
+// kept with probability p·b²: as many observations, at the same spacing, each averaging b²·stride²
+// pixels of the photo's noise instead of one (what a user's downscaled photos would give, but
+// only where the draw thins, and with every block checked to lie on one smooth surface). A block
+// that does not (an edge, a mask, a clipped pixel within it) is replaced by its centre cell's
+// pixel alone.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -27,7 +37,8 @@
 
 namespace igi {
 
-// The key of pixel (x, y) of photo `photo` for the hashed draws (sampling.h InHashedSubset).
+// The key of pixel (x, y) of photo `photo` for the hashed draws (sampling.h InHashedSubset); an
+// observation's key is that of its top-left pixel (Observation::x, y).
 inline uint64_t PixelKey(int photo, int x, int y) {
   return (uint64_t(photo) << 42) ^ (uint64_t(y) << 21) ^ uint64_t(x);
 }
@@ -44,18 +55,34 @@ struct RegionPixelCensus {
 
 // The keep probabilities per region and class, and what they were drawn from.
 struct ObservationDraw {
-  std::vector<double> p_near, p_rest;  // per region, in [0, 1]
+  std::vector<double> p_near, p_rest;       // per region, in [0, 1]
+  std::vector<int> block_near, block_rest;  // per region: block side in stride cells (>= 1)
   // Per region: whether its highlight candidates are a class of their own (a fitted lobe).
   std::vector<char> lobe_class;
   double budget = 0;     // observations allowed (infinity: no budget)
   double available = 0;  // pixels at the stride that see a reflective surface (census estimate)
   double expected = 0;   // observations the probabilities keep (census estimate)
   bool census = false;   // false: every pixel fits the budget and every probability is 1
-  // The probability of a pixel of `region` (near a highlight or not).
+  // The probability of a pixel of `region` (near a highlight or not): the observations' density
+  // per stride cell.
   double Probability(int region, bool near) const {
     return near && lobe_class[region] ? p_near[region] : p_rest[region];
   }
-  bool Keeps(int photo, int x, int y, int region, bool near) const;
+  // The side, in stride cells, of the blocks of `region`'s class (1: single pixels).
+  int Block(int region, bool near) const {
+    return near && lobe_class[region] ? block_near[region] : block_rest[region];
+  }
+  // The probability with which a block of the class is kept (its key's hash under it).
+  double Threshold(int region, bool near) const {
+    const double b = Block(region, near);
+    return std::min(1.0, Probability(region, near) * b * b);
+  }
+  // Whether the stride cell (pixel_stride `stride`) of `photo` whose sampled pixel (x, y) sees
+  // `region` yields an observation: for single pixels, whether that pixel is drawn; for blocks,
+  // whether the cell is its block's centre and the block is drawn. *x0, *y0, *size: the
+  // observation's top-left pixel and side in pixels ((x, y) and 1 for single pixels).
+  bool Draws(int photo, int x, int y, int stride, int region, bool near, int* x0, int* y0,
+             int* size) const;
 };
 
 struct ObservationDrawOptions {
@@ -63,6 +90,8 @@ struct ObservationDrawOptions {
   double budget = 0;  // observations; 0 or infinity: no budget
   int max_highlight_samples = 100000;
   int max_fit_samples = 6000;
+  // Blocks (above): at most this many stride cells on a side (1: single pixels only).
+  int max_block = 8;
   // Census grid: at most this many centre rays per photo.
   int census_rays_per_photo = 16384;
   int num_threads = 0;
@@ -79,7 +108,8 @@ std::vector<RegionPixelCensus> CensusPixels(
 
 // The probabilities (above) for `census`: each region's needs first (its highlight candidates up
 // to max_highlight_samples, its other pixels up to max_fit_samples; scaled down together when
-// they alone exceed the budget), then one probability for every other pixel.
+// they alone exceed the budget), then one probability for every other pixel; each class's block
+// side from its probability.
 ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census,
                                     const std::vector<char>& lobe_class,
                                     const ObservationDrawOptions& options);

@@ -74,12 +74,12 @@ double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Ei
 std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer::Impl& geometry,
                                                                   const Camera& camera, int x,
                                                                   int y, const SurfaceHit& centre,
-                                                                  double cos_min,
-                                                                  double max_offset) {
+                                                                  double cos_min, double max_offset,
+                                                                  int size) {
   const Eigen::Vector3d eye = camera.CenterInWorld();
   std::array<Eigen::Vector3d, 4> normals;
   for (int k = 0; k < 4; ++k) {
-    const double ox = (k & 1) ? 0.75 : 0.25, oy = (k & 2) ? 0.75 : 0.25;
+    const double ox = ((k & 1) ? 0.75 : 0.25) * size, oy = ((k & 2) ? 0.75 : 0.25) * size;
     const std::optional<SurfaceHit> h =
         TraceSurface(geometry, eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
     if (!(h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_min &&
@@ -118,6 +118,55 @@ std::vector<Observation> CollectObservations(
   std::vector<std::vector<Observation>> per_row(rows);
   std::vector<PhotoObservationStats> row_stats(rows);
   const double cos_edge = std::cos(10.0 * kPi / 180.0);
+  // Whether (hit) lies on the smooth piece of `centre`'s region (the edge tests of
+  // QuarterPixelNormals).
+  auto same_piece = [&](const std::optional<SurfaceHit>& h, const SurfaceHit& centre) {
+    return h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_edge &&
+           std::abs(centre.n_geo.dot(h->position - centre.position)) < 0.01 * centre.t;
+  };
+  // The observation of the block of `size` pixels at (x0, y0): its pixels' mean, when every one
+  // is usable and the block lies on one smooth piece of one region (its centre, its stride
+  // cells' centres and its quarter points); none otherwise.
+  auto block = [&](int x0, int y0, int size) -> std::optional<Observation> {
+    if (x0 + size > camera.width || y0 + size > camera.height) return std::nullopt;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int y = y0; y < y0 + size; ++y) {
+      for (int x = x0; x < x0 + size; ++x) {
+        Eigen::Vector3f value;
+        if (CheckPixel(radiance, mask, x, y, saturation, &value) != PixelUse::kUsable) {
+          return std::nullopt;
+        }
+        sum += value.cast<double>();
+      }
+    }
+    const Eigen::Vector3d dir =
+        camera.WorldRayFromImg(Eigen::Vector2d(x0 + 0.5 * size, y0 + 0.5 * size));
+    const std::optional<SurfaceHit> hit = TraceSurface(geometry, center, dir);
+    if (!hit || !IsReflective(scene.materials[hit->region].brdf)) return std::nullopt;
+    for (int y = y0 + stride / 2; y < y0 + size; y += stride) {
+      for (int x = x0 + stride / 2; x < x0 + size; x += stride) {
+        const Eigen::Vector2d px(x + 0.5, y + 0.5);
+        if (!same_piece(TraceSurface(geometry, center, camera.WorldRayFromImg(px)), *hit)) {
+          return std::nullopt;
+        }
+      }
+    }
+    const auto quarter = QuarterPixelNormals(geometry, camera, x0, y0, *hit, cos_edge, 0.01, size);
+    if (!quarter) return std::nullopt;
+    Observation o;
+    o.photo = photo_index;
+    o.x = x0, o.y = y0, o.size = size;
+    o.triangle = hit->triangle;
+    o.b1 = float(hit->b1), o.b2 = float(hit->b2);
+    o.region = hit->region;
+    o.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
+    o.position = hit->position.cast<float>();
+    o.normal = hit->n_s.cast<float>();
+    o.view = (-dir).cast<float>();
+    o.radiance = (sum / (double(size) * size)).cast<float>();
+    o.lobe_blur2 = float(PixelNormalSpread(*quarter, hit->n_s));
+    return o;
+  };
   ParallelFor(
       0, rows,
       [&](int64_t r) {
@@ -140,12 +189,23 @@ std::vector<Observation> CollectObservations(
             ++st.background;
             continue;
           }
-          if (options.draw != nullptr &&
-              !options.draw->Keeps(photo_index, x, yy, hit->region,
-                                   options.draw->lobe_class[hit->region] &&
-                                       NearHighlight(geometry, hit->position, -dir, hit->n_s))) {
-            ++st.undrawn;
-            continue;
+          int x0 = x, y0 = yy, size = 1;
+          if (options.draw != nullptr) {
+            const bool near = options.draw->lobe_class[hit->region] &&
+                              NearHighlight(geometry, hit->position, -dir, hit->n_s);
+            if (!options.draw->Draws(photo_index, x, yy, stride, hit->region, near, &x0, &y0,
+                                     &size)) {
+              ++st.undrawn;
+              continue;
+            }
+            if (size > 1) {
+              if (std::optional<Observation> o = block(x0, y0, size)) {
+                per_row[r].push_back(*o);
+                ++st.valid;
+                ++st.blocks;
+                continue;
+              }
+            }
           }
           // The pixel's footprint must lie on one smooth piece of one region.
           const auto corner_normal =
@@ -186,6 +246,7 @@ std::vector<Observation> CollectObservations(
     total.background += row_stats[r].background;
     total.edge += row_stats[r].edge;
     total.undrawn += row_stats[r].undrawn;
+    total.blocks += row_stats[r].blocks;
   }
   if (stats != nullptr) *stats = total;
   return out;

@@ -3,7 +3,10 @@
 // sees a reflective surface cleanly. A pixel is kept when its centre ray and four rays at
 // (±¼, ±¼) of a pixel hit the same region with normals within a few degrees (so the pixel's mean
 // radiance, CONTRACT.md §1, and its centre's agree), the mask allows it, every channel is finite
-// and non-negative, and no channel is clipped.
+// and non-negative, and no channel is clipped. Where the observations are drawn to a budget, one
+// may stand for a square block of pixels instead (solver/observation_draw.h): their mean, kept
+// when every pixel of it is usable and the rays through the centres of its stride cells and its
+// quarter points meet one smooth piece of one region.
 //
 // Frames and units: world frame, metres; radiance linear in the scene's units.
 
@@ -24,7 +27,8 @@ namespace igi {
 
 struct Observation {
   int photo = -1;        // index into Scene::photos
-  int x = 0, y = 0;      // pixel (column, row), row 0 at the top
+  int x = 0, y = 0;      // pixel (column, row), row 0 at the top: the footprint's top-left
+  int size = 1;          // the footprint's side in pixels: a pixel (1) or a block's mean
   int triangle = -1;     // index into Scene::mesh.triangles
   float b1 = 0, b2 = 0;  // barycentrics of the triangle's vertices 1 and 2 at the hit
   int region = -1;       // index into Scene::materials
@@ -62,6 +66,7 @@ struct PhotoObservationStats {
   int background = 0;     // sees no reflective surface (nothing, a light, an emitter or black)
   int edge = 0;           // footprint straddles regions, creases or depth steps
   int undrawn = 0;        // sees a reflective surface, not drawn (ObservationOptions::draw)
+  int blocks = 0;         // of the valid: blocks of pixels (Observation::size > 1)
   double saturation = 0;  // the clipping value used (infinity: none)
 };
 
@@ -71,13 +76,14 @@ double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Ei
 
 struct SurfaceHit;
 
-// The shading normals at the four quarter-pixel points of pixel (x, y) of `camera` (the order of
-// PixelNormalSpread), traced through `geometry`; none when a ray misses `centre`'s region, turns
-// its normal to a cosine of `cos_min` or less from the centre's, or meets a point off the
-// centre's face plane by `max_offset`·centre.t or more.
+// The shading normals at the four quarter points of the square of `size` pixels whose top-left
+// pixel is (x, y) (pixel (x, y) itself for size 1) of `camera` (the order of PixelNormalSpread),
+// traced through `geometry`; none when a ray misses `centre`'s region, turns its normal to a
+// cosine of `cos_min` or less from the centre's, or meets a point off the centre's face plane by
+// `max_offset`·centre.t or more.
 std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(
     const Renderer::Impl& geometry, const Camera& camera, int x, int y, const SurfaceHit& centre,
-    double cos_min, double max_offset = std::numeric_limits<double>::infinity());
+    double cos_min, double max_offset = std::numeric_limits<double>::infinity(), int size = 1);
 
 // The roughness a pixel sees: α widened by its spread of normals (√(α² + spread)).
 inline double WidenedAlpha(double alpha, double spread) {

@@ -232,6 +232,7 @@ void SolverState::PlanObservations() {
   d.pixel_stride = options.pixel_stride;
   d.max_highlight_samples = options.max_highlight_samples;
   d.max_fit_samples = options.max_fit_samples;
+  d.max_block = options.max_observation_block;
   d.num_threads = options.num_threads;
   std::vector<const Renderer::Impl*> geometry(lighting_scenes.size(), nullptr);
   for (size_t l = 0; l < lighting_scenes.size(); ++l) geometry[l] = lighting_scenes[l].get();
@@ -374,20 +375,21 @@ void SolverState::SelectFitSamples() {
   const size_t min_rest = max_fit / 3;
   for (size_t r = 0; r < materials.size(); ++r) {
     const size_t taken = DrawSubset(obs, near[r], size_t(options.max_highlight_samples),
-                                    DrawnShare(int(r), true), &in_fit);
+                                    DrawnThreshold(int(r), true), &in_fit);
     const size_t budget = std::max(min_rest, max_fit - std::min(taken, max_fit));
-    DrawSubset(obs, rest[r], budget, DrawnShare(int(r), false), &in_fit);
+    DrawSubset(obs, rest[r], budget, DrawnThreshold(int(r), false), &in_fit);
   }
 }
 
-// The footprint of observation o's pixel (solver/gather.h): ray directions at unit depth, so
-// that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion is
+// The footprint of observation o's pixel or block (solver/gather.h): ray directions at unit depth,
+// so that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion is
 // linearised over the pixel).
 GatherQuery::Footprint SolverState::PixelFootprint(const Observation& o) const {
   const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
   const Eigen::Quaterniond world_from_cam = cam.cam_from_world.rotation.conjugate();
   auto ray = [&](double u, double v) -> Eigen::Vector3d {
-    const Eigen::Vector3d d = cam.CamRayFromImg(Eigen::Vector2d(o.x + u, o.y + v));
+    const Eigen::Vector3d d =
+        cam.CamRayFromImg(Eigen::Vector2d(o.x + u * o.size, o.y + v * o.size));
     return world_from_cam * (d / d.z());
   };
   GatherQuery::Footprint f;

@@ -164,9 +164,14 @@ struct SolverState {
   // budget, else a census and the draw's probabilities; throws InputError when not even the
   // largest photo and the fits' fewest observations fit.
   void PlanObservations();
-  // The probability with which region r's observations (near a highlight or not) were drawn.
+  // The share of region r's pixels at the stride (near a highlight or not) that observations were
+  // drawn at (their density), and the hash threshold they were drawn under (the same for single
+  // pixels, larger for blocks: solver/observation_draw.h).
   double DrawnShare(int region, bool near) const {
     return draw.census ? draw.Probability(region, near) : 1.0;
+  }
+  double DrawnThreshold(int region, bool near) const {
+    return draw.census ? draw.Threshold(region, near) : 1.0;
   }
   void CollectAllObservations();
   void SelectFitSamples();
@@ -192,10 +197,11 @@ struct SolverState {
   std::vector<Eigen::Vector3d> NeighbourMean(
       const std::vector<Eigen::Vector3d>& values, double radius, bool same_photo,
       const std::vector<float>* point_radius = nullptr) const;
-  // Per observation, the adaptive smoothing's radius (SolveOptions::smoothing_accuracy), from
-  // stage 1's gather; empty until SmoothIrradiance first needs it.
+  // Per observation, its smoothing radius (the adaptive smoothing's, SolveOptions::
+  // smoothing_accuracy, from stage 1's gather); empty until SmoothIrradiance first needs it.
   std::vector<float> obs_smoothing_radius;
   void ComputeSmoothingRadii(double radius);
+  std::vector<float> DrawnSmoothingRadii(double radius) const;
   void ComputeSpecularTerms();
   void HeldOutAlbedos();
   double FitAll(int stage, int iteration);  // returns the largest relative change

@@ -295,16 +295,16 @@ void SolverState::RenderResiduals(Scene model, int stage) {
         const Observation& o = obs[i];
         const Photo& p = scene.photos[o.photo];
         const Camera& cam = scene.cameras[p.camera];
-        // Each path through its own point of the pixel (the photo's pixel is the mean over its
-        // footprint; igi-render's box filter), stratified 2×2 per half.
+        // Each path through its own point of the pixel or block (the photo's pixel is the mean
+        // over its footprint; igi-render's box filter), stratified 2×2 per half.
         const uint64_t seed = options.seed * 7919 + uint64_t(i) * 2;
         Pcg32 rng = PixelSampleRng(seed, uint64_t(i), 0xf00);
         Eigen::Vector3d half[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
         for (int k = 0; k < kSpp; ++k) {
           const int cell = (k / 2) % 4;
           const Eigen::Vector2d u = rng.Uniform2D();
-          const Eigen::Vector2d px(o.x + 0.5 * ((cell % 2) + u.x()),
-                                   o.y + 0.5 * ((cell / 2) + u.y()));
+          const Eigen::Vector2d px(o.x + 0.5 * o.size * ((cell % 2) + u.x()),
+                                   o.y + 0.5 * o.size * ((cell / 2) + u.y()));
           half[k % 2] += renderers[p.lighting]->Radiance(
               cam.CenterInWorld(), cam.WorldRayFromImg(px), 1, seed * kSpp + uint64_t(k));
         }

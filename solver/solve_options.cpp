@@ -25,7 +25,9 @@ void SolveOptions::Validate() const {
   check(memory_budget >= 0, "--memory-budget", fmt::format("{}", memory_budget),
         "must be >= 0 GiB (0 = the machine's memory less a margin)");
   check(max_observations >= 0, "--max-observations", std::to_string(max_observations),
-        "must be >= 0 (0 = as the memory budget allows)");
+        "must be >= 0 (0 = as many as the memory budget allows)");
+  check(max_observation_block >= 1 && max_observation_block <= 64, "--max-observation-block",
+        std::to_string(max_observation_block), "must be in [1, 64]");
   check(saturation >= 0, "--saturation", fmt::format("{}", saturation), "must be >= 0 (0 = auto)");
   check(patch_size_m >= 0, "--patch-size-m", fmt::format("{}", patch_size_m),
         "must be >= 0 (0 = auto)");

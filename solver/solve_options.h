@@ -18,8 +18,16 @@ struct SolveOptions {
   double memory_budget = 0;
   // At most this many observations in all (0 = as many as the memory budget allows): where the
   // photos offer more, each region keeps its highlight candidates and fit samples (below) and
-  // the rest is drawn evenly by a hash of photo and pixel (solver/observation_draw.h).
-  int64_t max_observations = 0;
+  // the rest is drawn evenly by a hash of photo and pixel (solver/observation_draw.h), each
+  // drawn observation the mean of a block of pixels (max_observation_block). What a solve costs
+  // is set by this, not by the photos' size: a room's fits (every region's highlight candidates
+  // and fit samples, a few observations per patch) need a few hundred thousand; photos that
+  // offer fewer (stride 2: up to ~1.2 MP in all) are collected whole.
+  int64_t max_observations = 300000;
+  // Where observations are drawn (above), each class kept with probability p stands for the mean
+  // of a block of up to this many stride cells on a side (⌊1/√p⌋; 1 = single pixels), so that
+  // the pixels between the drawn ones average its noise (solver/observation_draw.h).
+  int max_observation_block = 8;
   // Pixel values at or above this are clipped and ignored (scene radiance units); 0 = auto: a
   // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
   double saturation = 0;

@@ -211,9 +211,11 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   Json photos = Json::array();
   for (size_t k = 0; k < s.photos.size(); ++k) {
     const PhotoObservationStats& p = s.photos[k];
-    Json pj = {{"pixels", p.pixels},   {"valid", p.valid},     {"masked", p.masked},
-               {"clipped", p.clipped}, {"invalid", p.invalid}, {"background", p.background},
-               {"edge", p.edge},       {"undrawn", p.undrawn}, {"saturation", Num(p.saturation)}};
+    Json pj = {{"pixels", p.pixels},   {"valid", p.valid},
+               {"masked", p.masked},   {"clipped", p.clipped},
+               {"invalid", p.invalid}, {"background", p.background},
+               {"edge", p.edge},       {"undrawn", p.undrawn},
+               {"blocks", p.blocks},   {"saturation", Num(p.saturation)}};
     if (k < s.residuals.size()) {
       pj["file"] = s.residuals[k].file;
       pj["residual_paper"] = Num(s.residuals[k].stage1);
@@ -260,6 +262,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["options"] = {{"pixel_stride", o.pixel_stride},
                   {"memory_budget", o.memory_budget},
                   {"max_observations", o.max_observations},
+                  {"max_observation_block", o.max_observation_block},
                   {"smoothing_accuracy", o.smoothing_accuracy},
                   {"light_samples", o.light_samples},
                   {"indirect_rays", o.indirect_rays},

@@ -256,25 +256,64 @@ std::vector<Eigen::Vector3d> SolverState::NeighbourMean(
 void SolverState::SmoothIrradiance() {
   const double radius =
       options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
-  std::vector<Eigen::Vector3d> smooth;
-  if (options.smoothing_accuracy > 0) {
-    if (obs_smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
-    smooth = NeighbourMean(obs_e_indirect, 2 * radius, false, &obs_smoothing_radius);
-  } else {
-    smooth = NeighbourMean(obs_e_indirect, radius, false);
-  }
+  if (obs_smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
+  // The grid's cell: the widest radius any observation may have.
+  double widest = 0;
+  for (float r : DrawnSmoothingRadii(radius)) widest = std::max(widest, double(r));
+  if (options.smoothing_accuracy > 0) widest *= 2;
+  const std::vector<Eigen::Vector3d> smooth =
+      NeighbourMean(obs_e_indirect, widest, false, &obs_smoothing_radius);
   obs_e.resize(obs.size());
   for (size_t i = 0; i < obs.size(); ++i) obs_e[i] = obs_e_direct[i] + smooth[i];
 }
 
-// Ward's irradiance-cache radius per observation: the harmonic mean distance R = N / Σ 1/d_k of
-// its N indirect rays' hits (a ray that meets no patch counts as infinitely far; d at least
-// half a patch), times smoothing_accuracy, within [radius/4, 2·radius]. It grows beyond the
-// fixed radius only where the surface is flat: the irradiance also changes with the normal,
-// and on a curved surface (the observation's triangle has vertex normals more than 0.01 rad
-// apart) a wider mean biases it (igi-synth's sphere: ρd −2.7 % → −3.2 % when it grew there too).
+namespace {
+
+// The fewest observations a smoothing radius should hold where the observations were drawn.
+constexpr double kSmoothingNeighbours = 32;
+// How far the draw may widen the radius: at most this factor.
+constexpr double kMostDrawWidening = 4;
+
+}  // namespace
+
+// Per observation, the radius its region's observations hold kSmoothingNeighbours in under its
+// lighting (their count over the area of the patches they fall on), when the draw thinned them
+// so that `radius` holds fewer; within [radius, kMostDrawWidening·radius]. `radius` itself where
+// nothing was drawn.
+std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
+  std::vector<float> out(obs.size(), float(radius));
+  if (!draw.census) return out;
+  for (const LightingState& st : lighting_state) {
+    if (!st.active) continue;
+    std::vector<double> count(materials.size(), 0), area(materials.size(), 0);
+    std::vector<char> seen(patches.size(), 0);
+    for (int i : st.obs) {
+      const Observation& o = obs[i];
+      ++count[o.region];
+      if (o.patch >= 0 && !seen[o.patch])
+        seen[o.patch] = 1, area[o.region] += patches.area[o.patch];
+    }
+    for (int i : st.obs) {
+      const int r = obs[i].region;
+      if (!(area[r] > 0)) continue;
+      const double holding = std::sqrt(kSmoothingNeighbours * area[r] / (kPi * count[r]));
+      out[i] = float(std::clamp(holding, radius, kMostDrawWidening * radius));
+    }
+  }
+  return out;
+}
+
+// Each observation's smoothing radius. Without adaptive smoothing, its region's (radius, widened
+// where the observations were drawn: DrawnSmoothingRadii). With it, Ward's irradiance-cache
+// radius: the harmonic mean distance R = N / Σ 1/d_k of its N indirect rays' hits (a ray that
+// meets no patch counts as infinitely far; d at least half a patch), times smoothing_accuracy,
+// within [1/4, 2] × its region's radius. It grows beyond that radius only where the surface is
+// flat: the irradiance also changes with the normal, and on a curved surface (the observation's
+// triangle has vertex normals more than 0.01 rad apart) a wider mean biases it (igi-synth's
+// sphere: ρd −2.7 % → −3.2 % when it grew there too).
 void SolverState::ComputeSmoothingRadii(double radius) {
-  obs_smoothing_radius.assign(obs.size(), float(radius));
+  obs_smoothing_radius = DrawnSmoothingRadii(radius);
+  if (!(options.smoothing_accuracy > 0)) return;
   const double min_d = 0.5 * summary.patch_size_m;
   const TriangleMesh& mesh = scene.mesh;
   auto curved = [&](int t) {
@@ -288,6 +327,7 @@ void SolverState::ComputeSmoothingRadii(double radius) {
     for (int i : st.obs) {
       const GatherPoint& gp = st.gather.points[obs_point[i]];
       const int n = int(gp.indirect_end - gp.indirect_begin);
+      const double base = obs_smoothing_radius[i];
       if (n <= 0) continue;
       double inv = 0;
       for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
@@ -296,9 +336,9 @@ void SolverState::ComputeSmoothingRadii(double radius) {
         const double dist = double((patches.center[s.patch] - obs[i].position).norm());
         inv += 1.0 / std::max(dist, min_d);
       }
-      const double most = curved(obs[i].triangle) ? radius : 2 * radius;
+      const double most = curved(obs[i].triangle) ? base : 2 * base;
       const double r = inv > 0 ? options.smoothing_accuracy * n / inv : most;
-      obs_smoothing_radius[i] = float(std::clamp(r, 0.25 * radius, most));
+      obs_smoothing_radius[i] = float(std::clamp(r, 0.25 * base, most));
     }
   }
 }

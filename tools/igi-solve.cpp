@@ -30,9 +30,14 @@ int main(int argc, char** argv) {
                  "memory budget in GiB (0 = the machine's memory less a margin): fewer "
                  "observations are drawn to fit it, or the solve stops with one line")
       ->capture_default_str();
-  app.add_option("--max-observations", o.max_observations,
-                 "at most this many observations (0 = as the memory budget allows); each region "
-                 "keeps its highlight candidates and fit samples, the rest is drawn evenly")
+  app.add_option(
+         "--max-observations", o.max_observations,
+         "at most this many observations (0 = as many as the memory budget allows); each region "
+         "keeps its highlight candidates and fit samples, the rest is drawn evenly")
+      ->capture_default_str();
+  app.add_option("--max-observation-block", o.max_observation_block,
+                 "where observations are drawn, each stands for the mean of a block of up to "
+                 "this many stride cells on a side (1 = single pixels)")
       ->capture_default_str();
   app.add_option("--saturation", o.saturation, "clipping value of the photos (0 = auto)")
       ->capture_default_str();

@@ -1,8 +1,9 @@
 // Drawing the observations to a budget as they are collected (solver/observation_draw.h) and the
 // memory plan behind it (solver/solve_memory.h): the probabilities keep each region's highlight
 // candidates and fit samples and share the rest of the budget; a thinned collection keeps a
-// subset of the very pixels a full one keeps, every highlight candidate among them; a budget that
-// cannot hold one photo is refused before any work.
+// subset of the very pixels a full one keeps, every highlight candidate among them; drawn blocks
+// are the means of their pixels on one surface; a budget that cannot hold one photo is refused
+// before any work.
 //
 // Scene: tests/e2e/box_room.h's 2 m room with a Ward floor of unknown lobe, cam0 looking down at
 // the lamp's highlight on the floor, cam1 up; photos path-traced at 16 paths, every pixel
@@ -12,8 +13,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <tuple>
@@ -77,6 +80,66 @@ TEST(PlanObservationDraw, NeedsBeyondTheBudgetAreScaledTogether) {
   EXPECT_NEAR(d.p_rest[1] * 500000, s * 6000, 1e-6);
 }
 
+TEST(PlanObservationDraw, BlockSidesFollowTheProbabilities) {
+  const std::vector<RegionPixelCensus> census = {{50000, 200000}, {1000, 500000}, {0, 3000}};
+  ObservationDrawOptions o;
+  o.budget = 100000;
+  o.max_highlight_samples = 30000;
+  o.max_fit_samples = 6000;
+  ObservationDraw d = PlanObservationDraw(census, {1, 0, 0}, o);
+  // p_rest ≈ 0.096: blocks of ⌊1/√p⌋ = 3 cells, kept with p·9; p_near 0.6 and 1: single pixels.
+  ASSERT_NEAR(d.p_rest[0], 0.0956, 0.001);
+  EXPECT_EQ(d.Block(0, false), 3);
+  EXPECT_EQ(d.Block(1, false), 3);
+  EXPECT_EQ(d.Block(0, true), 1);
+  EXPECT_EQ(d.Block(2, false), 1);
+  EXPECT_NEAR(d.Threshold(0, false), 9 * d.p_rest[0], 1e-12);
+  EXPECT_EQ(d.Threshold(0, true), d.p_near[0]);
+  o.max_block = 2;
+  d = PlanObservationDraw(census, {1, 0, 0}, o);
+  EXPECT_EQ(d.Block(0, false), 2);
+  o.budget = 2000;  // p ≈ 0.003: ⌊18.3⌋ capped at max_block
+  o.max_block = 8;
+  d = PlanObservationDraw(census, {1, 0, 0}, o);
+  EXPECT_EQ(d.Block(1, false), 8);
+  EXPECT_LE(d.Threshold(1, false), 1.0);
+}
+
+TEST(ObservationDraw, BlocksKeepTheDensityOfSinglePixels) {
+  // One region, p = 1/20: blocks of 4 × 4 stride cells (stride 2), kept with p·16 = 0.8, the
+  // centre cell of each block its anchor.
+  ObservationDraw d;
+  d.lobe_class = {0};
+  d.p_near = d.p_rest = {0.05};
+  d.block_near = d.block_rest = {4};
+  const int stride = 2, cells = 400;
+  int kept = 0;
+  for (int cy = 0; cy < cells; ++cy) {
+    for (int cx = 0; cx < cells; ++cx) {
+      int x0 = -1, y0 = -1, size = 0;
+      if (!d.Draws(3, cx * stride + 1, cy * stride + 1, stride, 0, false, &x0, &y0, &size)) {
+        continue;
+      }
+      ++kept;
+      EXPECT_EQ(cx % 4, 2);
+      EXPECT_EQ(cy % 4, 2);
+      EXPECT_EQ(size, 8);
+      EXPECT_EQ(x0, (cx - 2) * stride);
+      EXPECT_EQ(y0, (cy - 2) * stride);
+    }
+  }
+  const double expected = 0.05 * cells * cells;  // 8000, binomial σ ≈ 40 over 10 000 blocks
+  EXPECT_NEAR(kept, expected, 4 * std::sqrt(expected * 0.2));
+  // Single pixels: the pixel itself.
+  d.block_rest = {1};
+  int x0 = -1, y0 = -1, size = 0;
+  for (int x = 1; x < 200; x += 2) {
+    if (d.Draws(3, x, 5, stride, 0, false, &x0, &y0, &size)) break;
+  }
+  EXPECT_EQ(size, 1);
+  EXPECT_EQ(y0, 5);
+}
+
 class ObservationDrawRoom : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -113,8 +176,9 @@ using Pixel = std::tuple<int, int, int>;  // photo, x, y
 TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSamePixels) {
   const Scene scene = LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();
-  o.max_fit_samples = 200;  // the regions' needs (their highlight candidates and 200 others)
-                            // well inside the budget below
+  o.max_fit_samples = 200;      // the regions' needs (their highlight candidates and 200 others)
+                                // well inside the budget below
+  o.max_observation_block = 1;  // single pixels (blocks: below)
   SolverState full(scene, o);
   full.Prepare();
   o.max_observations = 2000;
@@ -166,6 +230,43 @@ TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSame
   for (size_t i = 0; i < thin.obs.size(); ++i)
     walls_fit += thin.obs[i].region == walls && thin.in_fit[i];
   EXPECT_GT(walls_fit, 0);
+}
+
+TEST_F(ObservationDrawRoom, DrawnBlocksAreTheMeansOfTheirPixelsOnOneSurface) {
+  const Scene scene = LoadScene(*dir_ / "scene.json");
+  SolveOptions o = Options();
+  o.max_fit_samples = 200;
+  o.max_observations = 1000;
+  SolverState thin(scene, o);
+  thin.Prepare();
+  ASSERT_TRUE(thin.summary.observations_thinned);
+  EXPECT_LE(double(thin.obs.size()), 1000 + 3 * std::sqrt(1000.0));
+  const Image photos[2] = {ReadImage(scene.photos[0].file, 3), ReadImage(scene.photos[1].file, 3)};
+  int blocks = 0, counted = 0;
+  for (const Observation& ob : thin.obs) {
+    if (ob.size == 1) continue;
+    ++blocks;
+    const Image& im = photos[ob.photo];
+    ASSERT_LE(ob.x + ob.size, im.width);
+    ASSERT_LE(ob.y + ob.size, im.height);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int y = ob.y; y < ob.y + ob.size; ++y) {
+      for (int x = ob.x; x < ob.x + ob.size; ++x) {
+        for (int c = 0; c < 3; ++c) sum[c] += im.at(x, y, c);
+      }
+    }
+    const Eigen::Vector3d mean = sum / double(ob.size * ob.size);
+    EXPECT_LT((mean - ob.radiance.cast<double>()).norm(), 1e-5 * (1 + mean.norm()));
+    // Its point is where the block's centre ray meets the surface.
+    const Camera& cam = scene.cameras[scene.photos[ob.photo].camera];
+    const std::optional<Eigen::Vector2d> centre = cam.ImgFromWorld(ob.position.cast<double>());
+    ASSERT_TRUE(centre);
+    EXPECT_NEAR(centre->x(), ob.x + 0.5 * ob.size, 1e-3);
+    EXPECT_NEAR(centre->y(), ob.y + 0.5 * ob.size, 1e-3);
+  }
+  for (const PhotoObservationStats& st : thin.summary.photos) counted += st.blocks;
+  EXPECT_GT(blocks, 100);
+  EXPECT_EQ(blocks, counted);
 }
 
 TEST_F(ObservationDrawRoom, ABudgetThatCannotHoldAPhotoIsRefusedBeforeAnyWork) {
