@@ -21,6 +21,7 @@
 #include "solver/albedo_map.h"
 #include "solver/brdf.h"
 #include "solver/gather.h"
+#include "solver/observation_grid.h"
 #include "solver/sampling.h"
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
@@ -29,56 +30,6 @@
 
 namespace igi {
 namespace {
-
-// The observations of the mapped regions, by lighting, region and cell of a uniform grid.
-class ObservationGrid {
- public:
-  ObservationGrid(const SolverState& s, const std::vector<char>& mapped, double cell)
-      : s_(s), cell_(cell) {
-    for (size_t i = 0; i < s.obs.size(); ++i) {
-      const Observation& o = s.obs[i];
-      if (!mapped[o.region]) continue;
-      const int l = s.scene.photos[o.photo].lighting;
-      cells_[Key(l, o.region, CellOf(o.position.cast<double>()))].push_back(int(i));
-    }
-  }
-
-  // The nearest observation of `region` under lighting `l` to `p` with its normal within ~25° of
-  // n (dot >= 0.9), within the 27 cells around p's; -1 when none.
-  int Nearest(int l, int region, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
-    const Eigen::Vector3i c = CellOf(p);
-    int best = -1;
-    double best_d2 = INFINITY;
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const auto it = cells_.find(Key(l, region, c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == cells_.end()) continue;
-          for (int i : it->second) {
-            const Observation& o = s_.obs[i];
-            if (o.normal.cast<double>().dot(n) < 0.9) continue;
-            const double d2 = (o.position.cast<double>() - p).squaredNorm();
-            if (d2 < best_d2) best_d2 = d2, best = i;
-          }
-        }
-      }
-    }
-    return best;
-  }
-
- private:
-  Eigen::Vector3i CellOf(const Eigen::Vector3d& p) const {
-    return (p / cell_).array().floor().cast<int>();
-  }
-  static uint64_t Key(int l, int region, const Eigen::Vector3i& c) {
-    const auto u = [](int v) { return uint64_t(uint32_t(v) & 0xfffff); };
-    return (uint64_t(l & 0xff) << 56) ^ (uint64_t(region & 0xfff) << 44) ^
-           (u(c.x()) << 24 | u(c.y()) << 4) ^ (u(c.z()) * 0x9e3779b1ULL);
-  }
-  const SolverState& s_;
-  double cell_;
-  std::unordered_map<uint64_t, std::vector<int>> cells_;
-};
 
 // One pixel's contribution to its region's map.
 struct MapSample {

@@ -71,6 +71,18 @@ double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Ei
   return (a.squaredNorm() + b.squaredNorm()) / 12.0;
 }
 
+namespace {
+
+// Whether `h` lies on the smooth piece of `centre`'s region: the same region, its normal at a
+// cosine above cos_min from the centre's, off the centre's face plane by under max_offset·centre.t.
+bool OnPieceOf(const std::optional<SurfaceHit>& h, const SurfaceHit& centre, double cos_min,
+               double max_offset) {
+  return h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_min &&
+         std::abs(centre.n_geo.dot(h->position - centre.position)) < max_offset * centre.t;
+}
+
+}  // namespace
+
 std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer::Impl& geometry,
                                                                   const Camera& camera, int x,
                                                                   int y, const SurfaceHit& centre,
@@ -82,10 +94,7 @@ std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer
     const double ox = ((k & 1) ? 0.75 : 0.25) * size, oy = ((k & 2) ? 0.75 : 0.25) * size;
     const std::optional<SurfaceHit> h =
         TraceSurface(geometry, eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
-    if (!(h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_min &&
-          std::abs(centre.n_geo.dot(h->position - centre.position)) < max_offset * centre.t)) {
-      return std::nullopt;
-    }
+    if (!OnPieceOf(h, centre, cos_min, max_offset)) return std::nullopt;
     normals[k] = h->n_s;
   }
   return normals;
@@ -118,11 +127,23 @@ std::vector<Observation> CollectObservations(
   std::vector<std::vector<Observation>> per_row(rows);
   std::vector<PhotoObservationStats> row_stats(rows);
   const double cos_edge = std::cos(10.0 * kPi / 180.0);
-  // Whether (hit) lies on the smooth piece of `centre`'s region (the edge tests of
-  // QuarterPixelNormals).
-  auto same_piece = [&](const std::optional<SurfaceHit>& h, const SurfaceHit& centre) {
-    return h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_edge &&
-           std::abs(centre.n_geo.dot(h->position - centre.position)) < 0.01 * centre.t;
+  // The observation of the square of `size` pixels at (x0, y0) whose centre ray `dir` meets
+  // `hit`, of radiance `value`, its normals at the square's quarter points `quarter`.
+  auto make = [&](int x0, int y0, int size, const SurfaceHit& hit, const Eigen::Vector3d& dir,
+                  const Eigen::Vector3f& value, const std::array<Eigen::Vector3d, 4>& quarter) {
+    Observation o;
+    o.photo = photo_index;
+    o.x = x0, o.y = y0, o.size = size;
+    o.triangle = hit.triangle;
+    o.b1 = float(hit.b1), o.b2 = float(hit.b2);
+    o.region = hit.region;
+    o.patch = patches.PatchOf(hit.triangle, hit.b1, hit.b2);
+    o.position = hit.position.cast<float>();
+    o.normal = hit.n_s.cast<float>();
+    o.view = (-dir).cast<float>();
+    o.radiance = value;
+    o.lobe_blur2 = float(PixelNormalSpread(quarter, hit.n_s));
+    return o;
   };
   // The observation of the block of `size` pixels at (x0, y0): its pixels' mean, when every one
   // is usable and the block lies on one smooth piece of one region (its centre, its stride
@@ -146,26 +167,15 @@ std::vector<Observation> CollectObservations(
     for (int y = y0 + stride / 2; y < y0 + size; y += stride) {
       for (int x = x0 + stride / 2; x < x0 + size; x += stride) {
         const Eigen::Vector2d px(x + 0.5, y + 0.5);
-        if (!same_piece(TraceSurface(geometry, center, camera.WorldRayFromImg(px)), *hit)) {
+        if (!OnPieceOf(TraceSurface(geometry, center, camera.WorldRayFromImg(px)), *hit, cos_edge,
+                       0.01)) {
           return std::nullopt;
         }
       }
     }
     const auto quarter = QuarterPixelNormals(geometry, camera, x0, y0, *hit, cos_edge, 0.01, size);
     if (!quarter) return std::nullopt;
-    Observation o;
-    o.photo = photo_index;
-    o.x = x0, o.y = y0, o.size = size;
-    o.triangle = hit->triangle;
-    o.b1 = float(hit->b1), o.b2 = float(hit->b2);
-    o.region = hit->region;
-    o.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
-    o.position = hit->position.cast<float>();
-    o.normal = hit->n_s.cast<float>();
-    o.view = (-dir).cast<float>();
-    o.radiance = (sum / (double(size) * size)).cast<float>();
-    o.lobe_blur2 = float(PixelNormalSpread(*quarter, hit->n_s));
-    return o;
+    return make(x0, y0, size, *hit, dir, (sum / (double(size) * size)).cast<float>(), *quarter);
   };
   ParallelFor(
       0, rows,
@@ -214,20 +224,7 @@ std::vector<Observation> CollectObservations(
             ++st.edge;
             continue;
           }
-          Observation o;
-          o.photo = photo_index;
-          o.x = x;
-          o.y = yy;
-          o.triangle = hit->triangle;
-          o.b1 = float(hit->b1);
-          o.b2 = float(hit->b2);
-          o.region = hit->region;
-          o.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
-          o.position = hit->position.cast<float>();
-          o.normal = hit->n_s.cast<float>();
-          o.view = (-dir).cast<float>();
-          o.radiance = value;
-          o.lobe_blur2 = float(PixelNormalSpread(*corner_normal, hit->n_s));
+          const Observation o = make(x, yy, 1, *hit, dir, value, *corner_normal);
           per_row[r].push_back(o);
           ++st.valid;
         }

@@ -101,11 +101,11 @@ class LobeTable {
       row.clear();
       for (int64_t k = 0; k < s.incident_count; ++k) {
         const IncidentLocal& inc = s.incident[k];
-        const Eigen::Vector3d wi = inc.wi.cast<double>();
+        const Eigen::Vector3d wi = inc.Wi().cast<double>();
         double qx = 0, qy = 0, g = 0;
         if (!SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
         if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
-        const Eigen::Vector3d gv = g * inc.value.cast<double>();
+        const Eigen::Vector3d gv = g * inc.Value().cast<double>();
         if (!(g > 0.0) || !gv.allFinite()) continue;
         row.push_back({float(qx), float(qy), gv.cast<float>()});
       }

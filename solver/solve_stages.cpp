@@ -12,6 +12,7 @@
 #include "solver/albedo_map.h"
 #include "solver/held_out_albedo.h"
 #include "solver/neighbour_mean.h"
+#include "solver/observation_grid.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
@@ -183,7 +184,7 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           Eigen::Vector3d t = Eigen::Vector3d::Zero();
           if (summed && glossy) {
             for (const IncidentLocal& in : inc) {
-              t += lobe_weight(in.wi.cast<double>()) * in.value.cast<double>();
+              t += lobe_weight(in.Wi().cast<double>()) * in.Value().cast<double>();
             }
           }
           if (summed) {
@@ -257,10 +258,8 @@ void SolverState::SmoothIrradiance() {
   const double radius =
       options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
   if (obs_smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
-  // The grid's cell: the widest radius any observation may have.
-  double widest = 0;
-  for (float r : DrawnSmoothingRadii(radius)) widest = std::max(widest, double(r));
-  if (options.smoothing_accuracy > 0) widest *= 2;
+  double widest = 0;  // the grid's cell
+  for (float r : obs_smoothing_radius) widest = std::max(widest, double(r));
   const std::vector<Eigen::Vector3d> smooth =
       NeighbourMean(obs_e_indirect, widest, false, &obs_smoothing_radius);
   obs_e.resize(obs.size());
@@ -276,30 +275,35 @@ constexpr double kMostDrawWidening = 4;
 
 }  // namespace
 
-// Per observation, the radius its region's observations hold kSmoothingNeighbours in under its
-// lighting (their count over the area of the patches they fall on), when the draw thinned them
-// so that `radius` holds fewer; within [radius, kMostDrawWidening·radius]. `radius` itself where
-// nothing was drawn.
+// Per observation, where the draw thinned the observations: the distance within which
+// kSmoothingNeighbours observations of its region under its lighting lie (normals within ~25°,
+// itself included), held within [radius, kMostDrawWidening·radius]. `radius` itself where nothing
+// was drawn.
 std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
   std::vector<float> out(obs.size(), float(radius));
   if (!draw.census) return out;
-  for (const LightingState& st : lighting_state) {
-    if (!st.active) continue;
-    std::vector<double> count(materials.size(), 0), area(materials.size(), 0);
-    std::vector<char> seen(patches.size(), 0);
-    for (int i : st.obs) {
-      const Observation& o = obs[i];
-      ++count[o.region];
-      if (o.patch >= 0 && !seen[o.patch])
-        seen[o.patch] = 1, area[o.region] += patches.area[o.patch];
-    }
-    for (int i : st.obs) {
-      const int r = obs[i].region;
-      if (!(area[r] > 0)) continue;
-      const double holding = std::sqrt(kSmoothingNeighbours * area[r] / (kPi * count[r]));
-      out[i] = float(std::clamp(holding, radius, kMostDrawWidening * radius));
-    }
-  }
+  const double widest = kMostDrawWidening * radius;
+  const ObservationGrid grid(*this, std::vector<char>(materials.size(), 1), widest);
+  ParallelFor(
+      0, int64_t(obs.size()),
+      [&](int64_t i) {
+        const Observation& o = obs[i];
+        const Eigen::Vector3d p = o.position.cast<double>(), n = o.normal.cast<double>();
+        std::vector<double> d2;
+        grid.ForEachNear(scene.photos[o.photo].lighting, o.region, p, [&](int j) {
+          if (obs[j].normal.cast<double>().dot(n) < 0.9) return;
+          const double d = (obs[j].position.cast<double>() - p).squaredNorm();
+          if (d <= widest * widest) d2.push_back(d);
+        });
+        const size_t k = size_t(kSmoothingNeighbours) - 1;
+        if (d2.size() <= k) {
+          out[i] = float(widest);
+          return;
+        }
+        std::nth_element(d2.begin(), d2.begin() + k, d2.end());
+        out[i] = float(std::clamp(std::sqrt(d2[k]), radius, widest));
+      },
+      options.num_threads);
   return out;
 }
 
@@ -357,8 +361,8 @@ void SolverState::ComputeSpecularTerms() {
           const double ay = WidenedAlpha(m.params.AlphaY(), obs[i].lobe_blur2);
           for (const IncidentLocal& inc : obs_incident[i]) {
             const double w =
-                SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.wi.cast<double>());
-            if (w > 0) t += w * inc.value.cast<double>();
+                SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.Wi().cast<double>());
+            if (w > 0) t += w * inc.Value().cast<double>();
           }
         }
         obs_t[i] = t;

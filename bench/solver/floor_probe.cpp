@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
         s.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     for (const IncidentLocal& inc : s.obs_incident[i]) {
       const double w =
-          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.wi.cast<double>());
-      if (w > 0) t_true[i] += w * inc.value.cast<double>();
+          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
+      if (w > 0) t_true[i] += w * inc.Value().cast<double>();
     }
   }
   auto uv_of = [&](const Observation& o) {
@@ -314,11 +314,11 @@ int main(int argc, char** argv) {
     double tt = 0, tf = 0;
     for (const IncidentLocal& inc : s.obs_incident[i]) {
       const double w1 =
-          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.wi.cast<double>());
+          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
       const double w2 = SpecularWeight(m.params.model, m.params.alpha, m.params.alpha, m.params.ior,
-                                       wo, inc.wi.cast<double>());
-      if (w1 > 0) tt += w1 * inc.value.cast<double>().mean();
-      if (w2 > 0) tf += w2 * inc.value.cast<double>().mean();
+                                       wo, inc.Wi().cast<double>());
+      if (w1 > 0) tt += w1 * inc.Value().cast<double>().mean();
+      if (w2 > 0) tf += w2 * inc.Value().cast<double>().mean();
     }
     const Eigen::Vector3d tr = SampleTexture(tex, uv);
     const Eigen::Vector3d pa = s.PatchAlbedo(o.patch);

@@ -269,6 +269,44 @@ TEST_F(ObservationDrawRoom, DrawnBlocksAreTheMeansOfTheirPixelsOnOneSurface) {
   EXPECT_EQ(blocks, counted);
 }
 
+TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
+  const Scene scene = LoadScene(*dir_ / "scene.json");
+  SolveOptions o = Options();
+  o.max_fit_samples = 200;
+  o.indirect_rays = 8;
+  SolverState full(scene, o);
+  full.Prepare();
+  full.GatherAll();
+  const double r0 = full.summary.scene_diagonal_m / 96;
+  for (float r : full.DrawnSmoothingRadii(r0)) ASSERT_EQ(r, float(r0));
+  o.max_observations = 1000;
+  SolverState thin(scene, o);
+  thin.Prepare();
+  thin.GatherAll();
+  const std::vector<float> radii = thin.DrawnSmoothingRadii(r0);
+  // Within [r0, 4 r0]; below 4 r0 the radius holds 32 observations of the region (itself and its
+  // 31 nearest, normals within ~25°), above r0 it holds no more than 31 just inside.
+  auto within = [&](size_t i, double r) {
+    int n = 0;
+    for (const Observation& other : thin.obs) {
+      n += other.region == thin.obs[i].region && other.normal.dot(thin.obs[i].normal) >= 0.9f &&
+           (other.position - thin.obs[i].position).norm() <= r;
+    }
+    return n;
+  };
+  int widened = 0;
+  for (size_t i = 0; i < thin.obs.size(); ++i) {
+    ASSERT_GE(radii[i], float(r0) * 0.999f);
+    ASSERT_LE(radii[i], float(4 * r0) * 1.001f);
+    if (radii[i] < float(4 * r0) * 0.999f) EXPECT_GE(within(i, radii[i] * 1.0001), 32) << i;
+    if (radii[i] > float(r0) * 1.001f) {
+      ++widened;
+      EXPECT_LT(within(i, radii[i] * 0.9999), 32) << i;
+    }
+  }
+  EXPECT_GT(widened, 100);
+}
+
 TEST_F(ObservationDrawRoom, ABudgetThatCannotHoldAPhotoIsRefusedBeforeAnyWork) {
   const Scene scene = LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();

@@ -1,0 +1,76 @@
+#pragma once
+// Internal to igi_solver: the solver's observations by lighting, region and cell of a uniform
+// grid, for the queries that look at an observation's neighbours on the same surface (the albedo
+// maps' own pass, the smoothing radius where the observations were drawn).
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "solver/solve_internal.h"
+
+namespace igi {
+
+class ObservationGrid {
+ public:
+  // The observations of the regions r with regions[r] nonzero, in cells of `cell` metres.
+  ObservationGrid(const SolverState& s, const std::vector<char>& regions, double cell)
+      : s_(s), cell_(cell) {
+    for (size_t i = 0; i < s.obs.size(); ++i) {
+      const Observation& o = s.obs[i];
+      if (!regions[o.region]) continue;
+      const int l = s.scene.photos[o.photo].lighting;
+      cells_[Key(l, o.region, CellOf(o.position.cast<double>()))].push_back(int(i));
+    }
+  }
+
+  // Calls f(i) for every observation i of `region` under lighting `l` in the 27 cells around p's
+  // (all those within one cell of p, and some farther).
+  template <class F>
+  void ForEachNear(int l, int region, const Eigen::Vector3d& p, F&& f) const {
+    const Eigen::Vector3i c = CellOf(p);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = cells_.find(Key(l, region, c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (int i : it->second) {
+            const Observation& o = s_.obs[i];  // (keys of other cells may collide)
+            if (o.region == region && s_.scene.photos[o.photo].lighting == l) f(i);
+          }
+        }
+      }
+    }
+  }
+
+  // The nearest observation of `region` under lighting `l` to `p` with its normal within ~25° of
+  // n (dot >= 0.9), within the 27 cells around p's; -1 when none.
+  int Nearest(int l, int region, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+    int best = -1;
+    double best_d2 = INFINITY;
+    ForEachNear(l, region, p, [&](int i) {
+      const Observation& o = s_.obs[i];
+      if (o.normal.cast<double>().dot(n) < 0.9) return;
+      const double d2 = (o.position.cast<double>() - p).squaredNorm();
+      if (d2 < best_d2) best_d2 = d2, best = i;
+    });
+    return best;
+  }
+
+ private:
+  Eigen::Vector3i CellOf(const Eigen::Vector3d& p) const {
+    return (p / cell_).array().floor().cast<int>();
+  }
+  static uint64_t Key(int l, int region, const Eigen::Vector3i& c) {
+    const auto u = [](int v) { return uint64_t(uint32_t(v) & 0xfffff); };
+    return (uint64_t(l & 0xff) << 56) ^ (uint64_t(region & 0xfff) << 44) ^
+           (u(c.x()) << 24 | u(c.y()) << 4) ^ (u(c.z()) * 0x9e3779b1ULL);
+  }
+  const SolverState& s_;
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<int>> cells_;
+};
+
+}  // namespace igi
