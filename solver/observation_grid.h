@@ -26,14 +26,15 @@ class ObservationGrid {
     }
   }
 
-  // Calls f(i) for every observation i of `region` under lighting `l` in the 27 cells around p's
-  // (all those within one cell of p, and some farther).
+  // Calls f(i) for every observation i of `region` under lighting `l` in the cells within
+  // `reach` cells of p's ((2·reach + 1)³ cells: all those within reach cells of p, and some
+  // farther).
   template <class F>
-  void ForEachNear(int l, int region, const Eigen::Vector3d& p, F&& f) const {
+  void ForEachNear(int l, int region, const Eigen::Vector3d& p, F&& f, int reach = 1) const {
     const Eigen::Vector3i c = CellOf(p);
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    for (int dz = -reach; dz <= reach; ++dz) {
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
           const auto it = cells_.find(Key(l, region, c + Eigen::Vector3i(dx, dy, dz)));
           if (it == cells_.end()) continue;
           for (int i : it->second) {

@@ -283,20 +283,31 @@ std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
   std::vector<float> out(obs.size(), float(radius));
   if (!draw.census) return out;
   const double widest = kMostDrawWidening * radius;
-  const ObservationGrid grid(*this, std::vector<char>(materials.size(), 1), widest);
+  const int reach = int(std::ceil(kMostDrawWidening));
+  const size_t k = size_t(kSmoothingNeighbours) - 1;
+  // Cells of the radius: where `radius` holds enough (the densely drawn), one cell around.
+  const ObservationGrid grid(*this, std::vector<char>(materials.size(), 1), radius);
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
         const Observation& o = obs[i];
         const Eigen::Vector3d p = o.position.cast<double>(), n = o.normal.cast<double>();
+        const int l = scene.photos[o.photo].lighting;
         std::vector<double> d2;
-        grid.ForEachNear(scene.photos[o.photo].lighting, o.region, p, [&](int j) {
-          if (obs[j].normal.cast<double>().dot(n) < 0.9) return;
-          const double d = (obs[j].position.cast<double>() - p).squaredNorm();
-          if (d <= widest * widest) d2.push_back(d);
-        });
-        const size_t k = size_t(kSmoothingNeighbours) - 1;
-        if (d2.size() <= k) {
+        auto within = [&](double r, int cells) {
+          d2.clear();
+          grid.ForEachNear(
+              l, o.region, p,
+              [&](int j) {
+                if (obs[j].normal.cast<double>().dot(n) < 0.9) return;
+                const double d = (obs[j].position.cast<double>() - p).squaredNorm();
+                if (d <= r * r) d2.push_back(d);
+              },
+              cells);
+          return d2.size() > k;
+        };
+        if (within(radius, 1)) return;  // `radius` holds them
+        if (!within(widest, reach)) {
           out[i] = float(widest);
           return;
         }
