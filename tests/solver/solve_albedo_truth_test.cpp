@@ -184,10 +184,10 @@ SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
 //  - solved from all of its observations, the pass reproduces the map the observations give (same
 //    atlas; the pass gathers each pixel's direct light itself and takes the rest from the nearest
 //    observation): within 0.2 dB of the truth's PSNR, its seen mean within 0.5 %;
-//  - solved from a fifth of them, the map keeps the photos' texel (the fits' spacing is about √5
-//    times coarser) and its coverage, and comes within 1.5 dB of the full solve's PSNR (measured
-//    −1.05 dB: the thinned solve's indirect irradiance is averaged over a fifth of the neighbours,
-//    and its noise enters every texel), its mean within 1 %.
+//  - solved from a fifth of them (blocks of 2 × 2 pixels), the map keeps the photos' texel (the
+//    fits' spacing is about √5 times coarser) and its coverage, and comes within 1.5 dB of the
+//    full solve's PSNR (measured −1.07 dB: the thinned solve's indirect irradiance is averaged
+//    over fewer neighbours, and its noise enters every texel), its ρd no farther from the truth.
 TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
   const fs::path tmp = test::UniqueTempDir("solve_albedo_thinned");
   SynthOptions so;
@@ -243,8 +243,14 @@ TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
   EXPECT_NEAR(b.albedo_map->width, a.albedo_map->width, 0.05 * a.albedo_map->width);
   EXPECT_GT(thin_c.compared, 0.95 * full_c.compared);
   EXPECT_GT(thin_c.psnr_db, full_c.psnr_db - 1.5);
+  // Its ρd (the map's mean) no farther from the truth than the full solve's, within 0.5 %
+  // (measured: full +2.0, +2.0, +1.9 %; thinned +0.7, +0.7, +1.0 %).
+  const Json& rho = truth["floor"]["rho_d"];
   for (int c = 0; c < 3; ++c) {
-    EXPECT_LT(RelErr(b.final_params.rho_d[c], a.final_params.rho_d[c]), 0.01) << c;
+    const double t = rho[c].get<double>();
+    std::printf("rho_d[%d]: truth %.4f, full %+.2f %%, thinned %+.2f %%\n", c, t,
+                100 * (a.final_params.rho_d[c] / t - 1), 100 * (b.final_params.rho_d[c] / t - 1));
+    EXPECT_LT(RelErr(b.final_params.rho_d[c], t), RelErr(a.final_params.rho_d[c], t) + 0.005) << c;
   }
   fs::remove_all(tmp);
 }
