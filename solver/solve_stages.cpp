@@ -318,11 +318,11 @@ std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
   return out;
 }
 
-// Each observation's smoothing radius. Without adaptive smoothing, its region's (radius, widened
-// where the observations were drawn: DrawnSmoothingRadii). With it, Ward's irradiance-cache
-// radius: the harmonic mean distance R = N / Σ 1/d_k of its N indirect rays' hits (a ray that
-// meets no patch counts as infinitely far; d at least half a patch), times smoothing_accuracy,
-// within [1/4, 2] × its region's radius. It grows beyond that radius only where the surface is
+// Each observation's smoothing radius. Without adaptive smoothing, its drawn radius (`radius`,
+// widened where the observations were drawn: DrawnSmoothingRadii). With it, Ward's
+// irradiance-cache radius: the harmonic mean distance R = N / Σ 1/d_k of its N indirect rays'
+// hits (a ray that meets no patch counts as infinitely far; d at least half a patch), times
+// smoothing_accuracy, within [1/4, 2] × its drawn radius. It grows beyond that radius only where the surface is
 // flat: the irradiance also changes with the normal, and on a curved surface (the observation's
 // triangle has vertex normals more than 0.01 rad apart) a wider mean biases it (igi-synth's
 // sphere: ρd −2.7 % → −3.2 % when it grew there too).
