@@ -131,6 +131,10 @@ struct SceneLoadOptions {
   bool require_complete_materials = false;
 };
 
+// The scene.json entry of a camera: model, size, params, qvec, tvec, and vignetting when it has
+// any.
+Json CameraJson(const Camera& camera);
+
 // Loads and validates `path`. Throws InputError listing every problem ("FILE: KEY: VALUE: RULE").
 Scene LoadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
 

@@ -170,4 +170,19 @@ void ReadPhotos(const SceneLoader& ld, const JsonCursor& root, Scene* scene) {
   }
 }
 
+Json CameraJson(const Camera& camera) {
+  const Eigen::Vector4d q = QvecFromQuaternion(camera.cam_from_world.rotation);
+  const Eigen::Vector3d& t = camera.cam_from_world.translation;
+  Json j{{"model", std::string(CameraModelName(camera.model))},
+         {"width", camera.width},
+         {"height", camera.height},
+         {"params", camera.params},
+         {"qvec", Json::array({q[0], q[1], q[2], q[3]})},
+         {"tvec", Json::array({t.x(), t.y(), t.z()})}};
+  if (camera.HasVignetting()) {
+    j["vignetting"] = {{"k1", camera.vignetting_k1}, {"k2", camera.vignetting_k2}};
+  }
+  return j;
+}
+
 }  // namespace igi

@@ -27,6 +27,10 @@ int main(int argc, char** argv) {
                  "output folder (diagnosis.json, scene.json, report.html, steps/)")
       ->required();
   app.add_option("--spp", o.spp, "paths per pixel of the re-renders")->capture_default_str();
+  app.add_option("--analysis-megapixels", o.analysis_megapixels,
+                 "larger photos are analysed as the means of pixel blocks that bring them within "
+                 "this size (0 = full size)")
+      ->capture_default_str();
   app.add_option("--pixel-stride", o.pixel_stride, "residual samples: every Nth pixel")
       ->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "effects modelled at most")->capture_default_str();

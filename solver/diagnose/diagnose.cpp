@@ -15,6 +15,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "solver/diagnose/analysis_capture.h"
 #include "solver/diagnose/missing_geometry.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
@@ -531,11 +532,9 @@ size_t MostImprovedPhoto(const PhotoSet& photos, const std::vector<Image>& befor
   return best;
 }
 
-}  // namespace
-
-DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs::path& out_dir) {
-  o.Validate();
-  const auto start = std::chrono::steady_clock::now();
+// Diagnoses `scene` as it is (the analysis capture, when the photos were reduced).
+DiagnosisSummary DiagnoseCapture(const Scene& scene, const DiagnoseOptions& o,
+                                 const fs::path& out_dir) {
   DiagnosisSummary sum;
   PhotoSet photos = LoadPhotoSet(scene);  // valid pixels; a missing_geometry step masks more
   const bool solve = HasUnknowns(scene);
@@ -849,6 +848,32 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},
                         {render, "re-render of the improved model"},
                         {ResidualImage(photos, st.sim.sims, 0), "residual (render − photo)"}};
+  }
+  return sum;
+}
+
+}  // namespace
+
+DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs::path& out_dir) {
+  o.Validate();
+  const auto start = std::chrono::steady_clock::now();
+  const AnalysisCapture capture =
+      ReduceCapture(scene, AbsolutePaths(scene.document, scene.dir), o.analysis_megapixels,
+                    out_dir / "analysis", o.show_progress);
+  DiagnosisSummary sum;
+  if (!capture.reduced) {
+    sum = DiagnoseCapture(scene, o, out_dir);
+  } else {
+    for (const auto& [name, r] : capture.cameras) {
+      spdlog::info("igi-diagnose: camera {}'s photos analysed as {}x{} blocks' means ({}x{})", name,
+                   r.factor, r.factor, r.width, r.height);
+    }
+    sum = DiagnoseCapture(LoadScene(capture.scene_file), o, out_dir);
+    // The improved scene names the declared photos and intrinsics: what was fitted on the
+    // reduced capture holds at full size.
+    sum.final_scene =
+        RelativePaths(AtDeclaredSize(AbsolutePaths(sum.final_scene, out_dir), scene), out_dir);
+    sum.analysis = AnalysisCaptureJson(capture, o.analysis_megapixels);
   }
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return sum;

@@ -54,6 +54,7 @@ struct DiagnosisSummary {
   std::filesystem::path final_model_dir;
   Json final_scene;        // the improved scene.json (paths relative to the output folder)
   std::vector<std::pair<Image, std::string>> final_images;  // photo, render, residual (first photo)
+  Json analysis;  // the reduced capture analysed (AnalysisCaptureJson), null at full size
   double seconds = 0;
 };
 

@@ -16,6 +16,9 @@ void DiagnoseOptions::Validate() const {
         "must be in [1, 64]");
   check(max_steps >= 0 && max_steps <= 20, "--max-steps", std::to_string(max_steps),
         "must be in [0, 20]");
+  check(analysis_megapixels == 0 || (analysis_megapixels >= 0.01 && analysis_megapixels <= 1000),
+        "--analysis-megapixels", fmt::format("{}", analysis_megapixels),
+        "must be 0 (full size) or in [0.01, 1000]");
   check(holdout_fraction > 0 && holdout_fraction < 0.9, "--holdout-fraction",
         fmt::format("{}", holdout_fraction), "must be in (0, 0.9)");
   check(holdout_block_px >= 2 && holdout_block_px <= 1024, "--holdout-block-px",

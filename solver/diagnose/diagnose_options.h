@@ -11,6 +11,9 @@ struct DiagnoseOptions {
   int spp = 32;          // paths per pixel of the re-renders
   int pixel_stride = 2;  // every Nth pixel of each photo is a residual sample
   int max_steps = 4;     // effects modelled at most
+  // Photos over this many megapixels are analysed as the means of pixel blocks that bring them
+  // within it (solver/diagnose/analysis_capture.h); 0 = at full size.
+  double analysis_megapixels = 0.5;
   // Held-out pixels: square blocks, left out of every fit (the solver's and the effects').
   double holdout_fraction = 0.25;
   int holdout_block_px = 16;

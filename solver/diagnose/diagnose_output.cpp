@@ -65,6 +65,7 @@ Json DiagnosisJson(const DiagnosisSummary& s, const DiagnoseOptions& o) {
                    {"rule", fmt::format("a step is kept when the held-out residual² falls by "
                                         ">= {:.0f}% and >= {:.1f} standard errors",
                                         100 * o.min_gain, o.min_z)}};
+  if (!s.analysis.is_null()) j["analysis"] = s.analysis;
   j["seconds"] = Num(s.seconds);
   return j;
 }

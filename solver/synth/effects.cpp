@@ -5,6 +5,7 @@
 #include <numbers>
 #include <set>
 
+#include "recon/scene.h"
 #include "solver/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
@@ -357,17 +358,6 @@ Json SpecularAsDiffuse(Params& p, const SynthRoom& room, SynthScenes* s) {
 }
 
 }  // namespace
-
-Json CameraJson(const Camera& camera) {
-  const Eigen::Vector4d q = QvecFromQuaternion(camera.cam_from_world.rotation);
-  const Vector3d& t = camera.cam_from_world.translation;
-  return Json{{"model", std::string(CameraModelName(camera.model))},
-              {"width", camera.width},
-              {"height", camera.height},
-              {"params", camera.params},
-              {"qvec", Json::array({q[0], q[1], q[2], q[3]})},
-              {"tvec", Vec(t)}};
-}
 
 double PhotoEffects::VignettingFactor(const Camera& camera, double x, double y) const {
   if (!vignetting) return 1.0;

@@ -72,7 +72,4 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* scenes,
                   PhotoEffects* photo_effects);
 
-// igi-scene JSON of a camera (model, size, params, qvec, tvec).
-Json CameraJson(const Camera& camera);
-
 }  // namespace igi

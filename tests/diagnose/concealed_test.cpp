@@ -10,6 +10,7 @@
 // (so no solve; the full suite with unknown materials is bench/diagnose/run_concealed_suite.sh).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 #include "tests/diagnose/concealed_fixture.h"
@@ -83,6 +84,63 @@ TEST(ConcealedControlTest, NothingHiddenNothingReported) {
 
 namespace igi {
 namespace {
+
+// Photos larger than --analysis-megapixels are diagnosed as the means of pixel blocks: a capture
+// of 320 x 240 photos at 16 paths per pixel analysed at 0.02 MP (2 x 2 blocks: the CI size, 64
+// paths per analysed pixel) names the hidden vignetting first, with the corners' fall-off of the
+// truth, and reaches the floor measured the same way; the improved scene.json names the photos
+// and intrinsics as declared.
+TEST(ConcealedLargePhotosTest, VignettingIsNamedOnBlockMeansAndTheSceneKeepsTheDeclaredPhotos) {
+  const fs::path dir = test::UniqueTempDir("igi_concealed_large");
+  const fs::path capture = dir / "capture";
+  const test::RunResult synth = RunTool(
+      "igi-synth", "--out " + Quote(capture.string()) +
+                       " --cameras 4 --width 320 --height 240 --spp 16 --lamp point --unknowns "
+                       "none --threads 2 --quiet --seed 11 --effect vignetting");
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  const std::string analysis = " --analysis-megapixels 0.02";
+  const Json d = test::RunDiagnose(capture / "scene.json", dir / "diag", analysis);
+  ASSERT_TRUE(d.contains("analysis")) << d.dump(1);
+  for (const auto& [name, cam] : d["analysis"]["cameras"].items()) {
+    EXPECT_EQ(cam["factor"], 2) << name;
+    EXPECT_EQ(cam["width"], 160) << name;
+  }
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["effect"], "vignetting") << d.dump(1);
+  const Json truth = ReadJsonFile(capture / "truth.json");
+  ASSERT_EQ(truth["effects"].size(), 1u);
+  const Json& tp = truth["effects"][0]["params"];
+  const Json& fp = d["steps"][0]["params"];
+  EXPECT_NEAR(fp["k1"].get<double>() + fp["k2"].get<double>(),
+              tp["k1"].get<double>() + tp["k2"].get<double>(), 0.05)
+      << d["steps"][0].dump(1);
+  // The improved scene: the declared photos and intrinsics, the fitted vignetting.
+  const Json declared = ReadJsonFile(capture / "scene.json");
+  const Json improved = ReadJsonFile(dir / "diag" / "scene.json");
+  for (size_t i = 0; i < declared["photos"].size(); ++i) {
+    const fs::path file = dir / "diag" / improved["photos"][i]["file"].get<std::string>();
+    EXPECT_TRUE(fs::equivalent(file, capture / declared["photos"][i]["file"].get<std::string>()))
+        << file;
+  }
+  for (const auto& [name, cam] : declared["cameras"].items()) {
+    EXPECT_EQ(improved["cameras"][name]["width"], 320);
+    EXPECT_EQ(improved["cameras"][name]["params"], cam["params"]);
+    EXPECT_TRUE(improved["cameras"][name].contains("vignetting"));
+  }
+  const test::RunResult info = RunTool("igi-info", Quote((dir / "diag" / "scene.json").string()));
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  // The floor: the true model diagnosed the same way, no step.
+  const Json floor =
+      test::RunDiagnose(test::WriteTrueModel(capture), dir / "floor", " --max-steps 0" + analysis);
+  ASSERT_TRUE(floor.contains("baseline"));
+  test::ConcealedOutcome o{d, floor["baseline"]["residual"].get<double>()};
+  std::printf("[large photos] k1 + k2 %.4f (truth %.4f); final %.4f, floor %.4f\n",
+              fp["k1"].get<double>() + fp["k2"].get<double>(),
+              tp["k1"].get<double>() + tp["k2"].get<double>(), d["final"]["residual"].get<double>(),
+              o.floor);
+  test::ExpectReachesTheFloor(o);
+  fs::remove_all(dir);
+}
 
 // Bad input: one line naming the file or flag, exit 2, nothing written.
 TEST(DiagnoseBadInputTest, ExitsTwoWithOneLineAndWritesNothing) {

@@ -1,0 +1,153 @@
+#include "solver/diagnose/analysis_capture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+
+#include "solver/observations.h"
+#include "tools/common/image.h"
+#include "tools/common/parallel.h"
+#include "tools/common/progress.h"
+
+namespace igi {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Writes the f × f block means of photo `p` to `file`, and its mask to `mask_file` when a block
+// is invalid or the photo has a mask. Returns whether the mask was written.
+bool ReducePhoto(const Photo& p, int f, const fs::path& file, const fs::path& mask_file) {
+  const Image img = ReadImage(p.file, 3);
+  std::optional<Image> mask;
+  if (p.mask) mask = ReadImage(*p.mask, 1);
+  const double clip = AutoSaturation(img);
+  const int w = img.width / f, h = img.height / f;
+  Image out(w, h, 3), valid(w, h, 1);
+  ParallelFor(0, h, [&](int64_t yy) {
+    const int y = int(yy);
+    for (int x = 0; x < w; ++x) {
+      double sum[3] = {0, 0, 0};
+      bool ok = true;
+      for (int v = y * f; v < (y + 1) * f && ok; ++v) {
+        for (int u = x * f; u < (x + 1) * f && ok; ++u) {
+          ok = !mask || mask->at(u, v, 0) > 0.5f;
+          for (int c = 0; c < 3 && ok; ++c) {
+            const float value = img.at(u, v, c);
+            ok = std::isfinite(value) && value < clip;
+            sum[c] += p.LinearFromRecorded(value);
+          }
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double mean = sum[c] / (f * f);
+        out.at(x, y, c) = ok ? float(p.RecordedFromLinear(mean)) : 0.0f;
+      }
+      valid.at(x, y, 0) = ok ? 1.0f : 0.0f;
+    }
+  });
+  WriteImage(file, out);
+  const bool any_invalid =
+      std::any_of(valid.pixels.begin(), valid.pixels.end(), [](float v) { return v < 0.5f; });
+  if (!any_invalid && !mask) return false;
+  WriteImageOptions png;
+  png.type = PixelType::kUInt8;
+  WriteImage(mask_file, valid, png);
+  return true;
+}
+
+}  // namespace
+
+int AnalysisFactor(int width, int height, double max_megapixels) {
+  if (max_megapixels <= 0) return 1;
+  const double limit = max_megapixels * 1e6;
+  int f = std::max(1, int(std::ceil(std::sqrt(double(width) * height / limit))));
+  while (f > 1 && double(width / (f - 1)) * (height / (f - 1)) <= limit) --f;
+  while (double(width / f) * (height / f) > limit && f < std::min(width, height)) ++f;
+  return f;
+}
+
+AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double max_megapixels,
+                              const fs::path& dir, bool show_progress) {
+  AnalysisCapture capture;
+  std::vector<int> factor(scene.cameras.size(), 1);
+  for (size_t k = 0; k < scene.cameras.size(); ++k) {
+    const Camera& cam = scene.cameras[k];
+    factor[k] = AnalysisFactor(cam.width, cam.height, max_megapixels);
+    if (factor[k] > 1) {
+      capture.cameras[cam.name] = {factor[k], cam.width / factor[k], cam.height / factor[k]};
+    }
+  }
+  if (capture.cameras.empty()) return capture;
+  capture.reduced = true;
+  Json doc = declared;
+  doc["cameras"] = Json::object();
+  for (size_t k = 0; k < scene.cameras.size(); ++k) {
+    Camera cam = scene.cameras[k];
+    const int f = factor[k];
+    cam.width /= f;
+    cam.height /= f;
+    for (int i = 0; i < 4; ++i) cam.params[i] /= f;
+    doc["cameras"][cam.name] = CameraJson(cam);
+  }
+  fs::create_directories(dir);
+  Progress progress("igi-diagnose: reducing the photos", int64_t(scene.photos.size()), 2.0,
+                    show_progress && ProgressAllowed());
+  for (size_t i = 0; i < scene.photos.size(); ++i) {
+    const Photo& p = scene.photos[i];
+    Json& j = doc["photos"][i];
+    j["camera"] = scene.cameras[p.camera].name;
+    const int f = factor[p.camera];
+    if (f == 1) continue;
+    const fs::path sub = dir / "photos" / std::to_string(i);
+    fs::create_directories(sub);
+    const fs::path file = fs::absolute(sub / p.file.filename().replace_extension(".exr"));
+    const fs::path mask = fs::absolute(sub / "mask.png");
+    j["file"] = file.string();
+    if (ReducePhoto(p, f, file, mask)) {
+      j["mask"] = mask.string();
+    } else {
+      j.erase("mask");
+    }
+    progress.Add();
+  }
+  progress.Finish();
+  capture.scene_file = dir / "scene.json";
+  WriteJsonFile(capture.scene_file, doc, 1);
+  return capture;
+}
+
+Json AtDeclaredSize(Json doc, const Scene& declared) {
+  for (const Camera& cam : declared.cameras) {
+    if (!doc["cameras"].contains(cam.name)) continue;
+    Json& j = doc["cameras"][cam.name];
+    const Json full = CameraJson(cam);
+    for (const char* key : {"model", "width", "height", "params"}) j[key] = full[key];
+  }
+  for (size_t i = 0; i < declared.photos.size() && i < doc["photos"].size(); ++i) {
+    const Photo& p = declared.photos[i];
+    Json& j = doc["photos"][i];
+    j["file"] = fs::absolute(p.file).lexically_normal().string();
+    if (p.mask) {
+      j["mask"] = fs::absolute(*p.mask).lexically_normal().string();
+    } else {
+      j.erase("mask");
+    }
+  }
+  return doc;
+}
+
+Json AnalysisCaptureJson(const AnalysisCapture& capture, double max_megapixels) {
+  Json cams = Json::object();
+  for (const auto& [name, r] : capture.cameras) {
+    cams[name] = {{"factor", r.factor}, {"width", r.width}, {"height", r.height}};
+  }
+  return {{"max_megapixels", max_megapixels},
+          {"cameras", cams},
+          {"rule",
+           "photos over max_megapixels are analysed as the means of their factor x factor pixel "
+           "blocks (camera intrinsics divided by the factor); the final scene.json names the "
+           "photos and intrinsics as declared"}};
+}
+
+}  // namespace igi
