@@ -131,4 +131,49 @@ int Scene::FindLight(std::string_view name) const { return FindByName(lights, na
 int Scene::FindLighting(std::string_view name) const { return FindByName(lightings, name); }
 int Scene::FindCamera(std::string_view name) const { return FindByName(cameras, name); }
 
+void ForEachScenePath(Json* doc, const std::function<std::string(const std::string&)>& fn) {
+  auto key = [&](Json& j, const char* k) {
+    if (j.is_object() && j.contains(k) && j[k].is_string()) j[k] = fn(j[k].get<std::string>());
+  };
+  if (doc->contains("geometry")) {
+    for (Json& g : (*doc)["geometry"]) key(g, "file");
+  }
+  if (doc->contains("lights")) {
+    for (auto& [n, l] : (*doc)["lights"].items()) {
+      key(l, "file");
+      if (l.contains("profile")) key(l["profile"], "ies");
+    }
+  }
+  if (doc->contains("materials")) {
+    for (auto& [n, m] : (*doc)["materials"].items()) key(m, "rho_d_map");
+  }
+  if (doc->contains("cameras")) key((*doc)["cameras"], "colmap");
+  if (doc->contains("photos")) {
+    for (Json& p : (*doc)["photos"]) {
+      key(p, "file");
+      key(p, "mask");
+    }
+  }
+}
+
+Json AbsoluteScenePaths(Json doc, const std::filesystem::path& dir) {
+  ForEachScenePath(&doc, [&](const std::string& p) {
+    const std::filesystem::path path(p);
+    return (path.is_absolute() ? path : std::filesystem::absolute(dir / path))
+        .lexically_normal()
+        .string();
+  });
+  return doc;
+}
+
+Json RelativeScenePaths(Json doc, const std::filesystem::path& base) {
+  namespace fs = std::filesystem;
+  const fs::path b = fs::weakly_canonical(fs::absolute(base));
+  ForEachScenePath(&doc, [&](const std::string& p) {
+    const fs::path rel = fs::weakly_canonical(fs::path(p)).lexically_relative(b);
+    return rel.empty() ? p : rel.generic_string();
+  });
+  return doc;
+}
+
 }  // namespace igi

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -130,6 +131,14 @@ struct SceneLoadOptions {
   // Require every material value rendering needs (igi-render); otherwise absent = unknown.
   bool require_complete_materials = false;
 };
+
+// Applies `fn` to every file path of an igi-scene document: geometry and area-light meshes, IES
+// profiles, albedo maps, the COLMAP model, photos and masks.
+void ForEachScenePath(Json* doc, const std::function<std::string(const std::string&)>& fn);
+// The document with every path absolute (a relative one taken from `dir`) and normalised.
+Json AbsoluteScenePaths(Json doc, const std::filesystem::path& dir);
+// The document with every (absolute) path made relative to `base`.
+Json RelativeScenePaths(Json doc, const std::filesystem::path& base);
 
 // The scene.json entry of a camera: model, size, params, qvec, tvec, and vignetting when it has
 // any.

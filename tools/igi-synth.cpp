@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
   std::string photo_lightings = "L0", validation_lightings = "L1", lamp_position;
   std::vector<std::string> effects;
   app.add_option("--out", o.out, "Scene folder to write (empty or absent)")->required();
+  app.add_option("--from", o.from,
+                 "An existing capture's scene.json: hide the --effect(s) in its photos instead of "
+                 "rendering a room (vignetting, exposure_scale, camera_response, pose_error)");
   app.add_flag("--overwrite", o.overwrite, "Allow a non-empty --out folder");
   app.add_flag("--textured-walls", o.textured_walls,
                "Give every region a high-frequency albedo texture (for registration tests)");

@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
-# Scale benchmark: igi-solve's wall time, CPU time and peak memory as the photos grow in size and
-# number, and the recovered parameters against the truth at each size.
+# Scale benchmark: igi-solve's (or igi-diagnose's, STAGE=diagnose) wall time, CPU time and peak
+# memory as the photos grow in size and number, and the recovered parameters against the truth
+# at each size.
 #
 # Captures: igi-synth rooms (the default room: glossy floor with a texture, glossy and matte
 # boxes, a sphere, one lamp) of N photos at M megapixels (4:3), rendered once at SPP paths per
 # pixel and cached outside the repository ($IGI_SCALE_CACHE, default ~/.cache/igi-scale). Each is
-# solved with default flags (--threads $THREADS), and beside it the same capture downscaled to
+# solved (or diagnosed) with default flags (--threads $THREADS), and beside it the same capture downscaled to
 # 0.5 MP (oiiotool --resize, intrinsics scaled): the user's alternative to a full-size solve,
 # and the peer of each row (same machine, same run).
 #
-# Usage: bench/scale/run_scale_bench.sh [BUILD_DIR] [-- EXTRA igi-solve FLAGS]
-#   PHOTOS="8 30" MEGAPIXELS="0.5 3 12 24" SPP=16 THREADS=2
+# Usage: bench/scale/run_scale_bench.sh [BUILD_DIR] [-- EXTRA FLAGS of the stage's tool]
+#   PHOTOS="8 30" MEGAPIXELS="0.5 3 12 24" SPP=16 THREADS=2 STAGE=solve|diagnose IGI_SCALE_KEEP=1
+# A diagnosis's rows give its kept steps and final/baseline residual in place of the observations,
+# and the errors of its improved scene's materials (solved on the analysed capture).
 # Prints one markdown table (for bench/RESULTS.md) and the growth exponents of wall time and
 # peak memory in pixels per photo (at each photo count) and in photos (at each size).
 set -euo pipefail
@@ -24,16 +27,19 @@ PHOTOS="${PHOTOS:-8 30}"
 MEGAPIXELS="${MEGAPIXELS:-0.5 3 12 24}"
 SPP="${SPP:-16}"
 THREADS="${THREADS:-2}"
+STAGE="${STAGE:-solve}"
 CACHE="${IGI_SCALE_CACHE:-$HOME/.cache/igi-scale}"
 SYNTH="$BUILD/bin/igi-synth"
-SOLVE="$BUILD/bin/igi-solve"
+[[ "$STAGE" == solve || "$STAGE" == diagnose ]] || { echo "STAGE: $STAGE: solve or diagnose" >&2; exit 2; }
+TOOL="$BUILD/bin/igi-$STAGE"
 PY=/usr/bin/python3
-for t in "$SYNTH" "$SOLVE"; do
-  [[ -x "$t" ]] || { echo "no $t: ninja -C $BUILD igi-synth igi-solve" >&2; exit 2; }
+for t in "$SYNTH" "$TOOL"; do
+  [[ -x "$t" ]] || { echo "no $t: ninja -C $BUILD igi-synth igi-$STAGE" >&2; exit 2; }
 done
 command -v oiiotool >/dev/null || { echo "no oiiotool (Debian openimageio-tools)" >&2; exit 2; }
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/igi_scale_bench.XXXXXX")"
-trap 'rm -rf "$WORK"' EXIT
+# IGI_SCALE_KEEP=1 keeps the outputs (the folder is printed) for a look at each region.
+if [[ -n "${IGI_SCALE_KEEP:-}" ]]; then echo "outputs: $WORK" >&2; else trap 'rm -rf "$WORK"' EXIT; fi
 mkdir -p "$CACHE"
 
 # Width and height of M megapixels at 4:3, even.
@@ -80,25 +86,32 @@ json.dump(doc, open(os.path.join(dst, "scene.json"), "w"), indent=1)
 PYEOF
 }
 
-# solve SCENE OUT: "wall_s cpu_s peak_gib" of igi-solve, its output in OUT.
-solve() {
+# run SCENE OUT: "wall_s cpu_s peak_gib" of the stage's tool, its output in OUT.
+run() {
   local scene=$1 out=$2
   /usr/bin/time -f "%e %U %S %M" -o "$out.time" \
-    "$SOLVE" "$scene" --out "$out" --threads "$THREADS" --quiet "${EXTRA[@]}" >/dev/null 2>"$out.log" || {
+    "$TOOL" "$scene" --out "$out" --threads "$THREADS" --quiet "${EXTRA[@]}" >/dev/null 2>"$out.log" || {
     local rc=$?
-    [[ $rc -eq 3 ]] || { echo "igi-solve failed ($rc): $(tail -1 "$out.log")" >&2; echo "nan nan nan"; return; }
+    [[ $rc -eq 3 ]] || { echo "igi-$STAGE failed ($rc): $(tail -1 "$out.log")" >&2; echo "nan nan nan"; return; }
   }
   awk '{printf "%s %.1f %.2f\n", $1, $2 + $3, $4 / 1048576}' "$out.time"
 }
 
-# errors OUT TRUTH: "rho_d_max% rho_s_max% alpha_max% observations drawn_of_available".
+# errors OUT TRUTH: "rho_d_max% rho_s_max% alpha_max% observations available" (a diagnosis:
+# "... kept_steps final/baseline").
 errors() {
   $PY - "$1" "$2" <<'PYEOF'
-import json, sys
+import json, os, sys
 out, truth = sys.argv[1], sys.argv[2]
 try:
     solved = json.load(open(out + "/scene.json"))["materials"]
-    report = json.load(open(out + "/report.json"))
+    if os.path.exists(out + "/diagnosis.json"):
+        d = json.load(open(out + "/diagnosis.json"))
+        kept = "+".join(s["effect"] for s in d["steps"]) or "-"
+        ratio = d["final"]["residual"] / d["baseline"]["residual"]
+        report = {"observations": kept, "observation_draw": {"available": f"{ratio:.3f}"}}
+    else:
+        report = json.load(open(out + "/report.json"))
 except Exception:
     print("nan nan nan nan nan"); raise SystemExit
 true = json.load(open(truth))["materials"]
@@ -119,21 +132,25 @@ PYEOF
 }
 
 echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB, load $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "commit: $(git -C "$ROOT" rev-parse --short HEAD), igi-solve --threads $THREADS ${EXTRA[*]}"
+echo "commit: $(git -C "$ROOT" rev-parse --short HEAD), igi-$STAGE --threads $THREADS ${EXTRA[*]}"
 echo
-echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / peer | peak / peer |"
+if [[ "$STAGE" == solve ]]; then
+  echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / peer | peak / peer |"
+else
+  echo "| photos | MP | run | wall s | CPU s | peak GiB | kept steps | final / baseline | ρd max % | ρs max % | α max % | wall / peer | peak / peer |"
+fi
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 ROWS="$WORK/rows.txt"
 : > "$ROWS"
 for n in $PHOTOS; do
   for mp in $MEGAPIXELS; do
     dir=$(capture "$n" "$mp")
+    read -r fw fc fp < <(run "$dir/scene.json" "$WORK/full_n${n}_mp${mp}")
+    read -r fd fs fa fo favail < <(errors "$WORK/full_n${n}_mp${mp}" "$dir/truth.json")
     small="$WORK/small_n${n}_mp${mp}"
     downscaled "$dir" "$small" 0.5
-    read -r sw sc sp < <(solve "$small/scene.json" "$small/out")
+    read -r sw sc sp < <(run "$small/scene.json" "$small/out")
     read -r sd ss sa so savail < <(errors "$small/out" "$dir/truth.json")
-    read -r fw fc fp < <(solve "$dir/scene.json" "$WORK/full_n${n}_mp${mp}")
-    read -r fd fs fa fo favail < <(errors "$WORK/full_n${n}_mp${mp}" "$dir/truth.json")
     echo "| $n | $mp | capture | $fw | $fc | $fp | $fo | $favail | $fd | $fs | $fa | $($PY -c "print(f'{$fw/$sw:.2f}')") | $($PY -c "print(f'{$fp/$sp:.2f}')") |"
     echo "| $n | $mp | peer (0.5 MP) | $sw | $sc | $sp | $so | $savail | $sd | $ss | $sa | 1 | 1 |"
     echo "$n $mp $fw $fp" >> "$ROWS"

@@ -29,50 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Applies `fn` to every path-valued key of an igi-scene document.
-template <class F>
-void ForEachPath(Json* doc, F fn) {
-  auto key = [&](Json& j, const char* k) {
-    if (j.is_object() && j.contains(k) && j[k].is_string()) j[k] = fn(j[k].get<std::string>());
-  };
-  if (doc->contains("geometry")) {
-    for (Json& g : (*doc)["geometry"]) key(g, "file");
-  }
-  if (doc->contains("lights")) {
-    for (auto& [n, l] : (*doc)["lights"].items()) {
-      key(l, "file");
-      if (l.contains("profile")) key(l["profile"], "ies");
-    }
-  }
-  if (doc->contains("materials")) {
-    for (auto& [n, m] : (*doc)["materials"].items()) key(m, "rho_d_map");
-  }
-  if (doc->contains("cameras")) key((*doc)["cameras"], "colmap");
-  if (doc->contains("photos")) {
-    for (Json& p : (*doc)["photos"]) {
-      key(p, "file");
-      key(p, "mask");
-    }
-  }
-}
-
-Json AbsolutePaths(Json doc, const fs::path& dir) {
-  ForEachPath(&doc, [&](const std::string& p) {
-    const fs::path path(p);
-    return (path.is_absolute() ? path : fs::absolute(dir / path)).lexically_normal().string();
-  });
-  return doc;
-}
-
-Json RelativePaths(Json doc, const fs::path& base) {
-  const fs::path b = fs::weakly_canonical(fs::absolute(base));
-  ForEachPath(&doc, [&](const std::string& p) {
-    const fs::path rel = fs::weakly_canonical(fs::path(p)).lexically_relative(b);
-    return rel.empty() ? p : rel.generic_string();
-  });
-  return doc;
-}
-
 bool HasUnknowns(const Scene& scene) {
   for (const Material& m : scene.materials) {
     if (!m.MissingForRendering().empty()) return true;
@@ -539,7 +495,7 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, const DiagnoseOptions& o,
   PhotoSet photos = LoadPhotoSet(scene);  // valid pixels; a missing_geometry step masks more
   const bool solve = HasUnknowns(scene);
   sum.solved = solve;
-  Json declared = AbsolutePaths(scene.document, scene.dir);
+  Json declared = AbsoluteScenePaths(scene.document, scene.dir);
   const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   // A trial's refit is rendered only where its held-out test reads (and on a sparse grid for its
   // fitted pixels' residual), and completed only when it is applied: most trials are rejected
@@ -842,7 +798,8 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, const DiagnoseOptions& o,
   sum.unexplained = Unexplained(st, sum.noise_floor);
   sum.final_model_dir = st.dir;
   const fs::path model_file = st.dir / (solve ? "scene.json" : "declared.json");
-  sum.final_scene = RelativePaths(AbsolutePaths(ReadJsonFile(model_file), st.dir), out_dir);
+  sum.final_scene =
+      RelativeScenePaths(AbsoluteScenePaths(ReadJsonFile(model_file), st.dir), out_dir);
   if (!scene.photos.empty()) {
     Image render = st.sim.sims[0];
     sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},
@@ -858,7 +815,7 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   o.Validate();
   const auto start = std::chrono::steady_clock::now();
   const AnalysisCapture capture =
-      ReduceCapture(scene, AbsolutePaths(scene.document, scene.dir), o.analysis_megapixels,
+      ReduceCapture(scene, AbsoluteScenePaths(scene.document, scene.dir), o.analysis_megapixels,
                     out_dir / "analysis", o.show_progress);
   DiagnosisSummary sum;
   if (!capture.reduced) {
@@ -871,8 +828,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
     sum = DiagnoseCapture(LoadScene(capture.scene_file), o, out_dir);
     // The improved scene names the declared photos and intrinsics: what was fitted on the
     // reduced capture holds at full size.
-    sum.final_scene =
-        RelativePaths(AtDeclaredSize(AbsolutePaths(sum.final_scene, out_dir), scene), out_dir);
+    sum.final_scene = RelativeScenePaths(
+        AtDeclaredSize(AbsoluteScenePaths(sum.final_scene, out_dir), scene), out_dir);
     sum.analysis = AnalysisCaptureJson(capture, o.analysis_megapixels);
   }
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

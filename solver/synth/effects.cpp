@@ -259,9 +259,9 @@ Json Response(Params& p, PhotoEffects* post) {
               {"applies_to", "every photo of scene.json (not brackets or validation renders)"}};
 }
 
-Json PoseError(Params& p, const std::vector<PlacedCamera>& cameras, uint64_t seed, SynthScenes* s) {
+Json PoseError(Params& p, const std::vector<Camera>& cameras, uint64_t seed, SynthScenes* s) {
   std::vector<std::string> names;
-  for (const PlacedCamera& c : cameras) names.push_back(c.camera.name);
+  for (const Camera& c : cameras) names.push_back(c.name);
   const std::string name = p.Name("camera", names.front(), names);
   const double angle_deg = p.Number("rotation_deg", 1.0, 0.0, 45.0);
   const double shift_m = p.Number("translation_m", 0.02, 0.0, 1.0);
@@ -270,8 +270,8 @@ Json PoseError(Params& p, const std::vector<PlacedCamera>& cameras, uint64_t see
   const Vector3d dir = p.Direction("direction").value_or(SampleUniformSphere(rng.Uniform2D()));
   p.Finish();
   Camera cam;
-  for (const PlacedCamera& c : cameras) {
-    if (c.camera.name == name) cam = c.camera;
+  for (const Camera& c : cameras) {
+    if (c.name == name) cam = c;
   }
   const Vector3d center = cam.CenterInWorld() + shift_m * dir;
   const Eigen::Quaterniond delta(Eigen::AngleAxisd(angle_deg * kPi / 180.0, axis));
@@ -391,44 +391,68 @@ void PhotoEffects::ApplyAfterSensor(Image* image) const {
   }
 }
 
+namespace {
+
+// The effects that change the photos after they were made, or a declared value only: params of
+// `spec`'s effect, or nullopt when it changes what is rendered.
+std::optional<Json> PhotoEffect(const EffectSpec& spec, Params& p,
+                                const std::vector<Camera>& cameras,
+                                const std::vector<std::string>& photo_files, uint64_t seed,
+                                SynthScenes* s, PhotoEffects* post) {
+  const std::string& n = spec.name;
+  if (n == "vignetting") return Vignetting(p, post);
+  if (n == "exposure_scale") return ExposureScale(p, photo_files, post);
+  if (n == "camera_response") return Response(p, post);
+  if (n == "pose_error") return PoseError(p, cameras, seed, s);
+  return std::nullopt;
+}
+
+// The effects that change what is rendered: params of `spec`'s effect.
+Json SceneEffect(const EffectSpec& spec, Params& p, const SynthRoom& room, SynthScenes* s) {
+  const std::string& n = spec.name;
+  if (n == "light_emission_profile") return EmissionProfile(p, room, s);
+  if (n == "anisotropic_reflection") return Anisotropy(p, room, s);
+  if (n == "light_source_extent") return SourceExtent(p, room, s);
+  if (n == "missing_geometry") return MissingGeometry(p, s);
+  if (n == "ambient_light") return Ambient(p, room, s);
+  if (n == "specular_lobe_shape") return LobeShape(p, room, s);
+  if (n == "light_intensity") return Intensity(p, room, s);
+  if (n == "specular_reflection") return SpecularAsDiffuse(p, room, s);
+  if (n == "fresnel") return Fresnel(p, room, s);
+  p.Fail("", "", "unknown effect");
+}
+
+}  // namespace
+
 Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<PlacedCamera>& cameras,
                   const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
                   PhotoEffects* post) {
+  std::vector<Camera> plain;
+  for (const PlacedCamera& c : cameras) plain.push_back(c.camera);
   Json list = Json::array();
   for (const EffectSpec& spec : specs) {
     Params p(spec);
-    Json params;
-    const std::string& n = spec.name;
-    if (n == "vignetting")
-      params = Vignetting(p, post);
-    else if (n == "light_emission_profile")
-      params = EmissionProfile(p, room, s);
-    else if (n == "anisotropic_reflection")
-      params = Anisotropy(p, room, s);
-    else if (n == "light_source_extent")
-      params = SourceExtent(p, room, s);
-    else if (n == "missing_geometry")
-      params = MissingGeometry(p, s);
-    else if (n == "ambient_light")
-      params = Ambient(p, room, s);
-    else if (n == "exposure_scale")
-      params = ExposureScale(p, photo_files, post);
-    else if (n == "camera_response")
-      params = Response(p, post);
-    else if (n == "pose_error")
-      params = PoseError(p, cameras, seed, s);
-    else if (n == "specular_lobe_shape")
-      params = LobeShape(p, room, s);
-    else if (n == "light_intensity")
-      params = Intensity(p, room, s);
-    else if (n == "specular_reflection")
-      params = SpecularAsDiffuse(p, room, s);
-    else if (n == "fresnel")
-      params = Fresnel(p, room, s);
-    else
-      p.Fail("", "", "unknown effect");
-    list.push_back(Json{{"effect", n}, {"params", params}});
+    std::optional<Json> params = PhotoEffect(spec, p, plain, photo_files, seed, s, post);
+    if (!params) params = SceneEffect(spec, p, room, s);
+    list.push_back(Json{{"effect", spec.name}, {"params", *params}});
+  }
+  return list;
+}
+
+Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs, const std::vector<Camera>& cameras,
+                       const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
+                       PhotoEffects* post) {
+  Json list = Json::array();
+  for (const EffectSpec& spec : specs) {
+    Params p(spec);
+    const std::optional<Json> params = PhotoEffect(spec, p, cameras, photo_files, seed, s, post);
+    if (!params) {
+      p.Fail("", "",
+             "changes what is rendered: only a capture igi-synth renders can hide it (with "
+             "--from: vignetting, exposure_scale, camera_response, pose_error)");
+    }
+    list.push_back(Json{{"effect", spec.name}, {"params", *params}});
   }
   return list;
 }

@@ -72,4 +72,11 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* scenes,
                   PhotoEffects* photo_effects);
 
+// The effects of `specs` that change a capture's photos after they were made (any renderer's or
+// camera's), or a declared value only: vignetting, exposure_scale, camera_response, pose_error.
+// `cameras` are the capture's. Throws InputError "--effect: NAME: ...: RULE" for any other.
+Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs, const std::vector<Camera>& cameras,
+                       const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
+                       PhotoEffects* post);
+
 }  // namespace igi

@@ -153,6 +153,11 @@ void SynthOptions::Validate() const {
     if (Contains(seen, e.name)) p.Add("--effect", "", e.name, "effect given twice");
     seen.push_back(e.name);
   }
+  if (!from.empty() && (brackets.count > 0 || unposed || noise != NoiseModel::kNone)) {
+    p.Add("--from", "", from.string(),
+          "takes the capture's photos as they are: no --brackets, "
+          "--unposed or --noise");
+  }
   if (num_threads < 0) p.Add("--threads", "", std::to_string(num_threads), "must be >= 0");
   try {
     sensor.Validate();

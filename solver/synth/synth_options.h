@@ -105,6 +105,9 @@ struct SynthOptions {
   // scene.json declares no "cameras" and no "photos" (an unposed capture: the poses must be
   // recovered, e.g. by igi-register); truth/scene.json keeps the true cameras.
   bool unposed = false;
+  // An existing capture's scene.json whose photos get the effects instead of a rendered room
+  // (vignetting, exposure_scale, camera_response, pose_error: the effects that need no render).
+  std::filesystem::path from;
 
   // Every problem as one InputError (flag name, value, rule).
   void Validate() const;

@@ -302,12 +302,63 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
   return truth;
 }
 
+// --from: the capture of options.from with its photos given the photo effects.
+SynthSummary HideInCapture(const SynthOptions& options, Clock::time_point start) {
+  const Scene source = LoadScene(options.from);
+  const Json source_doc = AbsoluteScenePaths(source.document, source.dir);
+  // Each photo is written as photos/NAME.exr (NAME: its file's stem, with its index when two
+  // photos share one).
+  std::vector<std::string> photo_files;
+  std::map<std::string, int> stems;
+  for (const Photo& p : source.photos) ++stems[p.file.stem().string()];
+  for (size_t i = 0; i < source.photos.size(); ++i) {
+    const std::string stem = source.photos[i].file.stem().string();
+    photo_files.push_back("photos/" + (stems[stem] > 1 ? std::to_string(i) + "_" : "") + stem +
+                          ".exr");
+  }
+  SynthScenes scenes;
+  scenes.true_scene = scenes.declared_scene = source_doc;
+  PhotoEffects post;
+  const Json effects =
+      ApplyPhotoEffects(options.effects, source.cameras, photo_files, options.seed, &scenes, &post);
+  scenes.declared_scene["materials"] =
+      DeclaredMaterials(scenes.declared_scene["materials"], options.unknowns);
+  const fs::path& out = options.out;
+  fs::create_directories(out / "photos");
+  fs::create_directories(out / "truth");
+  SynthSummary summary;
+  for (size_t i = 0; i < source.photos.size(); ++i) {
+    const Photo& p = source.photos[i];
+    Image image = ReadImage(p.file, 3);
+    post.ApplyBeforeSensor(photo_files[i], source.cameras[p.camera], &image);
+    post.ApplyAfterSensor(&image);
+    WriteImage(out / photo_files[i], image);
+    scenes.declared_scene["photos"][i]["file"] = photo_files[i];
+    summary.photos.push_back(photo_files[i]);
+  }
+  WriteJsonFile(out / "truth/scene.json", scenes.true_scene);
+  WriteJsonFile(out / "scene.json", scenes.declared_scene);
+  WriteJsonFile(
+      out / "truth.json",
+      Json{{"format", "igi-truth"},
+           {"version", 1},
+           {"materials", scenes.true_scene["materials"]},
+           {"effects", effects},
+           {"scene", "truth/scene.json"},
+           {"unknowns", options.unknowns},
+           {"source", fs::absolute(options.from).lexically_normal().string()},
+           {"render", {{"renderer", "the source capture's (its photos given the effects)"}}}});
+  summary.seconds = Since(start);
+  return summary;
+}
+
 }  // namespace
 
 SynthSummary Synthesize(const SynthOptions& options) {
   const auto start = Clock::now();
   options.Validate();
   CheckOutputFolder(options);
+  if (!options.from.empty()) return HideInCapture(options, start);
   std::optional<ResponseCurve> response;
   if (options.brackets.count > 0) response = ResponseCurve::FromOptions(options.brackets);
 

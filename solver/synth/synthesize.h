@@ -12,6 +12,10 @@
 //   truth/scene.json         the TRUE scene, complete (renderable with igi-render)
 //   truth/radiance/CAM_L.exr the noise-free radiance each bracket folder exposes (with brackets)
 //   truth/...                files only the truth needs (textures, extra geometry, response)
+// With `from` (an existing capture's scene.json, any renderer's or camera's), nothing is
+// rendered: its photos are written to photos/ with the photo effects (vignetting,
+// exposure_scale, camera_response) applied, pose_error changes the declared pose, and
+// scene.json / truth/scene.json are its document (absolute paths) declared and true.
 
 #include <cstdint>
 #include <string>

@@ -1,4 +1,5 @@
-// igi-synth's room, cameras, options and effects (no rendering).
+// igi-synth's room, cameras, options and effects (no rendering), and the effects hidden in
+// another renderer's capture (--from).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -7,14 +8,18 @@
 #include <filesystem>
 
 #include "recon/mesh.h"
+#include "recon/scene.h"
 #include "solver/sampling.h"
 #include "solver/synth/camera_placement.h"
 #include "solver/synth/effects.h"
 #include "solver/synth/room_builder.h"
 #include "solver/synth/synth_mesh.h"
 #include "solver/synth/synth_options.h"
+#include "solver/synth/synthesize.h"
+#include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
+#include "tools/common/image.h"
 
 namespace igi {
 namespace {
@@ -389,6 +394,87 @@ TEST(SynthEffects, BadParametersAreInputErrors) {
   EXPECT_THROW(f.Apply("pose_error:camera=nope"), InputError);
   EXPECT_THROW(f.Apply("anisotropic_reflection:tangent=0/0/0"), InputError);
   EXPECT_THROW(f.Apply("exposure_scale:scale=abc"), InputError);
+}
+
+}  // namespace
+}  // namespace igi
+
+namespace igi {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path RadianceRoom() {
+  return fs::path(IGI_SHARED_DATA_DIR) / "reference" / "radiance_room" / "scene.json";
+}
+
+// --from: another renderer's capture (the shared RADIANCE room) given the photo effects: each
+// photo is the source's times the vignetting and its exposure scale, through the response; the
+// declared pose of pose_error's camera is off, the true scene is the source's; nothing is
+// rendered and the source is not touched.
+TEST(SynthFrom, HidesThePhotoEffectsInAnotherRenderersCapture) {
+  const fs::path out = test::UniqueTempDir("igi_synth_from");
+  SynthOptions o;
+  o.out = out / "capture";
+  o.from = RadianceRoom();
+  o.unknowns = {"rho_d"};
+  o.effects = {ParseEffectSpec("vignetting:k1=-0.3,k2=0"),
+               ParseEffectSpec("exposure_scale:photo=photos/cam1_L0.exr,scale=1.25"),
+               ParseEffectSpec("camera_response:exponent=0.8,reference=1"),
+               ParseEffectSpec("pose_error:camera=cam2,rotation_deg=1,translation_m=0.02")};
+  const SynthSummary s = Synthesize(o);
+  ASSERT_EQ(s.photos.size(), 4u);
+  const Scene source = LoadScene(RadianceRoom());
+  const Scene declared = LoadScene(o.out / "scene.json");
+  const Scene truth = LoadScene(o.out / "truth" / "scene.json");
+  ASSERT_EQ(declared.photos.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const Image src = ReadImage(source.photos[i].file, 3);
+    const Image got = ReadImage(declared.photos[i].file, 3);
+    const Camera& cam = source.cameras[source.photos[i].camera];
+    const double scale = declared.photos[i].file.filename() == "cam1_L0.exr" ? 1.25 : 1.0;
+    ASSERT_EQ(got.width, src.width);
+    for (const auto& [x, y] : {std::pair{0, 0}, {cam.width / 2, cam.height / 2}, {17, 200}}) {
+      const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
+      const double r2 =
+          (dx * dx + dy * dy) / (0.25 * (cam.width * cam.width + cam.height * cam.height));
+      const double want = std::pow(src.at(x, y, 1) * scale * (1 - 0.3 * r2), 0.8);
+      EXPECT_NEAR(got.at(x, y, 1), want, 1e-5 * want) << i << ": " << x << "," << y;
+    }
+  }
+  // The declared cam2 is off by the stated angle; the true one is the source's.
+  const Eigen::Quaterniond qd = declared.cameras[2].cam_from_world.rotation,
+                           qs = source.cameras[2].cam_from_world.rotation,
+                           qt = truth.cameras[2].cam_from_world.rotation;
+  EXPECT_NEAR(qd.angularDistance(qs) * 180 / kPi, 1.0, 1e-6);
+  EXPECT_NEAR(qt.angularDistance(qs), 0, 1e-9);
+  EXPECT_NEAR(declared.cameras[0].cam_from_world.rotation.angularDistance(
+                  source.cameras[0].cam_from_world.rotation),
+              0, 1e-9);
+  // Materials: rho_d left out of the declared scene; the truth's are the source's.
+  const Json d = ReadJsonFile(o.out / "scene.json"), t = ReadJsonFile(o.out / "truth.json");
+  EXPECT_FALSE(d["materials"]["floor"].contains("rho_d"));
+  EXPECT_EQ(t["materials"], source.document["materials"]);
+  ASSERT_EQ(t["effects"].size(), 4u);
+  EXPECT_EQ(t["effects"][1]["params"]["photo"], "photos/cam1_L0.exr");
+  fs::remove_all(out);
+}
+
+TEST(SynthFrom, AnEffectThatNeedsARenderIsAnInputError) {
+  const fs::path out = test::UniqueTempDir("igi_synth_from_bad");
+  SynthOptions o;
+  o.out = out / "capture";
+  o.from = RadianceRoom();
+  o.effects = {ParseEffectSpec("light_intensity")};
+  try {
+    Synthesize(o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("light_intensity"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("changes what is rendered"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(o.out));
+  fs::remove_all(out);
 }
 
 }  // namespace
