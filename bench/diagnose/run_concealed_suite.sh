@@ -25,6 +25,10 @@
 # no data from that lighting alone can tell them apart. Under a second lighting the albedos are the
 # same and the light is not.
 # The i-th case's capture has igi-synth seed SEED + i (SEED=107 none: the 8th case's capture).
+# FROM=SCENE.json: instead of igi-synth's room, another renderer's capture (e.g. the shared
+# RADIANCE room, ../shared/data/reference/radiance_room/scene.json) with the effects hidden in its
+# photos (igi-synth --from: vignetting, exposure_scale, camera_response, pose_error; default
+# cases: those four and a control).
 # Output: a Markdown table on stdout; the work folders stay under
 # ${IGI_BENCH_DIR:-/tmp/igi_concealed_suite}.
 set -euo pipefail
@@ -37,13 +41,17 @@ MATERIALS="${MATERIALS:-unknown}"
 THREADS="${THREADS:-2}"
 CAMERAS="${CAMERAS:-6}"
 SEED="${SEED:-100}"
+FROM="${FROM:-}"
 case "$MATERIALS" in
   unknown) UNKNOWNS=() ;;
   given) UNKNOWNS=(--unknowns none) ;;
   *) echo "MATERIALS must be unknown or given" >&2; exit 2 ;;
 esac
 CASES=("$@")
-if [ ${#CASES[@]} -eq 0 ]; then
+if [ ${#CASES[@]} -eq 0 ] && [ -n "$FROM" ]; then
+  CASES=(vignetting exposure_scale:photo=photos/cam1_L0.exr camera_response pose_error:camera=cam1
+         none)
+elif [ ${#CASES[@]} -eq 0 ]; then
   CASES=(vignetting exposure_scale camera_response ambient_light
          ambient_light:radiance=0.1 ambient_light:kind=panel light_emission_profile
          light_intensity specular_reflection specular_lobe_shape fresnel:regions=floor anisotropic_reflection
@@ -60,8 +68,12 @@ t = json.load(open(os.path.join(cap, "truth", "scene.json")))
 d = json.load(open(os.path.join(cap, "scene.json")))
 truth = json.load(open(os.path.join(cap, "truth.json")))
 photos = d["photos"]
+def up(f):  # relative to the capture -> relative to truth/
+    return f if os.path.isabs(f) else "../" + f
 for p in photos:
-    p["file"] = "../" + p["file"]
+    p["file"] = up(p["file"])
+    if isinstance(p.get("mask"), str):
+        p["mask"] = up(p["mask"])
 for e in truth["effects"]:
     n, q = e["effect"], e["params"]
     if n == "vignetting":
@@ -69,7 +81,7 @@ for e in truth["effects"]:
             c["vignetting"] = {"k1": q["k1"], "k2": q["k2"]}
     elif n == "exposure_scale":
         for p in photos:
-            if p["file"] == "../" + q["photo"]:
+            if p["file"] == up(q["photo"]):
                 p["exposure_scale"] = q["scale"]
     elif n == "camera_response":
         for p in photos:
@@ -81,7 +93,7 @@ json.dump(t, open(os.path.join(cap, "truth", "true_model.json"), "w"), indent=1)
 PY
 }
 
-echo "| hidden | first kept step | all kept steps | baseline | final | floor | final/floor | held-out final/floor | wall s | CPU s |"
+echo "| hidden | first kept step (after maps) | all kept steps | baseline | final | floor | final/floor | held-out final/floor | wall s | CPU s |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 i=0
 for case in "${CASES[@]}"; do
@@ -99,9 +111,14 @@ for case in "${CASES[@]}"; do
     fresnel*|specular_lobe_shape*) design=(--lamp-position 2,2,0.6 --grazing-cameras 1) ;;
     light_*|ambient_light*) if [ "$MATERIALS" = unknown ]; then design=(--photo-lightings L0,L1); fi ;;
   esac
-  "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 --spp 64 \
-      --lamp point --seed $((SEED + i)) --threads "$THREADS" --quiet "${UNKNOWNS[@]}" \
-      "${design[@]}" "${effects[@]}" > /dev/null
+  if [ -n "$FROM" ]; then
+    "$BIN/igi-synth" --from "$FROM" --out "$dir/capture" --seed $((SEED + i)) --quiet \
+        "${UNKNOWNS[@]}" "${effects[@]}" > /dev/null
+  else
+    "$BIN/igi-synth" --out "$dir/capture" --cameras "$CAMERAS" --width 160 --height 120 \
+        --spp 64 --lamp point --seed $((SEED + i)) --threads "$THREADS" --quiet \
+        "${UNKNOWNS[@]}" "${design[@]}" "${effects[@]}" > /dev/null
+  fi
   start=$(date +%s)
   /usr/bin/time -f "%U %S" -o "$dir/cpu.txt" \
     "$BIN/igi-diagnose" "$dir/capture/scene.json" --out "$dir/diag" --spp "$SPP" \
@@ -121,7 +138,8 @@ except Exception as e:
     print(f"| {case} | (failed: {e}) | | | | | | | {secs} | {cpu} |"); sys.exit(0)
 f, fh = fb["residual"], fb["held_out_residual"]
 kept = [s["effect"] for s in g["steps"]]
-first = kept[0] if kept else "(none)"
+named = [k for k in kept if k != "albedo_texture"]
+first = named[0] if named else "(none)"
 b, fin, finh = g["baseline"]["residual"], g["final"]["residual"], g["final"]["held_out_residual"]
 print(f"| {case} | {first} | {', '.join(kept) or '-'} | {b:.4f} | {fin:.4f} | {f:.4f} | {fin / f:.2f} | {finh / fh:.2f} | {secs} | {cpu} |")
 PY
