@@ -303,6 +303,18 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   // photo ≈ sim + c·(model_e − sim) (+ s·model_e): for c near 1 the exponent is e; in general
   // 1 + c(e − 1). The scale s moves the reference: (1 + s)·r·(u/r)^e = r'·(u/r')^e.
   const double e = 1 + best.coef[0] * (e_grid - 1);
+  // Near e = 1 the basis is about c·(e − 1)·s·ln(s/r): c and the searched exponent trade off,
+  // and only 1 + c(e − 1) is determined. An exponent outside the range a response can take
+  // (the scene's [0.1, 10]; a camera's gamma lies within [0.2, 5]) is the basis fitting
+  // something else through the albedos' freedom (−0.18 for a true 0.8, its refit refused by the
+  // scene's range check): not a response.
+  if (!(e >= 0.2 && e <= 5)) {
+    out.note = fmt::format(
+        "the level curve is not a camera response: exponent {:.3g} (coefficient {:.3g} at "
+        "{:.3g})",
+        e, best.coef[0], e_grid);
+    return out;
+  }
   const double scale = k == 2 ? 1 + best.coef[1] / std::max(1e-6, best.coef[0]) : 1.0;
   double reference =
       k == 2 && scale > 0 && std::abs(e - 1) > 1e-3 ? ref * std::pow(scale, 1 / (1 - e)) : ref;
@@ -1001,6 +1013,17 @@ std::vector<CandidateResult*> RankForTrials(std::vector<CandidateResult>& candid
                                             double min_gain, double min_z) {
   std::vector<CandidateResult*> ranked;
   for (CandidateResult& c : candidates) {
+    // A fit that leaves less than nothing on the held-out pixels (a predicted gain above 100 %:
+    // the fall of its residual² exceeds the residual² itself) has run away: a fit failure, not
+    // a prediction.
+    if (c.valid && c.held_after < 0) {
+      c.valid = false;
+      c.note = fmt::format(
+          "a fit failure: it explains more than the residual holds (held-out residual² {:.3g} "
+          "before, {:.3g} after)",
+          c.held_before, c.held_after);
+      continue;
+    }
     if (c.valid && c.Gain() >= min_gain && c.z >= min_z) ranked.push_back(&c);
   }
   std::stable_sort(

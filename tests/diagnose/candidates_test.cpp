@@ -674,5 +674,16 @@ TEST(RankForTrialsTest, WeakInsignificantAndInvalidAreLeftOut) {
   EXPECT_EQ(Order(cands), (std::vector<std::string>{"camera_response"}));
 }
 
+// A fit that explains more than the residual holds (predicted gain above 100 %: the camera
+// response fitted with an exponent of −0.18 on a capture with a true 0.8) is a fit failure:
+// not tried, and said so.
+TEST(RankForTrialsTest, AFitThatExplainsMoreThanTheResidualIsAFailure) {
+  std::vector<CandidateResult> cands = {Predicted("camera_response", 1.01, 40.0),
+                                        Predicted("vignetting", 0.2, 3.0)};
+  EXPECT_EQ(Order(cands), (std::vector<std::string>{"vignetting"}));
+  EXPECT_FALSE(cands[0].valid);
+  EXPECT_NE(cands[0].note.find("fit failure"), std::string::npos) << cands[0].note;
+}
+
 }  // namespace
 }  // namespace igi
