@@ -298,7 +298,9 @@ TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
   for (size_t i = 0; i < thin.obs.size(); ++i) {
     ASSERT_GE(radii[i], float(r0) * 0.999f);
     ASSERT_LE(radii[i], float(4 * r0) * 1.001f);
-    if (radii[i] < float(4 * r0) * 0.999f) EXPECT_GE(within(i, radii[i] * 1.0001), 32) << i;
+    if (radii[i] < float(4 * r0) * 0.999f) {
+      EXPECT_GE(within(i, radii[i] * 1.0001), 32) << i;
+    }
     if (radii[i] > float(r0) * 1.001f) {
       ++widened;
       EXPECT_LT(within(i, radii[i] * 0.9999), 32) << i;
