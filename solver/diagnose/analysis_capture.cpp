@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "solver/diagnose/pixel_records.h"
 #include "solver/observations.h"
 #include "tools/common/image.h"
 #include "tools/common/parallel.h"
@@ -31,12 +32,8 @@ bool ReducePhoto(const Photo& p, int f, const fs::path& file, const fs::path& ma
       bool ok = true;
       for (int v = y * f; v < (y + 1) * f && ok; ++v) {
         for (int u = x * f; u < (x + 1) * f && ok; ++u) {
-          ok = !mask || mask->at(u, v, 0) > 0.5f;
-          for (int c = 0; c < 3 && ok; ++c) {
-            const float value = img.at(u, v, c);
-            ok = std::isfinite(value) && value < clip;
-            sum[c] += p.LinearFromRecorded(value);
-          }
+          ok = UsablePixel(img, mask ? &*mask : nullptr, clip, u, v);
+          for (int c = 0; c < 3 && ok; ++c) sum[c] += p.LinearFromRecorded(img.at(u, v, c));
         }
       }
       for (int c = 0; c < 3; ++c) {

@@ -53,11 +53,7 @@ PhotoSet LoadPhotoSet(const Scene& scene) {
     ParallelFor(0, img.height, [&](int64_t yy) {
       const int y = int(yy);
       for (int x = 0; x < img.width; ++x) {
-        bool ok = !mask || mask->at(x, y, 0) > 0.5f;
-        for (int c = 0; c < 3 && ok; ++c) {
-          const float v = img.at(x, y, c);
-          ok = std::isfinite(v) && v < clip;
-        }
+        bool ok = UsablePixel(img, mask ? &*mask : nullptr, clip, x, y);
         if (ok) {
           const int r = RegionAt(impl, cam, x + 0.5, y + 0.5);
           ok = r >= 0;

@@ -62,6 +62,17 @@ struct PhotoSet {
   std::vector<Image> valid;  // 1 = a residual sample may come from this pixel
 };
 
+// Whether pixel (x, y) of a photo holds a usable value: inside its mask (when it has one), and
+// every channel finite and below the photo's clip level (AutoSaturation).
+inline bool UsablePixel(const Image& photo, const Image* mask, double clip, int x, int y) {
+  if (mask && !(mask->at(x, y, 0) > 0.5f)) return false;
+  for (int c = 0; c < 3; ++c) {
+    const float v = photo.at(x, y, c);
+    if (!std::isfinite(v) || !(v < clip)) return false;
+  }
+  return true;
+}
+
 // Reads every photo; a pixel is valid when finite, below the photo's clip level, inside its mask,
 // and its footprint (centre and four corners) lies on one reflective region.
 PhotoSet LoadPhotoSet(const Scene& scene);
