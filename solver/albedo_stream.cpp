@@ -67,7 +67,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
   // Cells of the smoothing radius: the indirect light is averaged over about that already.
   const double radius =
       options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
-  const ObservationGrid grid(*this, mapped, radius);
+  const ObservationGrid grid(scene, obs, mapped, radius);
   std::vector<AlbedoMapBuilder> builders;
   for (const RegionAtlas& atlas : atlases) builders.emplace_back(atlas);
   const double cos_edge = std::cos(10.0 * kPi / 180.0);
@@ -79,7 +79,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
     const Camera& cam = scene.cameras[photo.camera];
     const int l = photo.lighting;
     const Renderer::Impl& geometry = *lighting_scenes[l];
-    const LightingState& st = lighting_state[l];
+    const LightingState& st = light.lightings[l];
     const LoadedPhoto loaded = LoadPhoto(int(i));
     const std::vector<uint8_t>* mask = loaded.mask.empty() ? nullptr : &loaded.mask;
     const double saturation =
@@ -117,15 +117,15 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             const Eigen::Vector3d e_direct = GatherDirectAt(geometry, q, options.light_samples,
                                                             options.footprint_samples, rng, &direct)
                                                  .cast<double>();
-            const Eigen::Vector3d e_indirect = obs_e[j] - obs_e_direct[j];
+            const Eigen::Vector3d e_indirect = light.e[j] - light.e_direct[j];
             const Eigen::Vector3d ratio =
-                (e_direct + e_indirect).cwiseQuotient((obs_e[j]).cwiseMax(1e-300));
+                (e_direct + e_indirect).cwiseQuotient((light.e[j]).cwiseMax(1e-300));
             const Eigen::Vector3d e = map_e[j].cwiseProduct(ratio);
             Eigen::Vector3d t = Eigen::Vector3d::Zero();
             if (HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
               // The pixel's direct lobe, and the observation's other light from its T.
               const Observation& oj = obs[j];
-              const GatherPoint& gp = st.gather.points[obs_point[j]];
+              const GatherPoint& gp = st.gather.points[light.point[j]];
               const double spread =
                   options.pixel_footprint ? PixelNormalSpread(*quarter, hit->n_s) : 0.0;
               auto widened = [&](double spread2) {
@@ -134,11 +134,11 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
               };
               const auto [ax, ay] = widened(spread);
               const auto [axj, ayj] = widened(oj.lobe_blur2);
-              const Eigen::Vector3d t_direct_j =
-                  DirectLobe(m.params, axj, ayj, LocalFrame(oj.region, oj.normal.cast<double>()),
-                             oj.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
-                             gp.direct_end - gp.direct_begin);
-              t = DirectLobe(m.params, ax, ay, LocalFrame(hit->region, hit->n_s), -dir,
+              const Eigen::Vector3d t_direct_j = DirectLobe(
+                  m.params, axj, ayj, materials.LocalFrame(oj.region, oj.normal.cast<double>()),
+                  oj.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
+                  gp.direct_end - gp.direct_begin);
+              t = DirectLobe(m.params, ax, ay, materials.LocalFrame(hit->region, hit->n_s), -dir,
                              direct.data(), int64_t(direct.size())) +
                   (smooth_t[j] - t_direct_j).cwiseMax(0.0);
             }
@@ -146,7 +146,8 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             const Eigen::Vector3d diffuse = value.cast<double>() - spec;
             // As the maps from the observations (AlbedoMapOf): each weighted by its diffuse share.
             const int patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
-            const double diffuse_pred = (PatchAlbedo(patch).cwiseProduct(e) / kPi).sum();
+            const double diffuse_pred =
+                (materials.PatchAlbedo(patches, patch).cwiseProduct(e) / kPi).sum();
             const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
             const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
             if (!(w > 0) || !(e.minCoeff() > 0)) continue;

@@ -9,19 +9,22 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/solve_internal.h"
+#include "recon/scene.h"
+#include "solver/observation_set.h"
 
 namespace igi {
 
 class ObservationGrid {
  public:
   // The observations of the regions r with regions[r] nonzero, in cells of `cell` metres.
-  ObservationGrid(const SolverState& s, const std::vector<char>& regions, double cell)
-      : s_(s), cell_(cell) {
-    for (size_t i = 0; i < s.obs.size(); ++i) {
-      const Observation& o = s.obs[i];
+  // `scene` is the observations' (for their photos' lightings); both must outlive the grid.
+  ObservationGrid(const Scene& scene, const ObservationSet& obs, const std::vector<char>& regions,
+                  double cell)
+      : scene_(scene), obs_(obs), cell_(cell) {
+    for (size_t i = 0; i < obs.size(); ++i) {
+      const Observation& o = obs[i];
       if (!regions[o.region]) continue;
-      const int l = s.scene.photos[o.photo].lighting;
+      const int l = scene.photos[o.photo].lighting;
       cells_[Key(l, o.region, CellOf(o.position.cast<double>()))].push_back(int(i));
     }
   }
@@ -38,8 +41,8 @@ class ObservationGrid {
           const auto it = cells_.find(Key(l, region, c + Eigen::Vector3i(dx, dy, dz)));
           if (it == cells_.end()) continue;
           for (int i : it->second) {
-            const Observation& o = s_.obs[i];  // (keys of other cells may collide)
-            if (o.region == region && s_.scene.photos[o.photo].lighting == l) f(i);
+            const Observation& o = obs_[i];  // (keys of other cells may collide)
+            if (o.region == region && scene_.photos[o.photo].lighting == l) f(i);
           }
         }
       }
@@ -52,7 +55,7 @@ class ObservationGrid {
     int best = -1;
     double best_d2 = INFINITY;
     ForEachNear(l, region, p, [&](int i) {
-      const Observation& o = s_.obs[i];
+      const Observation& o = obs_[i];
       if (o.normal.cast<double>().dot(n) < 0.9) return;
       const double d2 = (o.position.cast<double>() - p).squaredNorm();
       if (d2 < best_d2) best_d2 = d2, best = i;
@@ -69,7 +72,8 @@ class ObservationGrid {
     return (uint64_t(l & 0xff) << 56) ^ (uint64_t(region & 0xfff) << 44) ^
            (u(c.x()) << 24 | u(c.y()) << 4) ^ (u(c.z()) * 0x9e3779b1ULL);
   }
-  const SolverState& s_;
+  const Scene& scene_;
+  const ObservationSet& obs_;
   double cell_;
   std::unordered_map<uint64_t, std::vector<int>> cells_;
 };

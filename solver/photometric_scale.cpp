@@ -120,9 +120,9 @@ std::vector<ScaleSample> ReferenceSamples(const SolverState& s, int channel, dou
   for (size_t i = 0; i < s.obs.size(); ++i) {
     const Observation& o = s.obs[i];
     if (!IsReference(s.materials[o.region])) continue;
-    const Eigen::Vector3d rho = s.KnownAlbedo(o);
-    const double e_direct = s.obs_e_direct[i][channel];
-    const double e_indirect = s.obs_e[i][channel] - e_direct;
+    const Eigen::Vector3d rho = s.materials.KnownAlbedo(s.scene.mesh, o);
+    const double e_direct = s.light.e_direct[i][channel];
+    const double e_indirect = s.light.e[i][channel] - e_direct;
     if (!(rho[channel] > 0) || !(e_direct > 0)) continue;
     out.push_back({o.radiance[channel], rho[channel] / kPi * e_direct,
                    rho[channel] / kPi * e_indirect, o.patch});
@@ -204,7 +204,7 @@ void FollowPhotoUnits(SolverState* s) {
   double area = 0;
   std::vector<double> region_area(s->materials.size(), 0.0);
   for (size_t r = 0; r < s->materials.size(); ++r) {
-    for (int q : s->region_patches[r]) region_area[r] += s->patches.area[q];
+    for (int q : s->materials.region_patches[r]) region_area[r] += s->patches.area[q];
     const MaterialState& m = s->materials[r];
     if (!m.reflective || !m.unknown_rho_d || m.observations == 0) continue;
     sum += region_area[r] * m.params.rho_d;
@@ -215,7 +215,7 @@ void FollowPhotoUnits(SolverState* s) {
       if (m.reflective && m.unknown_rho_d && m.observations == 0) m.params.rho_d = sum / area;
     }
   }
-  for (LightingState& st : s->lighting_state) {
+  for (LightingState& st : s->light.lightings) {
     if (st.active) s->UpdatePatchRadiance(&st);
   }
   s->IncidentFromPatches();

@@ -31,29 +31,6 @@ double Since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
-// drawn with the same probability by a hash of its photo and pixel; returns how many it marked.
-// The indices were themselves collected with probability `collected` by the same hash
-// (solver/observation_draw.h), so this draw is nested in that one: a pixel is marked when its
-// hash falls under `collected` × count / indices.size().
-// Not by the observation's index: a change to one photo's observations (its pose, its mask, a
-// pixel that passes an edge test or not) shifts every later photo's indices and redraws them
-// all, and a faint lobe's ρs moved by up to 11 points with the draw alone (bench/RESULTS.md,
-// session 33).
-size_t DrawSubset(const std::vector<Observation>& obs, const std::vector<int>& indices,
-                  size_t count, double collected, std::vector<char>* chosen) {
-  size_t marked = 0;
-  const double p = indices.empty() ? 0.0 : collected * (double(count) / double(indices.size()));
-  for (int i : indices) {
-    const Observation& o = obs[i];
-    if (InHashedSubset(PixelKey(o.photo, o.x, o.y), p)) {
-      (*chosen)[i] = 1;
-      ++marked;
-    }
-  }
-  return marked;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -68,7 +45,7 @@ void SolverState::Prepare() {
   summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
   patches = BuildPatches(scene.mesh, summary.patch_size_m);
   summary.patches = patches.size();
-  InitMaterials();
+  materials = MaterialEstimate::FromScene(scene, patches);
   summary.regions.resize(scene.materials.size());
   BuildLightingScenes();
   PlanObservations();
@@ -77,52 +54,6 @@ void SolverState::Prepare() {
   SelectFitSamples();
   ChooseTexelSize();
   AnalyseCoverage();
-}
-
-void SolverState::InitMaterials() {
-  const size_t n = scene.materials.size();
-  materials.resize(n);
-  for (size_t r = 0; r < n; ++r) {
-    const Material& m = scene.materials[r];
-    MaterialState& s = materials[r];
-    s.params.model = m.brdf;
-    s.reflective = IsReflective(m.brdf);
-    if (!s.reflective) continue;
-    const bool spec = HasSpecularLobe(m.brdf), aniso = IsAnisotropic(m.brdf);
-    s.unknown_rho_d = !m.rho_d && !m.rho_d_map;
-    s.unknown_rho_s = spec && !m.rho_s;
-    s.unknown_alpha = spec && (aniso ? !(m.alpha_x && m.alpha_y) : !m.alpha);
-    s.params.rho_d = m.rho_d.value_or(Eigen::Vector3d::Constant(0.5));
-    s.params.rho_s = m.rho_s.value_or(Eigen::Vector3d::Zero());
-    s.params.alpha = m.alpha.value_or(0.1);
-    s.params.alpha_x = m.alpha_x.value_or(m.alpha.value_or(0.1));
-    s.params.alpha_y = m.alpha_y.value_or(m.alpha.value_or(0.1));
-    s.params.ior = m.ior.value_or(Material::kDefaultIor);
-    s.tangent = m.tangent;
-    if (m.rho_d_map) s.known_map = std::make_shared<const Image>(ReadImage(*m.rho_d_map, 3));
-  }
-  region_patches.assign(n, {});
-  patch_slot.assign(patches.size(), -1);
-  for (int q = 0; q < patches.size(); ++q) {
-    const int r = patches.patch_region[q];
-    patch_slot[q] = static_cast<int>(region_patches[r].size());
-    region_patches[r].push_back(q);
-  }
-  for (size_t r = 0; r < n; ++r) {
-    materials[r].patch_rho_d.assign(region_patches[r].size(), Eigen::Vector3d::Constant(NAN));
-  }
-}
-
-Frame SolverState::LocalFrame(int region, const Eigen::Vector3d& n) const {
-  const MaterialState& m = materials[region];
-  if (IsAnisotropic(m.params.model) && m.tangent) return Frame::FromNormalTangent(n, *m.tangent);
-  return Frame::FromNormal(n);
-}
-
-Eigen::Vector3d SolverState::PatchAlbedo(int q) const {
-  const int r = patches.patch_region[q];
-  const Eigen::Vector3d& v = materials[r].patch_rho_d[patch_slot[q]];
-  return v.allFinite() ? v : materials[r].params.rho_d;
 }
 
 // Photo i as the solver reads it: linear radiance (photos whose values are not plain radiance
@@ -261,6 +192,7 @@ void SolverState::PlanObservations() {
             " observations with the scene, the patches and the largest photo); raise the budget "
             "or lower --indirect-rays, --refine-final-rays or --max-highlight-samples"));
   }
+  ObservationDraw& draw = obs.draw;
   draw = PlanObservationDraw(census, lobe_class, d);
   draw.census = draw.expected < draw.available;
   summary.observations_thinned = draw.census;
@@ -309,7 +241,7 @@ void SolverState::CollectAllObservations() {
   oo.pixel_stride = options.pixel_stride;
   oo.saturation = options.saturation;
   oo.num_threads = options.num_threads;
-  oo.draw = draw.census ? &draw : nullptr;
+  oo.draw = obs.draw.census ? &obs.draw : nullptr;
   summary.photos.resize(scene.photos.size());
   Progress progress("igi-solve: observations", int64_t(scene.photos.size()), 2.0,
                     options.show_progress && ProgressAllowed());
@@ -339,11 +271,11 @@ void SolverState::CollectAllObservations() {
                        " non-finite or negative, " + std::to_string(st.background) +
                        " see no reflective surface, " + std::to_string(st.edge) + " on edges)");
     }
-    obs.insert(obs.end(), o.begin(), o.end());
+    obs.items.insert(obs.items.end(), o.begin(), o.end());
   }
   progress.Finish();
   problems.ThrowIfAny();
-  obs.shrink_to_fit();
+  obs.items.shrink_to_fit();
   summary.observations = static_cast<int>(obs.size());
   for (const PhotoObservationStats& st : summary.photos) {
     summary.observations_available += st.valid + st.undrawn;
@@ -352,33 +284,19 @@ void SolverState::CollectAllObservations() {
 }
 
 void SolverState::SelectFitSamples() {
-  // Per region: the observations near a possible highlight (tanθh < 0.6 toward some light of
-  // its lighting) and the rest, each subsampled (below).
-  in_fit.assign(obs.size(), 0);
-  std::vector<std::vector<int>> near(materials.size()), rest(materials.size());
+  std::vector<char> fitted(materials.size(), 0), near(obs.size(), 0);
+  for (size_t r = 0; r < materials.size(); ++r) fitted[r] = materials[r].NeedsFit();
+  // Near a possible highlight: tanθh < 0.6 toward some light of the observation's lighting.
   for (size_t i = 0; i < obs.size(); ++i) {
     const Observation& o = obs[i];
     const MaterialState& m = materials[o.region];
-    if (!m.NeedsFit()) continue;
-    const bool highlight =
-        HasSpecularLobe(m.params.model) &&
+    near[i] =
+        m.NeedsFit() && HasSpecularLobe(m.params.model) &&
         NearHighlight(*lighting_scenes[scene.photos[o.photo].lighting], o.position.cast<double>(),
                       o.view.cast<double>(), o.normal.cast<double>());
-    (highlight ? near : rest)[o.region].push_back(int(i));
   }
-  // The highlight observations carry ρs and α, the rest mostly the albedo: up to
-  // max_highlight_samples of the first, then the rest (max_fit_samples in all, at least a third
-  // of it). Both drawn by a hash of the observation's photo and pixel: a regular stride through
-  // the photos' pixel rows aliased with a texture's period (the SolveSynth room's textured floor,
-  // ρs 0.04: −10.3 % with the stride, +2.1 % drawn by hash).
-  const size_t max_fit = size_t(options.max_fit_samples);
-  const size_t min_rest = max_fit / 3;
-  for (size_t r = 0; r < materials.size(); ++r) {
-    const size_t taken = DrawSubset(obs, near[r], size_t(options.max_highlight_samples),
-                                    DrawnThreshold(int(r), true), &in_fit);
-    const size_t budget = std::max(min_rest, max_fit - std::min(taken, max_fit));
-    DrawSubset(obs, rest[r], budget, DrawnThreshold(int(r), false), &in_fit);
-  }
+  igi::SelectFitSamples(fitted, near, size_t(options.max_highlight_samples),
+                        size_t(options.max_fit_samples), &obs);
 }
 
 // The footprint of observation o's pixel or block (solver/gather.h): ray directions at unit depth,
@@ -402,8 +320,8 @@ GatherQuery::Footprint SolverState::PixelFootprint(const Observation& o) const {
 
 void SolverState::GatherAll() {
   const auto start = Clock::now();
-  lighting_state.resize(scene.lightings.size());
-  obs_point.assign(obs.size(), -1);
+  light.lightings.resize(scene.lightings.size());
+  light.point.assign(obs.size(), -1);
   GatherOptions go;
   go.light_samples = options.light_samples;
   go.indirect_rays = options.indirect_rays;
@@ -415,7 +333,7 @@ void SolverState::GatherAll() {
     if (options.show_progress)
       go.progress_label = "igi-solve: gathering " + scene.lightings[l].name;
     if (!lighting_scenes[l]) continue;
-    LightingState& st = lighting_state[l];
+    LightingState& st = light.lightings[l];
     st.active = true;
     std::vector<GatherQuery> queries;
     for (size_t i = 0; i < obs.size(); ++i) {
@@ -429,7 +347,7 @@ void SolverState::GatherAll() {
       q.view = o.view.cast<double>();
       q.lobe = HasSpecularLobe(materials[o.region].params.model);
       if (options.pixel_footprint) q.footprint = PixelFootprint(o);
-      obs_point[i] = static_cast<int>(queries.size());
+      light.point[i] = static_cast<int>(queries.size());
       st.obs.push_back(int(i));
       queries.push_back(q);
     }
@@ -493,7 +411,7 @@ Eigen::Vector3d SolverState::PatchSpecular(const LightingState& st, int q,
   if (st.lobe_begin[q] == st.lobe_begin[q + 1] || !(m.params.rho_s.maxCoeff() > 0)) {
     return Eigen::Vector3d::Zero();
   }
-  const Frame frame = LocalFrame(r, patches.normal[q].cast<double>());
+  const Frame frame = materials.LocalFrame(r, patches.normal[q].cast<double>());
   const Eigen::Vector3d wo = frame.ToLocal(toward);
   if (!(wo.z() > 0)) return Eigen::Vector3d::Zero();
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
@@ -539,7 +457,7 @@ void SolverState::UpdatePatchRadiance(LightingState* st) {
   std::vector<int> count(patches.size(), 0);
   for (int i : st->obs) {
     const Observation& o = obs[i];
-    const Eigen::Vector3d spec = materials[o.region].params.rho_s.cwiseProduct(obs_t[i]);
+    const Eigen::Vector3d spec = materials[o.region].params.rho_s.cwiseProduct(light.t[i]);
     sum[o.patch] += (o.radiance.cast<double>() - spec).cwiseMax(0.0);
     ++count[o.patch];
   }
@@ -549,7 +467,8 @@ void SolverState::UpdatePatchRadiance(LightingState* st) {
         st->patch_d[q] = (sum[q] / count[q]).cast<float>();
       } else if (IsReflective(materials[patches.patch_region[q]].params.model)) {
         st->patch_d[q] =
-            (PatchAlbedo(q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi).cast<float>();
+            (materials.PatchAlbedo(patches, q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi)
+                .cast<float>();
       } else {
         st->patch_d[q].setZero();
       }
@@ -613,7 +532,7 @@ void SolverState::ChooseTexelSize() {
     const double d = (cam.CenterInWorld() - o.position.cast<double>()).norm();
     // The observations' spacing on the photo: the stride, widened where they were drawn.
     photo_footprints.push_back(d / cam.params[0] * options.pixel_stride);
-    footprints.push_back(photo_footprints.back() / std::sqrt(DrawnShare(o.region, false)));
+    footprints.push_back(photo_footprints.back() / std::sqrt(obs.DrawnShare(o.region, false)));
   }
   if (footprints.empty()) {
     summary.texel_size_m = summary.map_texel_size_m = 0.01;
@@ -629,7 +548,7 @@ void SolverState::ChooseTexelSize() {
 
 void SolverState::AnalyseCoverage() {
   HighlightCoverageOptions ho;
-  summary.coverage = AnalyseHighlightCoverage(scene, obs, lighting_scenes, ho);
+  summary.coverage = AnalyseHighlightCoverage(scene, obs.items, lighting_scenes, ho);
   for (const RegionHighlightCoverage& c : summary.coverage) {
     if (c.region < 0 || c.region >= int(materials.size()) || c.observed) continue;
     MaterialState& m = materials[c.region];

@@ -11,8 +11,9 @@
 
 #include "solver/brdf.h"
 #include "solver/gather.h"
-#include "solver/observation_draw.h"
-#include "solver/observations.h"
+#include "solver/light_model.h"
+#include "solver/material_estimate.h"
+#include "solver/observation_set.h"
 #include "solver/patches.h"
 #include "solver/region_fit.h"
 #include "solver/render_internal.h"
@@ -22,71 +23,6 @@
 #include "solver/uv_charts.h"
 
 namespace igi {
-
-struct MaterialState {
-  BrdfParams params;  // complete: known values, or the current estimate
-  bool reflective = false;
-  bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
-  bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
-  std::optional<Eigen::Vector3d> tangent;
-  std::shared_ptr<const Image> known_map;    // a known rho_d_map
-  std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d
-  RegionFitResult last_fit;
-  bool stage1_albedo_varies = false;  // stage 1's decision, kept by the refinement
-  // Factor applied to the albedo map built from the observations' πL/E (AlbedoMapOf): the
-  // refinement's update of the region's scale (1 unless a stage-2 round moved its mean away
-  // from its independent refit: the joint update, or a partial step).
-  Eigen::Vector3d map_scale = Eigen::Vector3d::Ones();
-  int observations = 0;
-  // A region no photo sees whose ρd was fitted to the light it bounces onto the seen regions
-  // (SolverState::FitUnobservedAlbedos): its relative uncertainty per channel (NaN: not fitted).
-  Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
-  bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
-};
-
-struct LightingState {
-  bool active = false;
-  std::vector<int> obs;  // observations under this lighting
-  GatherSet gather;      // their points first, then one per patch
-  int first_patch_point = 0;
-  std::vector<Eigen::Vector3f> patch_d;  // diffuse radiance leaving each patch
-  std::vector<Eigen::Vector3f> patch_e;  // irradiance of each patch
-  std::vector<int> lobe_begin;           // per patch (+1): representative direct samples
-  std::vector<DirectSample> lobes;
-};
-
-// Stage 2's joint update: the rendered light's derivatives with respect to every region's
-// parameters (Renderer::ReflectedRadiance: the log-scales of ρd, ρs and α), summed per fitted
-// region r over its fit observations. Row r of d_e: the derivatives of the raw indirect
-// irradiance E; of d_t: those of the specular term T = Σ S·W·v at the rendered α (glossy
-// regions); t: ΣT itself. Rows are regions × Renderer::kDerivativeKinds long.
-struct JointSums {
-  size_t regions = 0;
-  std::vector<Eigen::Vector3d> d_e, d_t, t;
-  void Resize(size_t n) {
-    regions = n;
-    const size_t k = n * n * Renderer::kDerivativeKinds;
-    d_e.assign(k, Eigen::Vector3d::Zero());
-    d_t.assign(k, Eigen::Vector3d::Zero());
-    t.assign(n, Eigen::Vector3d::Zero());
-  }
-  // Region `r`'s observation: its derivative rows and its T.
-  void Add(int r, const std::vector<Eigen::Vector3d>& de, const std::vector<Eigen::Vector3d>& dt,
-           const Eigen::Vector3d& tr) {
-    const size_t row = regions * Renderer::kDerivativeKinds, o = size_t(r) * row;
-    for (size_t j = 0; j < row; ++j) d_e[o + j] += de[j], d_t[o + j] += dt[j];
-    t[r] += tr;
-  }
-  void Add(const JointSums& other) {
-    if (other.regions != regions) return;
-    for (size_t j = 0; j < d_e.size(); ++j) d_e[j] += other.d_e[j], d_t[j] += other.d_t[j];
-    for (size_t j = 0; j < t.size(); ++j) t[j] += other.t[j];
-  }
-  // Row r's entry for region j's parameter `kind`.
-  const Eigen::Vector3d& E(const std::vector<Eigen::Vector3d>& v, int r, int j, int kind) const {
-    return v[(size_t(r) * regions + j) * Renderer::kDerivativeKinds + kind];
-  }
-};
 
 // The joint update's result per fitted region (NaN where the region's own refit stands):
 // its albedo, its ρs, and per channel the relative change of its fitted light per unit relative
@@ -118,39 +54,20 @@ struct SolverState {
   SolveOptions options;
   SolveSummary summary;
   PatchSet patches;
-  std::vector<MaterialState> materials;
-  std::vector<std::vector<int>> region_patches;  // per region: its patches (slot order)
-  std::vector<int> patch_slot;                   // per patch: index within its region
-  // The memory estimate and the observations' draw (solver/observation_draw.h), planned before
-  // any photo is read.
+  // The memory estimate (solver/solve_memory.h), planned before any photo is read.
   SolveMemoryEstimate memory;
-  ObservationDraw draw;
   std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
-  std::vector<Observation> obs;
-  std::vector<char> in_fit;    // per observation: used by the region fits
-  std::vector<int> obs_point;  // per observation: its point in its lighting's gather
-  std::vector<LightingState> lighting_state;
-  // Per observation, refreshed each iteration: direct and indirect irradiance (the indirect
-  // smoothed over neighbours), the incident samples in the local frame (regions with a
-  // specular lobe) and T = Σ S·W·v at the current α.
-  std::vector<Eigen::Vector3d> obs_e_direct, obs_e_indirect, obs_e;
-  std::vector<std::vector<IncidentLocal>> obs_incident;
-  // Stage 2's joint update (empty otherwise): the rendered light's derivatives, summed per
-  // fitted region over its fit observations.
-  JointSums joint_sums;
-  std::vector<Eigen::Vector3d> obs_e_stage1;  // obs_e at the end of stage 1
-  std::vector<Eigen::Vector3d> obs_t;
-  // Per observation of a textured glossy region: the other photos' observations off the
-  // highlights at the albedo map's texel (solver/held_out_albedo.h): their πL/E and their lobe
-  // per unit ρs, πT/E (the albedo is the first less ρs times the second); NaN elsewhere.
-  std::vector<Eigen::Vector3d> obs_rho_d_held, obs_held_lobe;
-  std::vector<std::unique_ptr<RegionAtlas>> held_atlases;  // per region, built when needed
+  // The solve's three products, each a plain structure that the stages read and write: the
+  // observations (and the draw they were collected under), the material estimate, and the
+  // light modelled at the observations.
+  ObservationSet obs;
+  MaterialEstimate materials;
+  LightModel light;
 
   SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
 
   // solve.cpp
   void Prepare();  // everything before the rays (Solve() then gathers and fits)
-  void InitMaterials();
   // A photo as the solver reads it: linear radiance and its 8-bit mask (0 = ignore; empty:
   // every pixel), the held-out and (for photos that are not plain radiance) clipped pixels
   // masked out.
@@ -164,22 +81,13 @@ struct SolverState {
   // budget, else a census and the draw's probabilities; throws InputError when not even the
   // largest photo and the fits' fewest observations fit.
   void PlanObservations();
-  // The share of region r's pixels at the stride (near a highlight or not) that observations were
-  // drawn at (their density), and the hash threshold they were drawn under (the same for single
-  // pixels, larger for blocks: solver/observation_draw.h).
-  double DrawnShare(int region, bool near) const {
-    return draw.census ? draw.Probability(region, near) : 1.0;
-  }
-  double DrawnThreshold(int region, bool near) const {
-    return draw.census ? draw.Threshold(region, near) : 1.0;
-  }
   void CollectAllObservations();
+  // The fit samples (obs.in_fit: SelectFitSamples in solver/observation_set.h) of the regions
+  // with an unknown.
   void SelectFitSamples();
   void GatherAll();
   GatherQuery::Footprint PixelFootprint(const Observation& o) const;
   void BuildPatchLobes(LightingState* st) const;
-  Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
-  Eigen::Vector3d PatchAlbedo(int patch) const;
   Eigen::Vector3d PatchSpecular(const LightingState& st, int q,
                                 const Eigen::Vector3d& toward) const;
   Eigen::Vector3d PatchRadiance(const LightingState& st, int q,
@@ -193,17 +101,17 @@ struct SolverState {
   // solve_stages.cpp
   void IncidentFromPatches();
   void IncidentFromRenderer(const Scene& model, uint64_t round);
+  // light.e (SmoothIrradiance in solver/light_model.h), the smoothing radii computed first
+  // where there are none yet.
   void SmoothIrradiance();
-  std::vector<Eigen::Vector3d> NeighbourMean(
-      const std::vector<Eigen::Vector3d>& values, double radius, bool same_photo,
-      const std::vector<float>* point_radius = nullptr) const;
-  // Per observation, its smoothing radius (the adaptive smoothing's, SolveOptions::
-  // smoothing_accuracy, from stage 1's gather); empty until SmoothIrradiance first needs it.
-  std::vector<float> obs_smoothing_radius;
+  // light.smoothing_radius: per observation, its smoothing radius (the adaptive smoothing's,
+  // SolveOptions::smoothing_accuracy, from stage 1's gather).
   void ComputeSmoothingRadii(double radius);
   std::vector<float> DrawnSmoothingRadii(double radius) const;
-  void ComputeSpecularTerms();
-  void HeldOutAlbedos();
+  // light.t at the current materials (SpecularTerms in solver/light_model.h).
+  void ComputeSpecularTerms() {
+    light.t = SpecularTerms(obs, materials, light.incident, options.num_threads);
+  }
   double FitAll(int stage, int iteration);  // returns the largest relative change
   // The joint update (per entry of `regions`, from their fits `fits`): the solution of the
   // fixed point p_r = fit_r(light(p)) with the light linearised by joint_sums.
@@ -255,7 +163,6 @@ struct SolverState {
                                       const std::vector<Eigen::Vector3d>& map_e,
                                       std::vector<Image>* seen,
                                       std::vector<double>* coverage) const;
-  Eigen::Vector3d KnownAlbedo(const Observation& o) const;
 
   // solve.cpp
   void SummariseRegions();

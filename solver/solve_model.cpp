@@ -61,8 +61,8 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 // room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
 // With photo_parity 0 or 1, only the photos of even or odd index contribute.
 static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
-                         const std::vector<Eigen::Vector3d>& obs_t,
-                         const std::vector<Eigen::Vector3d>& obs_e, Image* seen = nullptr,
+                         const std::vector<Eigen::Vector3d>& t,
+                         const std::vector<Eigen::Vector3d>& e, Image* seen = nullptr,
                          int photo_parity = -1) {
   AlbedoMapBuilder builder(atlas);
   const MaterialState& m = s.materials[r];
@@ -70,13 +70,14 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     const Observation& o = s.obs[i];
     if (o.region != r) continue;
     if (photo_parity >= 0 && o.photo % 2 != photo_parity) continue;
-    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
+    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t[i]);
     const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
     // Highlights tell little about the albedo and much about any error in the fitted lobe:
     // weight each observation by its diffuse share, and leave out those under half diffuse.
     // (from the model, not the observation: a test on the observed radiance would favour the
     // bright texels near highlights)
-    const double diffuse_pred = (s.PatchAlbedo(o.patch).cwiseProduct(obs_e[i]) / kPi).sum();
+    const double diffuse_pred =
+        (s.materials.PatchAlbedo(s.patches, o.patch).cwiseProduct(e[i]) / kPi).sum();
     const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
     const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
     if (!(w > 0)) continue;
@@ -85,9 +86,9 @@ static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, 
     // floor: −4.5 % with observations above 1.2 left out). The texel is a ratio of sums weighted
     // by E, so an E taken at the pixel's centre that differs from its footprint's (a shadow edge)
     // evens out over the texel's observations instead of dominating.
-    const Eigen::Vector3d e = obs_e[i];
-    if (!(e.minCoeff() > 0)) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e);
+    const Eigen::Vector3d& e_i = e[i];
+    if (!(e_i.minCoeff() > 0)) continue;
+    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e_i);
   }
   if (coverage != nullptr) *coverage = builder.Coverage();
   if (seen != nullptr) *seen = builder.DirectMask();
@@ -106,11 +107,10 @@ struct MapHalves {
 };
 
 MapHalves HalvesOf(const SolverState& s, int r, const RegionAtlas& atlas,
-                   const std::vector<Eigen::Vector3d>& obs_t,
-                   const std::vector<Eigen::Vector3d>& obs_e) {
+                   const std::vector<Eigen::Vector3d>& t, const std::vector<Eigen::Vector3d>& e) {
   MapHalves h;
   for (int k = 0; k < 2; ++k) {
-    h.map[k] = AlbedoMapOf(s, r, atlas, nullptr, obs_t, obs_e, &h.seen[k], k);
+    h.map[k] = AlbedoMapOf(s, r, atlas, nullptr, t, e, &h.seen[k], k);
   }
   for (int y = 0; y < h.seen[0].height; ++y) {
     for (int x = 0; x < h.seen[0].width; ++x) {
@@ -184,18 +184,20 @@ static RegionAtlas AtlasOf(const SolverState& s, int r) {
 }
 
 std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
-  const bool have_stage1 = obs_e_stage1.size() == obs.size() && summary.stage2_iterations > 0;
-  if (!have_stage1 || !IsJointUpdate(options.refine_update)) return obs_e;
-  if (!summary.refinement_accepted) return obs_e_stage1;
+  const bool have_stage1 = light.e_stage1.size() == obs.size() && summary.stage2_iterations > 0;
+  if (!have_stage1 || !IsJointUpdate(options.refine_update)) return light.e;
+  if (!summary.refinement_accepted) return light.e_stage1;
   const double radius = 4 * (options.smoothing_radius_m > 0 ? options.smoothing_radius_m
                                                             : summary.scene_diagonal_m / 96);
-  const std::vector<Eigen::Vector3d> now = NeighbourMean(obs_e, radius, false);
-  const std::vector<Eigen::Vector3d> then = NeighbourMean(obs_e_stage1, radius, false);
+  const std::vector<Eigen::Vector3d> now =
+      NeighbourMean(obs, light.lightings, light.e, radius, false, options.num_threads);
+  const std::vector<Eigen::Vector3d> then =
+      NeighbourMean(obs, light.lightings, light.e_stage1, radius, false, options.num_threads);
   std::vector<Eigen::Vector3d> out(obs.size());
   for (size_t i = 0; i < obs.size(); ++i) {
-    out[i] = obs_e[i];
+    out[i] = light.e[i];
     if (!(then[i].minCoeff() > 0) || !now[i].allFinite()) continue;
-    out[i] = obs_e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
+    out[i] = light.e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
   }
   return out;
 }
@@ -203,8 +205,8 @@ std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
 Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                                  const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
-  const std::vector<Eigen::Vector3d> smooth_t =
-      NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
+  const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
+      obs, light.lightings, light.t, summary.scene_diagonal_m / 96, true, options.num_threads);
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   atlases->clear();
   maps->clear();
@@ -283,7 +285,7 @@ void SolverState::RenderResiduals(Scene model, int stage) {
   summary.render_residual_spp = kSpp;
   std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
-    if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+    if (light.lightings[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
   std::vector<Eigen::Vector3d> pred(obs.size()), pred1(obs.size()), pred2(obs.size());
   Progress progress(fmt::format("igi-solve: rendering the stage-{} model", stage),
@@ -377,7 +379,7 @@ void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) 
   IncidentFromRenderer(model, uint64_t(round));
   if (spdlog::should_log(spdlog::level::debug)) {
     size_t entries = 0, lists = 0;
-    for (const auto& inc : obs_incident) entries += inc.capacity(), lists += !inc.empty();
+    for (const auto& inc : light.incident) entries += inc.capacity(), lists += !inc.empty();
     spdlog::debug("round {}: {} incident lists, {:.2f} GiB; peak so far {:.2f} GiB", round, lists,
                   entries * sizeof(IncidentLocal) / kGiB, PeakResidentBytes() / kGiB);
   }
@@ -401,7 +403,7 @@ void SolverState::RunStage2() {
   } cleanup{temp};
   std::vector<RegionAtlas> atlases;
   std::vector<Image> maps;
-  const std::vector<MaterialState> stage1 = materials;
+  const std::vector<MaterialState> stage1 = materials.regions;
   RenderResiduals(CompleteScene(&atlases, &maps, temp / "s1", true), 1);
   for (int round = 1; round <= options.refine_iterations; ++round) {
     RefineRound(round, temp / std::to_string(round));
@@ -434,8 +436,8 @@ void SolverState::RunStage2() {
 
 void SolverState::BuildAlbedoMaps() {
   std::vector<RegionAtlas> generated;
-  const std::vector<Eigen::Vector3d> smooth_t =
-      NeighbourMean(obs_t, summary.scene_diagonal_m / 96, true);
+  const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
+      obs, light.lightings, light.t, summary.scene_diagonal_m / 96, true, options.num_threads);
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   // Regions whose maps come from their own pass over the photos (observations drawn to a
   // budget), on atlases at the photos' footprint.
@@ -454,7 +456,8 @@ void SolverState::BuildAlbedoMaps() {
           rs.name, 100 * rs.texel_variation);
     }
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
-    if (options.albedo_map_pass == "always" || (options.albedo_map_pass == "auto" && draw.census)) {
+    if (options.albedo_map_pass == "always" ||
+        (options.albedo_map_pass == "auto" && obs.draw.census)) {
       AtlasOptions ao;
       ao.texel_size_m = summary.map_texel_size_m;
       streamed.push_back(int(r));

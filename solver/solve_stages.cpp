@@ -10,8 +10,6 @@
 #include <filesystem>
 
 #include "solver/albedo_map.h"
-#include "solver/held_out_albedo.h"
-#include "solver/neighbour_mean.h"
 #include "solver/observation_grid.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
@@ -69,33 +67,21 @@ double RelChange(double a, double b, double floor) {
 
 }  // namespace
 
-Eigen::Vector3d SolverState::KnownAlbedo(const Observation& o) const {
-  const MaterialState& m = materials[o.region];
-  if (m.known_map && scene.mesh.has_uvs()) {
-    const Eigen::Vector3i& t = scene.mesh.triangles[o.triangle];
-    const Eigen::Vector2d uv = ((1.0f - o.b1 - o.b2) * scene.mesh.uvs[t[0]] +
-                                o.b1 * scene.mesh.uvs[t[1]] + o.b2 * scene.mesh.uvs[t[2]])
-                                   .cast<double>();
-    return SampleTexture(*m.known_map, uv);
-  }
-  return m.params.rho_d;
-}
-
 void SolverState::IncidentFromPatches() {
   const size_t n = obs.size();
-  obs_e_direct.resize(n);
-  obs_e_indirect.resize(n);
-  obs_incident.resize(n);
-  for (LightingState& st : lighting_state) {
+  light.e_direct.resize(n);
+  light.e_indirect.resize(n);
+  light.incident.resize(n);
+  for (LightingState& st : light.lightings) {
     if (!st.active) continue;
     ParallelFor(
         0, int64_t(st.obs.size()),
         [&](int64_t k) {
           const int i = st.obs[k];
           const Observation& o = obs[i];
-          const GatherPoint& gp = st.gather.points[obs_point[i]];
+          const GatherPoint& gp = st.gather.points[light.point[i]];
           const bool glossy = HasSpecularLobe(materials[o.region].params.model);
-          const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
+          const Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
           if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
@@ -109,9 +95,9 @@ void SolverState::IncidentFromPatches() {
                   {frame.ToLocal(s.wi.cast<double>()).cast<float>(), (s.weight * l).cast<float>()});
             }
           }
-          obs_e_direct[i] = gp.e_direct.cast<double>();
-          obs_e_indirect[i] = e;
-          obs_incident[i] = std::move(inc);
+          light.e_direct[i] = gp.e_direct.cast<double>();
+          light.e_indirect[i] = e;
+          light.incident[i] = std::move(inc);
         },
         options.num_threads);
   }
@@ -121,7 +107,7 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
-    if (lighting_state[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+    if (light.lightings[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
   }
   std::atomic<uint64_t> rays{0};
   // The joint update also needs the derivatives of each region's fitted light with respect to
@@ -150,11 +136,11 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
         for (int64_t i = chunk * chunk_size; i < end; ++i) {
           const Observation& o = obs[i];
           const int l = scene.photos[o.photo].lighting;
-          const LightingState& st = lighting_state[l];
-          const GatherPoint& gp = st.gather.points[obs_point[i]];
+          const LightingState& st = light.lightings[l];
+          const GatherPoint& gp = st.gather.points[light.point[i]];
           const MaterialState& m = materials[o.region];
           const bool glossy = HasSpecularLobe(m.params.model);
-          const Frame frame = LocalFrame(o.region, o.normal.cast<double>());
+          const Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           GatherQuery q;
           q.position = o.position.cast<double>();
           q.view = o.view.cast<double>();
@@ -168,11 +154,11 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           // its written values are no noisier than a large region's.
           const int base = final_round ? FinalRoundRays(options.refine_final_rays, m.observations)
                                        : options.refine_rays;
-          const int n = base * (glossy && in_fit[i] ? 4 : 1);
+          const int n = base * (glossy && obs.in_fit[i] ? 4 : 1);
           std::vector<IncidentLocal> inc;
           if (glossy) inc = DirectIncident(st, gp, frame, n);
           const double eps = lighting_scenes[l]->ray_epsilon;
-          const bool summed = sums != nullptr && in_fit[i];
+          const bool summed = sums != nullptr && obs.in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
           // The lobe's weight of an incident direction (ComputeSpecularTerms' T = Σ S·W·v).
           const double ax = WidenedAlpha(m.params.AlphaX(), o.lobe_blur2);
@@ -213,57 +199,29 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
           }
           if (summed) sums->Add(o.region, d_e, d_t, t);
           rays += k;
-          obs_e_direct[i] = gp.e_direct.cast<double>();
-          obs_e_indirect[i] = e;
-          obs_incident[i] = std::move(inc);
+          light.e_direct[i] = gp.e_direct.cast<double>();
+          light.e_indirect[i] = e;
+          light.incident[i] = std::move(inc);
         }
         progress.Add(1);
       },
       options.num_threads);
   progress.Finish();
-  joint_sums = JointSums();
+  light.joint_sums = JointSums();
   if (joint) {
-    joint_sums.Resize(num_regions);
-    for (const JointSums& c : chunk_sums) joint_sums.Add(c);
+    light.joint_sums.Resize(num_regions);
+    for (const JointSums& c : chunk_sums) light.joint_sums.Add(c);
   }
   summary.seconds_rays +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.rays += rays.load();
 }
 
-// The mean of `values` over each observation's neighbours: same region, normals within 25°,
-// within `radius`, and (same_photo) in the same photo, else any photo of the same lighting
-// (solver/neighbour_mean.h).
-std::vector<Eigen::Vector3d> SolverState::NeighbourMean(
-    const std::vector<Eigen::Vector3d>& values, double radius, bool same_photo,
-    const std::vector<float>* point_radius) const {
-  std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
-  std::vector<NeighbourPoint> points(obs.size());
-  for (size_t i = 0; i < obs.size(); ++i) {
-    points[i] = {obs[i].position, obs[i].normal, obs[i].region, obs[i].photo};
-  }
-  for (const LightingState& st : lighting_state) {
-    if (st.active) {
-      igi::NeighbourMean(points, values, st.obs, radius, same_photo, options.num_threads, &out,
-                         point_radius);
-    }
-  }
-  return out;
-}
-
-// The indirect irradiance varies slowly over a surface while its per-point estimate is noisy:
-// it is averaged over the observations (any photo of the same lighting) within the smoothing
-// radius on the same region.
 void SolverState::SmoothIrradiance() {
   const double radius =
       options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
-  if (obs_smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
-  double widest = 0;  // the grid's cell
-  for (float r : obs_smoothing_radius) widest = std::max(widest, double(r));
-  const std::vector<Eigen::Vector3d> smooth =
-      NeighbourMean(obs_e_indirect, widest, false, &obs_smoothing_radius);
-  obs_e.resize(obs.size());
-  for (size_t i = 0; i < obs.size(); ++i) obs_e[i] = obs_e_direct[i] + smooth[i];
+  if (light.smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
+  igi::SmoothIrradiance(obs, options.num_threads, &light);
 }
 
 namespace {
@@ -281,12 +239,12 @@ constexpr double kMostDrawWidening = 4;
 // was drawn.
 std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
   std::vector<float> out(obs.size(), float(radius));
-  if (!draw.census) return out;
+  if (!obs.draw.census) return out;
   const double widest = kMostDrawWidening * radius;
   const int reach = int(std::ceil(kMostDrawWidening));
   const size_t k = size_t(kSmoothingNeighbours) - 1;
   // Cells of the radius: where `radius` holds enough (the densely drawn), one cell around.
-  const ObservationGrid grid(*this, std::vector<char>(materials.size(), 1), radius);
+  const ObservationGrid grid(scene, obs, std::vector<char>(materials.size(), 1), radius);
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
@@ -327,7 +285,7 @@ std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
 // triangle has vertex normals more than 0.01 rad apart) a wider mean biases it (igi-synth's
 // sphere: ρd −2.7 % → −3.2 % when it grew there too).
 void SolverState::ComputeSmoothingRadii(double radius) {
-  obs_smoothing_radius = DrawnSmoothingRadii(radius);
+  light.smoothing_radius = DrawnSmoothingRadii(radius);
   if (!(options.smoothing_accuracy > 0)) return;
   const double min_d = 0.5 * summary.patch_size_m;
   const TriangleMesh& mesh = scene.mesh;
@@ -337,12 +295,12 @@ void SolverState::ComputeSmoothingRadii(double radius) {
     const Eigen::Vector3f &a = mesh.normals[v[0]], &b = mesh.normals[v[1]], &c = mesh.normals[v[2]];
     return std::min({a.dot(b), b.dot(c), a.dot(c)}) < 0.99995f;  // 0.01 rad apart
   };
-  for (const LightingState& st : lighting_state) {
+  for (const LightingState& st : light.lightings) {
     if (!st.active) continue;
     for (int i : st.obs) {
-      const GatherPoint& gp = st.gather.points[obs_point[i]];
+      const GatherPoint& gp = st.gather.points[light.point[i]];
       const int n = int(gp.indirect_end - gp.indirect_begin);
-      const double base = obs_smoothing_radius[i];
+      const double base = light.smoothing_radius[i];
       if (n <= 0) continue;
       double inv = 0;
       for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
@@ -353,77 +311,7 @@ void SolverState::ComputeSmoothingRadii(double radius) {
       }
       const double most = curved(obs[i].triangle) ? base : 2 * base;
       const double r = inv > 0 ? options.smoothing_accuracy * n / inv : most;
-      obs_smoothing_radius[i] = float(std::clamp(r, 0.25 * base, most));
-    }
-  }
-}
-
-void SolverState::ComputeSpecularTerms() {
-  obs_t.resize(obs.size());
-  ParallelFor(
-      0, int64_t(obs.size()),
-      [&](int64_t i) {
-        const MaterialState& m = materials[obs[i].region];
-        Eigen::Vector3d t = Eigen::Vector3d::Zero();
-        if (HasSpecularLobe(m.params.model)) {
-          const Eigen::Vector3d wo = LocalFrame(obs[i].region, obs[i].normal.cast<double>())
-                                         .ToLocal(obs[i].view.cast<double>());
-          const double ax = WidenedAlpha(m.params.AlphaX(), obs[i].lobe_blur2);
-          const double ay = WidenedAlpha(m.params.AlphaY(), obs[i].lobe_blur2);
-          for (const IncidentLocal& inc : obs_incident[i]) {
-            const double w =
-                SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.Wi().cast<double>());
-            if (w > 0) t += w * inc.Value().cast<double>();
-          }
-        }
-        obs_t[i] = t;
-      },
-      options.num_threads);
-}
-
-// For each glossy region with an unknown, varying albedo and a fitted lobe: every observation's
-// albedo as the other photos see it off their highlights (modelled specular part under 10 % of
-// the modelled radiance in every channel, from the current parameters), per texel of the albedo
-// map's size. Kept as two parts, the held-out πL/E (obs_rho_d_held) and the lobe those samples
-// carry per unit ρs, πT/E (obs_held_lobe): the albedo is their difference at the ρs being fitted,
-// so that the fit takes ρs from both (solver/region_fit.h) instead of from the previous iteration.
-void SolverState::HeldOutAlbedos() {
-  obs_rho_d_held.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
-  obs_held_lobe.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
-  held_atlases.resize(materials.size());
-  for (size_t r = 0; r < materials.size(); ++r) {
-    const MaterialState& m = materials[r];
-    if (!m.NeedsFit() || !m.unknown_rho_d || m.no_highlight || !HasSpecularLobe(m.params.model) ||
-        !m.last_fit.fitted || !m.last_fit.albedo_varies || m.observations == 0) {
-      continue;
-    }
-    if (!held_atlases[r]) {
-      AtlasOptions ao;
-      ao.texel_size_m = summary.texel_size_m;
-      held_atlases[r] = std::make_unique<RegionAtlas>(BuildRegionAtlas(scene.mesh, int(r), ao));
-    }
-    HeldOutAlbedo held(*held_atlases[r]), lobe(*held_atlases[r]);
-    for (size_t i = 0; i < obs.size(); ++i) {
-      const Observation& o = obs[i];
-      if (o.region != int(r)) continue;
-      const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(obs_t[i]);
-      // Off the highlight by the model, not by the observation: a test on the observed radiance
-      // would let noise that brightens a pixel pass and bias the albedo. The model's diffuse part
-      // takes the region's mean albedo, not the patch's: a patch's albedo follows its texels
-      // (and its own samples' noise), and a bright patch would pass more of its samples closer
-      // to the highlight than a dark one, raising the held-out albedo where the lobe is fitted
-      // (on the true floor texture with exact radiances, the patch's albedo moved rho_s by
-      // several per cent, the region's mean by 0.2 %).
-      const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(obs_e[i]) / kPi;
-      if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
-      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), obs_e[i]);
-      lobe.Add(o.photo, o.triangle, o.b1, o.b2, kPi * obs_t[i], obs_e[i]);
-    }
-    for (size_t i = 0; i < obs.size(); ++i) {
-      const Observation& o = obs[i];
-      if (o.region != int(r) || !in_fit[i]) continue;
-      obs_rho_d_held[i] = held.At(o.photo, o.triangle, o.b1, o.b2);
-      obs_held_lobe[i] = lobe.At(o.photo, o.triangle, o.b1, o.b2);
+      light.smoothing_radius[i] = float(std::clamp(r, 0.25 * base, most));
     }
   }
 }
@@ -448,7 +336,7 @@ JointUpdate SolverState::JointParams(const std::vector<int>& regions,
   out.rho_d.assign(regions.size(), none);
   out.rho_s.assign(regions.size(), none);
   out.feedback.assign(regions.size(), none);
-  const JointSums& js = joint_sums;
+  const JointSums& js = light.joint_sums;
   if (js.regions != num_regions) return out;
   const bool lobes = options.refine_update == "joint";
   // The unknowns (entry of `regions`, kind), and the known α changes (ln of the ratio).
@@ -482,7 +370,7 @@ JointUpdate SolverState::JointParams(const std::vector<int>& regions,
   // ΣE per fitted region over its fit observations (the fits' E: smoothed, direct included).
   std::vector<Eigen::Vector3d> sum_e(num_regions, Eigen::Vector3d::Zero());
   for (size_t i = 0; i < obs.size(); ++i) {
-    if (in_fit[i]) sum_e[obs[i].region] += obs_e[i];
+    if (obs.in_fit[i]) sum_e[obs[i].region] += light.e[i];
   }
   for (int c = 0; c < 3; ++c) {
     Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, n);
@@ -548,7 +436,7 @@ JointUpdate SolverState::JointParams(const std::vector<int>& regions,
 
 double SolverState::FitAll(int stage, int iteration) {
   const auto start = std::chrono::steady_clock::now();
-  HeldOutAlbedos();
+  HeldOutAlbedos(obs, light.e, light.t, scene.mesh, summary.texel_size_m, &materials);
   std::vector<int> regions;
   for (size_t r = 0; r < materials.size(); ++r) {
     if (materials[r].NeedsFit() && materials[r].observations > 0) regions.push_back(int(r));
@@ -577,32 +465,32 @@ double SolverState::FitAll(int stage, int iteration) {
     if (m.last_fit.fitted && HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
     in.use_held_albedo = options.held_out_albedo;
-    in.num_slots = static_cast<int>(region_patches[r].size());
-    for (int q : region_patches[r]) in.slot_area.push_back(patches.area[q]);
+    in.num_slots = static_cast<int>(materials.region_patches[r].size());
+    for (int q : materials.region_patches[r]) in.slot_area.push_back(patches.area[q]);
   }
   std::vector<int> index_of(materials.size(), -1);
   for (size_t k = 0; k < regions.size(); ++k) index_of[regions[k]] = int(k);
   std::vector<size_t> samples(regions.size(), 0);
   for (size_t i = 0; i < obs.size(); ++i) {
-    if (in_fit[i] && index_of[obs[i].region] >= 0) ++samples[index_of[obs[i].region]];
+    if (obs.in_fit[i] && index_of[obs[i].region] >= 0) ++samples[index_of[obs[i].region]];
   }
   for (size_t k = 0; k < regions.size(); ++k) inputs[k].samples.reserve(samples[k]);
   for (size_t i = 0; i < obs.size(); ++i) {
     const Observation& o = obs[i];
-    if (!in_fit[i] || index_of[o.region] < 0) continue;
+    if (!obs.in_fit[i] || index_of[o.region] < 0) continue;
     RegionFitInput& in = inputs[index_of[o.region]];
     FitSample s;
     s.observed = o.radiance.cast<double>();
-    s.irradiance = obs_e[i];
-    s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : KnownAlbedo(o);
-    s.slot = patch_slot[o.patch];
-    s.rho_d_held = obs_rho_d_held[i];
-    s.held_lobe = obs_held_lobe[i];
+    s.irradiance = light.e[i];
+    s.rho_d_known = in.fit_rho_d ? Eigen::Vector3d::Zero() : materials.KnownAlbedo(scene.mesh, o);
+    s.slot = materials.patch_slot[o.patch];
+    s.rho_d_held = materials.held_rho_d[i];
+    s.held_lobe = materials.held_lobe[i];
     s.wo =
-        LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+        materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
     s.lobe_blur2 = o.lobe_blur2;
-    s.incident = obs_incident[i].data();  // read in place: the fit copies nothing
-    s.incident_count = int64_t(obs_incident[i].size());
+    s.incident = light.incident[i].data();  // read in place: the fit copies nothing
+    s.incident_count = int64_t(light.incident[i].size());
     in.samples.push_back(s);
   }
   for (size_t k = 0; k < regions.size(); ++k) {
@@ -721,7 +609,7 @@ double SolverState::FitAll(int stage, int iteration) {
 }
 
 void SolverState::UpdateIrradiance() {
-  for (LightingState& st : lighting_state) {
+  for (LightingState& st : light.lightings) {
     if (st.active) UpdatePatchRadiance(&st);
   }
   IncidentFromPatches();
@@ -748,12 +636,12 @@ double SolverState::FitUnobservedAlbedos() {
     MaterialState& mu = materials[u];
     if (!mu.reflective || !mu.unknown_rho_d || mu.observations > 0) continue;
     const Eigen::Vector3d rho0 = mu.params.rho_d;
-    const std::vector<Eigen::Vector3d> e0 = obs_e;
+    const std::vector<Eigen::Vector3d> e0 = light.e;
     const Eigen::Vector3d rho1 =
         (rho0.array() < 0.5).select(rho0.array() + 0.3, rho0.array() - 0.3);
     mu.params.rho_d = rho1;
     UpdateIrradiance();
-    const std::vector<Eigen::Vector3d> e1 = obs_e;
+    const std::vector<Eigen::Vector3d> e1 = light.e;
     // Evidence: per region, the sums of its observations' L² , L·a, L·b, a², a·b, b².
     struct Sums {
       Eigen::Vector3d ll = Eigen::Vector3d::Zero(), la = ll, lb = ll, aa = ll, ab = ll, bb = ll;
@@ -834,7 +722,7 @@ double SolverState::FitUnobservedAlbedos() {
 }
 
 void SolverState::RunStage1() {
-  obs_t.assign(obs.size(), Eigen::Vector3d::Zero());
+  light.t.assign(obs.size(), Eigen::Vector3d::Zero());
   summary.converged = false;
   for (int it = 1; it <= options.max_iterations; ++it) {
     UpdateIrradiance();
@@ -860,7 +748,7 @@ void SolverState::RunStage1() {
         summary.message);
   }
   summary.stage1_model_residual = summary.history.empty() ? 0 : summary.history.back().relative_rms;
-  obs_e_stage1 = obs_e;
+  light.e_stage1 = light.e;
   for (size_t r = 0; r < materials.size(); ++r) {
     summary.regions[r].stage1 = summary.regions[r].stage2 = materials[r].last_fit;
     materials[r].stage1_albedo_varies = materials[r].last_fit.albedo_varies;

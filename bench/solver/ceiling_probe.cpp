@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
   const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
   const int lighting = 0;
   const Renderer ref(truth_scene, lighting);
-  const LightingState& st = s.lighting_state[lighting];
+  const LightingState& st = s.light.lightings[lighting];
   std::vector<int> count(s.patches.size(), 0);
   for (int i : st.obs) ++count[s.obs[i].patch];
   std::vector<int> subset;
@@ -131,9 +131,9 @@ int main(int argc, char** argv) {
         const int i = subset[k];
         const Observation& o = s.obs[i];
         Row& row = rows[k];
-        row.e_dir = s.obs_e_direct[i];
-        row.e_ind_raw = s.obs_e_indirect[i];
-        row.e_ind_smooth = s.obs_e[i] - s.obs_e_direct[i];
+        row.e_dir = s.light.e_direct[i];
+        row.e_ind_raw = s.light.e_indirect[i];
+        row.e_ind_smooth = s.light.e[i] - s.light.e_direct[i];
         row.l_photo = o.radiance.cast<double>();
         const double eps = s.lighting_scenes[lighting]->ray_epsilon;
         GatherQuery q;
@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
           row.e_ind_ref += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * eps, d.wi, 1,
                                                             uint64_t(i) * 65536 + ray++);
         }
-        const GatherPoint& gp = st.gather.points[s.obs_point[i]];
+        const GatherPoint& gp = st.gather.points[s.light.point[i]];
         for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
           const IndirectSample& is = st.gather.indirect[j];
           const Eigen::Vector3d wi = is.wi.cast<double>();
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
               hq.n_s = h->n_s;
               hq.view = -wi;
               hq.lobe = true;
-              const Frame frame = s.LocalFrame(hr, h->n_s);
+              const Frame frame = s.materials.LocalFrame(hr, h->n_s);
               const Eigen::Vector3d wo = frame.ToLocal(-wi);
               Pcg32 r2(j * 3 + 1, 11);
               int m = 0;
@@ -290,13 +290,13 @@ int main(int argc, char** argv) {
       s.IncidentFromRenderer(variant == 0 ? truth_scene : model, std::stoull(kv["round"]));
       Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
       for (size_t k = 0; k < rows.size(); ++k) {
-        sum += s.obs_e_indirect[subset[k]];
+        sum += s.light.e_indirect[subset[k]];
         ref_sum += rows[k].e_ind_ref;
       }
       {
         std::vector<std::pair<double, size_t>> r;
         for (size_t k = 0; k < rows.size(); ++k)
-          r.emplace_back(s.obs_e_indirect[subset[k]].sum() / rows[k].e_ind_ref.sum(), k);
+          r.emplace_back(s.light.e_indirect[subset[k]].sum() / rows[k].e_ind_ref.sum(), k);
         std::sort(r.rbegin(), r.rend());
         for (int j = 0; j < 5 && j < int(r.size()); ++j)
           std::printf("  top ratio %.3f obs %d\n", r[j].first, subset[r[j].second]);
@@ -317,7 +317,7 @@ int main(int argc, char** argv) {
   // centres (direct and indirect) against a reference of the true scene there.
   std::map<int, int> hits;
   for (int i : subset) {
-    const GatherPoint& gp = st.gather.points[s.obs_point[i]];
+    const GatherPoint& gp = st.gather.points[s.light.point[i]];
     for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
       const int q = st.gather.indirect[j].patch;
       if (q >= 0 && count[q] == 0) ++hits[q];
@@ -345,7 +345,7 @@ int main(int argc, char** argv) {
         const GatherPoint& gp = st.gather.points[st.first_patch_point + q];
         const Eigen::Vector3d e_dir = gp.e_direct.cast<double>();
         pe[k] = {e_dir.sum(), (st.patch_e[q].cast<double>() - e_dir).sum(), e.sum(),
-                 double(hits[q]), s.PatchAlbedo(q).sum()};
+                 double(hits[q]), s.materials.PatchAlbedo(s.patches, q).sum()};
       },
       2, 1);
   std::map<std::string, std::array<double, 6>> by_region;

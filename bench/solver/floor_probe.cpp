@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
     const Observation& o = s.obs[i];
     if (o.region != floor) continue;
     const Eigen::Vector3d wo =
-        s.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
-    for (const IncidentLocal& inc : s.obs_incident[i]) {
+        s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
+    for (const IncidentLocal& inc : s.light.incident[i]) {
       const double w =
           SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
       if (w > 0) t_true[i] += w * inc.Value().cast<double>();
@@ -88,16 +88,16 @@ int main(int argc, char** argv) {
       if (o.region != floor) continue;
       const Eigen::Vector3d r = SampleTexture(tex, uv_of(o));
       const Eigen::Vector3d spec = rs_true * t_true[i];
-      const double share = spec.mean() / (r.cwiseProduct(s.obs_e[i]).mean() / kPi + spec.mean());
+      const double share = spec.mean() / (r.cwiseProduct(s.light.e[i]).mean() / kPi + spec.mean());
       const Eigen::Vector3d err =
-          (kPi * (o.radiance.cast<double>() - spec)).cwiseQuotient(s.obs_e[i]) - r;
+          (kPi * (o.radiance.cast<double>() - spec)).cwiseQuotient(s.light.e[i]) - r;
       const int b = share < 0.01 ? 0 : share < 0.03 ? 1 : share < 0.1 ? 2 : share < 0.2 ? 3 : 4;
       for (std::string key :
            {fmt::format("photo {} share<{}", o.photo, b), fmt::format("all share<{}", b),
-            fmt::format("photo {} fit {}", o.photo, int(s.in_fit[i]))}) {
+            fmt::format("photo {} fit {}", o.photo, int(s.obs.in_fit[i]))}) {
         auto& v = bins[key];
-        v[0] += err.mean() * s.obs_e[i].mean();
-        v[1] += r.mean() * s.obs_e[i].mean();
+        v[0] += err.mean() * s.light.e[i].mean();
+        v[1] += r.mean() * s.light.e[i].mean();
         v[2] += 1;
       }
     }
@@ -148,14 +148,14 @@ int main(int argc, char** argv) {
           }
           const Eigen::Vector3d eref = g.points[0].e_direct.cast<double>() + eind;
           const Eigen::Vector3d r = SampleTexture(tex, uv_of(o));
-          const Eigen::Vector3d model = r.cwiseProduct(s.obs_e[i]) / kPi + rs_true * t_true[i];
+          const Eigen::Vector3d model = r.cwiseProduct(s.light.e[i]) / kPi + rs_true * t_true[i];
           const Eigen::Vector3d model_ref = r.cwiseProduct(eref) / kPi + rs_true * t_true[i];
           res[k] = {lref.mean(),
                     model.mean(),
                     model_ref.mean(),
-                    s.obs_e[i].mean(),
+                    s.light.e[i].mean(),
                     eref.mean(),
-                    s.obs_e_direct[i].mean(),
+                    s.light.e_direct[i].mean(),
                     double(g.points[0].e_direct.mean()),
                     (rs_true * t_true[i]).mean()};
         },
@@ -197,30 +197,30 @@ int main(int argc, char** argv) {
           if (o.region != floor) continue;
           const Eigen::Vector3d l = o.radiance.cast<double>();
           const Eigen::Vector3d spec =
-              var == 0 ? Eigen::Vector3d(m.params.rho_s.cwiseProduct(s.obs_t[i]))
+              var == 0 ? Eigen::Vector3d(m.params.rho_s.cwiseProduct(s.light.t[i]))
                        : Eigen::Vector3d(rs_true * t_true[i]);
-          const Eigen::Vector3d alb = sel_mode == 0   ? s.PatchAlbedo(o.patch)
+          const Eigen::Vector3d alb = sel_mode == 0   ? s.materials.PatchAlbedo(s.patches, o.patch)
                                       : sel_mode == 1 ? Eigen::Vector3d(m.params.rho_d)
                                                       : SampleTexture(tex, uv_of(o));
-          const Eigen::Vector3d diffuse = alb.cwiseProduct(s.obs_e[i]) / kPi;
+          const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / kPi;
           const bool off = !(spec.array() > thr * (diffuse + spec).array()).any();
           const Eigen::Vector3d numer =
-              var == 2 ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.obs_e[i]))
+              var == 2 ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]))
                        : Eigen::Vector3d(kPi * (l - spec));
-          if (off) held.Add(o.photo, o.triangle, o.b1, o.b2, numer, s.obs_e[i]);
+          if (off) held.Add(o.photo, o.triangle, o.b1, o.b2, numer, s.light.e[i]);
           const TexelSplat sp = BilinearTexelSplat(atlas, o.triangle, o.b1, o.b2);
           for (int k = 0; k < 4; ++k) {
             const double w = sp.weight[k];
             if (!(w > 0)) continue;
             const int64_t key = int64_t(sp.y[k]) * atlas.width + sp.x[k];
             for (Acc* a : {&tot[key], &per[o.photo * nt + key]}) {
-              if (off) a->n += w * numer, a->d += w * s.obs_e[i], a->w += w;
-              if (s.in_fit[i]) {
+              if (off) a->n += w * numer, a->d += w * s.light.e[i], a->w += w;
+              if (s.obs.in_fit[i]) {
                 // the fit side: the observed radiance (var 2: the true texture's diffuse + true
                 // lobe)
                 const Eigen::Vector3d lv =
                     var == 2 ? Eigen::Vector3d(numer / kPi + rs_true * t_true[i]) : l;
-                a->l += w * lv, a->e += w * s.obs_e[i], a->t += w * t_true[i], a->wf += w;
+                a->l += w * lv, a->e += w * s.light.e[i], a->t += w * t_true[i], a->wf += w;
               }
             }
           }
@@ -228,16 +228,16 @@ int main(int argc, char** argv) {
         double num = 0, den = 0;
         for (size_t i = 0; i < s.obs.size(); ++i) {
           const Observation& o = s.obs[i];
-          if (o.region != floor || !s.in_fit[i]) continue;
+          if (o.region != floor || !s.obs.in_fit[i]) continue;
           const Eigen::Vector3d h = held.At(o.photo, o.triangle, o.b1, o.b2);
           if (!h.allFinite()) continue;
           const Eigen::Vector3d lv =
               var == 2
-                  ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.obs_e[i]) / kPi +
+                  ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]) / kPi +
                                     rs_true * t_true[i])
                   : Eigen::Vector3d(o.radiance.cast<double>());
           for (int c = 0; c < 3; ++c) {
-            num += (lv[c] - h[c] * s.obs_e[i][c] / kPi) * t_true[i][c];
+            num += (lv[c] - h[c] * s.light.e[i][c] / kPi) * t_true[i][c];
             den += t_true[i][c] * t_true[i][c];
           }
         }
@@ -266,23 +266,24 @@ int main(int argc, char** argv) {
             const Observation& o = s.obs[i];
             if (o.region != floor) continue;
             const Eigen::Vector3d spec =
-                var == 0 ? Eigen::Vector3d(m.params.rho_s.cwiseProduct(s.obs_t[i]))
+                var == 0 ? Eigen::Vector3d(m.params.rho_s.cwiseProduct(s.light.t[i]))
                          : Eigen::Vector3d(rs_true * t_true[i]);
-            const Eigen::Vector3d alb = sel_mode == 0 ? s.PatchAlbedo(o.patch) : m.params.rho_d;
-            const Eigen::Vector3d diffuse = alb.cwiseProduct(s.obs_e[i]) / kPi;
+            const Eigen::Vector3d alb =
+                sel_mode == 0 ? s.materials.PatchAlbedo(s.patches, o.patch) : m.params.rho_d;
+            const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / kPi;
             if ((spec.array() > thr * (diffuse + spec).array()).any()) continue;
-            h0.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), s.obs_e[i]);
-            tau.Add(o.photo, o.triangle, o.b1, o.b2, kPi * t_true[i], s.obs_e[i]);
+            h0.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), s.light.e[i]);
+            tau.Add(o.photo, o.triangle, o.b1, o.b2, kPi * t_true[i], s.light.e[i]);
           }
           double n3 = 0, d3 = 0;
           for (size_t i = 0; i < s.obs.size(); ++i) {
             const Observation& o = s.obs[i];
-            if (o.region != floor || !s.in_fit[i]) continue;
+            if (o.region != floor || !s.obs.in_fit[i]) continue;
             const Eigen::Vector3d h = h0.At(o.photo, o.triangle, o.b1, o.b2),
                                   tu = tau.At(o.photo, o.triangle, o.b1, o.b2);
             if (!h.allFinite() || !tu.allFinite()) continue;
             for (int c = 0; c < 3; ++c) {
-              const double a = s.obs_e[i][c] / kPi;
+              const double a = s.light.e[i][c] / kPi;
               const double u = o.radiance[c] - h[c] * a, v = t_true[i][c] - tu[c] * a;
               n3 += u * v, d3 += v * v;
             }
@@ -304,15 +305,15 @@ int main(int argc, char** argv) {
                "true2,patch0,patch1,patch2,Edir0\n");
   for (size_t i = 0; i < s.obs.size(); ++i) {
     const Observation& o = s.obs[i];
-    if (o.region != floor || !s.in_fit[i]) continue;
+    if (o.region != floor || !s.obs.in_fit[i]) continue;
     const Eigen::Vector3i& t = scene.mesh.triangles[o.triangle];
     const Eigen::Vector2d uv = ((1.0f - o.b1 - o.b2) * scene.mesh.uvs[t[0]] +
                                 o.b1 * scene.mesh.uvs[t[1]] + o.b2 * scene.mesh.uvs[t[2]])
                                    .cast<double>();
     const Eigen::Vector3d wo =
-        s.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
+        s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     double tt = 0, tf = 0;
-    for (const IncidentLocal& inc : s.obs_incident[i]) {
+    for (const IncidentLocal& inc : s.light.incident[i]) {
       const double w1 =
           SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
       const double w2 = SpecularWeight(m.params.model, m.params.alpha, m.params.alpha, m.params.ior,
@@ -321,12 +322,12 @@ int main(int argc, char** argv) {
       if (w2 > 0) tf += w2 * inc.Value().cast<double>().mean();
     }
     const Eigen::Vector3d tr = SampleTexture(tex, uv);
-    const Eigen::Vector3d pa = s.PatchAlbedo(o.patch);
-    const Eigen::Vector3d& h = s.obs_rho_d_held[i];
+    const Eigen::Vector3d pa = s.materials.PatchAlbedo(s.patches, o.patch);
+    const Eigen::Vector3d& h = s.materials.held_rho_d[i];
     std::fprintf(f, "%d,%d,%d,%.6f,%.6f,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g\n",
                  o.photo, o.x, o.y, uv.x(), uv.y(), o.radiance[0], o.radiance[1], o.radiance[2],
-                 s.obs_e[i][0], s.obs_e[i][1], s.obs_e[i][2], tt, tf, h[0], h[1], h[2], tr[0],
-                 tr[1], tr[2], pa[0], pa[1], pa[2], s.obs_e_direct[i].mean());
+                 s.light.e[i][0], s.light.e[i][1], s.light.e[i][2], tt, tf, h[0], h[1], h[2], tr[0],
+                 tr[1], tr[2], pa[0], pa[1], pa[2], s.light.e_direct[i].mean());
   }
   std::fclose(f);
   return 0;

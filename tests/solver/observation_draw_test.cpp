@@ -228,7 +228,7 @@ TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSame
   int walls_fit = 0;
   const int walls = scene.FindMaterial("walls");
   for (size_t i = 0; i < thin.obs.size(); ++i)
-    walls_fit += thin.obs[i].region == walls && thin.in_fit[i];
+    walls_fit += thin.obs[i].region == walls && thin.obs.in_fit[i];
   EXPECT_GT(walls_fit, 0);
 }
 

@@ -56,7 +56,7 @@ Draw Prepare(const fs::path& scene_path) {
     if (ob.region == floor) ++d.floor_observations;
     if (ob.region != walls) continue;
     ++d.walls_observations;
-    if (!s.in_fit[i]) continue;
+    if (!s.obs.in_fit[i]) continue;
     ++d.walls_drawn;
     if (ob.photo == 1) d.cam1_walls.insert({ob.x, ob.y});
   }

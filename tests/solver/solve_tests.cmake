@@ -12,3 +12,6 @@ igi_add_test(solve_fit_samples_test SOURCES solve_fit_samples_test.cpp DEPS igi_
 # Observations drawn to a budget at collection, and the memory plan's refusal (the 2 m room with a
 # glossy floor, three Prepares; a few seconds).
 igi_add_test(observation_draw_test SOURCES observation_draw_test.cpp DEPS igi_solver)
+# The solve's data and the stages that are functions of them alone (the fit samples' draw, the
+# specular terms, the smoothing, the material estimate) on hand-made observations; instant.
+igi_add_test(solve_state_test SOURCES solve_state_test.cpp DEPS igi_solver)
