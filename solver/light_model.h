@@ -12,6 +12,7 @@
 #include "solver/gather.h"
 #include "solver/material_estimate.h"
 #include "solver/observation_set.h"
+#include "solver/patches.h"
 #include "solver/region_fit.h"
 #include "solver/render.h"
 
@@ -99,5 +100,33 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
                                            const MaterialEstimate& materials,
                                            const std::vector<std::vector<IncidentLocal>>& incident,
                                            int num_threads);
+
+// Each patch's direct samples (its gather point's) grouped into at most four representative
+// directions, for the specular part of the radiance it sends toward other points.
+void BuildPatchLobes(const PatchSet& patches, const MaterialEstimate& materials, LightingState* st);
+
+// The radiance arriving along an indirect sample: its patch's radiance toward the sample's point
+// (the diffuse patch_d plus the patch's lobe over its representative directions) plus the
+// specular light its glossy hit reflects from the sample's bounce.
+Eigen::Vector3d IndirectRadiance(const PatchSet& patches, const MaterialEstimate& materials,
+                                 const LightingState& st, const IndirectSample& s);
+
+// D_q, st->patch_d: the diffuse radiance of each patch, the photos' mean over its observations
+// (of st->obs) less their predicted specular part ρs·t; patches no photo of the lighting sees
+// get ρd·E/π, their irradiance E (st->patch_e) from the patches' new radiance (two sweeps).
+void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
+                         const MaterialEstimate& materials, const std::vector<Eigen::Vector3d>& t,
+                         int num_threads, LightingState* st);
+
+// Per observation of the active lightings: light->e_direct (its gather point's), light->
+// e_indirect (its indirect samples' radiance from the patches) and light->incident (both as
+// local-frame samples, for regions with a lobe).
+void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
+                         const MaterialEstimate& materials, int num_threads, LightModel* light);
+
+// A gather point's direct samples in the local shading frame, with room reserved for `more`
+// samples to follow.
+std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
+                                          const Frame& frame, int64_t more);
 
 }  // namespace igi

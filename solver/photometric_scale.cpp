@@ -215,11 +215,7 @@ void FollowPhotoUnits(SolverState* s) {
       if (m.reflective && m.unknown_rho_d && m.observations == 0) m.params.rho_d = sum / area;
     }
   }
-  for (LightingState& st : s->light.lightings) {
-    if (st.active) s->UpdatePatchRadiance(&st);
-  }
-  s->IncidentFromPatches();
-  s->SmoothIrradiance();
+  s->UpdateIrradiance();
 }
 
 }  // namespace

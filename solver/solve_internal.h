@@ -87,19 +87,8 @@ struct SolverState {
   void SelectFitSamples();
   void GatherAll();
   GatherQuery::Footprint PixelFootprint(const Observation& o) const;
-  void BuildPatchLobes(LightingState* st) const;
-  Eigen::Vector3d PatchSpecular(const LightingState& st, int q,
-                                const Eigen::Vector3d& toward) const;
-  Eigen::Vector3d PatchRadiance(const LightingState& st, int q,
-                                const Eigen::Vector3d& toward) const;
-  // The radiance arriving along an indirect sample: its patch's radiance toward the sample's
-  // point plus the specular light its glossy hit reflects from the sample's bounce.
-  Eigen::Vector3d BounceRadiance(const LightingState& st, const IndirectSample& s) const;
-  Eigen::Vector3d IndirectRadiance(const LightingState& st, const IndirectSample& s) const;
-  void UpdatePatchRadiance(LightingState* st);
 
   // solve_stages.cpp
-  void IncidentFromPatches();
   void IncidentFromRenderer(const Scene& model, uint64_t round);
   // light.e (SmoothIrradiance in solver/light_model.h), the smoothing radii computed first
   // where there are none yet.
@@ -119,7 +108,7 @@ struct SolverState {
                           const std::vector<RegionFitResult>& fits) const;
   void RunStage1();
   // Every active lighting's patch radiances, the observations' indirect irradiance and its
-  // smoothing from the current materials (obs_e).
+  // smoothing from the current materials (light.e).
   void UpdateIrradiance();
   // The ρd of regions no photo sees, from the light they bounce onto the regions the photos show
   // (stage 1, from its second iteration): returns the largest relative change.

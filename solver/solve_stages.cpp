@@ -47,61 +47,11 @@ Json ParamsJson(const MaterialState& m) {
   return j;
 }
 
-// A gather point's direct samples in the local shading frame (for the specular term), with room
-// reserved for `more` samples to follow: the list is allocated once at its final size (grown by
-// doubling, a glossy observation's 16 + 512 directions took 1024 slots).
-std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
-                                          const Frame& frame, int64_t more) {
-  std::vector<IncidentLocal> inc;
-  inc.reserve(size_t(gp.direct_end - gp.direct_begin + more));
-  for (int64_t d = gp.direct_begin; d < gp.direct_end; ++d) {
-    const DirectSample& ds = st.gather.direct[d];
-    inc.push_back({frame.ToLocal(ds.wi.cast<double>()).cast<float>(), ds.value});
-  }
-  return inc;
-}
-
 double RelChange(double a, double b, double floor) {
   return std::abs(a - b) / std::max(std::abs(b), floor);
 }
 
 }  // namespace
-
-void SolverState::IncidentFromPatches() {
-  const size_t n = obs.size();
-  light.e_direct.resize(n);
-  light.e_indirect.resize(n);
-  light.incident.resize(n);
-  for (LightingState& st : light.lightings) {
-    if (!st.active) continue;
-    ParallelFor(
-        0, int64_t(st.obs.size()),
-        [&](int64_t k) {
-          const int i = st.obs[k];
-          const Observation& o = obs[i];
-          const GatherPoint& gp = st.gather.points[light.point[i]];
-          const bool glossy = HasSpecularLobe(materials[o.region].params.model);
-          const Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
-          std::vector<IncidentLocal> inc;
-          if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);
-          Eigen::Vector3d e = Eigen::Vector3d::Zero();
-          for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
-            const IndirectSample& s = st.gather.indirect[d];
-            if (s.patch < 0) continue;
-            const Eigen::Vector3d l = IndirectRadiance(st, s);
-            e += s.weight * l;
-            if (glossy) {
-              inc.push_back(
-                  {frame.ToLocal(s.wi.cast<double>()).cast<float>(), (s.weight * l).cast<float>()});
-            }
-          }
-          light.e_direct[i] = gp.e_direct.cast<double>();
-          light.e_indirect[i] = e;
-          light.incident[i] = std::move(inc);
-        },
-        options.num_threads);
-  }
-}
 
 void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
   const auto start = std::chrono::steady_clock::now();
@@ -280,10 +230,10 @@ std::vector<float> SolverState::DrawnSmoothingRadii(double radius) const {
 // widened where the observations were drawn: DrawnSmoothingRadii). With it, Ward's
 // irradiance-cache radius: the harmonic mean distance R = N / Σ 1/d_k of its N indirect rays'
 // hits (a ray that meets no patch counts as infinitely far; d at least half a patch), times
-// smoothing_accuracy, within [1/4, 2] × its drawn radius. It grows beyond that radius only where the surface is
-// flat: the irradiance also changes with the normal, and on a curved surface (the observation's
-// triangle has vertex normals more than 0.01 rad apart) a wider mean biases it (igi-synth's
-// sphere: ρd −2.7 % → −3.2 % when it grew there too).
+// smoothing_accuracy, within [1/4, 2] × its drawn radius. It grows beyond that radius only where
+// the surface is flat: the irradiance also changes with the normal, and on a curved surface (the
+// observation's triangle has vertex normals more than 0.01 rad apart) a wider mean biases it
+// (igi-synth's sphere: ρd −2.7 % → −3.2 % when it grew there too).
 void SolverState::ComputeSmoothingRadii(double radius) {
   light.smoothing_radius = DrawnSmoothingRadii(radius);
   if (!(options.smoothing_accuracy > 0)) return;
@@ -486,8 +436,9 @@ double SolverState::FitAll(int stage, int iteration) {
     s.slot = materials.patch_slot[o.patch];
     s.rho_d_held = materials.held_rho_d[i];
     s.held_lobe = materials.held_lobe[i];
-    s.wo =
-        materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>()).cast<float>();
+    s.wo = materials.LocalFrame(o.region, o.normal.cast<double>())
+               .ToLocal(o.view.cast<double>())
+               .cast<float>();
     s.lobe_blur2 = o.lobe_blur2;
     s.incident = light.incident[i].data();  // read in place: the fit copies nothing
     s.incident_count = int64_t(light.incident[i].size());
@@ -610,9 +561,9 @@ double SolverState::FitAll(int stage, int iteration) {
 
 void SolverState::UpdateIrradiance() {
   for (LightingState& st : light.lightings) {
-    if (st.active) UpdatePatchRadiance(&st);
+    if (st.active) UpdatePatchRadiance(obs, patches, materials, light.t, options.num_threads, &st);
   }
-  IncidentFromPatches();
+  IncidentFromPatches(obs, patches, materials, options.num_threads, &light);
   SmoothIrradiance();
 }
 

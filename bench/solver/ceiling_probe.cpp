@@ -154,8 +154,9 @@ int main(int argc, char** argv) {
           const Eigen::Vector3d wi = is.wi.cast<double>();
           const Eigen::Vector3d l_true =
               ref.ReflectedRadiance(q.position + q.n_geo * eps, wi, paths, uint64_t(j) * 977 + 5);
-          const Eigen::Vector3d l_model =
-              is.patch < 0 ? Eigen::Vector3d::Zero() : s.IndirectRadiance(st, is);
+          const Eigen::Vector3d l_model = is.patch < 0
+                                              ? Eigen::Vector3d::Zero()
+                                              : IndirectRadiance(s.patches, s.materials, st, is);
           const std::string hit =
               is.patch < 0 ? "none" : scene.materials[s.patches.patch_region[is.patch]].name;
           const std::string b = is.patch < 0 ? "none" : Bucket(count[is.patch]);

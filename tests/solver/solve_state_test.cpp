@@ -126,6 +126,62 @@ TEST(SmoothIrradianceTest, AveragesTheIndirectOverTheSameRegionsNeighboursAndKee
   EXPECT_TRUE(light.e[0].isApprox(Eigen::Vector3d::Constant(1) + mean01, 1e-12));
 }
 
+// Two patches of one Lambertian region (ρd 0.5) under one lighting: patch 0 seen by the one
+// observation, patch 1 unseen and lit directly (E 4); patch 0's gather point has one indirect
+// sample toward patch 1, the observation's point two (toward patch 0 and patch 1).
+TEST(IrradianceFromPatchesTest, SeenPatchesSendThePhotosRadianceUnseenOnesTheirAlbedoTimesE) {
+  Scene scene;
+  Material walls = Named("walls", BrdfModel::kLambert);
+  walls.rho_d = Eigen::Vector3d::Constant(0.5);
+  scene.materials = {walls};
+  PatchSet patches;
+  patches.patch_triangle = {0, 1};
+  patches.patch_region = {0, 0};
+  patches.center = {Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()};
+  patches.normal = {Eigen::Vector3f::UnitZ(), Eigen::Vector3f::UnitZ()};
+  const MaterialEstimate materials = MaterialEstimate::FromScene(scene, patches);
+  ObservationSet obs;
+  obs.items = {At(0, 0, 0, 0, Eigen::Vector3f::Zero())};
+  obs[0].patch = 0;
+  obs[0].radiance = Eigen::Vector3f::Constant(0.3f);
+  LightModel light;
+  light.point = {0};
+  light.lightings.resize(1);
+  LightingState& st = light.lightings[0];
+  st.active = true;
+  st.obs = {0};
+  st.first_patch_point = 1;
+  auto indirect = [](int patch, float weight) {
+    IndirectSample s;
+    s.patch = patch, s.weight = weight;
+    return s;
+  };
+  st.gather.indirect = {indirect(0, 0.5f), indirect(1, 0.25f), indirect(1, 1.0f)};
+  st.gather.points.resize(3);
+  st.gather.points[0].e_direct = Eigen::Vector3f::Constant(1);
+  st.gather.points[0].indirect_begin = 0, st.gather.points[0].indirect_end = 2;
+  st.gather.points[1].e_direct = Eigen::Vector3f::Constant(2);
+  st.gather.points[1].indirect_begin = 2, st.gather.points[1].indirect_end = 3;
+  st.gather.points[2].e_direct = Eigen::Vector3f::Constant(4);
+  st.gather.points[2].indirect_begin = st.gather.points[2].indirect_end = 3;
+  st.patch_e = {Eigen::Vector3f::Constant(2), Eigen::Vector3f::Constant(4)};
+  st.patch_d.assign(2, Eigen::Vector3f::Zero());
+  BuildPatchLobes(patches, materials, &st);  // Lambertian: none
+
+  UpdatePatchRadiance(obs, patches, materials, {Eigen::Vector3d::Zero()}, 1, &st);
+  const double d1 = 0.5 * 4 / M_PI;
+  EXPECT_NEAR(st.patch_d[0].x(), 0.3, 1e-6);  // the photo's
+  EXPECT_NEAR(st.patch_d[1].x(), d1, 1e-6);   // ρd·E/π
+  EXPECT_NEAR(st.patch_e[0].x(), 2 + d1, 1e-6);
+  EXPECT_NEAR(st.patch_e[1].x(), 4, 1e-6);
+
+  IncidentFromPatches(obs, patches, materials, 1, &light);
+  ASSERT_EQ(light.e_indirect.size(), 1u);
+  EXPECT_EQ(light.e_direct[0], Eigen::Vector3d::Constant(1));
+  EXPECT_NEAR(light.e_indirect[0].x(), 0.5 * 0.3 + 0.25 * d1, 1e-6);
+  EXPECT_TRUE(light.incident[0].empty());  // no lobe: no samples kept
+}
+
 // The fit samples of region 1 (50 observations of photo 2, first) and region 0 (1000 over photos
 // 0 and 1, the first 300 near a highlight); region 2 is not fitted.
 ObservationSet FitSampleObservations(bool with_photo_2) {
