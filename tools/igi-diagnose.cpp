@@ -47,8 +47,8 @@ int main(int argc, char** argv) {
   app.add_option("--solve-stride", o.solve.pixel_stride, "igi-solve --pixel-stride")
       ->capture_default_str();
   app.add_option("--memory-budget", o.solve.memory_budget,
-                 "igi-solve --memory-budget for its solves, GiB (0 = the machine's memory less a "
-                 "margin)")
+                 "memory budget, GiB (0 = the machine's memory less a margin): the photos and "
+                 "re-renders at the analysis size are planned first, its solves get the rest")
       ->capture_default_str();
   app.add_option("--max-observations", o.solve.max_observations,
                  "igi-solve --max-observations for its solves (0 = as the memory budget allows)")

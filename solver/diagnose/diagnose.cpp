@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "solver/diagnose/analysis_capture.h"
+#include "solver/diagnose/diagnose_memory.h"
 #include "solver/diagnose/missing_geometry.h"
 #include "solver/diagnose/pose_error.h"
 #include "solver/diagnose/residual_fit.h"
@@ -23,6 +24,7 @@
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
+#include "tools/common/memory.h"
 
 namespace igi {
 namespace fs = std::filesystem;
@@ -814,24 +816,30 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, const DiagnoseOptions& o,
 DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs::path& out_dir) {
   o.Validate();
   const auto start = std::chrono::steady_clock::now();
+  // The memory plan before anything is read or written: the solves get what the diagnosis
+  // itself does not hold.
+  const DiagnoseMemoryPlan memory = PlanDiagnoseMemory(scene, o);
+  DiagnoseOptions inner = o;
+  inner.solve.memory_budget = memory.solve_budget_bytes / kGiB;
   const AnalysisCapture capture =
       ReduceCapture(scene, AbsoluteScenePaths(scene.document, scene.dir), o.analysis_megapixels,
                     out_dir / "analysis", o.show_progress);
   DiagnosisSummary sum;
   if (!capture.reduced) {
-    sum = DiagnoseCapture(scene, o, out_dir);
+    sum = DiagnoseCapture(scene, inner, out_dir);
   } else {
     for (const auto& [name, r] : capture.cameras) {
       spdlog::info("igi-diagnose: camera {}'s photos analysed as {}x{} blocks' means ({}x{})", name,
                    r.factor, r.factor, r.width, r.height);
     }
-    sum = DiagnoseCapture(LoadScene(capture.scene_file), o, out_dir);
+    sum = DiagnoseCapture(LoadScene(capture.scene_file), inner, out_dir);
     // The improved scene names the declared photos and intrinsics: what was fitted on the
     // reduced capture holds at full size.
     sum.final_scene = RelativeScenePaths(
         AtDeclaredSize(AbsoluteScenePaths(sum.final_scene, out_dir), scene), out_dir);
     sum.analysis = AnalysisCaptureJson(capture, o.analysis_megapixels);
   }
+  sum.memory = DiagnoseMemoryJson(memory, PeakResidentBytes());
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return sum;
 }

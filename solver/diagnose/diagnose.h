@@ -55,6 +55,7 @@ struct DiagnosisSummary {
   Json final_scene;        // the improved scene.json (paths relative to the output folder)
   std::vector<std::pair<Image, std::string>> final_images;  // photo, render, residual (first photo)
   Json analysis;  // the reduced capture analysed (AnalysisCaptureJson), null at full size
+  Json memory;    // the memory plan and the peak (DiagnoseMemoryJson)
   double seconds = 0;
 };
 

@@ -66,6 +66,7 @@ Json DiagnosisJson(const DiagnosisSummary& s, const DiagnoseOptions& o) {
                                         ">= {:.0f}% and >= {:.1f} standard errors",
                                         100 * o.min_gain, o.min_z)}};
   if (!s.analysis.is_null()) j["analysis"] = s.analysis;
+  if (!s.memory.is_null()) j["memory"] = s.memory;
   j["seconds"] = Num(s.seconds);
   return j;
 }
