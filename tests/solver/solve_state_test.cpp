@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "recon/scene.h"
+#include "solver/fit_inputs.h"
 #include "solver/light_model.h"
 #include "solver/material_estimate.h"
 #include "solver/observation_set.h"
@@ -180,6 +181,48 @@ TEST(IrradianceFromPatchesTest, SeenPatchesSendThePhotosRadianceUnseenOnesTheirA
   EXPECT_EQ(light.e_direct[0], Eigen::Vector3d::Constant(1));
   EXPECT_NEAR(light.e_indirect[0].x(), 0.5 * 0.3 + 0.25 * d1, 1e-6);
   EXPECT_TRUE(light.incident[0].empty());  // no lobe: no samples kept
+}
+
+// Two regions: walls (ρd unknown) and a box whose ρd is given (not fitted); the walls' two
+// observations, one a fit sample.
+TEST(FitInputsTest, OneInputPerFittedRegionWithASamplePerFitObservation) {
+  Scene scene;
+  Material walls = Named("walls", BrdfModel::kLambert);
+  Material box = Named("box", BrdfModel::kLambert);
+  box.rho_d = Eigen::Vector3d::Constant(0.4);
+  scene.materials = {walls, box};
+  PatchSet patches;
+  patches.patch_triangle = {0, 1, 2};
+  patches.patch_region = {0, 1, 0};
+  patches.area = {0.5f, 0.25f, 1.5f};
+  MaterialEstimate materials = MaterialEstimate::FromScene(scene, patches);
+  materials[0].observations = 2;
+  materials[1].observations = 1;
+  ObservationSet obs;
+  obs.items = {At(0, 0, 0, 0, Eigen::Vector3f::Zero()), At(0, 1, 0, 1, Eigen::Vector3f::Zero()),
+               At(0, 2, 0, 0, Eigen::Vector3f::Zero())};
+  obs[0].patch = 2, obs[1].patch = 1, obs[2].patch = 0;
+  obs[0].radiance = Eigen::Vector3f(0.1f, 0.2f, 0.3f);
+  obs.in_fit = {1, 1, 0};
+  LightModel light;
+  light.e = {Eigen::Vector3d(1, 2, 3), Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones()};
+  light.incident.resize(3);
+
+  std::vector<int> regions;
+  const std::vector<RegionFitInput> in =
+      FitInputs(scene, patches, obs, light, materials, 1, false, true, &regions);
+  ASSERT_EQ(regions, std::vector<int>{0});
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_EQ(in[0].name, "walls");
+  EXPECT_TRUE(in[0].fit_rho_d);
+  EXPECT_EQ(in[0].num_slots, 2);
+  EXPECT_EQ(in[0].slot_area, (std::vector<double>{0.5, 1.5}));
+  ASSERT_EQ(in[0].samples.size(), 1u);  // the fit sample only
+  const FitSample& s = in[0].samples[0];
+  EXPECT_EQ(s.observed, Eigen::Vector3f(0.1f, 0.2f, 0.3f).cast<double>());
+  EXPECT_EQ(s.irradiance, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(s.slot, 1);  // patch 2 is the walls' second
+  EXPECT_FALSE(s.rho_d_held.allFinite());
 }
 
 // The fit samples of region 1 (50 observations of photo 2, first) and region 0 (1000 over photos
