@@ -1,6 +1,9 @@
 #pragma once
 // Internal to igi_solver: the state of one solve (solve.cpp: set-up and stage 1's image-based
-// model; solve_stages.cpp: the iterations, stage 2, residuals and albedo maps).
+// model; solve_stages.cpp: the iterations, stage 2, residuals and albedo maps). Its data are the
+// observation set, the material estimate and the light model (solver/observation_set.h,
+// solver/material_estimate.h, solver/light_model.h); the stages that only read and write those
+// are functions of them there and in solver/fit_inputs.h.
 
 #include <Eigen/Core>
 #include <filesystem>
