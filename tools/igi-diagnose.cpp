@@ -27,6 +27,13 @@ int main(int argc, char** argv) {
                  "output folder (diagnosis.json, scene.json, report.html, steps/)")
       ->required();
   app.add_option("--spp", o.spp, "paths per pixel of the re-renders")->capture_default_str();
+  app.add_option("--spp-max", o.spp_max,
+                 "when above --spp: the paths per pixel are chosen within [--spp, this] from the "
+                 "photos' noise (0 = fixed at --spp)")
+      ->capture_default_str();
+  app.add_option("--render-noise-share", o.render_noise_share,
+                 "the renders' variance the chosen paths allow, as a share of the photos' noise")
+      ->capture_default_str();
   app.add_option("--analysis-megapixels", o.analysis_megapixels,
                  "larger photos are analysed as the means of pixel blocks that bring them within "
                  "this size (0 = full size)")

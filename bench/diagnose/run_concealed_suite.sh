@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# igi-diagnose on concealed data, full size (issue 8): one igi-synth capture per hidden effect (and
+# igi-diagnose on concealed data, full size: one igi-synth capture per hidden effect (and
 # pairs, and controls), then a table of what the first kept step named, the final residual against
 # the noise floor (the true model's residual at the same samples per pixel over the same pixels),
 # the same on the held-out pixels (never fitted: with the materials solved, the albedo maps fit
@@ -17,7 +17,7 @@
 # fresnel and specular_lobe_shape cases get a capture that can show them: the lamp 0.6 m high and
 # a grazing view of the floor (igi-synth --lamp-position 2,2,0.6 --grazing-cameras 1); at the
 # default views, with the materials solved, a Ward lobe refitted in ρs and α stands in for either
-# (the suite's specular_lobe_shape capture of session 19 named nothing and ended at 1.07× the
+# (the suite's specular_lobe_shape capture then named nothing and ended at 1.07× the
 # floor held out: the effect was not in the photos to find). With the materials unknown, the
 # light_* and ambient_light cases photograph both lightings (--photo-lightings L0,L1: the lamp
 # alone, then lamp2 alone): under one lighting, a scale of its only light is a scale of every

@@ -1,15 +1,10 @@
 #pragma once
-// Candidate effects (CONTRACT.md §6 names): each studies the residual of the current model in
-// the frame where its physics shows itself, fits a model of it on the fitted (not held-out)
-// samples, and predicts the residual it would leave on the held-out samples. The best candidate
-// is then applied to the scene and the whole scene refitted (solver/diagnose/diagnose.cpp).
-//
-// Each candidate's fit is linear in its amplitudes (nonlinear parameters — a response exponent,
-// an emission axis, a lobe width — are searched on a grid), with the global scale free as a
-// nuisance where the materials are solved (it is absorbed by the albedos when refitted).
+// A candidate: one effect (CONTRACT.md §6 names) fitted to the residual of the current model on
+// the fitted (not held-out) samples, with the residual it predicts on the held-out samples; and
+// the ranking that decides which candidates a step refits (solver/diagnose/diagnose.cpp). The
+// effects that make candidates: solver/diagnose/effect.h, solver/diagnose/effects/.
 
 #include <array>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,8 +43,6 @@ struct CandidateResult {
   // step's significance then counts these blocks (its gain is still over every held-out block):
   // the others hold only the refit's small albedo changes and their noise. Empty: every block.
   std::vector<std::array<int, 3>> support_blocks;
-  // Writes the fitted model into the declared scene document.
-  std::function<void(Json* declared)> apply;
 
   double Gain() const { return held_before > 0 ? 1 - held_after / held_before : 0; }
   // The effect and what it applies to ("specular_lobe_shape:glossy_box"): a step is taken once
@@ -72,41 +65,5 @@ std::vector<std::string> PhotoFiles(const Scene& model);
 struct ResidualFit;
 // Copies a fit's predicted squared-error sums and significance into a candidate.
 void FillScores(const ResidualFit& fit, CandidateResult* out);
-
-class ResidualFitter;
-class RecordSubset;
-// specular_reflection for `region` (declared diffuse): a Ward lobe whose ρs and α best explain
-// the residual. Its apply() writes brdf "ward", with the fitted ρs and α where the region's
-// albedo is declared (nothing is solved then), without them otherwise (igi-solve fits them).
-CandidateResult SpecularReflection(const CandidateContext& context, const ResidualFitter& fitter,
-                                   int region);
-
-// camera_response: the photos follow the model's value through a power about a reference,
-// ref·(v/ref)^e (photo_model.h). The exponent is searched on the residual with a fit corrected
-// for the renders' noise in the model's value (ResidualFitter::FitNoisyBasis).
-CandidateResult Response(const CandidateContext& context, const ResidualFitter& fitter);
-
-// light_emission_profile for light `light` (index into model.lights): the light's direct term
-// becomes cos^n of the angle from an axis (a "spot" with a cos_power profile). The axis and n are
-// searched with a camera response as a nuisance (so that a response the photos also hide does not
-// bend them) and scored without it. The search runs on `search`'s records when given (a subsample
-// of the fitter's), the final fit and its scores on the fitter's.
-CandidateResult EmissionProfile(const CandidateContext& context, const ResidualFitter& fitter,
-                                int light, const RecordSubset* search = nullptr);
-
-// specular_lobe_shape (ward <-> ward_gmd) and fresnel (plain -> *_fresnel) on glossy region
-// `region`: the change of its specular term. With the materials given (the refit keeps ρs and α)
-// the alternative lobe less the current one at the same values, with an amplitude that must stay
-// near 1; with them solved (the refit re-solves ρs and α) the current lobe is replaced by the
-// alternative at a searched α' with a free ρs scale, and credited only with what it explains
-// beyond the current model re-fitted the same way. fresnel also searches the index.
-CandidateResult LobeChange(const CandidateContext& context, const ResidualFitter& fitter,
-                           int region, bool fresnel);
-
-// Every candidate that applies to this scene, fitted on `records`, except those whose Key() is in
-// `excluded` (they are not fitted at all).
-std::vector<CandidateResult> EvaluateCandidates(const CandidateContext& context,
-                                                const std::vector<PixelRecord>& records,
-                                                const std::vector<std::string>& excluded);
 
 }  // namespace igi

@@ -56,6 +56,7 @@ struct DiagnosisSummary {
   std::vector<std::pair<Image, std::string>> final_images;  // photo, render, residual (first photo)
   Json analysis;  // the reduced capture analysed (AnalysisCaptureJson), null at full size
   Json memory;    // the memory plan and the peak (DiagnoseMemoryJson)
+  Json render_noise;  // the photos' and renders' noise and the paths chosen (RenderNoiseJson)
   double seconds = 0;
 };
 

@@ -8,7 +8,12 @@
 namespace igi {
 
 struct DiagnoseOptions {
-  int spp = 32;          // paths per pixel of the re-renders
+  int spp = 32;  // paths per pixel of the re-renders
+  // When above spp: the re-renders' paths per pixel are chosen, within [spp, spp_max], so that
+  // their Monte Carlo variance is at most render_noise_share of the photos' own noise, measured
+  // on the baseline (render_noise.h).
+  int spp_max = 0;
+  double render_noise_share = 0.25;
   int pixel_stride = 2;  // every Nth pixel of each photo is a residual sample
   int max_steps = 4;     // effects modelled at most
   // Photos over this many megapixels are analysed as the means of pixel blocks that bring them

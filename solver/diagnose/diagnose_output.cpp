@@ -67,6 +67,7 @@ Json DiagnosisJson(const DiagnosisSummary& s, const DiagnoseOptions& o) {
                                         100 * o.min_gain, o.min_z)}};
   if (!s.analysis.is_null()) j["analysis"] = s.analysis;
   if (!s.memory.is_null()) j["memory"] = s.memory;
+  if (!s.render_noise.is_null()) j["render_noise"] = s.render_noise;
   j["seconds"] = Num(s.seconds);
   return j;
 }

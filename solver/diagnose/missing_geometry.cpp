@@ -884,7 +884,7 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
   }
   Json photo_files = Json::array(), pixels = Json::object(), shadow_pixels = Json::object();
   fs::create_directories(mask_dir);
-  std::vector<std::pair<size_t, std::string>> mask_files;
+  Json mask_files = Json::array();  // {"photo": index, "file": its mask}
   for (size_t i = 0; i < views.size(); ++i) {
     // The pixels counted are the undilated object's and shadow's; the masks add their margin.
     const auto [n_object, n_shadow] = counts[i];
@@ -907,7 +907,7 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
     const fs::path path =
         fs::absolute(mask_dir / (model.photos[i].file.stem().string() + "_mask.png"));
     WriteImage(path, keep);
-    mask_files.emplace_back(i, path.string());
+    mask_files.push_back({{"photo", i}, {"file", path.string()}});
     res.excluded.push_back(std::move(excluded));
     res.keep_masks.push_back(std::move(keep));
   }
@@ -925,7 +925,8 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
                 {"box_max", Vec(largest.box_max)},
                 {"voxel_m", std::round(voxel * 1e4) / 1e4},
                 {"objects", int(objects.size())},
-                {"masks", "photo masks exclude the object and its shadow"}};
+                {"masks", "photo masks exclude the object and its shadow"},
+                {"mask_files", mask_files}};
   out.where = {{"center", Vec(largest.center)},
                {"size_m", Vec(largest.size_m)},
                {"photos", photo_files},
@@ -952,9 +953,6 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
                         behind.pairs));
   spdlog::info("igi-diagnose: missing geometry: {}", out.evidence);
   out.valid = true;
-  out.apply = [mask_files](Json* doc) {
-    for (const auto& [i, path] : mask_files) (*doc)["photos"][i]["mask"] = path;
-  };
   return res;
 }
 

@@ -151,7 +151,7 @@ struct MissingGeometryResult {
 };
 
 // Locates missing geometry from the residual of `model` (sims: its simulated photos) and writes
-// the masks the candidate's apply() refers to into mask_dir (PNG, one per photo).
+// the masks into mask_dir (PNG, one per photo; the candidate's params "mask_files" name them).
 MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& photos,
                                             const std::vector<Image>& sims,
                                             const std::vector<PixelRecord>& records,

@@ -247,4 +247,24 @@ int SearchStride(const std::vector<PixelRecord>& records, int target) {
   return int(std::max<int64_t>(1, fitted / std::max(1, target)));
 }
 
+ResidualFit FitChange(const ResidualFitter& f, const Change& ch) {
+  const PixelRecord* base = f.records().data();
+  return f.Fit(
+      1, [&](const PixelRecord& r, int c, double* b) { b[0] = ch.basis[size_t(&r - base)][c]; },
+      [&](const PixelRecord& r, int c) {
+        return ch.offset.empty() ? 0.0 : double(ch.offset[size_t(&r - base)][c]);
+      });
+}
+
+double SignedRankZ(std::vector<double> values) {
+  values.erase(std::remove(values.begin(), values.end(), 0.0), values.end());
+  const double n = double(values.size());
+  if (n < 2) return 0;
+  std::sort(values.begin(), values.end(),
+            [](double a, double b) { return std::abs(a) < std::abs(b); });
+  double w = 0;
+  for (size_t k = 0; k < values.size(); ++k) w += values[k] > 0 ? double(k + 1) : -double(k + 1);
+  return w / std::sqrt(n * (n + 1) * (2 * n + 1) / 6);
+}
+
 }  // namespace igi

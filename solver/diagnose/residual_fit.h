@@ -70,7 +70,7 @@ class ResidualFitter {
   // model's value): b and the residual y = photo − s both carry the render's noise ε (variance
   // V = PixelRecord::sim_var), so a plain fit reads that noise as part of the curve (the photo's
   // slope on the noisy model value is diluted: a response's exponent comes out low, 0.718 for
-  // 0.791 at 10 % render noise in candidates_test's ResponseTest). To second order in ε, with
+  // 0.791 at 10 % render noise in camera_response_test's ResponseTest). To second order in ε, with
   // b' = ∂b/∂s and b'' = ∂²b/∂s², the sums' expectations exceed their noise-free values by
   //   Σ s·b: V (b' + s b''/2),  Σ b·y: V (y b''/2 − b'),  Σ b·bᵀ: V (b' b'ᵀ + (b b''ᵀ + b'' bᵀ)/2);
   // they are subtracted (with the nuisance's correction of FitNoiseFreeBasis), and the held-out
@@ -132,6 +132,10 @@ class ResidualFitter {
 // returned as it is.
 double BlockGainZ(const std::vector<std::pair<double, double>>& blocks);
 
+// Wilcoxon's signed-rank statistic of `values` (zeros dropped) as a normal z: whether they are
+// mostly positive, robust to the heavy tails of per-block gains on edges.
+double SignedRankZ(std::vector<double> values);
+
 // Cells for `model`'s records: per region, or per (region, voxel of `cell_m`) where the region
 // has an albedo map.
 std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
@@ -165,6 +169,16 @@ class RecordSubset {
 
 // The stride that leaves about `target` fitted (not held-out, not outlier) records, at least 1.
 int SearchStride(const std::vector<PixelRecord>& records, int target);
+
+// The records' change of model for one parameter set, per record and channel (zero where a
+// candidate does not touch the record).
+struct Change {
+  std::vector<Eigen::Vector3f> basis;   // amplitude-1 value of the new term
+  std::vector<Eigen::Vector3f> offset;  // fixed change (the old term removed), or empty
+};
+
+// `ch` fitted on f's records with one free amplitude against its fixed offset.
+ResidualFit FitChange(const ResidualFitter& f, const Change& ch);
 
 // ------------------------------------------------------------------ implementation
 // Per (cell, channel, set) the statistics are laid out as (y = photo − sim − offset, y0 = photo −

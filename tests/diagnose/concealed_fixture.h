@@ -1,5 +1,5 @@
 #pragma once
-// The shared fixture of igi-diagnose's concealed-data tests (issue 8): an igi-synth capture that
+// The shared fixture of igi-diagnose's concealed-data tests: an igi-synth capture that
 // hides one effect scene.json does not declare, igi-diagnose on it, and the "floor" — the residual
 // of the TRUE model (truth/scene.json plus the photo effects of truth.json) rendered the same way
 // over the same pixels.

@@ -5,8 +5,10 @@
 
 #include <Eigen/Core>
 
+#include "solver/diagnose/effect.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/photo_model.h"
+#include "tools/common/json.h"
 
 namespace igi::test {
 
@@ -31,6 +33,11 @@ inline PixelRecord OneLightRecord(int photo, int x, int y, int region,
   ls.distance = float(distance);
   r.lights.push_back(ls);
   return r;
+}
+
+// Candidate `c` written into `doc` by its effect (Effect::Write).
+inline void WriteCandidate(const CandidateResult& c, Json* doc) {
+  FindEffect(MakeEffects(), c.effect)->Write(c, doc);
 }
 
 }  // namespace igi::test

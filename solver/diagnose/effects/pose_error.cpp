@@ -1,4 +1,4 @@
-#include "solver/diagnose/pose_error.h"
+#include "solver/diagnose/effects/pose_error.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -13,11 +13,12 @@
 #include <numbers>
 #include <tuple>
 
+#include "solver/diagnose/effects/effects.h"
 #include "solver/render.h"
+#include "solver/sampling.h"
 
 namespace igi {
 namespace {
-constexpr double kPi = std::numbers::pi;
 
 // The held-out gain's significance where a pose error shows: on the model image's edges (flat
 // blocks add only their noise). The held-out blocks of the camera whose gradient energy is at
@@ -199,20 +200,7 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
       "{:.2f} deg and {:.1f} mm: its declared pose is off",
       cam.name, angle_deg, 1000 * delta.norm());
   out.valid = true;
-  const std::string name = cam.name;
-  out.apply = [name, omega, delta](Json* doc) { ComposePoseStep(name, omega, delta, doc); };
   return out;
-}
-
-double SignedRankZ(std::vector<double> values) {
-  values.erase(std::remove(values.begin(), values.end(), 0.0), values.end());
-  const double n = double(values.size());
-  if (n < 2) return 0;
-  std::sort(values.begin(), values.end(),
-            [](double a, double b) { return std::abs(a) < std::abs(b); });
-  double w = 0;
-  for (size_t k = 0; k < values.size(); ++k) w += values[k] > 0 ? double(k + 1) : -double(k + 1);
-  return w / std::sqrt(n * (n + 1) * (2 * n + 1) / 6);
 }
 
 Rigid3d PoseOfCameraJson(const Json& j) {
@@ -277,16 +265,16 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
       spdlog::info("igi-diagnose: pose of {}: the last step raised the residual; halved", name);
       continue;
     }
-    if (!step.valid || !step.apply) break;
+    if (!step.valid) break;
     halvings = 0;
     last_train = step.train_before;
     last_doc = *doc;
-    step.apply(doc);
-    ++out.iterations;
     const std::vector<double> w = step.params["rotation_vector"].get<std::vector<double>>();
     const std::vector<double> d = step.params["translation_m"].get<std::vector<double>>();
     last_omega = Eigen::Vector3d(w[0], w[1], w[2]);
     last_delta = Eigen::Vector3d(d[0], d[1], d[2]);
+    ComposePoseStep(name, last_omega, last_delta, doc);
+    ++out.iterations;
     out.last_step_deg = step.params["rotation_deg"].get<double>();
     out.last_step_m = last_delta.norm();
     spdlog::info("igi-diagnose: pose of {}: step {} of {:.3f} deg, {:.2f} mm", name, it + 1,
@@ -302,5 +290,119 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
   out.translation_m = (c1 - c0).norm();
   return out;
 }
+
+namespace {
+
+// The held-out blocks of `camera`'s photos whose model image's gradient energy is at least
+// kEdgeFactor times the median block's: where a pose error shows (its gain sits on edges; flat
+// blocks only add their noise).
+BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>& sims,
+                       const PixelHoldout& h) {
+  auto energies = std::make_shared<std::map<std::tuple<size_t, int, int>, double>>();
+  for (size_t i = 0; i < sims.size(); ++i) {
+    if (model.photos[i].camera != camera) continue;
+    const Image& s = sims[i];
+    for (int y = 1; y + 1 < s.height; ++y) {
+      for (int x = 1; x + 1 < s.width; ++x) {
+        if (!h.HeldOut(int(i), x, y)) continue;
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double gx = s.at(x + 1, y, c) - s.at(x - 1, y, c);
+          const double gy = s.at(x, y + 1, c) - s.at(x, y - 1, c);
+          if (std::isfinite(gx) && std::isfinite(gy)) e += gx * gx + gy * gy;
+        }
+        (*energies)[{i, x / h.block_px, y / h.block_px}] += e;
+      }
+    }
+  }
+  std::vector<double> values;
+  for (const auto& [k, e] : *energies) values.push_back(e);
+  double median = 0;
+  if (!values.empty()) {
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    median = values[values.size() / 2];
+  }
+  return [energies, median](size_t photo, int bx, int by) {
+    const auto it = energies->find({photo, bx, by});
+    return it != energies->end() && it->second >= kEdgeFactor * median;
+  };
+}
+
+// The index of the candidate's camera (params "camera") in `model`, or -1.
+int CameraOf(const CandidateResult& c, const Scene& model) {
+  const std::string name = c.params.value("camera", "");
+  for (int k = 0; k < int(model.cameras.size()); ++k) {
+    if (model.cameras[k].name == name) return k;
+  }
+  return -1;
+}
+
+class PoseErrorEffect final : public Effect {
+ public:
+  std::string Name() const override { return "pose_error"; }
+  void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
+               std::vector<CandidateTask>* tasks) const override {
+    for (int c = 0; c < int(cx.model.cameras.size()); ++c) {
+      if (!allowed(Name() + ":" + cx.model.cameras[c].name)) continue;
+      tasks->push_back({[&cx, &f = in.fitter, c] { return FitPoseError(cx, f, c); }});
+    }
+  }
+
+  // The candidate's step was fitted without the sharpest edges (flagged as outliers for the
+  // other candidates): the pose is iterated from the declared one by Gauss–Newton on re-renders
+  // of the camera, its outliers included (RefinePose), and the candidate becomes the pose found.
+  TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
+    TrialPlan plan{m.declared, m.maps, std::nullopt};
+    const int camera = CameraOf(*c, m.model);
+    if (camera < 0) return plan;
+    const PoseRefinement pr = RefinePose(m.model, camera, m.photos, m.sims, m.options,
+                                         m.materials_solved, m.cell_m, 8, &plan.document);
+    Json& p = c->params;
+    p["iterations"] = pr.iterations;
+    p["rotation_deg"] = pr.rotation_deg;
+    p["center_shift_m"] = pr.translation_m;
+    p.erase("rotation_vector");
+    p.erase("translation_m");
+    const Json& cam = plan.document["cameras"][p["camera"].get<std::string>()];
+    p["qvec"] = cam["qvec"];
+    p["tvec"] = cam["tvec"];
+    c->evidence = fmt::format(
+        "camera {}: the residual follows the model image's edges, as a shift of the view: {} "
+        "Gauss-Newton steps on re-renders move its pose by {:.3f} deg and its centre by {:.1f} "
+        "mm (last step {:.4f} deg, {:.2f} mm)",
+        p["camera"].get<std::string>(), pr.iterations, pr.rotation_deg, 1000 * pr.translation_m,
+        pr.last_step_deg, 1000 * pr.last_step_m);
+    return plan;
+  }
+
+  // A pose error shows on edges: the significance counts the pixels of the camera's held-out
+  // blocks with edges (EdgeBlocks), as signed-rank units.
+  HeldOutScope Scope(const CandidateResult& c, const DiagnosisModel& m) const override {
+    HeldOutScope scope;
+    const int camera = CameraOf(c, m.model);
+    if (camera < 0) return scope;
+    scope.blocks = EdgeBlocks(m.model, camera, m.sims, m.holdout);
+    scope.pixel_units = true;
+    return scope;
+  }
+
+  // The camera's pose: the one found (qvec, tvec), or the fitted step composed with the pose.
+  void Write(const CandidateResult& c, Json* doc) const override {
+    const std::string camera = c.params.at("camera").get<std::string>();
+    if (c.params.contains("qvec") && c.params.contains("tvec")) {
+      (*doc)["cameras"][camera]["qvec"] = c.params["qvec"];
+      (*doc)["cameras"][camera]["tvec"] = c.params["tvec"];
+      return;
+    }
+    const std::vector<double> w = c.params.at("rotation_vector").get<std::vector<double>>();
+    const std::vector<double> d = c.params.at("translation_m").get<std::vector<double>>();
+    ComposePoseStep(camera, Eigen::Vector3d(w[0], w[1], w[2]), Eigen::Vector3d(d[0], d[1], d[2]),
+                    doc);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Effect> MakePoseError() { return std::make_unique<PoseErrorEffect>(); }
 
 }  // namespace igi

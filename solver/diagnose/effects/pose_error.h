@@ -21,8 +21,8 @@
 namespace igi {
 
 // One damped Gauss–Newton (Levenberg–Marquardt) step for `camera` (six amplitudes: the damped
-// direction, its length fitted); its apply() composes the step with the
-// camera's qvec/tvec in the declared document.
+// direction, its length fitted); its params hold the step (rotation_vector, translation_m), which
+// the effect's Write composes with the camera's qvec/tvec in the declared document.
 CandidateResult FitPoseError(const CandidateContext& context, const ResidualFitter& fitter,
                              int camera);
 
@@ -51,10 +51,6 @@ double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, 
 // Blocks whose model-image gradient energy reaches this many times the median block's are the
 // edges where a pose error is scored.
 constexpr double kEdgeFactor = 4;
-
-// Wilcoxon's signed-rank statistic of `values` (zeros dropped) as a normal z: whether they are
-// mostly positive, robust to the heavy tails of per-block gains on edges.
-double SignedRankZ(std::vector<double> values);
 
 // The pose of a camera entry of a scene document (qvec w, x, y, z; tvec).
 Rigid3d PoseOfCameraJson(const Json& camera);

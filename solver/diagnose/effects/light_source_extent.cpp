@@ -1,269 +1,41 @@
-#include "solver/diagnose/candidates_brdf_light.h"
+// light_source_extent (CONTRACT.md §6): a point (or small sphere) light that is really a larger
+// sphere of the same intensity.
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
+#include <functional>
+#include <map>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <set>
+#include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "solver/brdf.h"
+#include "solver/diagnose/effects/effects.h"
+#include "solver/diagnose/residual_fit.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
 #include "solver/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
+
 namespace {
 
 using Eigen::Vector3d;
 
 Json Vec(const Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
-// The records' change of model for one parameter set, per record and channel (zero where the
-// candidate does not touch the record), fitted with one free amplitude against a fixed offset.
-struct Change {
-  std::vector<Eigen::Vector3f> basis;   // amplitude-1 value of the new term
-  std::vector<Eigen::Vector3f> offset;  // fixed change (the old term removed), or empty
-};
-
-ResidualFit FitChange(const ResidualFitter& f, const Change& ch) {
-  const PixelRecord* base = f.records().data();
-  return f.Fit(
-      1, [&](const PixelRecord& r, int c, double* b) { b[0] = ch.basis[size_t(&r - base)][c]; },
-      [&](const PixelRecord& r, int c) {
-        return ch.offset.empty() ? 0.0 : double(ch.offset[size_t(&r - base)][c]);
-      });
-}
-
-// ---------------------------------------------------------------- anisotropic_reflection
-BrdfModel AnisotropicOf(BrdfModel m) {
-  switch (m) {
-    case BrdfModel::kWard:
-      return BrdfModel::kWardAniso;
-    case BrdfModel::kWardGmd:
-      return BrdfModel::kWardGmdAniso;
-    case BrdfModel::kWardFresnel:
-      return BrdfModel::kWardAnisoFresnel;
-    case BrdfModel::kWardGmdFresnel:
-      return BrdfModel::kWardGmdAnisoFresnel;
-    default:
-      return m;
-  }
-}
-
-// The colourless specular factor of `model` (with its Fresnel weight) in `frame`.
-double Specular(BrdfModel model, double ax, double ay, double ior, const Frame& frame,
-                const Vector3d& wo, const Vector3d& wi) {
-  const Vector3d lo = frame.ToLocal(wo), li = frame.ToLocal(wi);
-  double s = SpecularFactor<double>(model, ax, ay, lo, li);
-  if (s > 0 && HasFresnel(model)) s *= FresnelWeight<double>(ior, lo, li);
-  return s;
-}
-
-// The lobe of one region at its records, for a lobe model and parameters.
-class RegionLobe {
- public:
-  RegionLobe(const std::vector<PixelRecord>& records, int region, const Material& m)
-      : records_(records),
-        region_(region),
-        rho_s_(m.rho_s.value_or(Vector3d::Zero())),
-        ior_(m.ior.value_or(Material::kDefaultIor)) {}
-
-  // ρs_c Σ S(wo, wi)·E_c per record (zero off the region); tangent only for anisotropic models.
-  std::vector<Eigen::Vector3f> Term(BrdfModel model, double ax, double ay,
-                                    const Vector3d& tangent) const {
-    std::vector<Eigen::Vector3f> out(records_.size(), Eigen::Vector3f::Zero());
-    for (size_t i = 0; i < records_.size(); ++i) {
-      const PixelRecord& r = records_[i];
-      if (r.region != region_) continue;
-      const Vector3d n = r.normal.cast<double>(), wo = r.view.cast<double>();
-      const Frame frame =
-          IsAnisotropic(model) ? Frame::FromNormalTangent(n, tangent) : Frame::FromNormal(n);
-      Vector3d sum = Vector3d::Zero();
-      for (const RecordLightSample& ls : r.lights) {
-        const double s = Specular(model, ax, ay, ior_, frame, wo, ls.wi.cast<double>());
-        sum += s * ls.irradiance.cast<double>();
-      }
-      out[i] = sum.cwiseProduct(rho_s_).cast<float>();
-    }
-    return out;
-  }
-
- private:
-  const std::vector<PixelRecord>& records_;
-  int region_;
-  Vector3d rho_s_;
-  double ior_;
-};
-
-// The region's normal where its current highlight is (weights: the current lobe's value), and
-// two directions spanning its plane.
-std::array<Vector3d, 3> HighlightPlane(const std::vector<PixelRecord>& records, int region,
-                                       const std::vector<Eigen::Vector3f>& lobe) {
-  Vector3d n = Vector3d::Zero(), plain = Vector3d::Zero();
-  for (size_t i = 0; i < records.size(); ++i) {
-    if (records[i].region != region || records[i].outlier) continue;
-    n += double(lobe[i].sum()) * records[i].normal.cast<double>();
-    plain += records[i].normal.cast<double>();
-  }
-  if (!(n.norm() > 1e-9)) n = plain;
-  if (!(n.norm() > 1e-9)) n = Vector3d::UnitZ();
-  const Frame f = Frame::FromNormal(n.normalized());
-  return {f.n, f.t, f.b};
-}
-
-struct LobeParams {
-  double phi = 0, ax = 0.1, ay = 0.1;  // tangent angle (radians) in the highlight plane
-};
-
-// The region's current lobe and an anisotropic one on one fitter's records.
-class LobeFit {
- public:
-  LobeFit(const ResidualFitter& f, int region, const Material& m)
-      : f_(f), lobe_(f.records(), region, m), to_(AnisotropicOf(m.brdf)) {
-    const double alpha = *m.alpha;
-    current_ = lobe_.Term(m.brdf, alpha, alpha, Vector3d::UnitX());
-    ch_.offset = current_;
-    for (Eigen::Vector3f& v : ch_.offset) v = -v;  // the current lobe is removed
-  }
-  const std::vector<Eigen::Vector3f>& current() const { return current_; }
-
-  ResidualFit operator()(double ax, double ay, const Vector3d& tangent) {
-    ch_.basis = lobe_.Term(to_, ax, ay, tangent);
-    return FitChange(f_, ch_);
-  }
-
- private:
-  const ResidualFitter& f_;
-  RegionLobe lobe_;
-  BrdfModel to_;
-  std::vector<Eigen::Vector3f> current_;
-  Change ch_;
-};
-
-// The lobe's parameters are searched on `search`'s records (the region's, subsampled), then
-// fitted and scored on `f`'s.
-CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter& f,
-                               const ResidualFitter& search, int region) {
-  CandidateResult out;
-  out.effect = "anisotropic_reflection";
-  const Material& m = cx.model.materials[region];
-  LobeFit lobe(search, region, m);
-  const std::array<Vector3d, 3> plane = HighlightPlane(search.records(), region, lobe.current());
-  const BrdfModel to = AnisotropicOf(m.brdf);
-  auto tangent_of = [&](double phi) {
-    return (std::cos(phi) * plane[1] + std::sin(phi) * plane[2]).normalized();
-  };
-  auto fit_at = [&](const LobeParams& p) { return lobe(p.ax, p.ay, tangent_of(p.phi)); };
-  auto physical = [](const ResidualFit& fit) {
-    return fit.coef.size() == 1 && fit.coef[0] > 0.2 && fit.coef[0] < 5;
-  };
-  // The best isotropic lobe (ratio 1) is the reference the anisotropy must beat.
-  ResidualFit iso;
-  for (double a = 0.02; a < 0.45; a *= 1.25) {
-    const ResidualFit fit = fit_at({0, a, a});
-    if (physical(fit) && (iso.coef.size() == 0 || fit.train_after < iso.train_after)) iso = fit;
-  }
-  ResidualFit best;
-  LobeParams bp;
-  auto consider = [&](const LobeParams& p) {
-    if (!(p.ax > 0.005 && p.ax < 1 && p.ay > 0.005 && p.ay < 1)) return false;
-    const ResidualFit fit = fit_at(p);
-    if (!physical(fit) || (best.coef.size() && fit.train_after >= best.train_after)) return false;
-    best = fit, bp = p;
-    return true;
-  };
-  const std::vector<double> grid = {0.02, 0.03, 0.045, 0.065, 0.095, 0.14, 0.2, 0.3};
-  for (int k = 0; k < 12; ++k) {
-    for (size_t i = 0; i < grid.size(); ++i) {
-      for (size_t j = i + 1; j < grid.size(); ++j) consider({k * kPi / 12, grid[i], grid[j]});
-    }
-  }
-  if (best.coef.size() == 0) {
-    out.note = "no anisotropic lobe with 0.2 < rho_s ratio < 5 fits region " + m.name;
-    return out;
-  }
-  for (double step : {1.0, 0.5, 0.25, 0.12}) {
-    for (int round = 0; round < 8; ++round) {
-      bool moved = false;
-      for (double s : {-1.0, 1.0}) {
-        moved |= consider({bp.phi + s * step * kPi / 24, bp.ax, bp.ay});
-        moved |= consider({bp.phi, bp.ax * std::pow(1.2, s * step), bp.ay});
-        moved |= consider({bp.phi, bp.ax, bp.ay * std::pow(1.2, s * step)});
-      }
-      if (!moved) break;
-    }
-  }
-  // As for specular_reflection: a lobe whose wide direction reaches the widest roughness of the
-  // grid is a broad brightening of the region, not a highlight stretched along a tangent.
-  if (std::max(bp.ax, bp.ay) >= grid.back()) {
-    out.note = fmt::format(
-        "region {}: the lobe's wide direction reaches the widest roughness searched (alpha {:.3f} "
-        "/ {:.3f}): a broad brightening, not a highlight",
-        m.name, bp.ax, bp.ay);
-    return out;
-  }
-  const double explained = best.train_before - best.train_after;
-  const double share = iso.coef.size() ? (iso.train_after - best.train_after) / explained : 1.0;
-  const double ratio = std::max(bp.ax, bp.ay) / std::min(bp.ax, bp.ay);
-  if (!(explained > 0) || !(share >= 0.1) || !(ratio >= 1.5)) {
-    out.note = fmt::format(
-        "region {}: an isotropic lobe explains as much (anisotropic lobe ratio {:.2f}, "
-        "{:.0f}% of its gain beyond the best isotropic one)",
-        m.name, ratio, 100 * share);
-    return out;
-  }
-  // The narrow direction first is a convention only: report the tangent of alpha_x as fitted.
-  const Vector3d tangent = tangent_of(bp.phi);
-  if (&search != &f) {
-    best = LobeFit(f, region, m)(bp.ax, bp.ay, tangent);
-    if (!physical(best)) {
-      out.note =
-          fmt::format("region {}: the lobe found on a subsample does not fit every record", m.name);
-      return out;
-    }
-  }
-  FillScores(best, &out);
-  const double k = best.coef[0];
-  const std::string to_name(BrdfModelName(to));
-  out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)},
-                {"to", to_name},    {"tangent", Vec(tangent)},
-                {"alpha_x", bp.ax}, {"alpha_y", bp.ay},
-                {"rho_s_factor", k}};
-  out.where = {{"regions", {m.name}}, {"frame", "half-vector azimuth in the tangent frame"}};
-  out.num_params = 4;  // tangent angle, two roughnesses, ρs scale
-  out.evidence = fmt::format(
-      "region '{}': the highlight's residual depends on the half vector's azimuth around the "
-      "normal, not only on its angle: the lobe is stretched, alpha {:.3f} along ({:.2f}, {:.2f}, "
-      "{:.2f}) and {:.3f} across it (ratio {:.1f}); {:.0f}% of the residual it explains is beyond "
-      "the best isotropic lobe",
-      m.name, bp.ax, tangent.x(), tangent.y(), tangent.z(), bp.ay, ratio, 100 * share);
-  out.valid = true;
-  const std::string name = m.name;
-  const double ax = bp.ax, ay = bp.ay;
-  out.apply = [name, to_name, tangent, ax, ay, k](Json* doc) {
-    Json& j = (*doc)["materials"][name];
-    j["brdf"] = to_name;
-    j["tangent"] = Vec(tangent);
-    const bool known_alpha = j.contains("alpha");
-    j.erase("alpha");
-    if (known_alpha) j["alpha_x"] = ax, j["alpha_y"] = ay;
-    if (j.contains("rho_s")) {
-      if (j["rho_s"].is_number()) j["rho_s"] = j["rho_s"].get<double>() * k;
-      if (j["rho_s"].is_array()) {
-        for (Json& v : j["rho_s"]) v = v.get<double>() * k;
-      }
-    }
-  };
-  return out;
-}
-
-// ---------------------------------------------------------------- light_source_extent
 // Per record: kFootprint points of the pixel's footprint (the photo and the model's render average
 // the pixel, and a hard shadow edge inside a pixel is no edge of the record's centre), each with
 // kConeSamples directions toward the light: 64 samples, the same for every radius.
@@ -681,8 +453,8 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
   out.support_blocks = scored.HeldOutSupport();
   const double amplitude = fit.coef[0];
   const Vector3d center = model.source().center, intensity = model.source().intensity;
-  out.params = {
-      {"light", l.name}, {"radius", radius}, {"declared_radius", r0}, {"amplitude", amplitude}};
+  out.params = {{"light", l.name},        {"radius", radius},      {"declared_radius", r0},
+                {"amplitude", amplitude}, {"center", Vec(center)}, {"intensity", Vec(intensity)}};
   out.where = {{"light", l.name}, {"frame", "shadow and highlight edges"}};
   out.num_params = 1;
   out.evidence = fmt::format(
@@ -694,45 +466,10 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
       l.name, r0 > 0 ? fmt::format("sphere of {:.3f} m", r0) : std::string("point"), radius, edge,
       100 * kMinChange, other, sim_sum > 0 ? 100 * hidden_sum / sim_sum : 0.0, amplitude);
   out.valid = true;
-  const std::string name = l.name;
-  out.apply = [name, center, intensity, radius](Json* doc) {
-    const Vector3d radiance = intensity / (kPi * radius * radius);
-    (*doc)["lights"][name] = {{"type", "sphere"},
-                              {"center", Vec(center)},
-                              {"radius", radius},
-                              {"radiance", Vec(radiance)}};
-  };
   return out;
 }
 
 }  // namespace
-
-CandidateResult AnisotropicReflection(const CandidateContext& cx, const ResidualFitter& f,
-                                      int region) {
-  const Material& m = cx.model.materials[region];
-  const bool plain = m.brdf == BrdfModel::kWard || m.brdf == BrdfModel::kWardGmd ||
-                     m.brdf == BrdfModel::kWardFresnel || m.brdf == BrdfModel::kWardGmdFresnel;
-  if (!plain || !m.rho_s || !m.alpha || !(m.rho_s->mean() > 0)) {
-    CandidateResult out;
-    out.effect = "anisotropic_reflection";
-    return out;
-  }
-  int count = 0, fitted = 0;
-  for (const PixelRecord& r : f.records()) {
-    count += r.region == region && !r.outlier;
-    fitted += r.region == region && !r.outlier && !r.held_out;
-  }
-  if (count < 50) {
-    CandidateResult out;
-    out.effect = "anisotropic_reflection";
-    return out;
-  }
-  // The search sees the region's records only (the others' residual is the same for every lobe,
-  // and cells do not cross regions), subsampled to about cx.search_records fitted ones.
-  const RecordSubset search(cx.model, f.records(), cx.cell_m, f.nuisance(), cx.block_px,
-                            std::max(1, fitted / std::max(1, cx.search_records)), region);
-  return AnisotropicFit(cx, f, search.fitter(), region);
-}
 
 CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light,
                                   const RecordSubset* search) {
@@ -807,136 +544,38 @@ std::vector<bool> WhereLightSizeShows(const CandidateContext& cx,
 
 namespace {
 
-// ---------------------------------------------------------------- ambient_light
-// What an ambient light of unit radiance adds at each record, as the photo sees it: the radiance
-// reflected toward the camera (ρd·1 at the point, plus what the room reflects of it: every bounce,
-// rendered with the model's materials and no other light; emitters made black), times the photo's
-// exposure scale and the camera's vignetting. 16 paths per record: the first vertex is exact for
-// the diffuse term (the renderer evaluates ambient light exactly), the bounces are averaged.
-std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
-                                                 const std::vector<PixelRecord>& records) {
-  Scene unit = model;
-  Light ambient;
-  ambient.name = "unit_ambient";
-  ambient.type = LightType::kAmbient;
-  ambient.radiance = Eigen::Vector3d::Ones();
-  unit.lights = {ambient};
-  unit.lightings = {Lighting{"unit_ambient", {0}}};
-  for (Material& m : unit.materials) {
-    if (m.brdf == BrdfModel::kEmitter) m.brdf = BrdfModel::kBlack;
-  }
-  const Renderer renderer(unit, 0);
-  std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
-  ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
-    const PixelRecord& r = records[i];
-    const Photo& photo = model.photos[r.photo];
-    const Camera& camera = model.cameras[photo.camera];
-    const Eigen::Vector3d center = camera.CenterInWorld();
-    const Eigen::Vector3d dir = r.position.cast<double>() - center;
-    if (!(dir.norm() > 0)) return;
-    const Eigen::Vector3d l = renderer.ReflectedRadiance(center, dir, 16, uint64_t(i) + 1);
-    const double k =
-        photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
-    out[i] = (l * k).cast<float>();
-  });
-  return out;
-}
-
-// The first reflection alone of a unit ambient light at each record: the directional albedo of
-// the point's BRDF (the record's ρd, its region's lobe) toward the camera, ∫ f cos θi dωi over the
-// hemisphere (the ambient light is never occluded), times the photo's exposure scale and the
-// camera's vignetting. 64 stratified BRDF samples (exact for the diffuse term).
-std::vector<Eigen::Vector3f> UnitAmbientFirstReflection(const Scene& model,
-                                                        const std::vector<PixelRecord>& records) {
-  constexpr int kSide = 8;
-  std::vector<ShadingMaterial> materials;
-  for (const Material& m : model.materials) materials.push_back(MakeShadingMaterial(m));
-  std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
-  ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
-    const PixelRecord& r = records[i];
-    if (r.region < 0 || r.region >= int(materials.size())) return;
-    const ShadingMaterial& sm = materials[r.region];
-    if (!IsReflective(sm.model)) return;
-    BrdfParams params = sm.params;
-    params.rho_d = r.albedo.cast<double>();
-    const Vector3d n = r.normal.cast<double>();
-    const Frame frame = IsAnisotropic(params.model) && sm.tangent
-                            ? Frame::FromNormalTangent(n, *sm.tangent)
-                            : Frame::FromNormal(n);
-    const Vector3d wo = frame.ToLocal(r.view.cast<double>());
-    Pcg32 rng(uint64_t(i) + 1, 17);
-    Vector3d sum = Vector3d::Zero();
-    for (int a = 0; a < kSide; ++a) {
-      for (int b = 0; b < kSide; ++b) {
-        const Eigen::Vector2d u((a + rng.UniformDouble()) / kSide,
-                                (b + rng.UniformDouble()) / kSide);
-        const BrdfSample smp = SampleBrdf(params, wo, rng.UniformDouble(), u);
-        if (smp.Valid()) sum += smp.weight;
+class LightSourceExtentEffect final : public Effect {
+ public:
+  std::string Name() const override { return "light_source_extent"; }
+  void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
+               std::vector<CandidateTask>* tasks) const override {
+    for (int l = 0; l < int(cx.model.lights.size()); ++l) {
+      const Light& light = cx.model.lights[l];
+      if ((light.type != LightType::kPoint && light.type != LightType::kSphere) ||
+          !allowed(Name() + ":" + light.name)) {
+        continue;
       }
+      tasks->push_back(
+          {[&cx, &f = in.fitter, sub = in.search, l] { return LightSourceExtent(cx, f, l, sub); }});
     }
-    const Photo& photo = model.photos[r.photo];
-    const Camera& camera = model.cameras[photo.camera];
-    const double k =
-        photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
-    out[i] = (sum * (k / (kSide * kSide))).cast<float>();
-  });
-  return out;
-}
+  }
+  // The light becomes a sphere of the fitted radius at its position, with its intensity.
+  void Write(const CandidateResult& c, Json* doc) const override {
+    const double radius = c.params.at("radius").get<double>();
+    const Json& intensity = c.params.at("intensity");
+    Json radiance = Json::array();
+    for (const Json& v : intensity) radiance.push_back(v.get<double>() / (kPi * radius * radius));
+    (*doc)["lights"][c.params.at("light").get<std::string>()] = {{"type", "sphere"},
+                                                                 {"center", c.params.at("center")},
+                                                                 {"radius", radius},
+                                                                 {"radiance", radiance}};
+  }
+};
 
 }  // namespace
 
-CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f) {
-  CandidateResult out;
-  out.effect = "ambient_light";
-  // An ambient light of radiance L adds L times the unit light's response where it lands (the
-  // point's ρd and what the lit room reflects of it), in shadow too. With the materials solved,
-  // the first reflection only: the solve has put the ambient light's share of every surface's
-  // radiance into its albedo, so the model's interreflections already carry the light the
-  // ambient term sends around the room (an albedo too high by the factor k lights the others as
-  // the true albedo under the lamp and the ambient light together); what the model lacks is the
-  // ambient light's own reflection at the point, against which the re-solve then lowers the
-  // albedos. The full response there counts the bounced light twice: on the suite's capture
-  // (session 17) it fitted 0.12 for the true 0.4.
-  const bool first_only = f.nuisance();
-  const std::vector<Eigen::Vector3f> response =
-      first_only ? UnitAmbientFirstReflection(cx.model, f.records())
-                 : UnitAmbientResponse(cx.model, f.records());
-  const PixelRecord* first = f.records().data();
-  // The response is rendered on its own paths: no part of the simulation's noise (a plain fit
-  // would credit it with the noise of the sim it partly replaces when the albedos are refitted).
-  const ResidualFit fit = f.FitNoiseFreeBasis(
-      3, [&](const PixelRecord& r, int c, double* b) { b[c] = response[&r - first][c]; });
-  if (fit.coef.size() == 0) return out;
-  const Eigen::Vector3d radiance(fit.coef[0], fit.coef[1], fit.coef[2]);
-  if (!(radiance.minCoeff() > 0)) {
-    out.note = "the offset that fits is negative in some channel: not an ambient light";
-    return out;
-  }
-  FillScores(fit, &out);
-  out.params = {{"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-  out.where = {{"photos", PhotoFiles(cx.model)}, {"frame", "surface (smooth offset)"}};
-  out.num_params = 3;
-  double mean_sim = 0;
-  int n = 0;
-  for (const PixelRecord& r : f.records()) mean_sim += r.sim.mean(), ++n;
-  out.evidence = fmt::format(
-      "a smooth offset proportional to the albedo everywhere, in shadow too, that no change of "
-      "the albedos explains: the photos are brighter than the model by what an ambient light of "
-      "radiance {:.4g} adds ({}; mean model radiance {:.4g}), light from no declared source",
-      radiance.mean(),
-      first_only ? "its first reflection, the solved albedos carrying its share of the room's "
-                   "interreflections"
-                 : "on each surface and through the room's bounces",
-      n ? mean_sim / n : 0.0);
-  out.valid = true;
-  out.apply = [radiance](Json* doc) {
-    std::string name = "ambient";
-    while ((*doc)["lights"].contains(name)) name += "_";
-    (*doc)["lights"][name] = {{"type", "ambient"},
-                              {"radiance", {radiance.x(), radiance.y(), radiance.z()}}};
-    for (auto& [lname, list] : (*doc)["lightings"].items()) list.push_back(name);
-  };
-  return out;
+std::unique_ptr<Effect> MakeLightSourceExtent() {
+  return std::make_unique<LightSourceExtentEffect>();
 }
 
 }  // namespace igi

@@ -1,0 +1,228 @@
+// light_emission_profile (solver/diagnose/effects/light_emission_profile.cpp) on synthetic records
+// with known truth: a point lamp that truly is a cos² spot pointing down, seen on a floor and a
+// wall, in photos that also hide a camera response (a power 0.8 of the pixel value). The
+// candidate searches the profile's axis and power with the response as a nuisance, so the
+// response does not bend them. And its Write: the light becomes a spot with the fitted profile.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "solver/diagnose/candidates.h"
+#include "solver/diagnose/effects/effects.h"
+#include "solver/diagnose/residual_fit.h"
+#include "solver/sampling.h"
+#include "tests/diagnose/one_light_record.h"
+#include "tests/diagnose/room_records.h"
+
+namespace igi {
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+using namespace test::room;
+
+// The emission-profile candidate fitted to RoomRecords(power, exponent, seed), its axis and power
+// searched on every `stride`-th record (1: on all of them).
+CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1) {
+  const Scene model = RoomModel();
+  const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
+  const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed);
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, false, 8);
+  if (stride == 1) return EmissionProfile({model, declared, false}, f, 0);
+  const RecordSubset search(model, records, 0.05, false, 8, stride);
+  return EmissionProfile({model, declared, false}, f, 0, &search);
+}
+
+// The emission-profile candidate of light 0 fitted to `records` (one cell per region; the albedo
+// nuisance on when `solved`), and the angle of its axis from −z in degrees.
+CandidateResult ProfileOn(const Scene& model, const Json& declared,
+                          const std::vector<PixelRecord>& records, bool solved) {
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, solved, 8);
+  return EmissionProfile({model, declared, solved}, f, 0);
+}
+double DegreesFromDown(const CandidateResult& c) {
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  return std::acos(std::min(1.0, -axis[2])) * 180 / kPi;
+}
+
+// Measured (seed 1): axis 0.3° from −z, power 2.12. Searched without the response nuisance the
+// same records gave axis 1.8°, power 1.60 (the response's power of the pixel value reads as a
+// weaker profile), which fails here. Allowed: 3° and 15 %.
+TEST(EmissionProfileTest, AHiddenResponseDoesNotBendTheProfile) {
+  const CandidateResult c = FitProfile(2.0, 0.8, 1);
+  ASSERT_TRUE(c.valid) << c.note;
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.5);
+}
+
+// Without a response the profile is found as well (measured: axis 0.3°, power 2.01).
+TEST(EmissionProfileTest, FindsTheProfileAlone) {
+  const CandidateResult c = FitProfile(2.0, 1.0, 2);
+  ASSERT_TRUE(c.valid) << c.note;
+  const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.9);
+}
+
+// The search on a quarter of the records (as igi-diagnose does on large captures) finds the same
+// profile, and the candidate's scores are those of the fit on every record: searched on a
+// subsample whose scores were kept, the held-out error before the change would be a quarter.
+TEST(EmissionProfileTest, SearchOnASubsampleScoresOnEveryRecord) {
+  const CandidateResult all = FitProfile(2.0, 0.8, 1);
+  const CandidateResult sub = FitProfile(2.0, 0.8, 1, 4);
+  ASSERT_TRUE(all.valid) << all.note;
+  ASSERT_TRUE(sub.valid) << sub.note;
+  const std::vector<double> axis = sub.params["direction"].get<std::vector<double>>();
+  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << sub.params.dump();
+  EXPECT_NEAR(sub.params["cos_power"].get<double>(), 2.0, 0.3) << sub.params.dump();
+  EXPECT_DOUBLE_EQ(sub.held_before, all.held_before);
+  EXPECT_DOUBLE_EQ(sub.train_before, all.train_before);
+  EXPECT_NEAR(sub.Gain(), all.Gain(), 0.02);
+}
+
+// With the materials solved and a second lighting photographed, the albedos (the fit's nuisance,
+// a free scale per cell) are shared by both lightings. The lamp truly is a cos² spot straight
+// down: its direct light falls off with the angle, and the light it sends after a bounce, most
+// of what the wall shows, drops in its own photos by a share that differs between surfaces
+// (the wall loses more than the floor). lamp2's photos agree with the model. The profile's axis
+// and power are searched on the lamp's photos alone, with their own albedo nuisance, and scored
+// on every record. Measured: axis 0.3° from −z, power 2.25; searched on every record with the
+// shared albedos the power comes out 2.53, which fails here. (A mild form of
+// the suite's seed-107 capture, where the search on every record gave cos^14 about an axis
+// pointing up, and on the lamp's photos alone cos^1.43 about one 6.8° from the true one.)
+TEST(EmissionProfileTest, SearchedOnItsOwnPhotosWhenAnotherLightingSharesTheAlbedos) {
+  Scene model = RoomModel();
+  Light lamp2 = model.lights[0];
+  lamp2.name = "lamp2";
+  const Vector3d at2(-1, 1, 2.2);
+  lamp2.position = at2;
+  model.lights.push_back(lamp2);
+  model.lightings.push_back(Lighting{"L1", {1}});
+  for (int j = 0; j < 8; ++j) {
+    Photo ph;
+    ph.lighting = j < 4 ? 0 : 1;
+    model.photos.push_back(ph);
+  }
+  const Json declared = {
+      {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  const double bounce = 0.02;  // the model's bounced light, the same everywhere
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = (i / 2) % 2 == 1;
+    const int lighting = i % 2;
+    const RoomPoint q = DrawRoomPoint(rng, wall, lighting == 0 ? kLamp : at2);
+    const Vector3d &p = q.p, &n = q.n, &wi = q.wi;
+    const double d = q.d, e = q.e;
+    const double direct = kRho / kPi * e;
+    const int photo = 4 * lighting + (i / 4) % 4;
+    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, p,
+                                         n, n, Vector3f::Constant(float(kRho)), wi, e, d);
+    r.lights[0].light = lighting;
+    const double truth =
+        lighting == 0 ? direct * std::pow(std::max(0.0, wi.z()), 2.0) + bounce * (wall ? 0.35 : 0.7)
+                      : direct + bounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(direct + bounce);
+      r.recorded[c] = float(truth * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  const CandidateResult c = ProfileOn(model, declared, records, true);
+  ASSERT_TRUE(c.valid) << c.note;
+  std::printf("axis %.1f deg from -z, power %.2f, predicted gain %.3f, z %.1f\n",
+              DegreesFromDown(c), c.params["cos_power"].get<double>(), c.Gain(), c.z);
+  EXPECT_LT(DegreesFromDown(c), 3) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
+  EXPECT_GT(c.Gain(), 0.3);
+}
+
+// A profile kept in an earlier step is refitted from the one in the model: the lamp is modelled
+// as a cos^1.4 spot about an axis 6° off (what a first round found on the suite's seed-107
+// capture: cos^1.43, 6.8° off); the photos show cos² straight down. The records' light carries
+// the model's profile, which the new one replaces. Materials given. Allowed: 1° and 0.15.
+TEST(EmissionProfileTest, AKeptProfileIsRefittedFromTheModelsOne) {
+  Scene model = RoomModel();
+  Light& lamp = model.lights[0];
+  lamp.type = LightType::kSpot;
+  const double tilt = 6 * kPi / 180;
+  lamp.direction = Vector3d(std::sin(tilt), 0, -std::cos(tilt));
+  lamp.profile.kind = SpotProfile::Kind::kCosPower;
+  lamp.profile.cos_power = 1.4;
+  const Json declared = {{"lights", {{"lamp", {{"type", "spot"}}}}}};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  for (int i = 0; i < 8000; ++i) {
+    const bool wall = i % 2 == 1;
+    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
+    const Vector3d &p = q.p, &n = q.n, &wi = q.wi;
+    const double d = q.d, e = q.e;
+    const double now = std::pow(std::max(0.0, (-wi).dot(lamp.direction)), 1.4);
+    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n,
+                                         n, Vector3f::Constant(float(kRho)), wi, e * now, d);
+    const double truth = kRho / kPi * e * std::pow(std::max(0.0, wi.z()), 2.0) + kBounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(kRho / kPi * e * now + kBounce);
+      r.recorded[c] = float(truth * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  const CandidateResult c = ProfileOn(model, declared, records, false);
+  ASSERT_TRUE(c.valid) << c.note;
+  std::printf("refitted: axis %.2f deg from -z, power %.2f, gain %.3f; key %s\n",
+              DegreesFromDown(c), c.params["cos_power"].get<double>(), c.Gain(), c.Key().c_str());
+  EXPECT_LT(DegreesFromDown(c), 1) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.15) << c.params.dump();
+  ASSERT_TRUE(c.params.contains("refined_from")) << c.params.dump();
+  EXPECT_NEAR(c.params["refined_from"]["cos_power"].get<double>(), 1.4, 1e-9);
+  EXPECT_EQ(c.Key(), "light_emission_profile:lamp:refit");
+  EXPECT_GT(c.Gain(), 0.5);
+}
+
+// Write replaces the light's whole entry (a sphere here: its centre, radius and radiance go) by a
+// spot at the params' position, with their intensity, axis and cos^n profile; the other light
+// and the rest of the document are left as they were.
+TEST(EmissionProfileTest, WriteMakesTheLightASpotWithTheFittedProfile) {
+  CandidateResult c;
+  c.effect = "light_emission_profile";
+  c.params = {{"light", "lamp"},
+              {"direction", {0.1, 0.0, -0.995}},
+              {"cos_power", 2.5},
+              {"position", {0.0, 0.0, 2.5}},
+              {"intensity", {8.0, 7.0, 6.0}}};
+  Json doc = {{"lights",
+               {{"lamp",
+                 {{"type", "sphere"},
+                  {"center", {0.0, 0.0, 2.5}},
+                  {"radius", 0.05},
+                  {"radiance", {1000.0, 900.0, 800.0}}}},
+                {"lamp2", {{"type", "point"}, {"position", {1, 1, 2}}, {"intensity", {3, 3, 3}}}}}},
+              {"lightings", {{"L0", {"lamp", "lamp2"}}}}};
+  Json expected = doc;
+  expected["lights"]["lamp"] = {{"type", "spot"},
+                                {"position", {0.0, 0.0, 2.5}},
+                                {"direction", {0.1, 0.0, -0.995}},
+                                {"intensity", {8.0, 7.0, 6.0}},
+                                {"profile", {{"cos_power", 2.5}}}};
+  test::WriteCandidate(c, &doc);
+  EXPECT_EQ(doc, expected) << doc.dump();
+}
+
+}  // namespace
+}  // namespace igi

@@ -1,0 +1,96 @@
+#pragma once
+// A room for the effects' unit tests: a Lambertian floor (z = 0, |x|, |y| < 3) and wall (x = 3,
+// |y| < 3, 0 < z < 2.5) under a point lamp 2.5 m above the floor's centre, and residual records
+// drawn on them with known truth. Shared by the emission-profile, exposure, response and
+// vignetting tests and the driver's (effect_test.cpp).
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/diagnose/pixel_records.h"
+#include "solver/sampling.h"
+#include "tests/diagnose/one_light_record.h"
+
+namespace igi::test::room {
+
+inline constexpr double kRho = 0.5;        // every surface's ρd (Lambert)
+inline constexpr double kIntensity = 8.0;  // the lamp's peak intensity, W/sr
+inline constexpr double kBounce = 0.03;  // light after a bounce (the same in the model and photos)
+inline const Eigen::Vector3d kLamp(0, 0, 2.5);
+
+// The room's model: regions "floor" (0) and "wall" (1), the point lamp "lamp" of kIntensity at
+// kLamp, and one lighting "L0" of it. No photos.
+inline Scene RoomModel() {
+  Scene s;
+  for (const char* name : {"floor", "wall"}) {
+    Material m;
+    m.name = name;
+    m.brdf = BrdfModel::kLambert;
+    m.rho_d = Eigen::Vector3d::Constant(kRho);
+    s.materials.push_back(m);
+  }
+  Light lamp;
+  lamp.name = "lamp";
+  lamp.type = LightType::kPoint;
+  lamp.position = kLamp;
+  lamp.intensity = Eigen::Vector3d::Constant(kIntensity);
+  s.lights.push_back(lamp);
+  s.lightings.push_back(Lighting{"L0", {0}});
+  return s;
+}
+
+// A point on the floor (z = 0, |x|, |y| < 3) or a wall (x = 3, |y| < 3, 0 < z < 2.5), seen along
+// its normal, lit by a point light of kIntensity at `light`: the unit direction toward the
+// light, its distance and the irradiance.
+struct RoomPoint {
+  Eigen::Vector3d p, n, wi;
+  double d = 0, e = 0;
+};
+inline RoomPoint DrawRoomPoint(std::mt19937_64& rng, bool wall, const Eigen::Vector3d& light) {
+  std::uniform_real_distribution<double> u(0, 1);
+  RoomPoint q;
+  q.p = wall ? Eigen::Vector3d(3, 6 * u(rng) - 3, 2.5 * u(rng))
+             : Eigen::Vector3d(6 * u(rng) - 3, 6 * u(rng) - 3, 0);
+  q.n = wall ? Eigen::Vector3d(-1, 0, 0) : Eigen::Vector3d(0, 0, 1);
+  q.d = (light - q.p).norm();
+  q.wi = (light - q.p) / q.d;
+  q.e = kIntensity * std::max(0.0, q.wi.dot(q.n)) / (q.d * q.d);
+  return q;
+}
+
+// Records on the floor (z = 0, |x|, |y| < 3) and a wall (x = 3, |y| < 3, 0 < z < 2.5), the view
+// straight along the normal, alternating floor and wall. The photo: the lamp's direct light times
+// cos^power of the angle from −z, plus the bounce term, through the response
+// v = (u/ref)^exponent·ref (ref 0.05), 1 % noise.
+inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  const double ref = 0.05;
+  std::vector<PixelRecord> out;
+  for (int i = 0; i < 8000; ++i) {
+    const bool wall = i % 2 == 1;
+    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
+    const Eigen::Vector3d &p = q.p, &n = q.n, &wi = q.wi;
+    const double d = q.d, e = q.e;
+    const double direct = kRho / kPi * e;
+    const double cos_axis = wi.z();  // cos of the angle from −z of the direction lamp → point
+    PixelRecord r = OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n, n,
+                                   Eigen::Vector3f::Constant(float(kRho)), wi, e, d);
+    const double truth = direct * std::pow(std::max(0.0, cos_axis), power) + kBounce;
+    const double recorded = ref * std::pow(truth / ref, exponent);
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(direct + kBounce);
+      r.recorded[c] = float(recorded * (1 + 0.01 * g(rng)));
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace igi::test::room
