@@ -86,21 +86,21 @@ CandidateResult ExposureScale(const CandidateContext& cx, const ResidualFitter& 
     ref = 1.0;
     num_groups = 1;
   }
-  // Materials solved and photos under several lightings (the albedos shared by them): a scale
-  // common to one lighting's photos is its lights' (their intensity, or an emission profile that
-  // leaves the room darker as a whole), and a scale common to every photo the albedos'. The
-  // photos' scales are credited only with what they explain beyond a scale per lighting (the
-  // fit's "before"), and fitted relative to their lighting's photo at its median (n − lightings
-  // parameters). Fitted free, 11 photo scales (0.13-0.42 under the lamp, 1.06-1.20 under lamp2)
-  // were applied first in the place of the suite's seed-107 hidden emission profile.
+  // Photos under several lightings: a scale common to one lighting's photos is its lights'
+  // (their intensity, or an emission profile that leaves the room darker as a whole), and, with
+  // the materials solved, a scale common to every photo the albedos'. The photos' scales are
+  // credited only with what they explain beyond a scale per lighting (the fit's "before"), and
+  // fitted relative to their lighting's photo at its median (n − lightings parameters). Fitted
+  // free, 11 photo scales (0.13-0.42 under the lamp, 1.06-1.20 under lamp2) were applied first in
+  // the place of the suite's seed-107 hidden emission profile (materials solved), and the three
+  // photos under the RADIANCE room's lamp, rendered by Cycles with the lamp 1.3x as bright, were
+  // named exposure_scale, not light_intensity (materials given).
   std::vector<int> group(n, 0);
-  if (cx.materials_solved) {
-    std::map<int, int> ids;
-    for (int j = 0; j < n; ++j) {
-      group[j] = ids.emplace(cx.model.photos[j].lighting, int(ids.size())).first->second;
-    }
-    if (ids.size() >= 2) num_groups = int(ids.size());
+  std::map<int, int> ids;
+  for (int j = 0; j < n; ++j) {
+    group[j] = ids.emplace(cx.model.photos[j].lighting, int(ids.size())).first->second;
   }
+  if (ids.size() >= 2) num_groups = int(ids.size());
   if (num_groups >= 2) {
     std::vector<int> is_ref(n, 0);
     for (int g = 0; g < num_groups; ++g) {

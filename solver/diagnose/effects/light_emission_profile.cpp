@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -108,7 +109,8 @@ class ProfileFit {
       : f_(f),
         num_regions_(int(cx.model.materials.size())),
         terms_(f.records().size()),
-        current_(f.records().size(), 1.0f) {
+        current_(f.records().size(), 1.0f),
+        in_lighting_(f.records().size(), 0) {
     const std::vector<PixelRecord>& recs = f.records();
     // A spot with a cos^n profile already (a profile kept earlier, refitted): its direct term
     // carries the current profile, which the new one replaces.
@@ -117,6 +119,7 @@ class ProfileFit {
     const Eigen::Vector3f axis0 = l.direction.normalized().cast<float>();
     for (size_t i = 0; i < terms_.size(); ++i) {
       terms_[i] = TermOf(cx.model, recs[i], light);
+      in_lighting_[i] = LitBy(cx.model, recs[i].photo, light);
       if (profiled && terms_[i].lit) {
         current_[i] =
             std::pow(std::max(0.0f, terms_[i].from_light.dot(axis0)), float(l.profile.cos_power));
@@ -132,13 +135,21 @@ class ProfileFit {
   // fixed change of amplitude 1. The light it sends after a bounce changes too, by a share that
   // differs between surfaces (the ceiling, lit only by bounces from what the spot lights, loses
   // more than the floor): what is not its direct term gets a free scale per region (the albedos'
-  // nuisance covers that when they are solved). With `response_nuisance`, a camera response
-  // beside the profile (its expansion to second order, u·ln(u/ref) and u·ln²(u/ref), u the
-  // profiled value; a power r·(u/r)^e = u·exp((e − 1)·ln(u/r))).
+  // nuisance covers that when they are solved). With the materials given, the spot's peak
+  // intensity is free too (the last coefficient scales D·cos^n): a lamp with a reflector sends
+  // more than its declared intensity along its axis and less elsewhere (the RADIANCE room's lamp
+  // rendered by Cycles as 2·cos θ about straight down: with the peak held at the declared
+  // intensity, the profile's power ran to 0.03, and light_intensity (0.60x) was kept in its place).
+  // With the materials solved, the refit's albedos absorb a scale of the light. With
+  // `response_nuisance`, a camera response beside the profile (its expansion to second order,
+  // u·ln(u/ref) and u·ln²(u/ref), u the profiled value; a power r·(u/r)^e = u·exp((e −
+  // 1)·ln(u/r))).
   ResidualFit operator()(const Eigen::Vector3d& axis, double n, bool response_nuisance) const {
     const Eigen::Vector3f ax = axis.cast<float>();
     const PixelRecord* base = f_.records().data();
     const int k_regions = f_.nuisance() ? 1 : num_regions_;
+    const int k_response = response_nuisance ? 2 : 0;
+    const bool peak = !f_.nuisance();
     // cos^n − 1 of the last record asked for (the fit asks per channel, record by record).
     const PixelRecord* last = nullptr;
     double change = 0;
@@ -154,18 +165,24 @@ class ProfileFit {
       return double(t.direct[c]) * change;
     };
     return f_.Fit(
-        k_regions + (response_nuisance ? 2 : 0),
+        k_regions + k_response + (peak ? 1 : 0),
         [&](const PixelRecord& r, int c, double* b) {
           const LightTerm& t = terms_[size_t(&r - base)];
-          if (!f_.nuisance() && r.region >= 0 && r.region < num_regions_) {
+          // The bounced light changes in the light's own photos only: a scale per region there
+          // (in other lightings' photos it would be a free scale of their whole light, and
+          // lamp2's profile, scaled so, stood in for the lamp's brightness at 69 %).
+          if (!f_.nuisance() && r.region >= 0 && r.region < num_regions_ &&
+              in_lighting_[size_t(&r - base)]) {
             b[r.region] = double(r.sim[c]) - double(t.direct[c]);
           }
-          const double u = double(r.sim[c]) + offset(r, c);
+          const double o = offset(r, c);
+          const double u = double(r.sim[c]) + o;
           if (response_nuisance && u > 0) {
             const double log_u = std::log(u / ref_);
             b[k_regions] = u * log_u;
             b[k_regions + 1] = u * log_u * log_u;
           }
+          if (peak) b[k_regions + k_response] = double(t.direct[c]) + o;  // D·cos^n, profiled
         },
         offset);
   }
@@ -175,6 +192,7 @@ class ProfileFit {
   int num_regions_;
   std::vector<LightTerm> terms_;
   std::vector<float> current_;  // per record: the light's current relative intensity toward it
+  std::vector<uint8_t> in_lighting_;  // per record: its photo's lighting has the light
   int lit_ = 0;
   double ref_ = 1;
 };
@@ -263,13 +281,21 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     out.note = "the profile alone does not fit (degenerate)";
     return out;
   }
+  // The spot's peak intensity relative to the declared one (materials given: the last
+  // coefficient; solved: 1). A profile that needs a light of no intensity, or one that leaves the
+  // room more than ten times as bright, is no emission profile.
+  const double peak = f.nuisance() ? 1.0 : 1 + best.coef[best.coef.size() - 1];
+  if (!(peak > 0.05 && peak < 10)) {
+    out.note = fmt::format("the profile's peak intensity comes out {:.3f}x the declared one", peak);
+    return out;
+  }
   FillScores(best, &out);
   const double n = best_n;
   const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity =
-      l.type == LightType::kSphere
-          ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
-          : l.intensity;
+      peak * (l.type == LightType::kSphere
+                  ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
+                  : l.intensity);
   out.params = {{"light", l.name},
                 {"direction", {best_axis.x(), best_axis.y(), best_axis.z()}},
                 {"cos_power", n},
@@ -279,13 +305,15 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
     out.params["refined_from"] = {{"direction", {axis0.x(), axis0.y(), axis0.z()}},
                                   {"cos_power", l.profile.cos_power}};
   }
+  out.params["peak_factor"] = peak;
   out.where = {{"light", l.name}, {"frame", "angle from the light"}};
-  out.num_params = 3;
+  out.num_params = f.nuisance() ? 3 : 4;
   out.evidence = fmt::format(
       "the residual follows the direction from light '{}': surfaces it reaches at larger angles "
       "from ({:.2f}, {:.2f}, {:.2f}) are darker in the photos than the model, as cos^{:.2f} of "
-      "that angle, whatever their distance, region or image position",
-      l.name, best_axis.x(), best_axis.y(), best_axis.z(), n);
+      "that angle, whatever their distance, region or image position (peak {:.2f}x the declared "
+      "intensity)",
+      l.name, best_axis.x(), best_axis.y(), best_axis.z(), n, peak);
   if (refit) {
     out.evidence += fmt::format(
         " (its profile refitted: it was cos^{:.2f} about ({:.2f}, {:.2f}, {:.2f}), {:.1f} deg "

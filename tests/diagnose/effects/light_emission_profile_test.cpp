@@ -26,12 +26,19 @@ using Eigen::Vector3d;
 using Eigen::Vector3f;
 using namespace test::room;
 
-// The emission-profile candidate fitted to RoomRecords(power, exponent, seed), its axis and power
-// searched on every `stride`-th record (1: on all of them).
-CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1) {
-  const Scene model = RoomModel();
+// The emission-profile candidate fitted to RoomRecords(power, exponent, seed, peak), its axis and
+// power searched on every `stride`-th record (1: on all of them).
+CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1,
+                           double peak = 1.0) {
+  Scene model = RoomModel();
+  for (int j = 0; j < 4; ++j) {  // RoomRecords' photos, under the lamp
+    Photo ph;
+    ph.file = "cam" + std::to_string(j) + "_L0.exr";
+    ph.lighting = 0;
+    model.photos.push_back(ph);
+  }
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
-  const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed);
+  const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed, peak);
   std::vector<int> cells(records.size());
   for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
   const ResidualFitter f(records, cells, 2, false, 8);
@@ -64,6 +71,69 @@ TEST(EmissionProfileTest, AHiddenResponseDoesNotBendTheProfile) {
   EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
   EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
   EXPECT_GT(c.Gain(), 0.5);
+}
+
+// With the materials given, the spot's peak intensity is fitted with its profile: a lamp that
+// sends 2·cos θ of its declared intensity about straight down (a reflector: more along the axis,
+// none above) is a spot of twice the intensity, cos¹ (held at the declared peak, the power of
+// the RADIANCE room's Cycles capture ran to 0.03). Measured: peak 2.00, power 1.00.
+TEST(EmissionProfileTest, ThePeakIntensityIsFittedWithTheMaterialsGiven) {
+  const CandidateResult c = FitProfile(1.0, 1.0, 3, 1, 2.0);
+  ASSERT_TRUE(c.valid) << c.note;
+  std::printf("peak and profile: %s\n", c.params.dump().c_str());
+  EXPECT_NEAR(c.params["peak_factor"].get<double>(), 2.0, 0.1) << c.params.dump();
+  EXPECT_NEAR(c.params["cos_power"].get<double>(), 1.0, 0.15) << c.params.dump();
+  EXPECT_NEAR(c.params["intensity"][0].get<double>(), 2 * kIntensity, 0.1 * 2 * kIntensity);
+  EXPECT_GT(c.Gain(), 0.9);
+  EXPECT_EQ(c.num_params, 4);
+}
+
+// A light's bounced light changes in its own photos only: lamp2's profile cannot take a scale of
+// the lamp's photos through its free scale per region. The lamp's 4 photos record 0.6x the model
+// (the lamp dimmer than declared), lamp2's 4 agree with it; lamp2's profile candidate explains
+// almost nothing (with the region scales over every photo it predicted 69 % on the RADIANCE
+// room's Cycles capture and was tried first).
+TEST(EmissionProfileTest, AnotherLightingsScaleIsNotThisLightsProfile) {
+  Scene model = RoomModel();
+  Light lamp2 = model.lights[0];
+  lamp2.name = "lamp2";
+  lamp2.position = Vector3d(-1, 1, 2.2);
+  model.lights.push_back(lamp2);
+  model.lightings.push_back(Lighting{"L1", {1}});
+  for (int j = 0; j < 8; ++j) {
+    Photo ph;
+    ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
+    ph.lighting = j / 4;
+    model.photos.push_back(ph);
+  }
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = (i / 8) % 2 == 1;
+    const int photo = i % 8;
+    const RoomPoint q = DrawRoomPoint(rng, wall, photo < 4 ? kLamp : lamp2.position);
+    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, q.p,
+                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    r.lights[0].light = photo < 4 ? 0 : 1;
+    const double sim = kRho / kPi * q.e + kBounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(sim);
+      r.recorded[c] = float(sim * (photo < 4 ? 0.6 : 1.0) * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, false, 8);
+  const Json declared = {
+      {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
+  const CandidateResult c = EmissionProfile({model, declared, false}, f, 1);
+  if (c.valid) {
+    std::printf("lamp2's profile: predicted held-out gain %.4f, %s\n", c.Gain(),
+                c.params.dump().c_str());
+    EXPECT_LT(c.Gain(), 0.05);
+  }
 }
 
 // Without a response the profile is found as well (measured: axis 0.3°, power 2.01).
