@@ -10,6 +10,7 @@
 #   env: SPP=256 SEED=1 THREADS=2   Cycles' samples per pixel, seed, threads
 #        MATERIALS=given|unknown    declared with the rho_d values, or without them (solved)
 #        PHOTOS="cam0_L0 cam1_L0 ..." the photos to keep (default: all 4)
+#        SCALE=1                    the cameras' size (and intrinsics) times this
 # Writes OUT_DIR/scene.json (the declared scene, photos and geometry by absolute path),
 # OUT_DIR/photos/*.exr and OUT_DIR/hidden.json (the effect). Needs Debian's blender.
 set -euo pipefail
@@ -23,6 +24,7 @@ SEED="${SEED:-1}"
 THREADS="${THREADS:-2}"
 MATERIALS="${MATERIALS:-given}"
 PHOTOS="${PHOTOS:-}"
+SCALE="${SCALE:-1}"
 ROOM="${IGI_SHARED_DATA_DIR:-$ROOT/../shared/data}/reference/radiance_room"
 
 command -v blender >/dev/null || { echo "blender not installed (apt-get install blender)"; exit 2; }
@@ -31,10 +33,14 @@ command -v blender >/dev/null || { echo "blender not installed (apt-get install 
 mkdir -p "$OUT/photos"
 OUT="$(cd "$OUT" && pwd)"
 
-/usr/bin/python3 - "$ROOM/scene.json" "$OUT" "$MATERIALS" "$EFFECT" "$PHOTOS" <<'EOF'
+/usr/bin/python3 - "$ROOM/scene.json" "$OUT" "$MATERIALS" "$EFFECT" "$PHOTOS" "$SCALE" <<'EOF'
 import json, os, sys
-src, out, materials, effect, keep = sys.argv[1:6]
+src, out, materials, effect, keep, scale = sys.argv[1:7]
+scale = float(scale)
 doc = json.load(open(src))
+for cam in doc["cameras"].values():
+    cam["width"], cam["height"] = round(cam["width"] * scale), round(cam["height"] * scale)
+    cam["params"] = [v * scale for v in cam["params"]]
 for g in doc["geometry"]:
     g["file"] = os.path.join(os.path.dirname(src), g["file"])
 for name, m in doc["materials"].items():
@@ -52,7 +58,7 @@ doc["photos"] = photos
 json.dump(doc, open(os.path.join(out, "scene.json"), "w"), indent=1)
 # The render's own copy keeps the values (Cycles renders them) and names the photos it writes.
 render = dict(doc)
-render["materials"] = json.load(open(src))["materials"]
+render["materials"] = json.load(open(src))["materials"]  # the cameras as scaled
 render["photos"] = [dict(p, file=os.path.relpath(p["file"], out)) for p in photos]
 json.dump(render, open(os.path.join(out, "render_scene.json"), "w"), indent=1)
 json.dump({"effect": effect, "renderer": "Blender Cycles"},
