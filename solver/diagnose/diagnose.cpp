@@ -363,8 +363,8 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
     MapMode maps;  // its albedo maps
     ModelState state;
     double gain = 0;
-    std::optional<PhotoSet>
-        photos;  // the photos' valid pixels after the step, when it changes them
+    // The photos' valid pixels after the step, when it changes them.
+    std::optional<PhotoSet> photos;
   };
   // Refits with candidate `c` as its effect plans the trial, and judges the held-out residual.
   auto try_step = [&](CandidateResult c) {
