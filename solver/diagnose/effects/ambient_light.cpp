@@ -1,22 +1,11 @@
 // ambient_light (CONTRACT.md §6): light from no declared source, the same from every direction.
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Geometry>
-#include <algorithm>
-#include <array>
 #include <cmath>
-#include <filesystem>
-#include <functional>
-#include <map>
 #include <memory>
-#include <numbers>
-#include <optional>
-#include <set>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/brdf.h"

@@ -2,29 +2,19 @@
 // surface direction.
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
-#include <functional>
-#include <map>
 #include <memory>
-#include <numbers>
-#include <optional>
-#include <set>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
 #include "solver/sampling.h"
-#include "tools/common/parallel.h"
 
 namespace igi {
 

@@ -2,18 +2,12 @@
 // sphere of the same intensity.
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
-#include <functional>
-#include <map>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <set>
 #include <string>

@@ -5,19 +5,10 @@
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <filesystem>
-#include <functional>
-#include <map>
 #include <memory>
-#include <numbers>
-#include <optional>
-#include <set>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/brdf.h"
@@ -25,7 +16,6 @@
 #include "solver/diagnose/residual_fit.h"
 #include "solver/observations.h"
 #include "solver/sampling.h"
-#include "tools/common/parallel.h"
 
 namespace igi {
 

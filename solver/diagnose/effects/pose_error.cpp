@@ -10,7 +10,6 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <numbers>
 #include <tuple>
 
 #include "solver/diagnose/effects/effects.h"

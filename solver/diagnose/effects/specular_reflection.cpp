@@ -1,22 +1,12 @@
 // specular_reflection (CONTRACT.md §6): a region declared diffuse that has a highlight.
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Geometry>
-#include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
-#include <functional>
-#include <map>
 #include <memory>
-#include <numbers>
-#include <optional>
-#include <set>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/brdf.h"
@@ -24,7 +14,6 @@
 #include "solver/diagnose/residual_fit.h"
 #include "solver/observations.h"
 #include "solver/sampling.h"
-#include "tools/common/parallel.h"
 
 namespace igi {
 
