@@ -32,8 +32,8 @@ struct DiagnoseOptions {
   // the predictions come from direct-light records and can be far off where a region's reflected
   // room dominates (a sphere lit by a bright ceiling: its lobe-shape change predicted 2.3 %,
   // measured 59 %); with 3, a floor's two rival lobe changes and a false missing-geometry blob took
-  // every try (session 23). 0.5 %: the predictions of a change that the re-solve's albedos follow
-  // fall short too; the full-size light_source_extent capture (seed 113, session 34) predicted
+  // every try. 0.5 %: the predictions of a change that the re-solve's albedos follow
+  // fall short too; the full-size light_source_extent capture (seed 113) predicted
   // the lamp's extent at 0.64 % (z 1.6), never tried at 1 %, and kept it, tried, at 2.7 % (z 3.9).
   double candidate_min_gain = 0.005;
   // The same for missing_geometry's trial before the maps: a rejected trial there keeps the
@@ -49,7 +49,7 @@ struct DiagnoseOptions {
   // albedo map's texel is the pixel footprint times the stride, and at igi-solve's default of 2
   // the maps cannot follow a texture the photos resolve (the full-size light_emission_profile
   // capture: the final residual 1.53 → 1.09 × the true model's, 86 → 93 s; bench/RESULTS.md,
-  // Diagnosis, session 15).
+  // Diagnosis).
   SolveOptions solve = [] {
     SolveOptions s;
     s.pixel_stride = 1;

@@ -15,7 +15,7 @@
 // over the cells, as a z (Spearman's ρ·√(n−1), a standard normal without a texture; ranks, so
 // that a few extreme cells cannot carry it); (b) of the same sign in most cells — a few shadow or
 // highlight edges are not most cells; (c) at least `min_amplitude` of the ratio.
-// (a) was the sign agreement's z until session 16: it ignores how large each cell's values are,
+// (a) is not the sign agreement's z: that ignores how large each cell's values are,
 // and the suite's control, a textured floor at 4 % amplitude, stayed at z 3.9–4.1 (64 % of 218
 // cells agreeing) — unmodelled, its texture raised a false missing_geometry.
 
@@ -35,7 +35,7 @@ struct TextureEvidenceOptions {
   // `dense_records`. One fine scale is blind to a texture of large flat tiles seen sparsely:
   // their high-pass lives only along the tiles' edges, and at full size (160 × 120 photos of a
   // 4 m room, 6.5 cm cells) few cells hold two records of each photo set; the suite's floor of
-  // 1 m tiles passed at 6.5 cm in 1 of 19 captures, at 13 or 20 cm in 15 (session 29), and no
+  // 1 m tiles passed at 6.5 cm in 1 of 19 captures, at 13 or 20 cm in 15, and no
   // untextured region reached z 3.7 at any of the three. Coarse cells are where a few long
   // edges (a shadow the model lacks) become a larger share of the cells: on records dense enough
   // for the fine scale they are not tried.

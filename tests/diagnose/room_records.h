@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "recon/scene.h"
@@ -92,6 +94,50 @@ inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint6
     out.push_back(r);
   }
   return out;
+}
+
+// The room with a second point lamp "lamp2" of kIntensity at kLamp2 in lighting "L1", and 8
+// photos: cam0-3 under the lamp (photos 0-3), cam0-3 under lamp2 (photos 4-7).
+inline const Eigen::Vector3d kLamp2(-1, 1, 2.2);
+inline Scene TwoLightingRoomModel() {
+  Scene model = RoomModel();
+  Light lamp2 = model.lights[0];
+  lamp2.name = "lamp2";
+  lamp2.position = kLamp2;
+  model.lights.push_back(lamp2);
+  model.lightings.push_back(Lighting{"L1", {1}});
+  for (int j = 0; j < 8; ++j) {
+    Photo ph;
+    ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
+    ph.lighting = j / 4;
+    model.photos.push_back(ph);
+  }
+  return model;
+}
+
+// 16 000 records of TwoLightingRoomModel's photos (photo i % 8, floor and wall in turns of 8),
+// each lit by its photo's lamp; the model's value is the lamp's direct light plus the bounce
+// term, the photo that value times `scale(photo)` with 1 % noise.
+inline std::vector<PixelRecord> TwoLightingRoomRecords(uint64_t seed,
+                                                       const std::function<double(int)>& scale) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<PixelRecord> records;
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = (i / 8) % 2 == 1;
+    const int photo = i % 8;
+    const RoomPoint q = DrawRoomPoint(rng, wall, photo < 4 ? kLamp : kLamp2);
+    PixelRecord r = OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, q.p, q.n,
+                                   q.n, Eigen::Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    r.lights[0].light = photo < 4 ? 0 : 1;
+    const double sim = kRho / kPi * q.e + kBounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(sim);
+      r.recorded[c] = float(sim * scale(photo) * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  return records;
 }
 
 }  // namespace igi::test::room

@@ -110,7 +110,7 @@ CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f
   // the true albedo under the lamp and the ambient light together); what the model lacks is the
   // ambient light's own reflection at the point, against which the re-solve then lowers the
   // albedos. The full response there counts the bounced light twice: on the suite's capture
-  // (session 17) it fitted 0.12 for the true 0.4.
+  // it fitted 0.12 for the true 0.4.
   const bool first_only = f.nuisance();
   const std::vector<Eigen::Vector3f> response =
       first_only ? UnitAmbientFirstReflection(cx.model, f.records())

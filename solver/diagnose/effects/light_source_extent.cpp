@@ -117,7 +117,7 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
 // held-out blocks with at least kMinBlockRecords such records per 16 × 16 pixels of the block (a
 // 16-pixel block of one changed record scores noise). Elsewhere it is set to zero: those records
 // are outside the candidate's support. On a subsample of one record in `stride` the blocks hold
-// that many times fewer records. (In proportion to the area since session 16: with 8-pixel blocks
+// that many times fewer records. (In proportion to the area: with 8-pixel blocks
 // the fixed 4 left no held-out block to a penumbra 2–3 records wide, and the suite's
 // light_source_extent candidate, at the right radius, predicted a gain of exactly 0.)
 void KeepMarkedChanges(const std::vector<PixelRecord>& recs, int block_px, int stride,
@@ -203,13 +203,13 @@ class ExtentModel {
   // that point no longer receives after a bounce). Without its shadow edges and highlights
   // (Direct's change), this is smooth and touches every record that sees the light: a lamp just
   // under a ceiling hides the ceiling's brightest patch, much of the room's bounced light
-  // (session 19: a 0.25 m sphere 0.6 m under the ceiling made the room's interreflected light
+  // (a 0.25 m sphere 0.6 m under the ceiling made the room's interreflected light
   // 6.5 % dimmer, which a weaker lamp had stood in for). Each record loses the hidden surface's
   // radiance (its region's albedo under the light's direct irradiance; its own bounced light left
   // out) over the sphere's solid angle, through the record's diffuse reflectance. The surface's
   // radiance is taken on the cone's axis: its mean over 8 directions in the cone (the patch behind
   // a lamp under a ceiling falls off within the cone) moved the suite's fitted amplitude from
-  // 0.717 to 0.721 at three times the cost (session 21).
+  // 0.717 to 0.721 at three times the cost).
   std::vector<Eigen::Vector3f> Hidden(double radius) const {
     std::vector<Eigen::Vector3f> out(records_.size(), Eigen::Vector3f::Zero());
     auto solid_angle = [](double r, double d) {

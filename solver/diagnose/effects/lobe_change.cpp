@@ -61,7 +61,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     };
     // The lights' reflection, and the room's (on a curved glossy object it is most of the lobe's
     // change: the sphere's Ward-GMD lobe was predicted 1-2 % from the lights alone and its refit
-    // cut the held-out residual by 59 %, bench/RESULTS.md session 23).
+    // cut the held-out residual by 59 %, bench/RESULTS.md).
     for (const RecordLightSample& ls : r.lights) add(ls);
     for (const RecordLightSample& ls : r.room) add(ls);
     return d;

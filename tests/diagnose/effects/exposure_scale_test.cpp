@@ -26,41 +26,11 @@ using namespace test::room;
 // model (lamp2 is dimmer than declared: a scale common to its lighting, another effect's), and
 // photo `off` (under lamp2; -1: none) records a further `off_scale`.
 CandidateResult ExposureWithTwoLightings(int off, double off_scale, bool solved = true) {
-  Scene model = RoomModel();
-  Light lamp2 = model.lights[0];
-  lamp2.name = "lamp2";
-  lamp2.position = Vector3d(-1, 1, 2.2);
-  model.lights.push_back(lamp2);
-  model.lightings.push_back(Lighting{"L1", {1}});
-  for (int j = 0; j < 8; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
-    ph.lighting = j / 4;
-    model.photos.push_back(ph);
-  }
+  const Scene model = TwoLightingRoomModel();
   const Json declared = {
       {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0, 1);
-  std::normal_distribution<double> g(0, 1);
-  std::vector<PixelRecord> records;
-  for (int i = 0; i < 16000; ++i) {
-    const bool wall = (i / 8) % 2 == 1;
-    const int photo = i % 8;
-    const RoomPoint q = DrawRoomPoint(rng, wall, photo < 4 ? kLamp : lamp2.position);
-    const Vector3d &p = q.p, &n = q.n, &wi = q.wi;
-    const double d = q.d, e = q.e;
-    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, p,
-                                         n, n, Vector3f::Constant(float(kRho)), wi, e, d);
-    r.lights[0].light = photo < 4 ? 0 : 1;
-    const double sim = kRho / kPi * e + kBounce;
-    const double scale = (photo < 4 ? 1.0 : 0.6) * (photo == off ? off_scale : 1.0);
-    for (int c = 0; c < 3; ++c) {
-      r.sim[c] = float(sim);
-      r.recorded[c] = float(sim * scale * (1 + 0.01 * g(rng)));
-    }
-    records.push_back(r);
-  }
+  const std::vector<PixelRecord> records = TwoLightingRoomRecords(
+      5, [&](int photo) { return (photo < 4 ? 1.0 : 0.6) * (photo == off ? off_scale : 1.0); });
   std::vector<std::string> excluded;
   for (const char* e : {"vignetting", "camera_response", "ambient_light"}) excluded.push_back(e);
   for (const char* l : {"lamp", "lamp2"}) {

@@ -94,35 +94,9 @@ TEST(EmissionProfileTest, ThePeakIntensityIsFittedWithTheMaterialsGiven) {
 // almost nothing (with the region scales over every photo it predicted 69 % on the RADIANCE
 // room's Cycles capture and was tried first).
 TEST(EmissionProfileTest, AnotherLightingsScaleIsNotThisLightsProfile) {
-  Scene model = RoomModel();
-  Light lamp2 = model.lights[0];
-  lamp2.name = "lamp2";
-  lamp2.position = Vector3d(-1, 1, 2.2);
-  model.lights.push_back(lamp2);
-  model.lightings.push_back(Lighting{"L1", {1}});
-  for (int j = 0; j < 8; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
-    ph.lighting = j / 4;
-    model.photos.push_back(ph);
-  }
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> g(0, 1);
-  std::vector<PixelRecord> records;
-  for (int i = 0; i < 16000; ++i) {
-    const bool wall = (i / 8) % 2 == 1;
-    const int photo = i % 8;
-    const RoomPoint q = DrawRoomPoint(rng, wall, photo < 4 ? kLamp : lamp2.position);
-    PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, q.p,
-                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
-    r.lights[0].light = photo < 4 ? 0 : 1;
-    const double sim = kRho / kPi * q.e + kBounce;
-    for (int c = 0; c < 3; ++c) {
-      r.sim[c] = float(sim);
-      r.recorded[c] = float(sim * (photo < 4 ? 0.6 : 1.0) * (1 + 0.01 * g(rng)));
-    }
-    records.push_back(r);
-  }
+  const Scene model = TwoLightingRoomModel();
+  const std::vector<PixelRecord> records =
+      TwoLightingRoomRecords(7, [](int photo) { return photo < 4 ? 0.6 : 1.0; });
   std::vector<int> cells(records.size());
   for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
   const ResidualFitter f(records, cells, 2, false, 8);
