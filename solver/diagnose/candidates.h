@@ -24,6 +24,10 @@ struct CandidateContext {
   // radius, an anisotropic lobe) run on a subsample of about this many fitted records; the
   // parameters they find are then fitted and scored on every record.
   int search_records = 30000;
+  // The photos and the model's complete renders of them, for the effects that work on images
+  // rather than on the records alone (pose_error's coarse-to-fine alignment); may be absent.
+  const PhotoSet* photos = nullptr;
+  const std::vector<Image>* sims = nullptr;
 };
 
 struct CandidateResult {

@@ -495,7 +495,9 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
     const KeyFilter allowed = [&](const std::string& key) {
       return std::find(excluded.begin(), excluded.end(), key) == excluded.end();
     };
-    const CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
+    CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
+    cx.photos = &photos;
+    cx.sims = &st.sim.sims;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<CandidateResult> cands = EvaluateCandidates(effects, cx, st.records, excluded);
     for (const auto& e : effects) {

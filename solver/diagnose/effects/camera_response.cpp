@@ -82,9 +82,16 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   best = f.FitNoisyBasis(k, basis_at(e_grid), derivatives_at(e_grid));
   if (best.coef.size() == 0) return out;
   FillScores(best, &out);
-  // photo ≈ sim + c·(model_e − sim) (+ s·model_e): for c near 1 the exponent is e; in general
-  // 1 + c(e − 1). The scale s moves the reference: (1 + s)·r·(u/r)^e = r'·(u/r')^e.
-  const double e = 1 + best.coef[0] * (e_grid - 1);
+  // photo ≈ f(v) = v + c·(m(v) − v) + d·m(v), m(v) = r·(v/r)^e_grid: the one power g(v) =
+  // (1 + d)·r·(v/r)^e with f's value, (1 + d)·r, and log-log slope, (1 − c + (c + d)·e_grid) /
+  // (1 + d), at the reference level v = r. For c near 1 the exponent is e_grid; with d = 0 it is
+  // 1 + c(e_grid − 1). The scale moves the reference: (1 + d)·r·(u/r)^e = r'·(u/r')^e.
+  const double d = k == 2 ? best.coef[1] : 0.0;
+  if (!(1 + d > 0.05)) {
+    out.note = fmt::format("the level curve is not a camera response: its scale is {:.3g}", 1 + d);
+    return out;
+  }
+  const double e = (1 - best.coef[0] + (best.coef[0] + d) * e_grid) / (1 + d);
   // Near e = 1 the basis is about c·(e − 1)·s·ln(s/r): c and the searched exponent trade off,
   // and only 1 + c(e − 1) is determined. An exponent outside the range a response can take
   // (the scene's [0.1, 10]; a camera's gamma lies within [0.2, 5]) is the basis fitting
@@ -97,9 +104,7 @@ CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
         e, best.coef[0], e_grid);
     return out;
   }
-  const double scale = k == 2 ? 1 + best.coef[1] / std::max(1e-6, best.coef[0]) : 1.0;
-  double reference =
-      k == 2 && scale > 0 && std::abs(e - 1) > 1e-3 ? ref * std::pow(scale, 1 / (1 - e)) : ref;
+  double reference = k == 2 && std::abs(e - 1) > 1e-3 ? ref * std::pow(1 + d, 1 / (1 - e)) : ref;
   if (!std::isfinite(reference) || !(reference > 1e-3 * ref) || !(reference < 1e3 * ref)) {
     reference = ref;  // an exponent near 1 leaves the reference undetermined
   }

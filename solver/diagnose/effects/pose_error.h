@@ -3,9 +3,13 @@
 // a slightly moved camera, so the residual follows the model image's gradient along the flow of a
 // small rotation ω (camera frame) and translation δ: photo − sim ≈ −∇sim · J(ω, δ).
 //
-// FitPoseError is one linear (Gauss–Newton) step of that fit; RefinePose iterates it — apply the
-// step, re-render the camera's photos, rebuild the records, refit — because one step recovers
-// only part of a pose error of a few pixels (the linearisation holds below a pixel).
+// FitPoseError fits that motion. Given the photos and the model's renders, it aligns them
+// coarse to fine (both blurred, a Gaussian of 4, 2 and 1 pixels, Gauss–Newton on the render
+// warped by each iterate), so that a pose error of a few pixels is within reach of the
+// linearisation, which holds below the blur's width; from the records alone it is one linear
+// step. RefinePose iterates it on re-renders — apply the step, re-render the camera's photos,
+// rebuild the records, refit — because a warped render is not a render from the moved camera
+// (occlusions, view-dependent shading).
 
 #include <string>
 #include <vector>
@@ -20,9 +24,11 @@
 
 namespace igi {
 
-// One damped Gauss–Newton (Levenberg–Marquardt) step for `camera` (six amplitudes: the damped
-// direction, its length fitted); its params hold the step (rotation_vector, translation_m), which
-// the effect's Write composes with the camera's qvec/tvec in the declared document.
+// The pose correction of `camera`: the coarse-to-fine alignment when `context` has the photos
+// and renders (scored as the change of the render it warps), otherwise one damped Gauss–Newton
+// (Levenberg–Marquardt) step (six amplitudes: the damped direction, its length fitted); its
+// params hold the step (rotation_vector, translation_m), which the effect's Write composes with
+// the camera's qvec/tvec in the declared document.
 CandidateResult FitPoseError(const CandidateContext& context, const ResidualFitter& fitter,
                              int camera);
 

@@ -94,6 +94,55 @@ TEST(ResponseTest, TheRendersNoiseDoesNotBendTheCurve) {
   EXPECT_GT(corrected.z, 10);
 }
 
+// Materials given, 4 photos under the lamp of the floor and the wall: the photos follow the
+// model's value through a response near linear with a darker exposure, 0.9·ref·(v/ref)^1.04
+// (ref 0.2), 1 % photo noise. Near an exponent of 1 the fit's curve coefficient and its searched
+// exponent trade off; the power written (its exponent and reference) must still be the one the
+// photos follow: it reproduces them to the photo noise.
+TEST(ResponseTest, WithTheMaterialsGivenThePowerWrittenReproducesThePhotos) {
+  Scene model = RoomModel();
+  for (int j = 0; j < 4; ++j) {
+    Photo ph;
+    ph.file = "cam" + std::to_string(j) + "_L0.exr";
+    model.photos.push_back(ph);
+  }
+  const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> g(0, 1);
+  auto truth_curve = [](double v) { return 0.9 * 0.2 * std::pow(v / 0.2, 1.04); };
+  std::vector<PixelRecord> records;
+  for (int i = 0; i < 16000; ++i) {
+    const bool wall = i % 2 == 1;
+    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
+    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q.p,
+                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    const double v = kRho / kPi * q.e + kBounce;
+    for (int c = 0; c < 3; ++c) {
+      r.sim[c] = float(v);
+      r.recorded[c] = float(truth_curve(v) * (1 + 0.01 * g(rng)));
+    }
+    records.push_back(r);
+  }
+  std::vector<int> cells(records.size());
+  for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
+  const ResidualFitter f(records, cells, 2, false, 8);
+  const CandidateResult c = Response({model, declared, false}, f);
+  ASSERT_TRUE(c.valid) << c.note;
+  const double e = c.params["exponent"].get<double>();
+  const double ref = c.params["reference"].get<double>();
+  double sq_err = 0, sq = 0;
+  for (const PixelRecord& r : records) {
+    const double v = r.sim[0], want = truth_curve(v);
+    const double got = ref * std::pow(v / ref, e);
+    sq_err += (got - want) * (got - want);
+    sq += want * want;
+  }
+  std::printf("camera_response: exponent %.4f, reference %.4f, relative error %.4f\n", e, ref,
+              std::sqrt(sq_err / sq));
+  EXPECT_NEAR(e, 1.04, 0.01);
+  EXPECT_LT(std::sqrt(sq_err / sq), 0.005);
+}
+
 // Write composes each photo's response with the fitted power: a declared exponent is multiplied
 // by the fitted one, an absent one (linear, 1) becomes it, and the reference is the fitted one
 // in every photo.
