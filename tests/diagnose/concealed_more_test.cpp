@@ -78,8 +78,10 @@ TEST_P(ConcealedMoreTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest,
-                         testing::Values("light_intensity", "specular_reflection",
-                                         "ambient_light:kind=uniform"));
+                         testing::Values("specular_reflection", "ambient_light:kind=uniform"));
+// Labelled slow: CI names a light's intensity in another renderer's photos
+// (concealed_cycles_test.cpp).
+INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedMoreTest, testing::Values("light_intensity"));
 
 INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest,
                          testing::Values("vignetting+exposure_scale",

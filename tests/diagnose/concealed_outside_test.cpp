@@ -1,10 +1,9 @@
 // igi-diagnose on a capture igi did not render: the shared RADIANCE room (RADIANCE 6.1a, pure
 // Monte Carlo, point-sampled pixels with 2-3.5 % noise; ../shared/data/reference/radiance_room),
 // its 4 photos box-filtered to 160×120, with one photo effect hidden in them (igi-synth --from),
-// the materials given. The first
-// kept step names the effect and the held-out residual comes within 1.2x the true model's (the
-// source scene with the effect declared, diagnosed the same way); the control (its photos as
-// RADIANCE wrote them) reports nothing.
+// the materials given. The first kept step names the effect and the held-out residual comes
+// within 1.2x the true model's (the source scene with the effect declared, diagnosed the same
+// way); the control (its photos as RADIANCE wrote them) reports nothing.
 #include <gtest/gtest.h>
 
 #include <cstdio>
