@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "tests/diagnose/concealed_fixture.h"
@@ -89,6 +90,11 @@ Outcome DiagnoseRadiance(const std::string& effect) {
                 effect.empty() ? "none" : effect.c_str(), kept.empty() ? "-" : kept.c_str(),
                 o.diagnosis["baseline"]["held_out_residual"].get<double>(),
                 o.diagnosis["final"]["held_out_residual"].get<double>(), o.floor_held_out);
+  }
+  // IGI_CONCEALED_KEEP names a folder to move everything to, for study.
+  if (const char* keep = std::getenv("IGI_CONCEALED_KEEP"); keep != nullptr && *keep != 0) {
+    fs::create_directories(keep);
+    fs::copy(dir, fs::path(keep) / dir.filename(), fs::copy_options::recursive);
   }
   fs::remove_all(dir);
   return o;
