@@ -67,8 +67,9 @@ inline RoomPoint DrawRoomPoint(std::mt19937_64& rng, bool wall, const Eigen::Vec
 
 // Records on the floor (z = 0, |x|, |y| < 3) and a wall (x = 3, |y| < 3, 0 < z < 2.5), the view
 // straight along the normal, alternating floor and wall, in photos 0-3. The photo: the lamp's
-// direct light times peak·cos^power of the angle from −z, plus the bounce term, through the
-// response v = (u/ref)^exponent·ref (ref 0.05), 1 % noise.
+// direct light times peak·cos^power of the angle from −z, plus the bounce term scaled as the
+// light's flux (peak / (2·(power + 1)) of the isotropic lamp's: the spot sends nothing above its
+// horizon), through the response v = (u/ref)^exponent·ref (ref 0.05), 1 % noise.
 inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t seed,
                                             double peak = 1.0) {
   std::mt19937_64 rng(seed);
@@ -85,7 +86,8 @@ inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint6
     const double cos_axis = wi.z();  // cos of the angle from −z of the direction lamp → point
     PixelRecord r = OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n, n,
                                    Eigen::Vector3f::Constant(float(kRho)), wi, e, d);
-    const double truth = peak * direct * std::pow(std::max(0.0, cos_axis), power) + kBounce;
+    const double truth = peak * direct * std::pow(std::max(0.0, cos_axis), power) +
+                         kBounce * peak / (2 * (power + 1));
     const double recorded = ref * std::pow(truth / ref, exponent);
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(direct + kBounce);
