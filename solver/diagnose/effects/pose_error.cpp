@@ -250,8 +250,7 @@ std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
       if (step.norm() < 1e-6) break;
     }
   }
-  fine->assign(photos.size(), cv::Mat());
-  for (size_t i = 0; i < photos.size(); ++i) (*fine)[i] = std::move(sim_at[i]);
+  *fine = std::move(sim_at);
   return x;
 }
 
@@ -333,9 +332,9 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
   FillScores(fit, &out);
   // The candidate's z decides only whether the pose is iterated on re-renders (the trial's
   // edge-pixel test then judges it): the larger of the edge pixels' signed-rank z and the fit's
-  // block z. The one linearised step overshoots on faint edges while it gains on the sharp ones
-  // (a 2.4 px turn of the RADIANCE room's view: 7.5 % predicted held-out gain, most edge pixels
-  // a little worse), and the block z counts the gain where it is.
+  // block z. A step that is not yet the pose (one linearised step; an alignment of blurred
+  // images) can gain on the sharp edges and lose a little on most faint ones, and the block z
+  // counts the gain where it is.
   out.z = std::max(out.z, EdgeBlockZ(f.records(), camera, cx.model, cx.block_px, basis, fit.coef));
   out.params = {{"camera", cam.name},
                 {"rotation_deg", angle_deg},
@@ -420,6 +419,15 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
       continue;
     }
     if (!step.valid) break;
+    // Converged to the noise: the last step cut the fitted residual² by less than
+    // kPoseMinStepGain of it (on a render's and a photo's noise the steps wander by a tenth of a
+    // degree without end).
+    if (std::isfinite(last_train) &&
+        last_train - step.train_before < kPoseMinStepGain * last_train) {
+      spdlog::info("igi-diagnose: pose of {}: the last step gained {:.2f}% of the residual²; done",
+                   name, 100 * (last_train - step.train_before) / last_train);
+      break;
+    }
     halvings = 0;
     last_train = step.train_before;
     last_doc = *doc;

@@ -46,6 +46,9 @@ constexpr double kPoseDamping = 0.01;
 // A pose step that raises the fitted residual is retried at half its length this many times.
 constexpr int kPoseHalvings = 2;
 
+// RefinePose stops once a step cuts the fitted residual² by less than this share of it.
+constexpr double kPoseMinStepGain = 0.002;
+
 // Composes a small rotation ω (camera frame, radians) and shift δ (scene units) with the pose of
 // camera entry `camera` in *doc: R ← exp(ω) R, t ← exp(ω) t + δ.
 void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
@@ -71,8 +74,9 @@ struct PoseRefinement {
 // Iterates the pose of `camera` in *doc from the model's pose: re-renders the camera's photos
 // with the moved pose, rebuilds the records (the camera's outliers included: its sharpest edges
 // are the signal) and applies the next step, until a step is below 0.005° and 3e-5 of the
-// median depth (0.1 mm at 3 m), a step raises the fitted residual even at a quarter of its
-// length (taken back), or max_iterations (halvings included) were made.
+// median depth (0.1 mm at 3 m), a step cuts the fitted residual² by less than kPoseMinStepGain
+// of it, a step raises it even at a quarter of its length (taken back), or max_iterations
+// (halvings included) were made.
 PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& options,
                           bool materials_solved, double cell_m, int max_iterations, Json* doc);
