@@ -181,13 +181,7 @@ TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
 // lobe change on a Lambertian region) is left out, one that could not be fitted for a reason
 // (vignetting without declared cameras) is kept with its note.
 TEST(EvaluateCandidatesTest, FitsTheCandidatesNotExcludedInTheEffectsOrder) {
-  Scene model = RoomModel();
-  for (int j = 0; j < 4; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j) + "_L0.exr";
-    ph.lighting = 0;
-    model.photos.push_back(ph);
-  }
+  const Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = RoomRecords(2.0, 1.0, 3);
   std::vector<std::string> excluded = {"ambient_light",

@@ -65,6 +65,27 @@ inline RoomPoint DrawRoomPoint(std::mt19937_64& rng, bool wall, const Eigen::Vec
   return q;
 }
 
+// RoomModel with the 4 photos of RoomRecords, cam0-3 under the lamp (lighting 0).
+inline Scene RoomModelWithPhotos() {
+  Scene s = RoomModel();
+  for (int j = 0; j < 4; ++j) {
+    Photo ph;
+    ph.file = "cam" + std::to_string(j) + "_L0.exr";
+    ph.lighting = 0;
+    s.photos.push_back(ph);
+  }
+  return s;
+}
+
+// Record i of the room: on the floor for even i, on the wall for odd, in photo i % 4, lit by the
+// lamp (its point in *q); its sim and recorded values are the caller's.
+inline PixelRecord RoomRecordAt(int i, std::mt19937_64& rng, RoomPoint* q) {
+  const bool wall = i % 2 == 1;
+  *q = DrawRoomPoint(rng, wall, kLamp);
+  return OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q->p, q->n, q->n,
+                        Eigen::Vector3f::Constant(float(kRho)), q->wi, q->e, q->d);
+}
+
 // Records on the floor (z = 0, |x|, |y| < 3) and a wall (x = 3, |y| < 3, 0 < z < 2.5), the view
 // straight along the normal, alternating floor and wall, in photos 0-3. The photo: the lamp's
 // direct light times peak·cos^power of the angle from −z, plus the bounce term scaled as the
@@ -78,14 +99,10 @@ inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint6
   const double ref = 0.05;
   std::vector<PixelRecord> out;
   for (int i = 0; i < 8000; ++i) {
-    const bool wall = i % 2 == 1;
-    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
-    const Eigen::Vector3d &p = q.p, &n = q.n, &wi = q.wi;
-    const double d = q.d, e = q.e;
-    const double direct = kRho / kPi * e;
-    const double cos_axis = wi.z();  // cos of the angle from −z of the direction lamp → point
-    PixelRecord r = OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n, n,
-                                   Eigen::Vector3f::Constant(float(kRho)), wi, e, d);
+    RoomPoint q;
+    PixelRecord r = RoomRecordAt(i, rng, &q);
+    const double direct = kRho / kPi * q.e;
+    const double cos_axis = q.wi.z();  // cos of the angle from −z of the direction lamp → point
     const double truth = peak * direct * std::pow(std::max(0.0, cos_axis), power) +
                          kBounce * peak / (2 * (power + 1));
     const double recorded = ref * std::pow(truth / ref, exponent);

@@ -22,6 +22,9 @@
 #include "solver/sampling.h"
 
 namespace igi {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
 namespace {
 
 // The held-out gain's significance where a pose error shows: on the model image's edges (flat
@@ -67,9 +70,7 @@ double EdgeBlockZ(const std::vector<PixelRecord>& records, int camera, const Sce
 // (as ResidualFitter: per cell and channel, every quantity v becomes v − sim·Σ v·sim / Σ sim²
 // when the albedos are free), solved with Levenberg–Marquardt damping: (A + λ diag A) x = g.
 template <class Flows>
-Eigen::Matrix<double, 6, 1> DampedPoseStep(const CandidateContext& cx, const ResidualFitter& f,
-                                           const Flows& flows) {
-  using Vec6 = Eigen::Matrix<double, 6, 1>;
+Vec6 DampedPoseStep(const CandidateContext& cx, const ResidualFitter& f, const Flows& flows) {
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   struct Acc {
     double ss = 0, sy = 0;
@@ -134,7 +135,7 @@ double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, 
   return z[z.size() / 2];
 }
 
-using Vec6 = Eigen::Matrix<double, 6, 1>;
+namespace {
 
 // The image flow (pixels) of a point `p` (camera frame) under the six motions: rotation ω
 // (radians) and translation δ / depth (radians at the median depth `depth`, so that a damping
@@ -147,6 +148,18 @@ void PoseFlows(const Eigen::Vector3d& p, double fx, double fy, double depth, dou
     du[k] = fx * (d.x() / p.z() - p.x() * d.z() / (p.z() * p.z()));
     dv[k] = fy * (d.y() / p.z() - p.y() * d.z() / (p.z() * p.z()));
   }
+}
+
+// The flows of record `r`'s point (PoseFlows) and its image shift under the motion x, (Σ du·x,
+// Σ dv·x); false when the point is not in front of the camera.
+bool RecordFlows(const PixelRecord& r, double fx, double fy, double depth, const Vec6& x,
+                 double du[6], double dv[6], double* shift_u, double* shift_v) {
+  const Eigen::Vector3d p = r.point_cam.cast<double>();
+  if (!(p.z() > 1e-6)) return false;
+  PoseFlows(p, fx, fy, depth, du, dv);
+  *shift_u = *shift_v = 0;
+  for (int k = 0; k < 6; ++k) *shift_u += du[k] * x[k], *shift_v += dv[k] * x[k];
+  return true;
 }
 
 // A photo or render, non-finite values set to 0 and values clamped to `limit` (a lamp's own
@@ -222,12 +235,8 @@ std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
       for (const PixelRecord& r : records) {
         if (r.held_out || cx.model.photos[r.photo].camera != camera) continue;
         if (sim_at[r.photo].empty()) continue;
-        const Eigen::Vector3d p = r.point_cam.cast<double>();
-        if (!(p.z() > 1e-6)) continue;
-        double du[6], dv[6];
-        PoseFlows(p, fx, fy, depth, du, dv);
-        double shift_u = 0, shift_v = 0;
-        for (int k = 0; k < 6; ++k) shift_u += du[k] * x[k], shift_v += dv[k] * x[k];
+        double du[6], dv[6], shift_u, shift_v;
+        if (!RecordFlows(r, fx, fy, depth, x, du, dv, &shift_u, &shift_v)) continue;
         const double u = r.x + 0.5, v = r.y + 0.5;
         for (int c = 0; c < 3; ++c) {
           double s, gx, gy, ph, unused_x, unused_y;
@@ -253,6 +262,8 @@ std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
   *fine = std::move(sim_at);
   return x;
 }
+
+}  // namespace
 
 // pose_error of one camera: the photo is the model seen from a slightly moved camera, so the
 // residual follows the model image's gradient along the flow of a small rotation ω (camera frame)
@@ -286,12 +297,8 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
     x = *aligned;
     basis = [&](const PixelRecord& r, int c, double* b) {
       if (cx.model.photos[r.photo].camera != camera || fine[r.photo].empty()) return;
-      const Eigen::Vector3d p = r.point_cam.cast<double>();
-      if (!(p.z() > 1e-6)) return;
-      double du[6], dv[6];
-      PoseFlows(p, fx, fy, depth, du, dv);
-      double shift_u = 0, shift_v = 0;
-      for (int k = 0; k < 6; ++k) shift_u += du[k] * x[k], shift_v += dv[k] * x[k];
+      double du[6], dv[6], shift_u, shift_v;
+      if (!RecordFlows(r, fx, fy, depth, x, du, dv, &shift_u, &shift_v)) return;
       double moved, here, gx, gy;
       if (SampleAt(fine[r.photo], r.x + 0.5 - shift_u, r.y + 0.5 - shift_v, c, &moved, &gx, &gy) &&
           SampleAt(fine[r.photo], r.x + 0.5, r.y + 0.5, c, &here, &gx, &gy)) {

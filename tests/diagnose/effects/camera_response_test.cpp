@@ -29,24 +29,17 @@ using namespace test::room;
 // `render_noise` relative Monte Carlo noise, its variance known to the records when
 // `variance_known` (as SimulatePhotos estimates it). The camera_response candidate.
 CandidateResult ResponseWithNoisyRenders(double render_noise, bool variance_known) {
-  Scene model = RoomModel();
-  for (int j = 0; j < 4; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j) + "_L0.exr";
-    model.photos.push_back(ph);
-  }
+  const Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::mt19937_64 rng(11);
   std::normal_distribution<double> g(0, 1);
   const double ref = 0.2;
   std::vector<PixelRecord> records;
   for (int i = 0; i < 16000; ++i) {
-    const bool wall = i % 2 == 1;
-    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
-    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q.p,
-                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    RoomPoint q;
+    PixelRecord r = RoomRecordAt(i, rng, &q);
     const double truth = kRho / kPi * q.e + kBounce;
-    const double recorded = ref * std::pow(truth * (wall ? 1.1 : 1.0) / ref, 0.8);
+    const double recorded = ref * std::pow(truth * (r.region == 1 ? 1.1 : 1.0) / ref, 0.8);
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(truth);
       r.recorded[c] = float(recorded * (1 + 0.01 * g(rng)));
@@ -100,22 +93,15 @@ TEST(ResponseTest, TheRendersNoiseDoesNotBendTheCurve) {
 // exponent trade off; the power written (its exponent and reference) must still be the one the
 // photos follow: it reproduces them to the photo noise.
 TEST(ResponseTest, WithTheMaterialsGivenThePowerWrittenReproducesThePhotos) {
-  Scene model = RoomModel();
-  for (int j = 0; j < 4; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j) + "_L0.exr";
-    model.photos.push_back(ph);
-  }
+  const Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g(0, 1);
   auto truth_curve = [](double v) { return 0.9 * 0.2 * std::pow(v / 0.2, 1.04); };
   std::vector<PixelRecord> records;
   for (int i = 0; i < 16000; ++i) {
-    const bool wall = i % 2 == 1;
-    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
-    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q.p,
-                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    RoomPoint q;
+    PixelRecord r = RoomRecordAt(i, rng, &q);
     const double v = kRho / kPi * q.e + kBounce;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(v);

@@ -30,13 +30,7 @@ using namespace test::room;
 // power searched on every `stride`-th record (1: on all of them).
 CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1,
                            double peak = 1.0) {
-  Scene model = RoomModel();
-  for (int j = 0; j < 4; ++j) {  // RoomRecords' photos, under the lamp
-    Photo ph;
-    ph.file = "cam" + std::to_string(j) + "_L0.exr";
-    ph.lighting = 0;
-    model.photos.push_back(ph);
-  }
+  const Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed, peak);
   std::vector<int> cells(records.size());
@@ -119,22 +113,14 @@ TEST(EmissionProfileTest, AnotherLightingsScaleIsNotThisLightsProfile) {
 // with a free scale of the bounced light per region, the prediction was that of a better fit
 // than the spot renders.
 TEST(EmissionProfileTest, ThePredictedResidualIsTheOneTheProfileRenders) {
-  Scene model = RoomModel();
-  for (int j = 0; j < 4; ++j) {
-    Photo ph;
-    ph.file = "cam" + std::to_string(j) + "_L0.exr";
-    ph.lighting = 0;
-    model.photos.push_back(ph);
-  }
+  const Scene model = RoomModelWithPhotos();
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g(0, 1);
   std::vector<PixelRecord> records;
   std::vector<double> direct;
   for (int i = 0; i < 8000; ++i) {
-    const bool wall = i % 2 == 1;
-    const RoomPoint q = DrawRoomPoint(rng, wall, kLamp);
-    PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q.p,
-                                         q.n, q.n, Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    RoomPoint q;
+    PixelRecord r = RoomRecordAt(i, rng, &q);
     const double d = kRho / kPi * q.e;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(d + kBounce);
