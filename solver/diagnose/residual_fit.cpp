@@ -188,7 +188,11 @@ double BlockGainZ(const std::vector<std::pair<double, double>>& blocks) {
   const double se_ratio = std::sqrt(sq_ratio * n / (n - 1)) / sum_e;
   const double z_rel = se_rel > 0 ? mean / se_rel : 0;
   const double z_ratio = se_ratio > 0 ? ratio / se_ratio : 0;
-  const double best = std::max(z_rel, z_ratio);
+  return EitherZ(z_rel, z_ratio);
+}
+
+double EitherZ(double z1, double z2) {
+  const double best = std::max(z1, z2);
   const double p = UpperTail(best);
   return best > 0 && p > 0 ? UpperQuantile(2 * p) : best;
 }

@@ -132,6 +132,10 @@ class ResidualFitter {
 // returned as it is.
 double BlockGainZ(const std::vector<std::pair<double, double>>& blocks);
 
+// Two tests of one hypothesis, Bonferroni-combined: the z whose one-sided p-value is twice the
+// smaller one's (the larger z as it is when neither is positive).
+double EitherZ(double z1, double z2);
+
 // Wilcoxon's signed-rank statistic of `values` (zeros dropped) as a normal z: whether they are
 // mostly positive, robust to the heavy tails of per-block gains on edges.
 double SignedRankZ(std::vector<double> values);
