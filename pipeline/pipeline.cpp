@@ -144,6 +144,7 @@ std::vector<Stage> Stages(const Context& ctx) {
        [&](Fingerprint* fp) {
          fp->AddText(std::to_string(o.report_spp) + "/" + std::to_string(o.report_photos) + "/" +
                      std::to_string(o.report_lightings));
+         fp->AddText(fmt::format("report_megapixels {:.17g}", o.report_megapixels));
        },
        ReportStage},
   };

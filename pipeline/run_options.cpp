@@ -1,5 +1,7 @@
 #include "pipeline/run_options.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -22,6 +24,10 @@ void RunOptions::Validate() const {
   }
   if (report_lightings < 1) {
     problems.Add("", "--report-lightings", std::to_string(report_lightings), "must be >= 1");
+  }
+  if (!(report_megapixels == 0 || (report_megapixels >= 0.001 && report_megapixels <= 1000))) {
+    problems.Add("", "--report-megapixels", fmt::format("{}", report_megapixels),
+                 "must be 0 or in [0.001, 1000]");
   }
   if (diagnose_spp < 0) {
     problems.Add("", "--diagnose-spp", std::to_string(diagnose_spp), "must be >= 0");

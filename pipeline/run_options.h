@@ -31,6 +31,10 @@ struct RunOptions {
   int report_spp = 32;       // samples per pixel of the report's renders, >= 1
   int report_photos = 4;     // photos shown with their re-render and residual, >= 1
   int report_lightings = 6;  // lightings of the relit renders, >= 1
+  // The report's renders and its photos' figures at most this many megapixels: each camera
+  // rendered at its size divided by ReductionFactor, each photo shown as the means of its blocks
+  // of that size (0 = the photos' size).
+  double report_megapixels = 0.5;
   int num_threads = 0;       // --threads given to every stage (0 = all cores)
 
   void Validate() const;  // InputError naming the flag

@@ -156,8 +156,12 @@ void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
     const Photo& p = scene.photos[k];
     const fs::path render_file = out / "06-report" / "renders" / fmt::format("photo_{}.exr", k);
     if (!fs::exists(render_file)) continue;
-    Image photo = ReadImage(scene.dir / p.file, 3);
+    // The render is at the photo's size or reduced by an integer factor (report_megapixels):
+    // the photo and its mask are shown as the means of blocks of that factor.
     const Image render = ReadImage(render_file, 3);
+    Image photo = ReadImage(scene.dir / p.file, 3);
+    const int f = std::max(1, photo.width / std::max(1, render.width));
+    photo = BlockMeans(photo, f);
     double exposure = 0;
     const Image photo_display = ToneMapSrgb(photo, 0, &exposure);
     std::string row = "<div class=\"row\">" +
@@ -165,10 +169,12 @@ void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
                       Figure(ToneMapSrgb(render, exposure), "re-render (solved model)");
     if (render.width == photo.width && render.height == photo.height) {
       Image residual = render;
+      // A block is valid when every pixel of it is.
       const std::optional<Image> mask =
-          p.mask ? std::optional<Image>(ReadImage(scene.dir / *p.mask, 1)) : std::nullopt;
+          p.mask ? std::optional<Image>(BlockMeans(ReadImage(scene.dir / *p.mask, 1), f))
+                 : std::nullopt;
       for (size_t i = 0; i < residual.pixels.size(); ++i) {
-        const bool valid = !mask || mask->pixels[i / 3] > 0;
+        const bool valid = !mask || mask->pixels[i / 3] > 1.0f - 1e-4f;
         const float d = render.pixels[i] - photo.pixels[i];
         residual.pixels[i] = valid && std::isfinite(d) ? d : 0.0f;
       }
@@ -254,6 +260,7 @@ void ReportStage(const Context& ctx, StageRun* run) {
   const fs::path renders = run->dir() / "renders";
   fs::create_directories(renders);
   auto render = [&](const Camera& cam, const Lighting& l, const fs::path& file) {
+    const int f = ReductionFactor(cam.width, cam.height, ctx.options.report_megapixels);
     std::vector<std::string> args = {solved.string(),
                                      "--camera",
                                      cam.name,
@@ -261,6 +268,10 @@ void ReportStage(const Context& ctx, StageRun* run) {
                                      l.name,
                                      "--spp",
                                      std::to_string(ctx.options.report_spp),
+                                     "--width",
+                                     std::to_string(cam.width / f),
+                                     "--height",
+                                     std::to_string(cam.height / f),
                                      "--out",
                                      file.string()};
     const auto threads = ThreadArgs(ctx);

@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--report-lightings", o.report_lightings, "Lightings of the relit renders")
       ->capture_default_str();
+  app.add_option("--report-megapixels", o.report_megapixels,
+                 "The report's renders and photo figures at most this many megapixels (block "
+                 "means of the photos; 0 = their size)")
+      ->capture_default_str();
   app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
   app.add_option("--demo-cameras", demo.cameras, "--demo: cameras")->capture_default_str();
   app.add_option("--demo-ceiling-cameras", demo.ceiling_cameras,

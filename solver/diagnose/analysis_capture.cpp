@@ -55,22 +55,13 @@ bool ReducePhoto(const Photo& p, int f, const fs::path& file, const fs::path& ma
 
 }  // namespace
 
-int AnalysisFactor(int width, int height, double max_megapixels) {
-  if (max_megapixels <= 0) return 1;
-  const double limit = max_megapixels * 1e6;
-  int f = std::max(1, int(std::ceil(std::sqrt(double(width) * height / limit))));
-  while (f > 1 && double(width / (f - 1)) * (height / (f - 1)) <= limit) --f;
-  while (double(width / f) * (height / f) > limit && f < std::min(width, height)) ++f;
-  return f;
-}
-
 AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double max_megapixels,
                               const fs::path& dir, bool show_progress) {
   AnalysisCapture capture;
   std::vector<int> factor(scene.cameras.size(), 1);
   for (size_t k = 0; k < scene.cameras.size(); ++k) {
     const Camera& cam = scene.cameras[k];
-    factor[k] = AnalysisFactor(cam.width, cam.height, max_megapixels);
+    factor[k] = ReductionFactor(cam.width, cam.height, max_megapixels);
     if (factor[k] > 1) {
       capture.cameras[cam.name] = {factor[k], cam.width / factor[k], cam.height / factor[k]};
     }

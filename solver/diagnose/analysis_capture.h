@@ -33,10 +33,6 @@ struct AnalysisCapture {
   std::map<std::string, Reduction> cameras;
 };
 
-// The integer factor that brings a width × height photo within `max_megapixels` (1 when it is
-// within already, or when max_megapixels is 0).
-int AnalysisFactor(int width, int height, double max_megapixels);
-
 // Writes the reduced capture of `scene` under `dir` (nothing when no camera needs reducing);
 // `declared` is its document with absolute paths.
 AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double max_megapixels,

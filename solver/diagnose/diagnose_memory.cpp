@@ -8,6 +8,7 @@
 #include "solver/diagnose/pixel_records.h"
 #include "solver/solve_memory.h"
 #include "tools/common/error.h"
+#include "tools/common/image.h"
 #include "tools/common/memory.h"
 
 namespace igi {
@@ -24,7 +25,7 @@ DiagnoseMemoryPlan PlanDiagnoseMemory(const Scene& scene, const DiagnoseOptions&
   plan.budget_bytes = SolveMemoryBudgetBytes(options.solve);
   for (const Photo& p : scene.photos) {
     const Camera& cam = scene.cameras[p.camera];
-    const int f = AnalysisFactor(cam.width, cam.height, options.analysis_megapixels);
+    const int f = ReductionFactor(cam.width, cam.height, options.analysis_megapixels);
     plan.pixels += double(cam.width / f) * double(cam.height / f);
   }
   // The photos twice (a step's masked copy beside them), the current model's re-render and up

@@ -151,5 +151,39 @@ TEST_F(ImageTest, FailedWriteLeavesNoFileBehind) {
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
 }
 
+TEST(ReductionFactor, IsTheSmallestThatBringsThePhotoWithinTheLimit) {
+  EXPECT_EQ(ReductionFactor(5656, 4242, 0.5), 7);  // 808 x 606
+  EXPECT_EQ(ReductionFactor(160, 120, 0.5), 1);
+  EXPECT_EQ(ReductionFactor(320, 240, 0.02), 2);
+  EXPECT_EQ(ReductionFactor(6000, 4000, 0), 1);
+  for (int w : {101, 640, 1999, 4032, 6000}) {
+    for (double mp : {0.01, 0.05, 0.3, 1.0}) {
+      const int h = w * 2 / 3, f = ReductionFactor(w, h, mp);
+      EXPECT_LE(double(w / f) * (h / f), mp * 1e6) << w << " " << mp;
+      if (f > 1) {
+        EXPECT_GT(double(w / (f - 1)) * (h / (f - 1)), mp * 1e6) << w << " " << mp;
+      }
+    }
+  }
+}
+
+TEST(BlockMeans, AreTheMeansOfWholeBlocks) {
+  Image img(7, 5, 2);
+  for (int y = 0; y < 5; ++y) {
+    for (int x = 0; x < 7; ++x) {
+      img.at(x, y, 0) = float(x + 10 * y);
+      img.at(x, y, 1) = 1.0f;
+    }
+  }
+  const Image out = BlockMeans(img, 3);
+  ASSERT_EQ(out.width, 2);  // the seventh column and the last two rows fill no block
+  ASSERT_EQ(out.height, 1);
+  ASSERT_EQ(out.channels, 2);
+  EXPECT_FLOAT_EQ(out.at(0, 0, 0), 1.0f + 10.0f);  // columns 0-2, rows 0-2
+  EXPECT_FLOAT_EQ(out.at(1, 0, 0), 4.0f + 10.0f);  // columns 3-5
+  EXPECT_FLOAT_EQ(out.at(1, 0, 1), 1.0f);
+  EXPECT_EQ(BlockMeans(img, 1).pixels, img.pixels);
+}
+
 }  // namespace
 }  // namespace igi

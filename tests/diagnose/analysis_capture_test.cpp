@@ -21,22 +21,6 @@ using test::SquareObj;
 using test::TempSceneDir;
 using test::WriteText;
 
-TEST(AnalysisFactor, IsTheSmallestThatBringsThePhotoWithinTheLimit) {
-  EXPECT_EQ(AnalysisFactor(5656, 4242, 0.5), 7);  // 808 x 606
-  EXPECT_EQ(AnalysisFactor(160, 120, 0.5), 1);
-  EXPECT_EQ(AnalysisFactor(320, 240, 0.02), 2);
-  EXPECT_EQ(AnalysisFactor(6000, 4000, 0), 1);
-  for (int w : {101, 640, 1999, 4032, 6000}) {
-    for (double mp : {0.01, 0.05, 0.3, 1.0}) {
-      const int h = w * 2 / 3, f = AnalysisFactor(w, h, mp);
-      EXPECT_LE(double(w / f) * (h / f), mp * 1e6) << w << " " << mp;
-      if (f > 1) {
-        EXPECT_GT(double(w / (f - 1)) * (h / (f - 1)), mp * 1e6) << w << " " << mp;
-      }
-    }
-  }
-}
-
 // Two cameras over a floor: photo a (37 x 29) with a NaN pixel, photo b (40 x 24) with a response
 // and a mask that leaves out its top-left pixel.
 struct TwoPhotos {

@@ -14,6 +14,7 @@
 #include "tests/e2e/run.h"
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
+#include "tools/common/image.h"
 #include "tools/common/json.h"
 
 namespace igi {
@@ -55,6 +56,7 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
       "igi-run", "--hdr-photos --scene " + Quote((scene_dir / "scene.json").string()) + " --out " +
                      Quote(out.string()) +
                      " --threads 2 --report-photos 1 --report-lightings 1 --report-spp 4"
+                     " --report-megapixels 0.001"
                      " --solve-arg=--photo-scale=solve --solve-arg=--indirect-rays=32"
                      " --solve-arg=--refine-iterations=0 --diagnose-arg=--max-steps=1"
                      " --diagnose-arg=--spp=8 --diagnose-arg=--refine-iterations=0"
@@ -83,7 +85,14 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
   EXPECT_EQ(diagnosis["format"], "igi-diagnosis");
   EXPECT_TRUE(diagnosis["baseline"]["residual"].is_number());
   EXPECT_TRUE(fs::exists(out / "05-diagnose" / "scene.json"));
-  EXPECT_NE(ReadFileToString(out / "report.html").find("iagnos"), std::string::npos);
+  const std::string report = ReadFileToString(out / "report.html");
+  EXPECT_NE(report.find("iagnos"), std::string::npos);
+  // The report's renders within --report-megapixels (64 × 48 photos: blocks of 2 × 2), and the
+  // photo shown beside its render as the residual at that size.
+  const ImageInfo render = ReadImageInfo(out / "06-report" / "renders" / "photo_0.exr");
+  EXPECT_EQ(render.width, 32);
+  EXPECT_EQ(render.height, 24);
+  EXPECT_NE(report.find("residual render"), std::string::npos);
   fs::remove_all(dir);
 }
 

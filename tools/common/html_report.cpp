@@ -58,26 +58,10 @@ float SrgbEncode(double v) {
   return float(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
 }
 
-// Box-downsamples by an integer factor when the image is more than twice `width_px` wide.
+// Block means by an integer factor when the image is more than twice `width_px` wide.
 igi::Image ShrinkForDisplay(const igi::Image& image, int width_px) {
   if (width_px <= 0 || image.width <= 2 * width_px) return image;
-  const int f = image.width / width_px;
-  igi::Image out((image.width + f - 1) / f, (image.height + f - 1) / f, image.channels);
-  for (int y = 0; y < out.height; ++y) {
-    for (int x = 0; x < out.width; ++x) {
-      for (int c = 0; c < image.channels; ++c) {
-        double sum = 0;
-        int n = 0;
-        for (int yy = y * f; yy < std::min(image.height, (y + 1) * f); ++yy) {
-          for (int xx = x * f; xx < std::min(image.width, (x + 1) * f); ++xx, ++n) {
-            sum += image.at(xx, yy, c);
-          }
-        }
-        out.at(x, y, c) = float(sum / n);
-      }
-    }
-  }
-  return out;
+  return igi::BlockMeans(image, image.width / width_px);
 }
 
 std::string Figure(const igi::Image& display, const std::string& caption, int width_px,

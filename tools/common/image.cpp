@@ -4,6 +4,9 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 
@@ -275,6 +278,34 @@ void ImageRowWriter::Commit() {
     throw Error(DescribeProblem(impl_->path.string(), "", "", "cannot finish image: " + error));
   }
   impl_->atomic->Commit();
+}
+
+int ReductionFactor(int width, int height, double max_megapixels) {
+  if (max_megapixels <= 0) return 1;
+  const double limit = max_megapixels * 1e6;
+  int f = std::max(1, int(std::ceil(std::sqrt(double(width) * height / limit))));
+  while (f > 1 && double(width / (f - 1)) * (height / (f - 1)) <= limit) --f;
+  while (double(width / f) * (height / f) > limit && f < std::min(width, height)) ++f;
+  return f;
+}
+
+Image BlockMeans(const Image& image, int f) {
+  if (f <= 1) return image;
+  Image out(image.width / f, image.height / f, image.channels);
+  out.metadata = image.metadata;
+  const double n = double(f) * f;
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      for (int c = 0; c < image.channels; ++c) {
+        double sum = 0;
+        for (int v = y * f; v < (y + 1) * f; ++v) {
+          for (int u = x * f; u < (x + 1) * f; ++u) sum += image.at(u, v, c);
+        }
+        out.at(x, y, c) = float(sum / n);
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace igi

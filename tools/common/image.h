@@ -38,6 +38,15 @@ struct Image {
   float at(int x, int y, int c = 0) const { return pixels[index(x, y, c)]; }
 };
 
+// The smallest integer factor f that brings a width × height image within `max_megapixels`
+// as (width / f) × (height / f) pixels (1 when it is within already, or when max_megapixels is 0).
+int ReductionFactor(int width, int height, double max_megapixels);
+
+// The means of the image's f × f pixel blocks, (width / f) × (height / f) pixels: the radiance
+// a camera with f× larger pixels records. The last columns and rows that fill no block are left
+// out. f = 1 returns the image as it is.
+Image BlockMeans(const Image& image, int f);
+
 // The stored sample type of an image file.
 enum class PixelType { kAuto, kUInt8, kUInt16, kHalf, kFloat };
 
