@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Scale benchmark: igi-solve's (or igi-diagnose's, STAGE=diagnose) wall time, CPU time and peak
-# memory as the photos grow in size and number, and the recovered parameters against the truth
-# at each size.
+# Scale benchmark: igi-solve's (or igi-diagnose's, STAGE=diagnose, or igi-run's end to end,
+# STAGE=run) wall time, CPU time and peak memory as the photos grow in size and number, and the
+# recovered parameters against the truth at each size.
 #
 # Captures: igi-synth rooms (the default room: glossy floor with a texture, glossy and matte
 # boxes, a sphere, one lamp) of N photos at M megapixels (4:3), rendered once at SPP paths per
@@ -11,9 +11,12 @@
 # and the peer of each row (same machine, same run).
 #
 # Usage: bench/scale/run_scale_bench.sh [BUILD_DIR] [-- EXTRA FLAGS of the stage's tool]
-#   PHOTOS="8 30" MEGAPIXELS="0.5 3 12 24" SPP=16 THREADS=2 STAGE=solve|diagnose IGI_SCALE_KEEP=1
+#   PHOTOS="8 30" MEGAPIXELS="0.5 3 12 24" SPP=16 THREADS=2 STAGE=solve|diagnose|run PEER=1
+#   IGI_SCALE_KEEP=1
 # A diagnosis's rows give its kept steps and final/baseline residual in place of the observations,
-# and the errors of its improved scene's materials (solved on the analysed capture).
+# and the errors of its improved scene's materials (solved on the analysed capture). STAGE=run
+# runs `igi-run --hdr-photos` (solve, diagnose, report), scored as a diagnosis, and prints each
+# stage's wall and CPU seconds. PEER=0 leaves out the downscaled peer.
 # Prints one markdown table (for bench/RESULTS.md) and the growth exponents of wall time and
 # peak memory in pixels per photo (at each photo count) and in photos (at each size).
 set -euo pipefail
@@ -30,7 +33,9 @@ THREADS="${THREADS:-2}"
 STAGE="${STAGE:-solve}"
 CACHE="${IGI_SCALE_CACHE:-$HOME/.cache/igi-scale}"
 SYNTH="$BUILD/bin/igi-synth"
-[[ "$STAGE" == solve || "$STAGE" == diagnose ]] || { echo "STAGE: $STAGE: solve or diagnose" >&2; exit 2; }
+PEER="${PEER:-1}"
+[[ "$STAGE" == solve || "$STAGE" == diagnose || "$STAGE" == run ]] ||
+  { echo "STAGE: $STAGE: solve, diagnose or run" >&2; exit 2; }
 TOOL="$BUILD/bin/igi-$STAGE"
 PY=/usr/bin/python3
 for t in "$SYNTH" "$TOOL"; do
@@ -86,11 +91,13 @@ json.dump(doc, open(os.path.join(dst, "scene.json"), "w"), indent=1)
 PYEOF
 }
 
-# run SCENE OUT: "wall_s cpu_s peak_gib" of the stage's tool, its output in OUT.
+# run SCENE OUT: "wall_s cpu_s peak_gib" of the stage's tool (igi-run: of its largest stage's
+# process), its output in OUT.
 run() {
-  local scene=$1 out=$2
+  local scene=$1 out=$2 args
+  if [[ "$STAGE" == run ]]; then args=(--hdr-photos --scene "$scene"); else args=("$scene"); fi
   /usr/bin/time -f "%e %U %S %M" -o "$out.time" \
-    "$TOOL" "$scene" --out "$out" --threads "$THREADS" --quiet "${EXTRA[@]}" >/dev/null 2>"$out.log" || {
+    "$TOOL" "${args[@]}" --out "$out" --threads "$THREADS" --quiet "${EXTRA[@]}" >/dev/null 2>"$out.log" || {
     local rc=$?
     [[ $rc -eq 3 ]] || { echo "igi-$STAGE failed ($rc): $(tail -1 "$out.log")" >&2; echo "nan nan nan"; return; }
   }
@@ -98,11 +105,13 @@ run() {
 }
 
 # errors OUT TRUTH: "rho_d_max% rho_s_max% alpha_max% observations available" (a diagnosis:
-# "... kept_steps final/baseline").
+# "... kept_steps final/baseline"; igi-run: its diagnosis's).
 errors() {
   $PY - "$1" "$2" <<'PYEOF'
 import json, os, sys
 out, truth = sys.argv[1], sys.argv[2]
+if os.path.isdir(out + "/05-diagnose"):
+    out += "/05-diagnose"
 try:
     solved = json.load(open(out + "/scene.json"))["materials"]
     if os.path.exists(out + "/diagnosis.json"):
@@ -134,6 +143,22 @@ PYEOF
 echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB, load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "commit: $(git -C "$ROOT" rev-parse --short HEAD), igi-$STAGE --threads $THREADS ${EXTRA[*]}"
 echo
+# stages OUT: igi-run's stage markers as "stage wall s / CPU s" (nothing for the other stages).
+stages() {
+  $PY - "$1" <<'PYEOF'
+import json, os, sys
+out = sys.argv[1]
+parts = []
+for s in sorted(os.listdir(out)) if os.path.isdir(out) else []:
+    m = os.path.join(out, s, "stage.json")
+    if os.path.exists(m):
+        d = json.load(open(m))
+        cpu = d.get("details", {}).get("cpu_seconds")
+        parts.append(f"{s} {d.get('seconds', float('nan')):.0f} s" + (f" / {cpu:.0f} CPU s" if cpu else ""))
+print(", ".join(parts))
+PYEOF
+}
+
 if [[ "$STAGE" == solve ]]; then
   echo "| photos | MP | run | wall s | CPU s | peak GiB | obs | available | ρd max % | ρs max % | α max % | wall / peer | peak / peer |"
 else
@@ -147,6 +172,12 @@ for n in $PHOTOS; do
     dir=$(capture "$n" "$mp")
     read -r fw fc fp < <(run "$dir/scene.json" "$WORK/full_n${n}_mp${mp}")
     read -r fd fs fa fo favail < <(errors "$WORK/full_n${n}_mp${mp}" "$dir/truth.json")
+    [[ "$STAGE" == run ]] && echo "stages ($n photos, $mp MP): $(stages "$WORK/full_n${n}_mp${mp}")" >&2
+    if [[ "$PEER" == 0 ]]; then
+      echo "| $n | $mp | capture | $fw | $fc | $fp | $fo | $favail | $fd | $fs | $fa | — | — |"
+      echo "$n $mp $fw $fp" >> "$ROWS"
+      continue
+    fi
     small="$WORK/small_n${n}_mp${mp}"
     downscaled "$dir" "$small" 0.5
     read -r sw sc sp < <(run "$small/scene.json" "$small/out")
