@@ -346,4 +346,77 @@ Eigen::Vector3d TextureMeanOverSeenTexels(const Image& texture, const Image& see
   return count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d::Constant(NAN);
 }
 
+namespace {
+
+// Mean of `map`'s channel c over the texels of `mask` in the (2k+1)² window around (x, y).
+double LocalMean(const Image& map, const std::vector<char>& mask, int x, int y, int c, int k) {
+  double sum = 0;
+  int n = 0;
+  for (int yy = std::max(0, y - k); yy <= std::min(map.height - 1, y + k); ++yy) {
+    for (int xx = std::max(0, x - k); xx <= std::min(map.width - 1, x + k); ++xx) {
+      if (!mask[size_t(yy) * map.width + xx]) continue;
+      sum += map.at(xx, yy, c);
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : map.at(x, y, c);
+}
+
+}  // namespace
+
+TexelDetail SharedTexelDetail(const Image& a, const Image& b, const std::vector<int>& both) {
+  TexelDetail out;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : both) {
+    for (int c = 0; c < 3; ++c) mean[c] += a.pixels[size_t(i) * 3 + c] + b.pixels[size_t(i) * 3 + c];
+  }
+  if (!both.empty()) mean /= 2.0 * double(both.size());
+  if (both.size() < 64 || !(mean.minCoeff() > 0)) return out;
+  const int w = a.width;
+  std::vector<char> in_both(size_t(w) * a.height, 0);
+  for (int i : both) in_both[i] = 1;
+  // Per tile: the sum of the texels' products and their count.
+  const int tiles_x = (w + kTexelDetailTile - 1) / kTexelDetailTile;
+  std::vector<double> tile_sum(size_t(tiles_x) * ((a.height + kTexelDetailTile - 1) / kTexelDetailTile));
+  std::vector<int> tile_n(tile_sum.size(), 0);
+  std::vector<double> products(both.size());
+  double covariance = 0;
+  for (size_t k = 0; k < both.size(); ++k) {
+    const int i = both[k], x = i % w, y = i / w;
+    double product = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double da = a.at(x, y, c) - LocalMean(a, in_both, x, y, c, kTexelDetailHalfWidth);
+      const double db = b.at(x, y, c) - LocalMean(b, in_both, x, y, c, kTexelDetailHalfWidth);
+      product += da * db;
+    }
+    const size_t t = size_t(y / kTexelDetailTile) * tiles_x + x / kTexelDetailTile;
+    tile_sum[t] += product;
+    ++tile_n[t];
+    products[k] = product;
+    covariance += product;
+  }
+  const double n = double(both.size());
+  covariance /= n;
+  out.variation = std::sqrt(std::max(0.0, covariance / mean.squaredNorm()));
+  // The ratio estimator's variance, Σ (S_t − cov·n_t)² / n² · T / (T − 1), over the tiles when
+  // there are at least kMinTiles, else over the texels (which their local means correlate, so
+  // that the z of a small region is overstated).
+  constexpr int kMinTiles = 8;
+  double spread = 0;
+  int samples = 0;
+  for (size_t t = 0; t < tile_sum.size(); ++t) {
+    if (tile_n[t] == 0) continue;
+    spread += std::pow(tile_sum[t] - covariance * tile_n[t], 2);
+    ++samples;
+  }
+  if (samples < kMinTiles) {
+    spread = 0;
+    for (size_t k = 0; k < both.size(); ++k) spread += std::pow(products[k] - covariance, 2);
+    samples = int(both.size());
+  }
+  out.z = spread > 0 ? covariance / std::sqrt(spread / (n * n) * samples / (samples - 1.0))
+                     : (covariance > 0 ? INFINITY : 0.0);
+  return out;
+}
+
 }  // namespace igi

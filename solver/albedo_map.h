@@ -100,4 +100,25 @@ Eigen::Vector3d SeenTexelMean(const Image& map, const Image& seen);
 // NaN when no texel falls in a seen one.
 Eigen::Vector3d TextureMeanOverSeenTexels(const Image& texture, const Image& seen);
 
+// The albedo detail two maps of one region share, finer than the gathered irradiance's errors.
+// `a` and `b` are estimated from disjoint halves of the photos (independent noise, the same
+// texture); `both` lists the texels (y·width + x) both estimate directly. Each map less its local
+// mean over the shared texels of the (2k+1)² window, k = kTexelDetailHalfWidth: the irradiance's
+// errors are patch-sized and cancel there, a texture finer than the window does not. The
+// detail's variance is the two deviations' covariance summed over the channels, relative to the
+// channels' summed mean² (a texture multiplies every channel alike, while a lobe's error is grey
+// and would dominate a dark channel's relative variance).
+struct TexelDetail {
+  double variation = NAN;  // sqrt(max(0, covariance) / mean²): the relative standard deviation
+  // The covariance over its standard error, tiles of kTexelDetailTile² texels taken as the
+  // independent samples (the local means correlate neighbours): a photo's noise with a heavy
+  // tail (a few paths per pixel) makes a sizeable covariance from few texels by chance, a
+  // texture makes it from many.
+  double z = NAN;
+};
+inline constexpr int kTexelDetailHalfWidth = 3;  // 7 × 7 texels
+inline constexpr int kTexelDetailTile = 16;
+// NaN (both fields) when fewer than 64 texels are shared or a channel's mean is not positive.
+TexelDetail SharedTexelDetail(const Image& a, const Image& b, const std::vector<int>& both);
+
 }  // namespace igi

@@ -65,6 +65,9 @@ struct RegionSolution {
   // halves of the photos, each less its local mean; NaN: not measured). Above 10 % the region
   // gets a map anyway: a texture finer than the patches averages out in the fit's per-patch test.
   double texel_variation = NAN;
+  // texel_variation's covariance over its standard error (SharedTexelDetail): the region gets a
+  // map only above 3 as well, so that a photo's heavy-tailed noise on few texels gives none.
+  double texel_variation_z = NAN;
   // The map's mean over its seen texels (equal areas: a texel is texel_size_m square on the
   // surface), NaN without a map (report.json's albedo_map.seen_mean). It is the region's final ρd
   // (final_params.rho_d, scene.json's rho_d; rho_d_from_map) where it is positive; stage1/stage2

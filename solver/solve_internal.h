@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/albedo_map.h"
 #include "solver/brdf.h"
 #include "solver/gather.h"
 #include "solver/light_model.h"
@@ -133,9 +134,9 @@ struct SolverState {
   bool MapCandidate(size_t r) const;
   // Whether scene.json gives region r an albedo map: a MapCandidate with --albedo-maps all, an
   // albedo fitted per patch, or (auto) an albedo that varies from texel to texel beyond the photos'
-  // noise (its variation in *texel_variation when that test ran).
+  // noise, significantly (SharedTexelDetail; *detail when that test ran).
   bool WritesMap(size_t r, const RegionAtlas& atlas, const std::vector<Eigen::Vector3d>& smooth_t,
-                 const std::vector<Eigen::Vector3d>& map_e, double* texel_variation) const;
+                 const std::vector<Eigen::Vector3d>& map_e, TexelDetail* detail) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and
   // stage 2's acceptance test); `model` is CompleteScene's as_written.
   void RenderResiduals(Scene model, int stage);

@@ -25,6 +25,8 @@ namespace {
 // sphere (42 % standard deviation) about 20 % (session 22); a constant sphere whose Ward fit has
 // the wrong lobe shape 5 % (10.8 % with the channels' relative variances averaged, session 23).
 constexpr double kTexelTextureMin = 0.10;
+// ... and when that variation is significant: its covariance over its standard error.
+constexpr double kTexelTextureZ = 3.0;
 
 // The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
 TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases) {
@@ -103,7 +105,6 @@ namespace {
 struct MapHalves {
   Image map[2], seen[2];
   std::vector<int> both;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // per channel, over `both`, both halves
 };
 
 MapHalves HalvesOf(const SolverState& s, int r, const RegionAtlas& atlas,
@@ -119,63 +120,11 @@ MapHalves HalvesOf(const SolverState& s, int r, const RegionAtlas& atlas,
       }
     }
   }
-  for (int i : h.both) {
-    for (int c = 0; c < 3; ++c) {
-      for (int k = 0; k < 2; ++k) h.mean[c] += h.map[k].pixels[size_t(i) * 3 + c];
-    }
-  }
-  if (!h.both.empty()) h.mean /= 2.0 * double(h.both.size());
   return h;
 }
 
-// Mean of `map`'s channel c over the texels of `mask` in the (2k+1)² window around (x, y).
-double LocalMean(const Image& map, const std::vector<char>& mask, int x, int y, int c, int k) {
-  double sum = 0;
-  int n = 0;
-  for (int yy = std::max(0, y - k); yy <= std::min(map.height - 1, y + k); ++yy) {
-    for (int xx = std::max(0, x - k); xx <= std::min(map.width - 1, x + k); ++xx) {
-      if (!mask[size_t(yy) * map.width + xx]) continue;
-      sum += map.at(xx, yy, c);
-      ++n;
-    }
-  }
-  return n > 0 ? sum / n : map.at(x, y, c);
-}
-
-constexpr int kLocalMeanHalfWidth = 3;  // 7×7 texels
 
 }  // namespace
-
-// How much region r's albedo varies from texel to texel beyond the photos' noise: the relative
-// standard deviation of its texture's detail, NaN when fewer than 64 texels are shared. The
-// detail's variance is the covariance of the two halves' deviations from their local means over
-// the shared texels, summed over the channels and divided by the channels' summed mean² (an
-// albedo texture multiplies every channel alike, while a lobe's error is grey and would dominate
-// a dark channel's relative variance): errors of the gathered
-// irradiance are smooth (patch-sized) and cancel in the local means; a texture finer than the
-// patches does not, and averages out within each patch, where the fit's per-patch test
-// (AlbedoVaries in region_fit.cpp) cannot see it: the demo's glossy box (a noise texture, 42 %
-// standard deviation) kept a constant albedo +3.1 % off its area mean.
-static double TexelScaleVariation(const MapHalves& h) {
-  if (h.both.size() < 64 || !(h.mean.minCoeff() > 0)) return std::nan("");
-  const int w = h.map[0].width;
-  std::vector<char> in_both(size_t(w) * h.map[0].height, 0);
-  for (int i : h.both) in_both[i] = 1;
-  double covariance = 0;
-  for (int c = 0; c < 3; ++c) {
-    double cov = 0;
-    for (int i : h.both) {
-      const int x = i % w, y = i / w;
-      double d[2];
-      for (int k = 0; k < 2; ++k) {
-        d[k] = h.map[k].at(x, y, c) - LocalMean(h.map[k], in_both, x, y, c, kLocalMeanHalfWidth);
-      }
-      cov += d[0] * d[1];
-    }
-    covariance += cov / double(h.both.size());
-  }
-  return std::sqrt(std::max(0.0, covariance / h.mean.squaredNorm()));
-}
 
 static RegionAtlas AtlasOf(const SolverState& s, int r) {
   AtlasOptions ao;
@@ -267,13 +216,14 @@ bool SolverState::MapCandidate(size_t r) const {
 bool SolverState::WritesMap(size_t r, const RegionAtlas& atlas,
                             const std::vector<Eigen::Vector3d>& smooth_t,
                             const std::vector<Eigen::Vector3d>& map_e,
-                            double* texel_variation) const {
+                            TexelDetail* detail) const {
   const MaterialState& m = materials[r];
   if (!MapCandidate(r)) return false;
   if (options.albedo_maps == "all" || m.last_fit.albedo_varies) return true;
-  const double v = TexelScaleVariation(HalvesOf(*this, int(r), atlas, smooth_t, map_e));
-  if (texel_variation) *texel_variation = v;
-  return v > kTexelTextureMin;
+  const MapHalves h = HalvesOf(*this, int(r), atlas, smooth_t, map_e);
+  const TexelDetail d = SharedTexelDetail(h.map[0], h.map[1], h.both);
+  if (detail) *detail = d;
+  return d.variation > kTexelTextureMin && d.z > kTexelTextureZ;
 }
 
 void SolverState::RenderResiduals(Scene model, int stage) {
@@ -448,12 +398,16 @@ void SolverState::BuildAlbedoMaps() {
     if (!MapCandidate(r)) continue;
     const RegionAtlas atlas = AtlasOf(*this, int(r));
     RegionSolution& rs = summary.regions[r];
-    if (!WritesMap(r, atlas, smooth_t, map_e, &rs.texel_variation)) continue;
+    TexelDetail detail;
+    const bool mapped = WritesMap(r, atlas, smooth_t, map_e, &detail);
+    rs.texel_variation = detail.variation;
+    rs.texel_variation_z = detail.z;
+    if (!mapped) continue;
     if (!m.last_fit.albedo_varies && options.albedo_maps != "all") {
       spdlog::info(
           "region {}: its albedo varies by {:.0f} % from texel to texel (finer than the "
-          "patches): given a map",
-          rs.name, 100 * rs.texel_variation);
+          "patches; z {:.1f}): given a map",
+          rs.name, 100 * rs.texel_variation, rs.texel_variation_z);
     }
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
     if (options.albedo_map_pass == "always" ||

@@ -189,11 +189,13 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     if (std::isfinite(r.texel_variation)) {
       rj["texel_variation"] = {
           {"value", r.texel_variation},
+          {"z", r.texel_variation_z},
           {"mapped", !r.albedo_map_file.empty()},
           {"meaning",
            "the fit kept a constant albedo; the albedo's relative standard deviation from texel to "
            "texel beyond the photos' noise (covariance of two maps from disjoint halves of the "
-           "photos, each less its local 7x7-texel mean); above 0.1 the region gets a map"}};
+           "photos, each less its local 7x7-texel mean; z: the covariance over its standard "
+           "error, 16x16-texel tiles as samples); above 0.1 at z above 3 the region gets a map"}};
     }
     if (!r.albedo_map_file.empty()) {
       rj["albedo_map"] = {{"file", r.albedo_map_file},

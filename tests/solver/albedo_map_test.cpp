@@ -6,7 +6,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "solver/render_internal.h"
 #include "tools/common/error.h"
@@ -373,6 +376,64 @@ TEST(AlbedoMap, SeenMeansCountOnlyTheSeenTexels) {
   EXPECT_NEAR(t[2], 357.5 + 2000, 1e-3);
   EXPECT_TRUE(std::isnan(SeenTexelMean(map, Image(4, 2, 1, 0.0f))[0]));
   EXPECT_TRUE(std::isnan(TextureMeanOverSeenTexels(texture, Image(4, 2, 1, 0.0f))[1]));
+}
+
+// Two maps of a 96 × 96-texel region from disjoint halves of the photos: `albedo` times each
+// half's own noise, a few paths per pixel (3 % of the texels take a firefly of 8× the mean).
+std::pair<Image, Image> NoisyHalves(const std::function<double(int, int)>& albedo, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 0.1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Image h[2] = {Image(96, 96, 3), Image(96, 96, 3)};
+  for (Image& m : h) {
+    for (int y = 0; y < 96; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        const double noise = 1 + gauss(rng) + (u(rng) < 0.03 ? 8.0 : 0.0);
+        for (int c = 0; c < 3; ++c) m.at(x, y, c) = float(albedo(x, y) * noise);
+      }
+    }
+  }
+  return {h[0], h[1]};
+}
+
+std::vector<int> AllTexels(int n) {
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  return all;
+}
+
+TEST(SharedTexelDetail, HeavyTailedNoiseIsNotTakenForTextureButATextureIs) {
+  const std::vector<int> both = AllTexels(96 * 96);
+  int variation_over_bar = 0, significant = 0, textures_found = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    const auto [a, b] = NoisyHalves([](int, int) { return 0.5; }, seed);
+    const TexelDetail d = SharedTexelDetail(a, b, both);
+    ASSERT_TRUE(std::isfinite(d.variation) && std::isfinite(d.z));
+    variation_over_bar += d.variation > 0.1;
+    significant += d.variation > 0.1 && d.z > 3;
+    // A checker of 3-texel cells, ±40 % (a relative standard deviation of 0.4), under the same
+    // noise.
+    const auto [ta, tb] = NoisyHalves(
+        [](int x, int y) { return 0.5 * ((x / 3 + y / 3) % 2 ? 1.4 : 0.6); }, 100 + seed);
+    const TexelDetail t = SharedTexelDetail(ta, tb, both);
+    textures_found += t.variation > 0.1 && t.z > 3;
+    EXPECT_NEAR(t.variation, 0.4, 0.1) << seed;
+  }
+  // The noise alone reads a variation over the 10 % bar in some draws (so that the bar alone
+  // would give the region a map), never significantly; the texture is found in every draw.
+  EXPECT_GE(variation_over_bar, 3);
+  EXPECT_EQ(significant, 0);
+  EXPECT_EQ(textures_found, 30);
+}
+
+TEST(SharedTexelDetail, IsNaNOnFewTexelsOrADarkChannel) {
+  const auto [a, b] = NoisyHalves([](int, int) { return 0.5; }, 7);
+  EXPECT_TRUE(std::isnan(SharedTexelDetail(a, b, AllTexels(63)).variation));
+  Image dark[2] = {a, b};
+  for (Image& m : dark) {
+    for (size_t i = 2; i < m.pixels.size(); i += 3) m.pixels[i] = 0;
+  }
+  EXPECT_TRUE(std::isnan(SharedTexelDetail(dark[0], dark[1], AllTexels(96 * 96)).z));
 }
 
 }  // namespace
