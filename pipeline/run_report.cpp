@@ -49,7 +49,9 @@ void StagesSection(const fs::path& out, HtmlReport* page) {
     const auto m = ReadStageMarker(out / s);
     const bool cpu =
         m && m->details.contains("cpu_seconds") && m->details["cpu_seconds"].is_number();
-    rows.push_back({s, m ? m->status : "not finished", m ? fmt::format("{:.1f}", m->seconds) : "",
+    const std::string status =
+        m ? m->status : (s == StageNames().back() ? "writing this page" : "not finished");
+    rows.push_back({s, status, m ? fmt::format("{:.1f}", m->seconds) : "",
                     cpu ? fmt::format("{:.1f}", m->details["cpu_seconds"].get<double>()) : "",
                     m ? m->finished_utc : ""});
   }
@@ -74,6 +76,28 @@ void ResponseSection(const fs::path& out, HtmlReport* page) {
       s.y.push_back(r["g"][c][i].get<double>());
     }
     series.push_back(s);
+  }
+  // Channels whose curves coincide on the plot (within 0.5 % of its range) are drawn as one,
+  // named for all ("R = G" when equal to 1e-9, "R ≈ G" otherwise).
+  double lo = INFINITY, hi = -INFINITY;
+  for (const HtmlReport::Series& s : series) {
+    for (double y : s.y) {
+      lo = std::min(lo, y);
+      hi = std::max(hi, y);
+    }
+  }
+  for (size_t c = 1; c < series.size();) {
+    const HtmlReport::Series& a = series[c - 1];
+    bool same = a.y.size() == series[c].y.size();
+    double diff = 0;
+    for (size_t i = 0; same && i < a.y.size(); ++i)
+      diff = std::max(diff, std::abs(a.y[i] - series[c].y[i]));
+    if (!same || !(diff <= 0.005 * (hi - lo))) {
+      ++c;
+      continue;
+    }
+    series[c - 1].name += (diff < 1e-9 ? " = " : " ≈ ") + series[c].name;
+    series.erase(series.begin() + long(c));
   }
   page->LinePlot("response g(level) = ln(exposure), method " + r.value("method", "?"), series,
                  "pixel level", "ln exposure");
@@ -145,7 +169,8 @@ void ParametersSection(const fs::path& out, HtmlReport* page) {
                   ". Full solver report: 04-solve/report.html.");
 }
 
-// Photo / re-render / residual for the photos rendered by the report stage.
+// Photo / re-render / residual for the photos rendered by the report stage (renders/photo_K.exr:
+// the solved model as photo K records it).
 void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
   page->Heading("Photos, re-renders of the solved model, residuals");
   SceneLoadOptions load;
@@ -281,8 +306,15 @@ void ReportStage(const Context& ctx, StageRun* run) {
   const int n = std::min<int>(ctx.options.report_photos, int(scene.photos.size()));
   for (int k = 0; k < n; ++k) {
     const Photo& p = scene.photos[k];
-    render(scene.cameras[p.camera], scene.lightings[p.lighting],
-           renders / fmt::format("photo_{}.exr", k));
+    const fs::path file = renders / fmt::format("photo_{}.exr", k);
+    render(scene.cameras[p.camera], scene.lightings[p.lighting], file);
+    // The model as the photo records it (v = R(s · L), the render carrying the vignetting), so
+    // that the figure and the residual compare like with like.
+    if (p.exposure_scale != 1.0 || p.HasResponse()) {
+      Image image = ReadImage(file);
+      for (float& v : image.pixels) v = float(p.RecordedFromLinear(v * p.exposure_scale));
+      WriteImage(file, image);
+    }
   }
   if (!scene.photos.empty()) {
     const Camera& cam = scene.cameras[scene.photos[0].camera];

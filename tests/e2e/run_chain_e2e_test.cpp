@@ -1,10 +1,11 @@
 // igi-run --hdr-photos through every stage, diagnosis included, on a 2 m box room whose photos
-// igi-render made (tests/e2e/box_room.h): the photos are declared 4x too dark (exposure_scale
-// 0.25) and the ceiling's albedo is given, so igi-solve --photo-scale solve (passed with
-// --solve-arg) recovers the factor; igi-diagnose then gets the solve's input scene (materials
-// still unknown, so that it solves them itself without its held-out pixels and refits them with
-// each candidate) with the solved exposure_scale, and writes its diagnosis; the report shows it.
-// About a minute on 2 cores.
+// igi-render made (tests/e2e/box_room.h), recording half the radiance: the photos are declared
+// 4x darker still (exposure_scale 0.125) and the ceiling's albedo is given, so igi-solve
+// --photo-scale solve (passed with --solve-arg) recovers the factor; igi-diagnose then gets the
+// solve's input scene (materials still unknown, so that it solves them itself without its
+// held-out pixels and refits them with each candidate) with the solved exposure_scale, and writes
+// its diagnosis; the report shows it, its re-render at the photo's scale. About a minute on 2
+// cores.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -43,8 +44,12 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
                                              " --lighting L0 --spp 64 --threads 2 --quiet --out " +
                                              Quote((scene_dir / file).string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    // The camera records half the radiance (its true exposure_scale 0.5).
+    Image photo = ReadImage(scene_dir / file);
+    for (float& v : photo.pixels) v *= 0.5f;
+    WriteImage(scene_dir / file, photo);
     photos.push_back(PhotoEntry(file, cam, "L0"));
-    photos.back()["exposure_scale"] = 0.25;
+    photos.back()["exposure_scale"] = 0.125;
   }
   Json materials = TrueMaterials(false);
   materials["floor"].erase("rho_d");
@@ -67,10 +72,10 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
   const Json diagnosed_input = ReadJsonFile(out / "05-diagnose" / "input" / "scene.json");
   ASSERT_EQ(diagnosed_input["photos"].size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
-    // The solved factor (1 / 0.25 measured on the ceiling) makes the photos' scale the true 1
+    // The solved factor (4, measured on the ceiling) makes the photos' scale the true 0.5
     // (tolerance 3 %, as in solve_e2e_test's PhotoScale case), and igi-diagnose gets it.
     const double e = solved["photos"][i]["exposure_scale"].get<double>();
-    EXPECT_NEAR(e, 1.0, 0.03);
+    EXPECT_NEAR(e, 0.5, 0.015);
     EXPECT_DOUBLE_EQ(diagnosed_input["photos"][i]["exposure_scale"].get<double>(), e);
     // Paths rebased: the photo is found from the new folder.
     const fs::path photo = out / "05-diagnose" / "input" /
@@ -93,6 +98,17 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
   EXPECT_EQ(render.width, 32);
   EXPECT_EQ(render.height, 24);
   EXPECT_NE(report.find("residual render"), std::string::npos);
+  // The re-render is the model as the photo records it (its solved exposure_scale applied): its
+  // mean within 5 % of the photo's (4 paths per pixel against 64).
+  const Image photo = ReadImage(scene_dir / "photos" / "cam0_L0.exr");
+  const Image rerender = ReadImage(out / "06-report" / "renders" / "photo_0.exr");
+  const auto mean = [](const Image& im) {
+    double sum = 0;
+    for (float v : im.pixels) sum += v;
+    return sum / double(im.pixels.size());
+  };
+  EXPECT_NEAR(mean(rerender) / mean(photo), 1.0, 0.05);
+  EXPECT_EQ(report.find("not finished"), std::string::npos) << "every stage finished";
   fs::remove_all(dir);
 }
 
