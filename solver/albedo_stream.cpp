@@ -66,7 +66,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
   for (size_t k = 0; k < regions.size(); ++k) mapped[regions[k]] = 1, map_of[regions[k]] = int(k);
   // Cells of the smoothing radius: the indirect light is averaged over about that already.
   const double radius =
-      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
+      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_scale_m / 96;
   const ObservationGrid grid(scene, obs, mapped, radius);
   std::vector<AlbedoMapBuilder> builders;
   for (const RegionAtlas& atlas : atlases) builders.emplace_back(atlas);

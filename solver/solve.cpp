@@ -16,6 +16,7 @@
 #include "solver/render.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "solver/scene_scale.h"
 #include "solver/solve_internal.h"
 #include "solver/surface_hit.h"
 #include "tools/common/error.h"
@@ -39,15 +40,18 @@ double Since(Clock::time_point t) {
 // Everything before the rays: patches, materials, photos, observations, fit samples, texel size
 // and highlight coverage.
 void SolverState::Prepare() {
-  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
-  for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  summary.scene_diagonal_m = (hi - lo).norm();
-  summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : (hi - lo).norm() / 96.0;
+  BuildLightingScenes();
+  const Renderer::Impl* geometry = nullptr;
+  for (const auto& s : lighting_scenes) geometry = geometry ? geometry : s.get();
+  const SceneScale scale = MeasureSceneScale(scene, geometry);
+  summary.scene_diagonal_m = scale.diagonal_m;
+  summary.free_path_m = scale.free_path_m;
+  summary.scene_scale_m = scale.scale_m;
+  summary.patch_size_m = options.patch_size_m > 0 ? options.patch_size_m : scale.scale_m / 96.0;
   patches = BuildPatches(scene.mesh, summary.patch_size_m);
   summary.patches = patches.size();
   materials = MaterialEstimate::FromScene(scene, patches);
   summary.regions.resize(scene.materials.size());
-  BuildLightingScenes();
   PlanObservations();
   CollectAllObservations();
   SummariseRegions();

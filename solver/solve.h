@@ -142,6 +142,9 @@ struct SolveSummary {
   // drawn observations' spacing, serves the fits and stage 2's model.
   double map_texel_size_m = 0;
   double scene_diagonal_m = 0;  // of the geometry's bounding box
+  // The mean free path from the seen surfaces (NaN: an open scene) and the length scale the
+  // patches and smoothing radii follow (solver/scene_scale.h).
+  double free_path_m = NAN, scene_scale_m = 0;
   int patches = 0, observations = 0;
   // Pixels at the stride that saw a reflective surface (observations plus those not drawn), the
   // observation budget (infinity: none), whether the draw thinned the photos, and the memory:

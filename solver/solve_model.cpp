@@ -137,7 +137,7 @@ std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
   if (!have_stage1 || !IsJointUpdate(options.refine_update)) return light.e;
   if (!summary.refinement_accepted) return light.e_stage1;
   const double radius = 4 * (options.smoothing_radius_m > 0 ? options.smoothing_radius_m
-                                                            : summary.scene_diagonal_m / 96);
+                                                            : summary.scene_scale_m / 96);
   const std::vector<Eigen::Vector3d> now =
       NeighbourMean(obs, light.lightings, light.e, radius, false, options.num_threads);
   const std::vector<Eigen::Vector3d> then =
@@ -155,7 +155,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
                                  const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
   const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
-      obs, light.lightings, light.t, summary.scene_diagonal_m / 96, true, options.num_threads);
+      obs, light.lightings, light.t, summary.scene_scale_m / 96, true, options.num_threads);
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   atlases->clear();
   maps->clear();
@@ -387,7 +387,7 @@ void SolverState::RunStage2() {
 void SolverState::BuildAlbedoMaps() {
   std::vector<RegionAtlas> generated;
   const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
-      obs, light.lightings, light.t, summary.scene_diagonal_m / 96, true, options.num_threads);
+      obs, light.lightings, light.t, summary.scene_scale_m / 96, true, options.num_threads);
   const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
   // Regions whose maps come from their own pass over the photos (observations drawn to a
   // budget), on atlases at the photos' footprint.

@@ -31,7 +31,8 @@ struct SolveOptions {
   // Pixel values at or above this are clipped and ignored (scene radiance units); 0 = auto: a
   // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
   double saturation = 0;
-  // Patch size, metres: 0 = auto (the scene's bounding-box diagonal / 96).
+  // Patch size, metres: 0 = auto (the scene's length scale / 96: its bounding-box diagonal, or
+  // 3.5 mean free paths from the seen surfaces where that is shorter; solver/scene_scale.h).
   double patch_size_m = 0;
   // Gathering at each observation and patch: samples per extended light (sphere, area) and
   // stratified hemisphere rays for the light arriving from other surfaces.
@@ -52,7 +53,8 @@ struct SolveOptions {
   bool pixel_footprint = true;
   int footprint_samples = 4;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
-  // surface is averaged to remove gathering noise; 0 = auto (the scene diagonal / 96).
+  // surface is averaged to remove gathering noise; 0 = auto (the scene's length scale / 96, as
+  // the patch size).
   double smoothing_radius_m = 0;
   // Adaptive smoothing (0 = off: every observation averages over smoothing_radius_m): each
   // observation's radius is this factor times the harmonic mean distance of its indirect rays'

@@ -248,6 +248,9 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["rays"] = s.rays;
   j["patches"] = s.patches;
   j["patch_size_m"] = s.patch_size_m;
+  j["scene_scale"] = {{"diagonal_m", s.scene_diagonal_m},
+                      {"free_path_m", std::isfinite(s.free_path_m) ? Json(s.free_path_m) : Json()},
+                      {"scale_m", s.scene_scale_m}};
   j["texel_size_m"] = s.texel_size_m;
   j["map_texel_size_m"] = s.map_texel_size_m;
   j["observations"] = s.observations;

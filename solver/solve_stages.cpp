@@ -170,7 +170,7 @@ void SolverState::IncidentFromRenderer(const Scene& model, uint64_t round) {
 
 void SolverState::SmoothIrradiance() {
   const double radius =
-      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_diagonal_m / 96;
+      options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_scale_m / 96;
   if (light.smoothing_radius.size() != obs.size()) ComputeSmoothingRadii(radius);
   igi::SmoothIrradiance(obs, options.num_threads, &light);
 }

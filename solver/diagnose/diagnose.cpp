@@ -20,6 +20,7 @@
 #include "solver/diagnose/effect.h"
 #include "solver/diagnose/render_noise.h"
 #include "solver/diagnose/residual_fit.h"
+#include "solver/scene_scale.h"
 #include "solver/solve.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -288,12 +289,11 @@ Json Unexplained(const ModelState& st, double floor) {
   return out;
 }
 
-// Surface cell for the albedo nuisance of regions with maps: the scene diagonal / 96 (igi-solve's
-// patch size).
+// Surface cell for the albedo nuisance of regions with maps: the scene's length scale / 96
+// (igi-solve's patch size).
 double CellSize(const Scene& model) {
-  Eigen::AlignedBox3f box;
-  for (const Eigen::Vector3f& p : model.mesh.positions) box.extend(p);
-  return box.isEmpty() ? 0.05 : std::max(1e-3, double(box.diagonal().norm()) / 96);
+  const double scale = MeasureSceneScale(model).scale_m;
+  return scale > 0 ? std::max(1e-3, scale / 96) : 0.05;
 }
 
 // The photo whose held-out residual the step reduced most (for the report's images).

@@ -277,7 +277,7 @@ TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
   SolverState full(scene, o);
   full.Prepare();
   full.GatherAll();
-  const double r0 = full.summary.scene_diagonal_m / 96;
+  const double r0 = full.summary.scene_scale_m / 96;
   for (float r : full.DrawnSmoothingRadii(r0)) ASSERT_EQ(r, float(r0));
   o.max_observations = 1000;
   SolverState thin(scene, o);
