@@ -81,7 +81,7 @@ Context Validate(const RunOptions& o) {
   } else {
     ctx.layout = ScanPhotosDir(o.photos_dir, Lightings(ctx.scene));
   }
-  std::vector<std::string> tools = {"igi-solve", "igi-render"};
+  std::vector<std::string> tools = {"igi-solve", "igi-render", "igi-export"};
   if (!o.hdr_photos) tools.insert(tools.end(), {"igi-calib", "igi-hdr", "igi-register"});
   if (!o.skip_diagnose) tools.push_back("igi-diagnose");
   for (const std::string& t : tools) {

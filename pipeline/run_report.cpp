@@ -260,6 +260,40 @@ void DiagnosisSection(const fs::path& out, HtmlReport* page) {
 
 }  // namespace
 
+// Links to the exported scenes (relative to report.html) and their main files.
+void ExportsSection(const fs::path& out, const Json& exports, HtmlReport* page) {
+  page->Heading("The solved scene for other renderers");
+  if (exports.empty()) {
+    page->Note("No exports.", "warning");
+    return;
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [format, e] : exports.items()) {
+    if (e.contains("error")) {
+      rows.push_back({format, "failed: " + e["error"].get<std::string>()});
+      continue;
+    }
+    const fs::path dir = out / e["dir"].get<std::string>();
+    std::vector<std::string> files;
+    if (fs::exists(dir)) {
+      for (const auto& f : fs::directory_iterator(dir)) {
+        if (f.is_regular_file()) files.push_back(f.path().filename().string());
+      }
+    }
+    std::sort(files.begin(), files.end());
+    std::string links;
+    for (const std::string& f : files) {
+      const std::string href = e["dir"].get<std::string>() + "/" + f;
+      links += "<a href=\"" + HtmlEscape(href) + "\">" + HtmlEscape(f) + "</a> ";
+    }
+    rows.push_back({format, links});
+  }
+  page->RawHtml("<table><tr><th>format</th><th>files</th></tr>");
+  for (const auto& r : rows)
+    page->RawHtml("<tr><td>" + HtmlEscape(r[0]) + "</td><td>" + r[1] + "</td></tr>");
+  page->RawHtml("</table>\n");
+}
+
 void WriteRunReport(const RunReportInputs& in) {
   HtmlReport page("igi-run report");
   page.Paragraph("Run folder: " + fs::absolute(in.out).string());
@@ -270,6 +304,7 @@ void WriteRunReport(const RunReportInputs& in) {
   PhotosSection(in.out, in.max_photos, &page);
   RelitSection(in.out, &page);
   DiagnosisSection(in.out, &page);
+  ExportsSection(in.out, in.exports, &page);
   page.Write(in.out / "report.html");
 }
 
@@ -323,7 +358,21 @@ void ReportStage(const Context& ctx, StageRun* run) {
       render(cam, scene.lightings[l], renders / ("relit_" + scene.lightings[l].name + ".exr"));
     }
   }
-  WriteRunReport({ctx.options.out, ctx.options.report_photos});
+  // The solved scene for other renderers, each format in its own folder; a format that fails
+  // is named on the page, the others kept.
+  Json exports = Json::object();
+  for (const char* format : {"radiance", "mitsuba", "gltf"}) {
+    const fs::path dir = run->dir() / "export" / format;
+    fs::remove_all(dir);
+    try {
+      run->Tool("igi-export", {solved.string(), "--format", format, "--out", dir.string()});
+      exports[format] = {{"dir", fs::relative(dir, ctx.options.out).generic_string()}};
+    } catch (const Error& e) {
+      exports[format] = {{"error", e.Lines().front()}};
+    }
+  }
+  run->details["exports"] = exports;
+  WriteRunReport({ctx.options.out, ctx.options.report_photos, exports});
 }
 
 }  // namespace pipeline_internal

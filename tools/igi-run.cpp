@@ -24,7 +24,8 @@ PHOTOS_DIR layout (one sub-folder per photo):
       a capture               manifest.jsonl of igi-capture (merged with igi-hdr --manifest)
   PHOTOS_DIR/camera.json      optional known intrinsics (igi-calib intrinsics) for registration
   PHOTOS_DIR/markers.json     optional control points (igi-markers) for registration
-Output: DIR/01-response 02-hdr 03-register 04-solve 05-diagnose 06-report, DIR/report.html.
+Output: DIR/01-response 02-hdr 03-register 04-solve 05-diagnose 06-report (renders, exports),
+DIR/report.html.
 Exit codes: 0 ok, 1 a stage failed (named; finished stages kept), 2 bad input (nothing
 written), 3 partial (e.g. photos that did not register).)";
 

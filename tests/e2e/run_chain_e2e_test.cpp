@@ -109,6 +109,15 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
   };
   EXPECT_NEAR(mean(rerender) / mean(photo), 1.0, 0.05);
   EXPECT_EQ(report.find("not finished"), std::string::npos) << "every stage finished";
+  // The solved scene exported for other renderers, and the report links each export.
+  for (const char* format : {"radiance", "mitsuba", "gltf"}) {
+    const fs::path dir = out / "06-report" / "export" / format;
+    ASSERT_TRUE(fs::is_directory(dir)) << dir;
+    EXPECT_FALSE(fs::is_empty(dir)) << dir;
+    EXPECT_NE(report.find(std::string("href=\"06-report/export/") + format + "/"),
+              std::string::npos)
+        << format;
+  }
   fs::remove_all(dir);
 }
 
