@@ -165,7 +165,7 @@ PhotoLayout ScanPhotosDir(const fs::path& dir, const std::vector<std::string>& l
             [](const PhotoSource& a, const PhotoSource& b) { return a.name < b.name; });
   if (layout.photos.empty() && problems.empty()) {
     problems.Add(dir.string(), "PHOTOS_DIR", "no photo folders",
-                 "needs one sub-folder per photo (README: igi-run)");
+                 "needs one sub-folder per photo (docs/run.md)");
   }
   problems.ThrowIfAny();
   return layout;

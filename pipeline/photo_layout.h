@@ -1,5 +1,5 @@
 #pragma once
-// The PHOTOS_DIR layout igi-run reads (README "igi-run"):
+// The PHOTOS_DIR layout igi-run reads (docs/run.md):
 //
 //   PHOTOS_DIR/NAME_LIGHTING/   one sub-folder per photo; LIGHTING (the text after the last
 //                               '_') names a lighting of scene.json. When the scene has a single

@@ -34,7 +34,7 @@ namespace fs = std::filesystem;
 using test::Quote;
 using test::RunTool;
 
-// Tolerances on top of the solver's own (README: 1-7 % on igi-synth rooms from true poses and
+// Tolerances on top of the solver's own (docs/solve.md: 1-7 % on igi-synth rooms from true poses and
 // true radiance): the demo's photos are 8 spp renders, 3 brackets of 8 bits merged with a
 // recovered response (about 1 % in radiance), COLMAP poses refined with the control points, and
 // the HDR maps' absolute scale solved from the matte box (the demo's default
