@@ -1,5 +1,5 @@
 #pragma once
-// Per-texel diffuse albedo maps (issue 7): the solver's per-point albedo estimates, accumulated
+// Per-texel diffuse albedo maps: the solver's per-point albedo estimates, accumulated
 // into the texels of a region's atlas (solver/uv_charts.h) and turned into a linear RGB image.
 //
 // Texel convention = the renderer's lookup (solver/render.cpp SampleTexture): a UV (u right, v

@@ -1,5 +1,5 @@
 #pragma once
-// Where the photos show the specular highlights (issue 7): a region's ρs and α can only be
+// Where the photos show the specular highlights: a region's ρs and α can only be
 // recovered from pixels that see the light mirrored in it, i.e. whose half vector between the
 // direction to a light and the direction to the camera lies inside the specular lobe. For every
 // region with a specular lobe and an unknown ρs or α this finds the observations inside the lobe

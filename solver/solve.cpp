@@ -472,7 +472,7 @@ void SolverState::FinishRegions() {
     // renders there. The fit's region mean (each patch with samples weighted by its area, in
     // report.json's paper/refined blocks) weights each patch's texture by where its samples
     // crowd and by its irradiance: +1.7 % on SolveAlbedoTruth's floor where the map's mean is
-    // within 0.2 % of the true texture's over the same texels (bench/RESULTS.md, session 18).
+    // within 0.2 % of the true texture's over the same texels (bench/RESULTS.md).
     if (rs.albedo_map && rs.albedo_map_seen_mean.allFinite() &&
         rs.albedo_map_seen_mean.minCoeff() > 0) {
       rs.rho_d_from_map = true;

@@ -72,7 +72,7 @@ struct RegionSolution {
   // surface), NaN without a map (report.json's albedo_map.seen_mean). It is the region's final ρd
   // (final_params.rho_d, scene.json's rho_d; rho_d_from_map) where it is positive; stage1/stage2
   // keep the fit's region mean (each patch with samples weighted by its area), which runs a few
-  // per cent off on textured regions (bench/RESULTS.md, sessions 12 and 18).
+  // per cent off on textured regions (bench/RESULTS.md).
   Eigen::Vector3d albedo_map_seen_mean = Eigen::Vector3d::Constant(NAN);
   bool rho_d_from_map = false;
   // An unobserved region whose ρd was fitted to the light it bounces onto the regions the photos

@@ -36,7 +36,7 @@ struct JointUpdate {
 };
 
 // "joint" (every region's ρd and ρs jointly, the α changes included) or "joint_albedo" (the
-// albedos only, session 11's update).
+// albedos only).
 inline bool IsJointUpdate(const std::string& update) {
   return update == "joint" || update == "joint_albedo";
 }

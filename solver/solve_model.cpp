@@ -22,8 +22,8 @@ namespace {
 // A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
 // texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.
 // 0.1: a constant sphere's smooth shading errors read 5 %, the demo's noise-textured box and
-// sphere (42 % standard deviation) about 20 % (session 22); a constant sphere whose Ward fit has
-// the wrong lobe shape 5 % (10.8 % with the channels' relative variances averaged, session 23).
+// sphere (42 % standard deviation) about 20 %; a constant sphere whose Ward fit has the wrong
+// lobe shape 5 % (10.8 % with the channels' relative variances averaged).
 constexpr double kTexelTextureMin = 0.10;
 // ... and when that variation is significant: its covariance over its standard error.
 constexpr double kTexelTextureZ = 3.0;

@@ -62,7 +62,7 @@ struct SolveOptions {
   // of the nearby geometry), held within [1/4, 2] × smoothing_radius_m. Near a contact or a
   // corner the light changes fast and the radius shrinks; in the open it grows, averaging more
   // of the gathering noise. 0.3: igi-synth's smooth-floor capture's albedo map 33.13 → 33.50 dB
-  // over the seen texels, 35.01 → 36.33 dB two texels inside (bench/RESULTS.md, session 12).
+  // over the seen texels, 35.01 → 36.33 dB two texels inside (bench/RESULTS.md).
   double smoothing_accuracy = 0.3;
   // The paper's alternation: fit, recompute specular differences, refit.
   int max_iterations = 8;
@@ -114,9 +114,9 @@ struct SolveOptions {
   // new albedos would send (a Newton step on the fixed point; ρs and α are refitted as before;
   // albedo maps keep stage 1's texel detail, scaled to the new region means). On igi-synth's
   // 1024-spp room the joint rounds relight as well as the paper stage (1.53 / 1.49 % beyond the
-  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %). The default
-  // since session 11: solve_e2e_test's small room, which had held it back (floor −3.03 % vs
-  // −2.83 % independent), owed its −3 % to the noise of its 64-spp photos, not to the update
+  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %). The default:
+  // solve_e2e_test's small room, where the independent update looked better (floor −3.03 % vs
+  // −2.83 %), owes its −3 % to the noise of its 64-spp photos, not to the update
   // (bench/RESULTS.md).
   std::string refine_update = "joint";
   // Share of each refinement round's albedo change that is applied (1 = the full step). Half

@@ -1,5 +1,5 @@
 #pragma once
-// The texture parameterisation of one region, for its albedo map (issue 7): the mesh's own UVs
+// The texture parameterisation of one region, for its albedo map: the mesh's own UVs
 // where it has usable ones, else charts generated from the geometry and packed into one atlas.
 //
 // UV convention (the renderer's, solver/render.cpp SampleTexture): u right, v up, in [0, 1];

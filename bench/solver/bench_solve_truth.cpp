@@ -4,7 +4,7 @@
 // over the texels some photo sees. Keys: threads, stride, texel (m), refine, held (0/1), rays,
 // step, bounce (0/1), smooth (m), acc (smoothing_accuracy), joint (0/1/2: independent, joint,
 // joint_albedo), refine_rays (stage 2's path-traced directions per observation), seed, dump;
-// spp is not a key (the capture's). For issue 7's experiments; not a test.
+// spp is not a key (the capture's). For experiments on the solver's accuracy; not a test.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

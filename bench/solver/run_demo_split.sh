@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# What each stage of igi-run --demo adds to the recovered parameters (issue 9: "the same
-# tolerances as the solver issue, plus what HDR and registration add"). From a finished demo
+# What each stage of igi-run --demo adds to the recovered parameters (the solver's own
+# tolerances, plus what HDR and registration add). From a finished demo
 # folder (igi-run --demo --out DEMO), the solve is repeated three ways, each with the demo's
 # options (every third pixel, no refinement rounds; bench_solve_truth):
 #   registered: the demo's HDR maps and registered poses, every photo's exposure_scale the scale
