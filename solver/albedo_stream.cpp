@@ -10,7 +10,7 @@
 // the nearest observation of the same region under the same lighting (normals within ~25°):
 //   E = E_map(o) · (E_direct(p) + E_indirect(o)) / (E_direct(o) + E_indirect(o)),
 //   T = T_direct(p) + (T(o) − T_direct(o)),
-// E_map(o) being the irradiance the maps divide by at the observation (MapIrradiance) and T the
+// E_map(o) being the irradiance the maps divide by at the observation (MapLightOf) and T the
 // lobe term of the written ρs (smoothed, as the maps from the observations use it).
 #include <spdlog/spdlog.h>
 
@@ -57,10 +57,11 @@ Eigen::Vector3d DirectLobe(const BrdfParams& p, double ax, double ay, const Fram
 
 std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions,
                                                  const std::vector<RegionAtlas>& atlases,
-                                                 const std::vector<Eigen::Vector3d>& smooth_t,
-                                                 const std::vector<Eigen::Vector3d>& map_e,
+                                                 const MapLight& map_light,
                                                  std::vector<Image>* seen,
                                                  std::vector<double>* coverage) const {
+  const std::vector<Eigen::Vector3d>& smooth_t = map_light.t;
+  const std::vector<Eigen::Vector3d>& map_e = map_light.e;
   std::vector<char> mapped(materials.size(), 0);
   std::vector<int> map_of(materials.size(), -1);
   for (size_t k = 0; k < regions.size(); ++k) mapped[regions[k]] = 1, map_of[regions[k]] = int(k);

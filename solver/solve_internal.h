@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "solver/albedo_map.h"
+#include "solver/albedo_map_stage.h"
 #include "solver/brdf.h"
 #include "solver/gather.h"
 #include "solver/light_model.h"
@@ -34,12 +35,6 @@ namespace igi {
 struct JointUpdate {
   std::vector<Eigen::Vector3d> rho_d, rho_s, feedback;
 };
-
-// "joint" (every region's ρd and ρs jointly, the α changes included) or "joint_albedo" (the
-// albedos only).
-inline bool IsJointUpdate(const std::string& update) {
-  return update == "joint" || update == "joint_albedo";
-}
 
 // An albedo map as scene.json holds it when its region's fitted ρd exceeds 1 in some channel
 // (BoundReflectances): scaled by `factor` per channel (1/ρd where ρd > 1, else 1) and its texels
@@ -127,34 +122,18 @@ struct SolverState {
   // whatever the options write, the report renders the model scene.json will hold.
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir, bool as_written = false) const;
-  // Whether the options let region r have an albedo map in scene.json (not --albedo-maps none,
-  // and among albedo_map_regions when those are listed).
-  bool MapAllowed(size_t r) const;
-  // Whether region r may have an albedo map in scene.json: observed, of unknown ρd, MapAllowed.
-  bool MapCandidate(size_t r) const;
-  // Whether scene.json gives region r an albedo map: a MapCandidate with --albedo-maps all, an
-  // albedo fitted per patch, or (auto) an albedo that varies from texel to texel beyond the photos'
-  // noise, significantly (SharedTexelDetail; *detail when that test ran).
-  bool WritesMap(size_t r, const RegionAtlas& atlas, const std::vector<Eigen::Vector3d>& smooth_t,
-                 const std::vector<Eigen::Vector3d>& map_e, TexelDetail* detail) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and
   // stage 2's acceptance test); `model` is CompleteScene's as_written.
   void RenderResiduals(Scene model, int stage);
-  // The irradiance the albedo maps divide by. After joint stage-2 rounds: stage 1's per
-  // observation (gathered from the photographed patches: less noisy than the rounds' few
-  // path-traced directions) times the ratio of the rounds' to stage 1's irradiance averaged over
-  // 4 smoothing radii, so that the maps' texel detail keeps stage 1's noise while their level
-  // follows the path tracer; otherwise obs_e (stage 1's after a rejected refinement).
-  std::vector<Eigen::Vector3d> MapIrradiance() const;
+  // The albedo-map stage's view of the solve (solver/albedo_map_stage.h).
+  MapStageData MapData() const;
   void BuildAlbedoMaps();
   // The albedo maps of `regions` on `atlases` (one each) from every photo read again, every pixel
   // at the stride (solver/albedo_stream.cpp): for observations drawn to a budget, whose own
   // spacing is coarser than the photos'. Also each map's seen texels and coverage.
   std::vector<Image> StreamAlbedoMaps(const std::vector<int>& regions,
                                       const std::vector<RegionAtlas>& atlases,
-                                      const std::vector<Eigen::Vector3d>& smooth_t,
-                                      const std::vector<Eigen::Vector3d>& map_e,
-                                      std::vector<Image>* seen,
+                                      const MapLight& map_light, std::vector<Image>* seen,
                                       std::vector<double>* coverage) const;
 
   // solve.cpp

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "solver/albedo_map.h"
+#include "solver/albedo_map_stage.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "tools/common/error.h"
@@ -18,15 +19,6 @@
 
 namespace igi {
 namespace {
-
-// A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
-// texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.
-// 0.1: a constant sphere's smooth shading errors read 5 %, the demo's noise-textured box and
-// sphere (42 % standard deviation) about 20 %; a constant sphere whose Ward fit has the wrong
-// lobe shape 5 % (10.8 % with the channels' relative variances averaged).
-constexpr double kTexelTextureMin = 0.10;
-// ... and when that variation is significant: its covariance over its standard error.
-constexpr double kTexelTextureZ = 3.0;
 
 // The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
 TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases) {
@@ -58,105 +50,11 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 
 }  // namespace
 
-// The albedo map of region r: π(L − ρs·T)/E accumulated per texel over every observation.
-// The specular term T of each observation is noisy (few incident samples carry the reflected
-// room); for the maps it is averaged over neighbours in the same photo (same view, nearly).
-// With photo_parity 0 or 1, only the photos of even or odd index contribute.
-static Image AlbedoMapOf(const SolverState& s, int r, const RegionAtlas& atlas, double* coverage,
-                         const std::vector<Eigen::Vector3d>& t,
-                         const std::vector<Eigen::Vector3d>& e, Image* seen = nullptr,
-                         int photo_parity = -1) {
-  AlbedoMapBuilder builder(atlas);
-  const MaterialState& m = s.materials[r];
-  for (size_t i = 0; i < s.obs.size(); ++i) {
-    const Observation& o = s.obs[i];
-    if (o.region != r) continue;
-    if (photo_parity >= 0 && o.photo % 2 != photo_parity) continue;
-    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t[i]);
-    const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
-    // Highlights tell little about the albedo and much about any error in the fitted lobe:
-    // weight each observation by its diffuse share, and leave out those under half diffuse.
-    // (from the model, not the observation: a test on the observed radiance would favour the
-    // bright texels near highlights)
-    const double diffuse_pred =
-        (s.materials.PatchAlbedo(s.patches, o.patch).cwiseProduct(e[i]) / kPi).sum();
-    const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
-    const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
-    if (!(w > 0)) continue;
-    // No cut on the observation's own albedo πd/E: a photo's noise has a long upper tail (a few
-    // paths per pixel), and leaving out what exceeds a bound darkens the map (the demo's 8-spp
-    // floor: −4.5 % with observations above 1.2 left out). The texel is a ratio of sums weighted
-    // by E, so an E taken at the pixel's centre that differs from its footprint's (a shadow edge)
-    // evens out over the texel's observations instead of dominating.
-    const Eigen::Vector3d& e_i = e[i];
-    if (!(e_i.minCoeff() > 0)) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e_i);
-  }
-  if (coverage != nullptr) *coverage = builder.Coverage();
-  if (seen != nullptr) *seen = builder.DirectMask();
-  return builder.Finish(m.params.rho_d);
-}
-
-namespace {
-
-// Two maps of one region from disjoint halves of the photos (even and odd index), and the texels
-// both estimate directly (indices y·width + x). Each half's noise is independent of the other's,
-// while both see the same texture and, nearly, the same errors of the gathered irradiance.
-struct MapHalves {
-  Image map[2], seen[2];
-  std::vector<int> both;
-};
-
-MapHalves HalvesOf(const SolverState& s, int r, const RegionAtlas& atlas,
-                   const std::vector<Eigen::Vector3d>& t, const std::vector<Eigen::Vector3d>& e) {
-  MapHalves h;
-  for (int k = 0; k < 2; ++k) {
-    h.map[k] = AlbedoMapOf(s, r, atlas, nullptr, t, e, &h.seen[k], k);
-  }
-  for (int y = 0; y < h.seen[0].height; ++y) {
-    for (int x = 0; x < h.seen[0].width; ++x) {
-      if (h.seen[0].at(x, y, 0) > 0.5f && h.seen[1].at(x, y, 0) > 0.5f) {
-        h.both.push_back(y * h.seen[0].width + x);
-      }
-    }
-  }
-  return h;
-}
-
-
-}  // namespace
-
-static RegionAtlas AtlasOf(const SolverState& s, int r) {
-  AtlasOptions ao;
-  ao.texel_size_m = s.summary.texel_size_m;
-  return BuildRegionAtlas(s.scene.mesh, r, ao);
-}
-
-std::vector<Eigen::Vector3d> SolverState::MapIrradiance() const {
-  const bool have_stage1 = light.e_stage1.size() == obs.size() && summary.stage2_iterations > 0;
-  if (!have_stage1 || !IsJointUpdate(options.refine_update)) return light.e;
-  if (!summary.refinement_accepted) return light.e_stage1;
-  const double radius = 4 * (options.smoothing_radius_m > 0 ? options.smoothing_radius_m
-                                                            : summary.scene_scale_m / 96);
-  const std::vector<Eigen::Vector3d> now =
-      NeighbourMean(obs, light.lightings, light.e, radius, false, options.num_threads);
-  const std::vector<Eigen::Vector3d> then =
-      NeighbourMean(obs, light.lightings, light.e_stage1, radius, false, options.num_threads);
-  std::vector<Eigen::Vector3d> out(obs.size());
-  for (size_t i = 0; i < obs.size(); ++i) {
-    out[i] = light.e[i];
-    if (!(then[i].minCoeff() > 0) || !now[i].allFinite()) continue;
-    out[i] = light.e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
-  }
-  return out;
-}
-
 Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                                  const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
-  const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
-      obs, light.lightings, light.t, summary.scene_scale_m / 96, true, options.num_threads);
-  const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
+  const MapStageData data = MapData();
+  const MapLight map_light = MapLightOf(data);
   atlases->clear();
   maps->clear();
   bool generated = false;
@@ -177,14 +75,14 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
       if (out.rho_d) out.rho_d = out.rho_d->cwiseMin(1.0);
       if (out.rho_s) out.rho_s = out.rho_s->cwiseMin(1.0);
     }
-    if (as_written ? !MapCandidate(r)
+    if (as_written ? !MapCandidate(data, r)
                    : !m.unknown_rho_d || m.last_fit.albedo_model != "per_patch") {
       continue;
     }
-    RegionAtlas atlas = AtlasOf(*this, int(r));
-    if (!as_written || WritesMap(r, atlas, smooth_t, map_e, nullptr)) {
+    RegionAtlas atlas = MapAtlas(data, int(r));
+    if (!as_written || WritesMap(data, r, atlas, map_light, nullptr)) {
       atlases->push_back(std::move(atlas));
-      maps->push_back(AlbedoMapOf(*this, int(r), atlases->back(), nullptr, smooth_t, map_e));
+      maps->push_back(AlbedoMapOf(data, int(r), atlases->back(), map_light));
       if (as_written) {
         const Eigen::Vector3d rho = m.params.rho_d;
         ScaleMapHeldAtOne((rho.array() > 1).select(rho.cwiseInverse(), 1.0), &maps->back());
@@ -199,31 +97,6 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
     model.mesh = ApplyAtlases(scene.mesh, *atlases);
   }
   return model;
-}
-
-bool SolverState::MapAllowed(size_t r) const {
-  const std::vector<std::string>& only = options.albedo_map_regions;
-  return options.albedo_maps != "none" &&
-         (only.empty() ||
-          std::find(only.begin(), only.end(), scene.materials[r].name) != only.end());
-}
-
-bool SolverState::MapCandidate(size_t r) const {
-  const MaterialState& m = materials[r];
-  return m.reflective && m.unknown_rho_d && m.observations > 0 && MapAllowed(r);
-}
-
-bool SolverState::WritesMap(size_t r, const RegionAtlas& atlas,
-                            const std::vector<Eigen::Vector3d>& smooth_t,
-                            const std::vector<Eigen::Vector3d>& map_e,
-                            TexelDetail* detail) const {
-  const MaterialState& m = materials[r];
-  if (!MapCandidate(r)) return false;
-  if (options.albedo_maps == "all" || m.last_fit.albedo_varies) return true;
-  const MapHalves h = HalvesOf(*this, int(r), atlas, smooth_t, map_e);
-  const TexelDetail d = SharedTexelDetail(h.map[0], h.map[1], h.both);
-  if (detail) *detail = d;
-  return d.variation > kTexelTextureMin && d.z > kTexelTextureZ;
 }
 
 void SolverState::RenderResiduals(Scene model, int stage) {
@@ -384,22 +257,34 @@ void SolverState::RunStage2() {
   }
 }
 
+MapStageData SolverState::MapData() const {
+  return MapStageData{scene,
+                      options,
+                      obs,
+                      materials,
+                      patches,
+                      light,
+                      summary.texel_size_m,
+                      summary.scene_scale_m,
+                      summary.stage2_iterations,
+                      summary.refinement_accepted};
+}
+
 void SolverState::BuildAlbedoMaps() {
   std::vector<RegionAtlas> generated;
-  const std::vector<Eigen::Vector3d> smooth_t = NeighbourMean(
-      obs, light.lightings, light.t, summary.scene_scale_m / 96, true, options.num_threads);
-  const std::vector<Eigen::Vector3d> map_e = MapIrradiance();
+  const MapStageData data = MapData();
+  const MapLight map_light = MapLightOf(data);
   // Regions whose maps come from their own pass over the photos (observations drawn to a
   // budget), on atlases at the photos' footprint.
   std::vector<int> streamed;
   std::vector<RegionAtlas> fine;
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
-    if (!MapCandidate(r)) continue;
-    const RegionAtlas atlas = AtlasOf(*this, int(r));
+    if (!MapCandidate(data, r)) continue;
+    const RegionAtlas atlas = MapAtlas(data, int(r));
     RegionSolution& rs = summary.regions[r];
     TexelDetail detail;
-    const bool mapped = WritesMap(r, atlas, smooth_t, map_e, &detail);
+    const bool mapped = WritesMap(data, r, atlas, map_light, &detail);
     rs.texel_variation = detail.variation;
     rs.texel_variation_z = detail.z;
     if (!mapped) continue;
@@ -419,8 +304,7 @@ void SolverState::BuildAlbedoMaps() {
       continue;
     }
     Image seen;
-    rs.albedo_map =
-        AlbedoMapOf(*this, int(r), atlas, &rs.albedo_map_coverage, smooth_t, map_e, &seen);
+    rs.albedo_map = AlbedoMapOf(data, int(r), atlas, map_light, &rs.albedo_map_coverage, &seen);
     rs.albedo_map_seen_mean = SeenTexelMean(*rs.albedo_map, seen);
     rs.albedo_map_seen = std::move(seen);
     rs.albedo_map_generated_uvs = atlas.generated;
@@ -429,7 +313,7 @@ void SolverState::BuildAlbedoMaps() {
   if (!streamed.empty()) {
     std::vector<Image> seen;
     std::vector<double> coverage;
-    std::vector<Image> maps = StreamAlbedoMaps(streamed, fine, smooth_t, map_e, &seen, &coverage);
+    std::vector<Image> maps = StreamAlbedoMaps(streamed, fine, map_light, &seen, &coverage);
     for (size_t k = 0; k < streamed.size(); ++k) {
       RegionSolution& rs = summary.regions[streamed[k]];
       rs.albedo_map_seen_mean = SeenTexelMean(maps[k], seen[k]);

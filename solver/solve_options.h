@@ -154,4 +154,10 @@ inline constexpr int kFinalRoundRegionObservations = 1024;
 // 8 times it (and 4096).
 int FinalRoundRays(int refine_final_rays, int observations);
 
+// "joint" (every region's ρd and ρs jointly, the α changes included) or "joint_albedo" (the
+// albedos only).
+inline bool IsJointUpdate(const std::string& update) {
+  return update == "joint" || update == "joint_albedo";
+}
+
 }  // namespace igi

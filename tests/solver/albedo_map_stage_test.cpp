@@ -1,0 +1,154 @@
+// The albedo-map stage alone (solver/albedo_map_stage.h), on data built by hand: observations of
+// a 1 m square under a known irradiance, photographed by two photos, whose radiance is a true
+// albedo × E/π with a few paths' noise. No photo is read and nothing is gathered or fitted.
+#include "solver/albedo_map_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "tests/solver/test_scenes.h"
+
+namespace igi {
+namespace {
+
+constexpr double kIrradiance = 3.0;
+
+// A checker of 0.1 m cells, ±30 % about 0.5.
+double Checker(double u, double v) { return 0.5 * ((int(u * 10) + int(v * 10)) % 2 ? 1.3 : 0.7); }
+
+// The stage's inputs and what it reads from them.
+struct StageFixture {
+  Scene scene;
+  SolveOptions options;
+  PatchSet patches;
+  MaterialEstimate materials;
+  ObservationSet obs;
+  LightModel light;
+
+  // `albedo(u, v)` on the square, `per_texel` observations per 2 cm texel on average, each
+  // observation's radiance times (1 + noise) with 3 % of them fireflies of 8×.
+  StageFixture(const std::function<double(double, double)>& albedo, int per_texel, unsigned seed) {
+    const auto dir = test::TempSceneDir("map_stage");
+    test::WriteText(dir / "square.obj", test::SquareObj("floor", 0.5));
+    WriteJsonFile(
+        dir / "scene.json",
+        Json{{"format", "igi-scene"},
+             {"version", 1},
+             {"geometry", Json::array({Json{{"file", "square.obj"}}})},
+             {"materials", {{"floor", {{"brdf", "lambert"}}}}},
+             {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 2}}, {"intensity", 1}}}}},
+             {"lightings", {{"L", {"l"}}}},
+             {"cameras", Json::object()},
+             {"photos", Json::array()}});
+    scene = LoadScene(dir / "scene.json");
+    patches = BuildPatches(scene.mesh, 0.1);
+    materials = MaterialEstimate::FromScene(scene, patches);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    std::normal_distribution<double> gauss(0.0, 0.1);
+    const int n = 2500 * per_texel;
+    light.lightings.resize(1);
+    light.lightings[0].active = true;
+    for (int i = 0; i < n; ++i) {
+      // A point of the square, uniform: the triangle by area, barycentrics uniform in it.
+      const int tri = u01(rng) < 0.5 ? 0 : 1;
+      double b1 = u01(rng), b2 = u01(rng);
+      if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
+      const auto& t = scene.mesh.triangles[tri];
+      const Eigen::Vector3f p0 = scene.mesh.positions[t[0]], p1 = scene.mesh.positions[t[1]],
+                            p2 = scene.mesh.positions[t[2]];
+      const Eigen::Vector3f p = p0 + float(b1) * (p1 - p0) + float(b2) * (p2 - p0);
+      const double u = p.x() + 0.5, v = p.y() + 0.5;
+      Observation o;
+      o.photo = i % 2;
+      o.triangle = tri;
+      o.b1 = float(b1);
+      o.b2 = float(b2);
+      o.region = 0;
+      o.patch = patches.PatchOf(tri, b1, b2);
+      o.position = p;
+      const double noise = 1 + gauss(rng) + (u01(rng) < 0.03 ? 8.0 : 0.0);
+      o.radiance = Eigen::Vector3f::Constant(float(albedo(u, v) * kIrradiance / kPi * noise));
+      light.lightings[0].obs.push_back(i);
+      obs.items.push_back(o);
+    }
+    materials[0].observations = n;
+    light.e.assign(n, Eigen::Vector3d::Constant(kIrradiance));
+    light.t.assign(n, Eigen::Vector3d::Zero());
+  }
+
+  MapStageData Data() const {
+    return MapStageData{scene, options, obs, materials, patches, light, 0.02, 1.0};
+  }
+};
+
+TEST(AlbedoMapStage, TheMapOfTheObservationsIsTheirAlbedo) {
+  // 32 observations per texel: the texel means' noise (mean 1.24, the fireflies' share) is a
+  // scale the maps carry; the checker's contrast shows through it.
+  const StageFixture f(Checker, 32, 1);
+  const MapStageData d = f.Data();
+  ASSERT_TRUE(MapCandidate(d, 0));
+  const RegionAtlas atlas = MapAtlas(d, 0);
+  const MapLight light = MapLightOf(d);
+  double coverage = 0;
+  Image seen;
+  const Image map = AlbedoMapOf(d, 0, atlas, light, &coverage, &seen);
+  ASSERT_EQ(map.width, 50);
+  EXPECT_GT(coverage, 0.95);
+  // Texel centres away from the cells' edges: the ratio to the truth is the noise's mean.
+  double ratio_light = 0, ratio_dark = 0;
+  int n_light = 0, n_dark = 0;
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      const double u = (x + 0.5) / map.width, v = 1 - (y + 0.5) / map.height;
+      if (std::abs(u * 10 - std::round(u * 10)) < 0.2 ||
+          std::abs(v * 10 - std::round(v * 10)) < 0.2) {
+        continue;
+      }
+      const double truth = Checker(u, v);
+      (truth > 0.5 ? ratio_light : ratio_dark) += map.at(x, y, 0) / truth;
+      ++(truth > 0.5 ? n_light : n_dark);
+    }
+  }
+  ASSERT_GT(n_light, 100);
+  ASSERT_GT(n_dark, 100);
+  // The light and dark cells in the same ratio to their truth: the map has the texture.
+  EXPECT_NEAR((ratio_light / n_light) / (ratio_dark / n_dark), 1.0, 0.05);
+}
+
+TEST(AlbedoMapStage, ATextureFinerThanThePatchesGetsAMapAndNoiseDoesNot) {
+  TexelDetail detail;
+  {
+    const StageFixture f(Checker, 8, 2);
+    const MapStageData d = f.Data();
+    EXPECT_TRUE(WritesMap(d, 0, MapAtlas(d, 0), MapLightOf(d), &detail));
+    // The checker's 30 % relative to the map's mean (raised 24 % by the fireflies), less what
+    // the 7 × 7-texel local means take of its 5-texel cells: about 20 %.
+    EXPECT_GT(detail.variation, 0.15);
+    EXPECT_LT(detail.variation, 0.3);
+    EXPECT_GT(detail.z, 3);
+  }
+  for (unsigned seed = 3; seed < 8; ++seed) {
+    const StageFixture f([](double, double) { return 0.5; }, 8, seed);
+    const MapStageData d = f.Data();
+    EXPECT_FALSE(WritesMap(d, 0, MapAtlas(d, 0), MapLightOf(d), &detail))
+        << seed << ": variation " << detail.variation << ", z " << detail.z;
+  }
+}
+
+TEST(AlbedoMapStage, TheOptionsDecideWhichRegionsMayHaveAMap) {
+  StageFixture f([](double, double) { return 0.5; }, 1, 9);
+  EXPECT_TRUE(MapCandidate(f.Data(), 0));
+  f.options.albedo_maps = "none";
+  EXPECT_FALSE(MapCandidate(f.Data(), 0));
+  f.options.albedo_maps = "all";
+  EXPECT_TRUE(WritesMap(f.Data(), 0, MapAtlas(f.Data(), 0), MapLightOf(f.Data()), nullptr));
+  f.options.albedo_map_regions = {"wall"};
+  EXPECT_FALSE(MapCandidate(f.Data(), 0));
+}
+
+}  // namespace
+}  // namespace igi
