@@ -1,5 +1,5 @@
 // igi-diagnose on concealed data for the effects that change the shape of reflected or emitted
-// light (issue 8): an igi-synth capture hiding anisotropic_reflection (glossy_box's lobe
+// light: an igi-synth capture hiding anisotropic_reflection (glossy_box's lobe
 // stretched along a surface direction), light_source_extent (the declared point lamp is a 0.25 m
 // sphere of the same intensity) or light_emission_profile (the lamp is a cos² spot pointing down,
 // of the same peak intensity). The first step igi-diagnose keeps names the hidden effect, with the
@@ -67,7 +67,7 @@ TEST(ConcealedBrdfLightTest, LightSourceExtent) {
 // The lamp is a spot, I·cos²(angle from −z): the room is 4× darker than the model, its ceiling lit
 // only by bounces. The candidate fits the lamp's whole direct term (diffuse and specular) as
 // cos^n with a free scale per region for what the light sends after a bounce (and, in the search
-// of the axis and n only, a camera response as a nuisance); seed 11 measured (2026-11-22, session
+// of the axis and n only, a camera response as a nuisance); seed 11 measured (session
 // 7): axis 1.1° from −z, cos power 1.92, held-out residual² down 99.9 %, then a small vignetting
 // step (k1 −0.07, k2 0.05: what the power's error leaves), which this test allows; final residual
 // 0.0502 against the true model's 0.0482 (1.04×). (Session 6: axis 0.7°, power 2.14, then

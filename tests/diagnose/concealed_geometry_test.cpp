@@ -1,4 +1,4 @@
-// igi-diagnose on concealed data (issue 8): missing_geometry and pose_error, at the CI size of
+// igi-diagnose on concealed data: missing_geometry and pose_error, at the CI size of
 // concealed_test.cpp (4 cameras of 160×120, photos at 64 paths per pixel, a point lamp,
 // materials given).
 //

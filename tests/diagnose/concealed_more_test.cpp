@@ -1,11 +1,11 @@
-// igi-diagnose on concealed data (issue 8): the effects of the suite not proven elsewhere —
+// igi-diagnose on concealed data: the effects of the suite not proven elsewhere —
 // light_intensity, specular_reflection, ambient_light — and captures hiding a PAIR of effects.
 // Same fixture and size as diagnose_concealed_test (4 cameras of 160×120, photos at 64 paths per
 // pixel, a point lamp, materials given, seed 11). For each: the first step igi-diagnose keeps names
 // the hidden effect (for a pair, one of the two, and both are kept), and the final residual comes
 // within 1.2× of the true model's (ExpectReachesTheFloor).
 //
-// Measured 2026-11-22 (load average 5–6, 2–4 min per case):
+// Measured (load average 5–6, 2–4 min per case):
 // - light_intensity (the lamp 1.25× brighter): light_intensity first, factor 1.241; final
 //   residual 0.1444 against the true model's 0.1446 (1.00×; baseline 0.2410). The lamp is the
 //   only light of every photo, so with the materials given a common scale of all photos IS its
@@ -19,12 +19,12 @@
 //   (k1 0.113, k2 −0.419; truth −0.25, −0.05), which had passed the first round too but explained
 //   less; final 0.1516 against 0.1436 (1.06×; baseline 0.1858).
 // - ambient_light:kind=uniform (the contract's ambient light, radiance 0.4, in every lighting;
-//   measured 2026-11-22, session 7): ambient_light first and alone, radiance 0.394 (each
+//   measured 2026-11-22): ambient_light first and alone, radiance 0.394 (each
 //   channel), final residual 0.1260 against the true model's 0.1260 (1.00×; baseline 0.2461).
 //   It passes since the renderer evaluates the ambient light exactly (before, its uniform-sphere
 //   samples made the true model noisier than the declared one at radiance 0.1) and the candidate
 //   fits the rendered response to a unit ambient light (bounces included).
-// - light_emission_profile + camera_response (session 7): light_emission_profile first (axis
+// - light_emission_profile + camera_response: light_emission_profile first (axis
 //   1.3° from −z, cos power 1.81; truth −z, 2), then camera_response (exponent 0.817; 0.8),
 //   light_intensity (1.047) and exposure_scale; final 0.0554 against 0.0510 (1.09×; baseline
 //   2.2915). The profile is searched with the response as a nuisance (before: axis 11° off,

@@ -1,4 +1,4 @@
-// igi-diagnose on concealed data (issue 8) with the materials unknown: scene.json leaves ρd, ρs
+// igi-diagnose on concealed data with the materials unknown: scene.json leaves ρd, ρs
 // and α out and igi-diagnose solves them at every step (igi-synth's default unknowns). Same size
 // as diagnose_concealed_more_test otherwise (4 cameras of 160×120, 64-spp photos, seed 11);
 // 3–6 min per case on 2 cores, so labelled slow (IGI_SLOW=1 runs them). The same effects with the
@@ -49,14 +49,14 @@ TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
 // compromise between them, and the lamp's photos (its bounced light too) are darker as a whole.
 // The profile's axis and power are searched on the lamp's photos alone (their own albedo
 // nuisance), per-photo exposure scales are credited only beyond a scale per lighting, and a kept
-// profile is refitted once. Before (session 19), the full-size suite's capture applied 11 photo
+// profile is refitted once. Before, the full-size suite's capture applied 11 photo
 // scales first (1.85× the floor) and the profile's search on every record gave cos^14 about an
 // axis pointing up.
-// Measured 2026-11-28 (seed 11, 4.6 min on 2 cores): the profile first (axis 2.2° off, cos^1.40,
+// Measured (seed 11, 4.6 min on 2 cores): the profile first (axis 2.2° off, cos^1.40,
 // held-out residual² −89 %); the texture test, missed at the baseline under the profile's error,
 // run again on that model: the floor alone textured, its maps kept (−23 %); the profile's refit
 // (2.2° off, cos^1.81, −24 %); final 0.1305 against the true model's 0.1322: 0.99× (held out
-// 1.04×). Before the texture test was repeated (sessions 26–34) the maps came only as the last
+// 1.04×). Before the texture test was repeated the maps came only as the last
 // resort, for every region whose albedo varies, were rejected, and the run ended at 1.215×.
 TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings) {
   const ConcealedOutcome o =
@@ -93,10 +93,10 @@ TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings
 // its highlight at 60-80°, as for fresnel) the lobes differ where the photos look. Every glossy
 // region is truly Ward-GMD. The first step after the real textures (albedo maps, which the
 // texture test may name first) must name it.
-// Measured 2026-11-26 (seed 11, 2.7 min on 2 cores): specular_lobe_shape on glossy_sphere first
+// Measured (seed 11, 2.7 min on 2 cores): specular_lobe_shape on glossy_sphere first
 // (held-out residual² −56.7 %, 68.6 standard errors; fresnel on the sphere passed too, −55.3 %,
 // and was not applied), the albedo maps, specular_lobe_shape on the floor (−20.5 %, 3.4); final
-// 0.0611 against the true model's 0.0571 (1.07×; held out 1.23×). Re-measured 2026-11-28 with
+// 0.0611 against the true model's 0.0571 (1.07×; held out 1.23×). Re-measured with
 // the texture test repeated after each kept step (6.4 min for the three slow cases):
 // albedo_texture, specular_lobe_shape, fresnel, specular_lobe_shape; final 0.0639 against 0.0571
 // (1.12×).

@@ -1,4 +1,4 @@
-// igi-diagnose on real photographs (issue 8): the DiLiGenT ball (shared data real/diligent_ball,
+// igi-diagnose on real photographs: the DiLiGenT ball (shared data real/diligent_ball,
 // Shi et al. CVPR 2016: a shiny sphere under directional lights, one 16-bit photo per light, a
 // mask; see its README). The shared scene.json is used as it is, on every 4th of its 48 photos
 // (12 photos, 12 lights: the cost of a CI test), with the material unknown (solved at every
@@ -139,7 +139,7 @@ TEST(DiligentDiagnoseTest, FindsOnlyPlausiblePhysicsOnTheRealBall) {
                 s["held_out_before"].get<double>(), s["held_out_after"].get<double>());
     // albedo_texture (igi's added name: a free albedo per texel) is not physics of this
     // uniformly painted ball, but since the step gate weighs held-out blocks by their error
-    // (2026-11-22) it is kept after pose_error (measured: held-out residual² -21.6 %, z 3.8): the
+    // it is kept after pose_error (measured: held-out residual² -21.6 %, z 3.8): the
     // maps absorb the diffuse falloff toward the terminator that no candidate models (see
     // bench/RESULTS "DiLiGenT ball"). Allowed as the last step only, a known limit.
     if (effect == "albedo_texture") {

@@ -1,4 +1,4 @@
-// End to end on igi-synth brackets with known radiance and response (issue 4): igi-synth writes
+// End to end on igi-synth brackets with known radiance and response: igi-synth writes
 // LDR brackets of one rendered photo through a known response with realistic sensor noise (shot
 // and read noise, 8-bit levels) and the noise-free radiance they expose (truth/radiance/). Then
 // `igi-calib response` recovers the curve and `igi-hdr` merges the bracket with it:
@@ -87,7 +87,7 @@ fs::path* HdrSynthE2e::dir_ = nullptr;
 // range (x = electrons / full well 0.044 .. 0.53 for this sigmoid). Below, the sigmoid's toe packs
 // x = 0.5 % .. 4 % into 25 levels, where noise blurred by the steep curve biases the data. Measure:
 // |exp(g - g_true - c) - 1| at every level, c the median difference (the free additive
-// constant of g). Tolerance 1 % (issue 4); each level's g rests on many equations, so pixel
+// constant of g). Tolerance 1 %; each level's g rests on many equations, so pixel
 // noise averages out and what is measured is the recovery's bias. 2000 samples: the room has
 // few distinct radiances, so a sample gives ~3 equations; with the default 1000 the error was
 // 0.99 % (measured), with 2000 0.37 % (lambda auto).

@@ -1,4 +1,4 @@
-// igi-run --demo end to end (issue 9, items 2, 3, 5): igi-synth writes an unposed capture of its
+// igi-run --demo end to end: igi-synth writes an unposed capture of its
 // textured room (LDR brackets through a gamma response), igi-run recovers the response, merges
 // the HDR maps, registers the photos (COLMAP, with control points and the known intrinsics),
 // solves and writes the report. Checked:
@@ -39,9 +39,9 @@ using test::RunTool;
 // recovered response (about 1 % in radiance), COLMAP poses refined with the control points, and
 // the HDR maps' absolute scale solved from the matte box (the demo's default
 // --demo-calibration reference; the matte box's material is given and left out of the
-// comparison). Measured 2026-11-21 with the ceiling seen by no photo (calibration "measured"):
+// comparison). Measured with the ceiling seen by no photo (calibration "measured"):
 // ρd −7.5..+14 %, ρs −0.6 % / −0.3 % / −8.3 %, α +0.2..+4 %; "reference" solved the scale
-// −13.3 %. Measured 2026-11-22 with 2 ceiling cameras posed from the surveyed targets, after k:
+// −13.3 %. Measured with 2 ceiling cameras posed from the surveyed targets, after k:
 // "reference" (k = 1.030, the scale solved −3.1 %): ρd −9.4..+4.7 % (wall_x4 −9.4 %, the ceiling
 // −0.9 %), ρs −6.3..+1.6 %, α −1.5..+1.6 %; "measured" (k = 1.009): ρd −8.4..+5.6 %, ρs
 // −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
@@ -52,14 +52,14 @@ using test::RunTool;
 // 2.7 % (solve from every third pixel, as the demo now does: the same within 1.5 points). Regions
 // no photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are
 // reported by igi-solve and not compared. Since 2026-11-26 (session 22; bench/RESULTS.md "End to
-// end", sessions 19 and 22), with every photo registered, the truth over the solved maps' seen
+// end"), with every photo registered, the truth over the solved maps' seen
 // texels and the glossy box and sphere mapped (their texture is finer than the solver's patches):
 // ρd −0.6..+1.25 % (wall_y4 +1.1 and +1.25 %: half of wall_x4, unseen, is brighter than its seen
 // half), ρs −3.1..+0.2 % and −2.5..−0.5 %, α −0.7..+3.3 % and −0.7..+1.1 %, k 1.001 and 0.999. The
 // bounds keep about twice that: an error several times larger fails. 2026-11-28 (session 32,
 // bench/solver/run_demo_split.sh: the solve repeated from the true poses and the true radiance):
 // ρd −0.4..+0.2 % but wall_y4 +1.2 % (the solver's on this capture: +1.4 % from the true
-// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. 2026-11-28 (session 33): that
+// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. 2026-11-28: that
 // spread of the floor's lobe was the fit's sample draw (keyed by the observation's index, redrawn
 // by any change to an earlier photo), not the registration; every highlight sample fitted and 4
 // ceiling cameras: ρd −0.7..+0.8 % (wall_y4 +0.8 %), ρs and α −3.4..+0.5 %, poses within
@@ -77,7 +77,7 @@ constexpr double kCeilingRhoDTolerance = 0.03;
 // Registration against the true cameras: issue 6's bars, 0.1° and 0.5 % of the scene's size (the
 // room's 6.4 m diagonal: 32 mm; held here to 0.2 %, 12.8 mm). Measured with exact control points:
 // COLMAP's poses within 0.011° and 0.6 mm, the ceiling cameras within 1e-4°; with the demo's
-// 0.1 px of noise on them (2026-11-22): every photo within 0.085° and 5.4 mm (cam2; the ceiling
+// 0.1 px of noise on them: every photo within 0.085° and 5.4 mm (cam2; the ceiling
 // cameras, posed from about 13 targets alone, and the markers anchor the joint refinement).
 constexpr double kRotationToleranceDeg = 0.1;
 constexpr double kPositionToleranceM = 0.002 * 6.4;

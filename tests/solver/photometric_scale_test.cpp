@@ -47,7 +47,7 @@ std::vector<PhotoScaleSample> TexturedReference(int patches, int per_patch, uint
 TEST(PhotoScaleTest, TextureFinerThanAPixelLeavesTheScaleUnbiased) {
   const std::vector<PhotoScaleSample> samples = TexturedReference(400, 30, 3);
   // Single samples' residuals are skewed: the sample-wise 4-σ cut that the estimator used before
-  // (session 13) drops only the dark lookups, and k comes out several per cent low (igi-run
+  // drops only the dark lookups, and k comes out several per cent low (igi-run
   // --demo's textured matte box: −3.4 %).
   double num = 0, den = 0, k_all = 0;
   for (const PhotoScaleSample& s : samples) num += s.p - s.b, den += s.a;

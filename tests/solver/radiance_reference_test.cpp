@@ -1,7 +1,7 @@
 // Agreement with an independent renderer: igi-render's path tracer against RADIANCE 6.1a
 // renders of ../shared/data/reference/radiance_room (same scene, cameras, units).
 //
-// Tolerances (issue 3, item 3):
+// Tolerances:
 // - Image means per channel within 1 %. RADIANCE's -ab 8 bounce cap loses about 0.35 % of the
 //   image mean (its README), the two references' own Monte Carlo noise on a mean is ~0.02 %,
 //   and ours at the spp below is ~0.1 %: 1 % leaves room for those and nothing systematic.

@@ -88,7 +88,7 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   // irradiance (SolveOptions::smoothing_accuracy: a radius from the harmonic mean distance of
   // each observation's indirect hits) gives 33.50 and 36.33 dB (with a fixed radius 33.13 and
   // 35.01); the same capture at 2048 spp (nearly noise-free: the slow NoiseFree case below)
-  // 35.49 and 39.81 dB (fixed radius 35.01, 37.43; bench/RESULTS.md, session 12). Guarded 1 dB
+  // 35.49 and 39.81 dB (fixed radius 35.01, 37.43; bench/RESULTS.md). Guarded 1 dB
   // below the measured values: the interior bound fails with the fixed radius.
   EXPECT_GT(seen.psnr_db, seen_bar_db);
   EXPECT_GT(interior.psnr_db, interior_bar_db);
@@ -287,7 +287,7 @@ TEST(SolveAlbedoTruth, AGlossyRegionsFineTextureGetsAMap) {
         "%+.2f %% (against the true texture's mean over the map's seen texels)\n",
         name, 100 * r.texel_variation, r.texel_variation_z, 100 * (r.final_params.rho_d.mean() / want.mean() - 1),
         100 * (r.stage1.rho_d.mean() / want.mean() - 1));
-    // Measured (session 22): the box -0.59 % (its constant fit +0.37 %), the sphere -1.20 %
+    // Measured: the box -0.59 % (its constant fit +0.37 %), the sphere -1.20 %
     // (its constant fit +3.08 %); this small capture's walls and ceiling are off by up to 5 %
     // themselves (160 x 120 photos), which the regions' bounced light inherits. The demo's
     // (480 x 360): box -0.2 %, sphere -0.5 % (constant fits +3.1 %, +1.1 %).
@@ -387,7 +387,7 @@ TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
                 100 * (r.final_params.rho_d[0] / t[0].get<double>() - 1),
                 100 * (r.final_params.rho_d[1] / t[1].get<double>() - 1),
                 100 * (r.final_params.rho_d[2] / t[2].get<double>() - 1));
-    // Measured (session 22): ceiling 0.786 / 0.776 / 0.769, the walls and the matte box
+    // Measured: ceiling 0.786 / 0.776 / 0.769, the walls and the matte box
     // -0.1..+2.1 %. With the placeholder (sphere lamp, same cameras) the walls were +4..+11 %.
     for (int c = 0; c < 3; ++c) {
       EXPECT_LT(RelErr(r.final_params.rho_d[c], t[c].get<double>()), 0.03) << name << c;

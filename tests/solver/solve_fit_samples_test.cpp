@@ -3,7 +3,7 @@
 // by a hash. The draw must be a property of each photo's own pixels: keyed by the observation's
 // index, a change to one photo's observations (its pose, its mask, a pixel passing an edge test)
 // shifted every later photo's indices and redrew them all, and the demo floor's faint lobe (ρs
-// 0.04) moved by up to 11 points with the draw alone (bench/RESULTS.md, session 33).
+// 0.04) moved by up to 11 points with the draw alone (bench/RESULTS.md).
 //
 // Scene: tests/e2e/box_room.h's 2 m room, cam0 looking down, cam1 up, photos path-traced at 16
 // paths. The second solve's cam0 photo has its floor pixels invalid (NaN): cam1 sees no floor,

@@ -281,7 +281,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
                 100 * (r.final_params.rho_d[1] / t["rho_d"][1].get<double>() - 1),
                 100 * (r.final_params.rho_d[2] / t["rho_d"][2].get<double>() - 1));
     for (int c = 0; c < 3; ++c) {
-      // The paper's stage (stage 1), 256-spp photos (session 26): wall_x0 -1.20 / -1.02 %, the
+      // The paper's stage (stage 1), 256-spp photos: wall_x0 -1.20 / -1.02 %, the
       // glossy sphere -2.26..-2.83 % (clean / noisy; its patches' gathered indirect light is
       // 1.9 % high at these cameras' 3-4 cm per pixel and exact at twice the resolution,
       // bench/RESULTS.md), the others within 0.9 %. 3.5 % guards them; the refinement below
@@ -295,11 +295,11 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // photos themselves are 0.83 / 0.44 / 0.34 % (standard error 0.34 %) darker on the sphere
       // than a box-filtered 1024-path render of the true scene (bench/solver/ceiling_probe);
       // from 1024-spp photos (0.1 % off) the sphere comes to -0.5..-0.9 % and from another
-      // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md, session 26). The sphere
+      // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md). The sphere
       // is guarded at 2 % from 256-spp photos. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
       // The "converged" cases' 1024-spp photos are within 0.1 % of the true scene's radiance
       // (issue 7's noise-free capture; "converged_noisy" adds the realistic sensor noise): there
-      // the sphere too has the issue's 1 %. Measured (session 31), the worst written rho_d:
+      // the sphere too has the issue's 1 %. Measured, the worst written rho_d:
       // converged the sphere -0.80 %, the ceiling +0.60 %, the rest within 0.46 %;
       // converged_noisy the sphere -0.79 %, the glossy box +0.62 %, the rest within 0.40 %.
       // (The "noisy" case at 256 spp, sessions 26-30, was replaced by converged_noisy.)
@@ -400,7 +400,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
   // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here), the
   // issue's bar. Session 26, 256-spp photos, igi-solve's defaults: 1.39 % beyond (clean: model
-  // 0.0267, floor 0.0228), 1.35 % (noisy: 0.0265, 0.0228). From 64-spp photos (sessions 18-25)
+  // 0.0267, floor 0.0228), 1.35 % (noisy: 0.0265, 0.0228). From 64-spp photos
   // it was 2.63 %: 78 % of the squared error sat on the floor's blocks, the texel noise of a map
   // from photos that noisy (bench/solver/relight_probe, bench/RESULTS.md).
   EXPECT_LT(err, std::sqrt(floor * floor + 0.02 * 0.02));
