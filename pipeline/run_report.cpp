@@ -258,41 +258,38 @@ void DiagnosisSection(const fs::path& out, HtmlReport* page) {
   }
 }
 
-}  // namespace
-
-// Links to the exported scenes (relative to report.html) and their main files.
+// The exported scenes: per format, links to its files (relative to report.html) or the line its
+// export failed with.
 void ExportsSection(const fs::path& out, const Json& exports, HtmlReport* page) {
   page->Heading("The solved scene for other renderers");
   if (exports.empty()) {
     page->Note("No exports.", "warning");
     return;
   }
-  std::vector<std::vector<std::string>> rows;
+  std::string html = "<table><tr><th>format</th><th>files</th></tr>";
   for (const auto& [format, e] : exports.items()) {
+    std::string cell;
     if (e.contains("error")) {
-      rows.push_back({format, "failed: " + e["error"].get<std::string>()});
-      continue;
-    }
-    const fs::path dir = out / e["dir"].get<std::string>();
-    std::vector<std::string> files;
-    if (fs::exists(dir)) {
-      for (const auto& f : fs::directory_iterator(dir)) {
-        if (f.is_regular_file()) files.push_back(f.path().filename().string());
+      cell = HtmlEscape("failed: " + e["error"].get<std::string>());
+    } else {
+      const std::string dir = e["dir"].get<std::string>();
+      std::vector<std::string> files;
+      if (fs::exists(out / dir)) {
+        for (const auto& f : fs::directory_iterator(out / dir)) {
+          if (f.is_regular_file()) files.push_back(f.path().filename().string());
+        }
+      }
+      std::sort(files.begin(), files.end());
+      for (const std::string& f : files) {
+        cell += "<a href=\"" + HtmlEscape(dir + "/" + f) + "\">" + HtmlEscape(f) + "</a> ";
       }
     }
-    std::sort(files.begin(), files.end());
-    std::string links;
-    for (const std::string& f : files) {
-      const std::string href = e["dir"].get<std::string>() + "/" + f;
-      links += "<a href=\"" + HtmlEscape(href) + "\">" + HtmlEscape(f) + "</a> ";
-    }
-    rows.push_back({format, links});
+    html += "<tr><td>" + HtmlEscape(format) + "</td><td>" + cell + "</td></tr>";
   }
-  page->RawHtml("<table><tr><th>format</th><th>files</th></tr>");
-  for (const auto& r : rows)
-    page->RawHtml("<tr><td>" + HtmlEscape(r[0]) + "</td><td>" + r[1] + "</td></tr>");
-  page->RawHtml("</table>\n");
+  page->RawHtml(html + "</table>\n");
 }
+
+}  // namespace
 
 void WriteRunReport(const RunReportInputs& in) {
   HtmlReport page("igi-run report");
