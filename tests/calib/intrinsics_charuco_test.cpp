@@ -1,7 +1,7 @@
 // ChArUco calibration (igi-calib intrinsics --board-type charuco) on synthetic views with known
 // intrinsics: OpenCV draws a 5 x 7 ChArUco board (DICT_4X4_50, 4 cm squares, 3 cm markers), which
 // is warped into 640 x 480 views of a pinhole camera (fx = fy = 800, cx = 320, cy = 240 in
-// OpenCV's convention) from known tilted poses. The recovered fx must be within 0.5 % (issue 6's
+// OpenCV's convention) from known tilted poses. The recovered fx must be within 0.5 % (the
 // bar; the exact rendering leaves far less), a view without the board is rejected (exit 3).
 #include <gtest/gtest.h>
 

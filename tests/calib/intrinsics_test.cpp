@@ -69,7 +69,7 @@ TEST(IntrinsicsTest, MatchesOpenCvReferenceOnRealChessboard) {
   ASSERT_EQ(camera.views.size(), 13u);  // the board is in all 13 views
   EXPECT_TRUE(camera.rejected_views.empty());
   ASSERT_EQ(camera.params.size(), 12u);
-  // Issue 6: fx within 0.5 % and RMS within 0.05 px of OpenCV's reference.
+  // Target: fx within 0.5 % and RMS within 0.05 px of OpenCV's reference.
   EXPECT_NEAR(camera.params[0], ref.fx, 0.005 * ref.fx);
   EXPECT_DOUBLE_EQ(camera.params[0], camera.params[1]);  // fixed aspect ratio 1
   EXPECT_NEAR(camera.rms_px, ref.rms, 0.05);

@@ -1,4 +1,4 @@
-// Response recovery on synthetic brackets with a known response (1 % claims of issue 4) and on
+// Response recovery on synthetic brackets with a known response (the 1 % targets) and on
 // the real Memorial bracket against OpenCV's CalibrateDebevec.
 #include "calib/response_recovery.h"
 

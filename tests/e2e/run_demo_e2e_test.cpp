@@ -74,7 +74,7 @@ constexpr double kAlphaTolerance = 0.08;
 // −1.0 % with "measured", +0.0 % and +0.3 % in sessions 19 and 22; 40 % low when no photo saw it
 // and it kept a placeholder).
 constexpr double kCeilingRhoDTolerance = 0.03;
-// Registration against the true cameras: issue 6's bars, 0.1° and 0.5 % of the scene's size (the
+// Registration against the true cameras: the targets, 0.1° and 0.5 % of the scene's size (the
 // room's 6.4 m diagonal: 32 mm; held here to 0.2 %, 12.8 mm). Measured with exact control points:
 // COLMAP's poses within 0.011° and 0.6 mm, the ceiling cameras within 1e-4°; with the demo's
 // 0.1 px of noise on them: every photo within 0.085° and 5.4 mm (cam2; the ceiling

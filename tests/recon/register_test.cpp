@@ -126,7 +126,7 @@ TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   const double expected = kFocalFullPx / kDownscale;
   std::printf("Sceaux: %s focal %.2f px, K.txt %.2f px (%.2f %%)\n", camera.model.c_str(),
               camera.params[0], expected, 100 * (camera.params[0] / expected - 1));
-  // Issue 6 asks for 2 %, which igi does NOT reach on the full-size photos, so this checks 3 % to
+  // The target is 2 %, which igi does NOT reach on the full-size photos, so this checks 3 % to
   // catch regressions. Measured (bench/RESULTS.md "Registration"): here with the defaults
   // +1.9..+2.3 % (COLMAP's matching is not deterministic); with guided matching +1.65, +1.75,
   // +1.86 % (three runs of this test), with DSP-SIFT +1.87..+1.97 %. But at full size every

@@ -4,10 +4,11 @@
 // (--camera), the scene and control points (the room's and the boxes' corners projected with
 // the true poses). Checked: exit 3 with only the noise photo unregistered, the known intrinsics
 // kept, every photo's final reprojection RMS, and every photo's pose in the scene frame within
-// issue 6's bars (0.1 degrees, 2 cm); then the same COLMAP model with the markers weighted as if
-// clicked by hand (checked loosely), and the error of each stage of the alignment (printed).
-// Takes 3-7 minutes on the 2 shared cores (measured: igi-synth 45-160 s, igi-register 160-275 s
-// with the machine's load at 10-17, most of it COLMAP's exhaustive matching): LABELS slow.
+// the registration targets (0.1 degrees, 2 cm); then the same COLMAP model with the markers
+// weighted as if clicked by hand (checked loosely), and the error of each stage of the alignment
+// (printed). Takes 3-7 minutes on the 2 shared cores (measured: igi-synth 45-160 s, igi-register
+// 160-275 s with the machine's load at 10-17, most of it COLMAP's exhaustive matching): LABELS
+// slow.
 //
 // Where the error comes from (measured, worst photo, on 2 shared cores; stages printed by
 // PrintStages): COLMAP's own model, even under the similarity that best maps its camera centres
@@ -57,8 +58,8 @@ using test::RunTool;
 constexpr int kCameras = 16;  // 4 close-ups of the highlights + 12 overviews around the room
 // The markers are the exact projections of the corners; igi-register is told they are good to
 // 0.1 px (--marker-sigma), what targets detected with sub-pixel refinement (ArUco/ChArUco
-// corners) give. Issue 6's bars: 0.1 degrees and 0.5 % of the room size (2 cm) for every photo;
-// measured 0.015-0.022 degrees and 0.8-1.5 mm (worst photo, 8 runs), so the bars hold with a
+// corners) give. The registration targets: 0.1 degrees and 0.5 % of the room size (2 cm) for every
+// photo; measured 0.015-0.022 degrees and 0.8-1.5 mm (worst photo, 8 runs), so the bars hold with a
 // 4.5x margin.
 constexpr double kMarkerSigmaPx = 0.1;
 constexpr double kMaxRotationDeg = 0.1;

@@ -1,4 +1,4 @@
-// igi-solve's albedo map against known truth, fairly (issue 7: "albedo maps within 35 dB PSNR of
+// igi-solve's albedo map against known truth, fairly (the target: "albedo maps within 35 dB PSNR of
 // the truth (noise-free)"): igi-synth's default floor has grain finer than a pixel's footprint
 // and one-texel grout lines, which no photo resolves. Here the floor is --floor-texture smooth
 // (the same tiles and grout low-pass filtered, σ = 6.25 cm), lit by a point lamp (direct light
@@ -80,7 +80,7 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
       all.psnr_db, seen.psnr_db, 100 * seen.compared, interior.psnr_db, 100 * interior.compared);
   // About three quarters of the floor is seen (the boxes and the sphere hide the rest).
   EXPECT_GT(seen.compared, 0.65);
-  // Issue 7 asks 35 dB (noise-free). At 256 spp: measured 33.1 dB over the seen texels and 34.9 dB
+  // The target is 35 dB (noise-free). At 256 spp: measured 33.1 dB over the seen texels and 34.9 dB
   // two texels (9 cm) inside them (32.9 / 34.4 dB before the specular bounces; 33.8 and 35.3 dB
   // with 512-spp photos then, bench/RESULTS.md): the rest is the photos' Monte Carlo noise (about
   // 7 % per pixel at 256 spp), the gathered indirect irradiance's noise, and its bias near the
@@ -99,10 +99,10 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   // scale): measured rho_s -2.0 %, alpha -1.5 % in session 12 (-0.4 %, -0.2 % in an earlier
   // session; -1.5 %, -0.6 % before the specular bounces;
   // -1.0 %, -0.3 % before rho_s was fitted through the held-out samples' own lobe and the
-  // off-highlight test took the region's mean albedo); guarded at issue 7's bar, 5 %.
+  // off-highlight test took the region's mean albedo); guarded at the 5 % target.
   EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
   EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
-  // Issue 7: region-mean albedos within 1 %. The floor's (scene.json's rho_d) is its map's mean
+  // Target: region-mean albedos within 1 %. The floor's (scene.json's rho_d) is its map's mean
   // over the texels the photos show, against the true texture's over the same texels: measured
   // -0.18..-0.33 % in session 18 (the fit's patch-area mean, kept in report.json, +1.73 %: it
   // weights each patch's texture by where its samples crowd).
@@ -141,7 +141,7 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
   CheckMapOfAResolvedTexture(256, 32.5, 35.3);
 }
 
-// Issue 7's 35 dB is for noise-free photos: the same capture at 2048 paths per pixel (123 s alone
+// The 35 dB target is for noise-free photos: the same capture at 2048 paths per pixel (123 s alone
 // on 2 threads; labelled slow, run with IGI_SLOW=1). Measured (session 31, as in session 12):
 // 35.49 dB over the seen texels, 39.81 dB two texels inside; every region's rho_d within 0.57 %.
 TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolveNoiseFree) {

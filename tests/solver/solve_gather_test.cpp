@@ -83,7 +83,7 @@ TEST_F(SolveGather, GlossySurfacesPassOnTheirSpecularReflectionOfTheRoom) {
               100 * without);
   // Measured -0.63 % with, +4.44 % without (the floor's specular reflection of the ceiling
   // missing from the ceiling's irradiance); with another photo seed and 256 indirect rays
-  // -0.13 % / +4.78 %: the -0.6 % is gathering noise. 1 %: issue 7's bar for region means.
+  // -0.13 % / +4.78 %: the -0.6 % is gathering noise. 1 %: the accuracy target for region means.
   EXPECT_LT(std::abs(with), 0.01);
   // The scene must show the effect, or the check above guards nothing.
   EXPECT_GT(without, 0.03);

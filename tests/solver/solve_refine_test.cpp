@@ -141,7 +141,7 @@ TEST_P(SolveRefineLambert, JointRoundLandsOnTheAlbedosWhereTheIndependentOneOver
       "worst albedo error: start %+.2f %%, joint round %+.2f %%, independent round %+.2f %%\n",
       100 * joint_before, 100 * joint_after, 100 * indep_after);
   EXPECT_GT(joint_before, 0.04);  // the start really is off
-  // 1 %: issue 7's bar for region means. The round's own noise (64 rendered directions per
+  // 1 %: the accuracy target for region means. The round's own noise (64 rendered directions per
   // observation, every pixel, 256-path photos) is a few tenths of a per cent.
   EXPECT_LT(std::abs(joint_after), 0.01);
   // The scene must show the feedback, or the check above guards nothing: the independent

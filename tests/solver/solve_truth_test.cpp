@@ -1,4 +1,4 @@
-// igi-solve against known truth (issue 7's evidence):
+// igi-solve against known truth (the accuracy targets' evidence):
 //  - the independent RADIANCE room (../shared/data/reference/radiance_room, every value known):
 //    material values stripped, solved, compared with truth.json;
 //  - an igi-synth room (Ward regions with highlights, a textured glossy floor), noise-free and
@@ -70,13 +70,13 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
     ASSERT_EQ(r.status, "solved") << r.name;
     for (int c = 0; c < 3; ++c) {
       const double want = t["rho_d"][c].get<double>();
-      // Issue 7: within 2 %. Measured (paper stage): at most 0.45 %.
+      // Target: within 2 %. Measured (paper stage): at most 0.45 %.
       EXPECT_LT(RelErr(r.stage1.rho_d[c], want), 0.02) << r.name << " paper rho_d[" << c << "]";
       // The path-traced refinement: measured within 1 % (its noisier gathering moves them).
       EXPECT_LT(RelErr(r.stage2.rho_d[c], want), 0.03) << r.name << " refined rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Issue 7: within 10 %. Measured: rho_s 0.0 %, alpha +0.2 % (paper); -0.4 %, -0.4 %.
+      // Target: within 10 %. Measured: rho_s 0.0 %, alpha +0.2 % (paper); -0.4 %, -0.4 %.
       for (const RegionFitResult* f : {&r.stage1, &r.stage2}) {
         EXPECT_LT(RelErr(f->rho_s.mean(), t["rho_s"].get<double>()), 0.10) << r.name;
         EXPECT_LT(RelErr(f->alpha, t["alpha"].get<double>()), 0.10) << r.name;
@@ -220,13 +220,13 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // Measured (paper stage), session 26 (256-spp photos): rho_d +0.73..+1.19 % (clean),
       // +0.42..+0.82 % (noisy), the fit's area mean over the patches (it weights each patch's
       // texture by where its samples crowd); guarded at 2 %: the region's final rho_d is the
-      // map's (below), which meets issue 7's 1 %. The lobe is fitted with each highlight
+      // map's (below), which meets the 1 % target. The lobe is fitted with each highlight
       // sample's albedo as the other photos see its texel off their highlights
       // (solver/held_out_albedo.h), rho_s through that albedo's own lobe: rho_s -4.14 % (clean),
       // -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos, session 18:
       // -2.19 %, -1.69 %, -1.54 %, -1.37 %); since session 14 rho_s and alpha also join stage
-      // 2's joint update. Issue 7's 5 % guards them. History: rho_s -10.3 % / -8.1 % before session
-      // 14 (the photos' Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
+      // 2's joint update. The 5 % target guards them. History: rho_s -10.3 % / -8.1 % before
+      // session 14 (the photos' Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
       // highlight samples' radiance, so 0.07 % of albedo error is 1 % of rho_s;
       // bench/solver/floor_probe, bench/RESULTS.md).
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
@@ -234,7 +234,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05);
       EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
       // The region's final rho_d (scene.json's) is its albedo map's mean over the texels the
-      // photos show, compared with the true texture's mean over the same texels. Issue 7's 1 %:
+      // photos show, compared with the true texture's mean over the same texels. The 1 % target:
       // measured +0.01..+0.16 % (clean), +0.22..+0.34 % (noisy) in session 26 (256-spp
       // photos; -0.17..-0.23 % and -0.5..-0.8 % from 64-spp photos in session 18).
       ASSERT_TRUE(r.rho_d_from_map);
@@ -288,7 +288,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // is what igi-solve writes.
       EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.035)
           << r.name << " rho_d[" << c << "]";
-      // The written (refined) value, issue 7's 1 %. Session 26 (256-spp photos, the last round's
+      // The written (refined) value, the 1 % target. Session 26 (256-spp photos, the last round's
       // rays scaled up for regions with few observations): every region but the sphere within
       // 0.88 % (the glossy box's red, noisy; the walls and the ceiling within 0.51 %); the
       // sphere -1.14 / -1.26 / -1.31 % (clean), -1.01 / -0.86 / -1.20 % (noisy): these
@@ -298,7 +298,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md). The sphere
       // is guarded at 2 % from 256-spp photos. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
       // The "converged" cases' 1024-spp photos are within 0.1 % of the true scene's radiance
-      // (issue 7's noise-free capture; "converged_noisy" adds the realistic sensor noise): there
+      // (the noise-free capture; "converged_noisy" adds the realistic sensor noise): there
       // the sphere too has the issue's 1 %. Measured, the worst written rho_d:
       // converged the sphere -0.80 %, the ceiling +0.60 %, the rest within 0.46 %;
       // converged_noisy the sphere -0.79 %, the glossy box +0.62 %, the rest within 0.40 %.
@@ -308,7 +308,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
           << r.name << " final rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Issue 7: within 5 %; measured (256-spp photos, session 26; rho_s / alpha, clean and
+      // Target: within 5 %; measured (256-spp photos, session 26; rho_s / alpha, clean and
       // noisy): glossy_box -0.1 / +0.3 % and -1.4 / +0.5 %, wall_y4 -0.0 / +1.5 % and
       // -1.2 / +2.6 %, glossy_sphere +1.4 / +0.6 % and +3.4 / +1.5 %. 5 % (the issue's bar)
       // guards them.
@@ -348,7 +348,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     const double psnr = AlbedoPsnr(resampled, want, peak);
     std::printf("floor albedo map: %dx%d, PSNR %.1f dB against the true texture\n", mine.width,
                 mine.height, psnr);
-    // Issue 7 asks 35 dB (noise-free): see solve_albedo_truth_test for a texture the photos
+    // The target is 35 dB (noise-free): see solve_albedo_truth_test for a texture the photos
     // resolve. Measured here 18.7 dB (18.0 dB from 64-spp photos): the tiles' edges are finer
     // than these cameras' 4.6 cm texel, most texels hold one or two observations, and a quarter
     // of the floor is seen by no photo (filled from neighbours). Guarded at 16 dB.
@@ -398,7 +398,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   };
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
-  // Issue 7: within 2 % relative RMS plus the noise floor (added in quadrature here), the
+  // Target: within 2 % relative RMS plus the noise floor (added in quadrature here), the
   // issue's bar. Session 26, 256-spp photos, igi-solve's defaults: 1.39 % beyond (clean: model
   // 0.0267, floor 0.0228), 1.35 % (noisy: 0.0265, 0.0228). From 64-spp photos
   // it was 2.63 %: 78 % of the squared error sat on the floor's blocks, the texel noise of a map
