@@ -19,7 +19,7 @@
 //   (k1 0.113, k2 −0.419; truth −0.25, −0.05), which had passed the first round too but explained
 //   less; final 0.1516 against 0.1436 (1.06×; baseline 0.1858).
 // - ambient_light:kind=uniform (the contract's ambient light, radiance 0.4, in every lighting;
-//   measured 2026-11-22): ambient_light first and alone, radiance 0.394 (each
+//   measured): ambient_light first and alone, radiance 0.394 (each
 //   channel), final residual 0.1260 against the true model's 0.1260 (1.00×; baseline 0.2461).
 //   It passes since the renderer evaluates the ambient light exactly (before, its uniform-sphere
 //   samples made the true model noisier than the declared one at radiance 0.1) and the candidate

@@ -59,7 +59,7 @@ using test::RunTool;
 // bounds keep about twice that: an error several times larger fails. 2026-11-28 (session 32,
 // bench/solver/run_demo_split.sh: the solve repeated from the true poses and the true radiance):
 // ρd −0.4..+0.2 % but wall_y4 +1.2 % (the solver's on this capture: +1.4 % from the true
-// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. 2026-11-28: that
+// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. That
 // spread of the floor's lobe was the fit's sample draw (keyed by the observation's index, redrawn
 // by any change to an earlier photo), not the registration; every highlight sample fitted and 4
 // ceiling cameras: ρd −0.7..+0.8 % (wall_y4 +0.8 %), ρs and α −3.4..+0.5 %, poses within

@@ -288,7 +288,7 @@ TEST_F(SolveE2E, RefineAlbedoStepMovesPartOfTheWay) {
 // lamp), every albedo stripped, solved back. Tolerance 2 %: the photos are the same renderer's
 // output, so there is no model error; what remains is the photos' Monte Carlo noise (256 spp,
 // averaged over the floor's 100 observations), the solver's gathering noise at 32 indirect rays
-// and one (joint) refinement round. Measured 2026-11-22: floor -0.50 / -0.64 /
+// and one (joint) refinement round. Measured: floor -0.50 / -0.64 /
 // -0.92 %, ceiling within 0.2 %, walls within 0.1 %; with the photos rendered from seeds 2 and 3
 // the floor stays within 1.05 %. With 64-spp photos the floor's noise alone had put it at -3.3 %
 // (seed 0; -0.5 % and -1.6 % with seeds 2 and 3), which the 3 % bound then allowed. Indirect

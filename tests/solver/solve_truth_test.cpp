@@ -223,10 +223,10 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // map's (below), which meets the 1 % target. The lobe is fitted with each highlight
       // sample's albedo as the other photos see its texel off their highlights
       // (solver/held_out_albedo.h), rho_s through that albedo's own lobe: rho_s -4.14 % (clean),
-      // -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos, session 18:
-      // -2.19 %, -1.69 %, -1.54 %, -1.37 %); since session 14 rho_s and alpha also join stage
-      // 2's joint update. The 5 % target guards them. History: rho_s -10.3 % / -8.1 % before
-      // session 14 (the photos' Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
+      // -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos:
+      // -2.19 %, -1.69 %, -1.54 %, -1.37 %); rho_s and alpha also join stage 2's joint update.
+      // The 5 % target guards them. Without that, rho_s came out -10.3 % / -8.1 % (the photos'
+      // Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
       // highlight samples' radiance, so 0.07 % of albedo error is 1 % of rho_s;
       // bench/solver/floor_probe, bench/RESULTS.md).
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
@@ -288,7 +288,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // is what igi-solve writes.
       EXPECT_LT(RelErr(f.rho_d[c], t["rho_d"][c].get<double>()), 0.035)
           << r.name << " rho_d[" << c << "]";
-      // The written (refined) value, the 1 % target. Session 26 (256-spp photos, the last round's
+      // The written (refined) value, the 1 % target. Measured (256-spp photos, the last round's
       // rays scaled up for regions with few observations): every region but the sphere within
       // 0.88 % (the glossy box's red, noisy; the walls and the ceiling within 0.51 %); the
       // sphere -1.14 / -1.26 / -1.31 % (clean), -1.01 / -0.86 / -1.20 % (noisy): these
