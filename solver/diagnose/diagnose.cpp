@@ -354,10 +354,12 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
   spdlog::info("igi-diagnose: baseline residual {:.4f} (held out {:.4f})", sum.baseline_residual,
                sum.baseline_held_out);
   const std::vector<std::unique_ptr<Effect>> effects = MakeEffects();
+  // The albedo nuisance's cell, from the baseline's geometry (the steps add no room to it).
+  const double cell = CellSize(st.model);
   // The current model as the effects see it.
   auto view = [&]() {
-    return DiagnosisModel{scene,   st.model, declared, photos, st.sim.sims,        st.records,
-                          holdout, o,        maps,     solve,  CellSize(st.model), out_dir};
+    return DiagnosisModel{scene,   st.model, declared, photos, st.sim.sims, st.records,
+                          holdout, o,        maps,     solve,  cell,        out_dir};
   };
   std::vector<std::string> kept_effects, rejected;
   int attempt = 0;
@@ -500,7 +502,7 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
     const KeyFilter allowed = [&](const std::string& key) {
       return std::find(excluded.begin(), excluded.end(), key) == excluded.end();
     };
-    CandidateContext cx{st.model, declared, solve, CellSize(st.model), o.holdout_block_px};
+    CandidateContext cx{st.model, declared, solve, cell, o.holdout_block_px};
     cx.photos = &photos;
     cx.sims = &st.sim.sims;
     const auto t0 = std::chrono::steady_clock::now();
