@@ -40,10 +40,9 @@ struct CaptureOptions {
   int settle_frames = 1;                   // frames dropped after each exposure change
   std::optional<std::string> file_format;  // "png" (default) or "tiff"
   bool resume = false;                     // finish the plan in DIR
-  // true: each frame file and manifest line is fsynced before the next frame
-  // (survives a power cut; on a disk with ~4 ms flushes this caps the rate near
-  // 125 frames/s). false
-  // (--no-fsync): written and renamed/appended at once (survive a crash of
+  // true: each frame file and manifest line is fsynced as it is written
+  // (survives a power cut; the disk's flush time then caps the sustained rate).
+  // false (--no-fsync): written and renamed/appended at once (survive a crash of
   // igi-capture or a pulled cable), flushed to disk together at the end of the
   // run.
   bool fsync_each_frame = true;

@@ -40,6 +40,7 @@ RawFileInfo ReadRawInfo(const std::filesystem::path& path);
 
 struct RawImportOptions {
   std::filesystem::path raw_dir;  // folder of raw files (not recursive)
+  // The capture folder written (required): frames/ and manifest.jsonl.
   std::filesystem::path out_dir;
   bool resume = false;  // add only the files the manifest lacks
   void Validate() const;

@@ -26,6 +26,7 @@ struct HdrInputOptions {
   calib::ExposureSource exposures;  // both empty = EXIF / raw metadata
   std::filesystem::path response;   // response.json; empty = see `linear`
   bool linear = false;              // non-raw input is linear (no response.json needed)
+  // How raw input is decoded (white balance, colour, binning).
   RawDecodeOptions raw;
   bool headers_only = false;  // leave the pixels of non-raw frames unread where possible
 };

@@ -24,63 +24,62 @@
 namespace igi {
 
 struct DemoOptions {
+  // DIR (required): 00-capture (igi-synth's capture) and igi-run's stages under it.
   std::filesystem::path out;
   std::filesystem::path bin_dir;  // empty = igi-run's folder
-  int cameras = 16;  // 12 at 320x240 registered nothing (measured); 16 at 480x360 as in tests/recon
+  int cameras = 16;  // overview cameras, >= 3; COLMAP must match enough features between them
+  // Photo size, pixels (at least 64 × 48); smaller photos give COLMAP fewer features to match.
   int width = 480;
   int height = 360;
+  // igi-synth's render samples per pixel, >= 1.
   int spp = 8;
+  // LDR exposures per photo (igi-synth --brackets) and the EV between neighbouring ones.
   int brackets = 3;
   double stops = 2;
+  // Leave out 05-diagnose (igi-run --skip-diagnose).
   bool skip_diagnose = false;
+  // --threads given to igi-synth and every stage (0 = all cores).
   int num_threads = 0;
   // Cameras that look up at the ceiling, on top of `cameras` (igi-synth gets cameras +
   // ceiling_cameras, --ceiling-cameras ceiling_cameras: its last overview cameras look up). A
   // ceiling no photo sees keeps a placeholder albedo, which removes light the rest of the room
-  // receives (measured without them: the walls' rho_d -7.5..+14.4 %). COLMAP matches no feature
-  // of theirs with the downward views; igi-register poses them from the surveyed targets on the
-  // ceiling and upper walls (markers.json, see demo.cpp SurveyedTargets). Four, not two: with two, the upper half of wall_x4 and most of the ceiling went unseen and took
-  // their seen parts' albedo, and the light they bounce left wall_y4 +1.2 % (the solver's own on
-  // that capture: +1.4 % from the true radiance); with four every ρd came within 0.8 % after k,
-  // the poses within 0.071 deg / 2.5 mm (two runs; with two 0.087 deg / 5.5 mm), for 12 s more
-  // (bench/RESULTS.md, End to end).
+  // receives. COLMAP matches no feature of theirs with the downward views; igi-register poses
+  // them from the surveyed targets on the ceiling and upper walls (markers.json, see demo.cpp
+  // SurveyedTargets). >= 0; more of them see more of the ceiling and upper walls, whose unseen
+  // parts otherwise take their seen parts' albedo (measured: docs/run.md).
   int ceiling_cameras = 4;
   // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
-  // which weakens every bounce; measured: rho_s/k -27..-29 %):
-  //  - "reference": the capture holds a reference of known reflectance (the matte box, its
+  // which weakens every bounce):
+  //  - "reference": the capture holds a reference of known reflectance (reference_region, its
   //    material given in scene.json as if measured with a spectrophotometer) and igi-solve
   //    solves the photos' scale from it (--photo-scale solve);
   //  - "measured": the camera calibrated absolutely (igi-run --radiance-scale), as a lab camera
   //    measured against a radiance standard (simulated with igi-synth's noise-free radiance);
   //  - "none".
   // "reference" by default: it is what a user without a lab does (a grey card, a measured
-  // wall) and needs no truth. Measured with the ceiling seen (2 cameras looking up):
-  // the scale solved -3.1 % (0.2208 against 0.2278), the regions' absolute errors as with
-  // "measured" (rho_d -6.7..+7.8 % against -7.6..+6.6 %). Before the ceiling was seen it was
-  // -13.3 %: the ceiling's placeholder albedo removed light that reaches the matte box (54 %
-  // of its light is indirect).
+  // wall) and needs no truth. Measured: docs/run.md.
   std::string calibration = "reference";
+  // With "reference": the region whose true material is given (and left out of the comparison).
   std::string reference_region = "matte_box";
   // The control points' pixels are their true projections plus Gaussian noise of this standard
-  // deviation (pixels, per axis; fixed seed), as a detector of printed targets finds them
-  // (sub-pixel corners); 0 = exact projections. Measured with 0.3 px (careful
-  // clicks): the photos posed from markers alone (the ceiling cameras) 0.11-0.12 deg off, one
-  // COLMAP photo 0.156 deg / 9.8 mm (exact markers: every photo within 0.02 deg / 1.1 mm).
+  // deviation (pixels, per axis, in [0, 10]; fixed seed), as a detector of printed targets
+  // finds them (sub-pixel corners); 0 = exact projections. More noise: the photos posed from
+  // markers alone (the ceiling cameras) come out further off (measured: docs/run.md).
   double marker_noise_px = 0.1;
-  // igi-register weighs the control points by the same sigma (its default, 1 px, is for
-  // hand-clicked points). At most 1024 SIFT keypoints per photo (COLMAP's default 8192): the
-  // exhaustive matching of the 18 photos (2 ceiling cameras then) 51.9 s -> 22.0 s, the poses as
-  // accurate (measured: every photo registered, worst 0.089 deg / 5.7 mm either way).
+  // Passed to igi-register: the control points weighed by the default marker noise, 0.1 px (its
+  // own default, 1 px, is for hand-clicked points), and at most 1024 SIFT keypoints per photo
+  // (COLMAP's default 8192), which shortens COLMAP's exhaustive matching.
   std::vector<std::string> register_args = {"--marker-sigma", "0.1", "--max-features", "1024"};
-  // Every third pixel: 344 k observations, 92 s of CPU with the scale solved (every second
-  // pixel: 773 k, 358 s; the same errors within the run-to-run spread).
+  // Passed to igi-solve (igi-run --solve-arg replaces them): the paper's stage only, from every
+  // third pixel (fewer observations than igi-solve's default stride 2, a shorter solve).
   std::vector<std::string> solve_args = {"--refine-iterations", "0", "--pixel-stride", "3"};
-  // The demo's diagnosis: coarser samples, its solves from every fourth pixel, at most two steps
-  // (it is the slowest stage: 580 s of CPU with --solve-stride 4, 1146 s with igi-solve's
-  // default stride 2, the same steps kept and rejected).
+  // Passed to igi-diagnose, the slowest stage (igi-run --diagnose-arg replaces them): residuals
+  // at every fourth pixel, 16 paths per pixel, its solves from every fourth pixel without
+  // refinement, at most two steps.
   std::vector<std::string> diagnose_args = {"--pixel-stride", "4",  "--max-steps",         "2",
                                             "--spp",          "16", "--refine-iterations", "0",
                                             "--solve-stride", "4"};
+  // Samples per pixel of the report's renders (RunOptions::report_spp), >= 1.
   int report_spp = 16;
   void Validate() const;
 };

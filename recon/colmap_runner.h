@@ -33,33 +33,25 @@ struct ColmapRunOptions {
   int max_image_size = 3200;          // SIFT extraction downscales larger photos (COLMAP default)
   // At most this many SIFT keypoints per photo (COLMAP's --SiftExtraction.max_num_features, its
   // default 8192; a keypoint may carry several orientations, so the features stored can be
-  // more). COLMAP 3.8 matches on the CPU by brute force: on igi-run's demo (18 photos of
-  // 480x360) 1024 cut the exhaustive matching from 51.9 s to 22.0 s (about 3800 features per
-  // photo to 1800), the poses as accurate (bench/RESULTS.md "Registration").
+  // more). COLMAP 3.8 matches on the CPU by brute force, so fewer keypoints shorten the
+  // exhaustive matching, and leave fewer matches between photos that overlap little.
   int max_features = 8192;
+  // Known intrinsics, held fixed during mapping; absent: COLMAP self-calibrates camera_model.
   std::optional<KnownIntrinsics> intrinsics;
   // The COLMAP camera model self-calibrated when `intrinsics` is not given (ignored with it):
-  // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. Measured on the Sceaux photos
-  // (downscaled 4x, one database, focal error against K.txt; bench/RESULTS.md "Registration"):
-  // SIMPLE_RADIAL +2.16 %, RADIAL +2.77 %, OPENCV +2.65/+2.83 %, SIMPLE_PINHOLE +5.85 % (the lens
-  // has barrel distortion). Each extra distortion term trades off against the focal length (11
-  // photos of one facade do not separate them), so the one-parameter model is the default.
+  // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. The pinhole models leave a lens's
+  // distortion in the focal length; each extra distortion term trades off against the focal
+  // length where the photos do not separate them (a few photos of one facade), so the
+  // one-parameter model is the default.
   std::string camera_model = "SIMPLE_RADIAL";
   // COLMAP's --SiftMatching.guided_matching: once a pair's two-view geometry is estimated, match
-  // again along it, which keeps more correct matches (Sceaux 4x: 44274 verified matches instead
-  // of 30437). On the Sceaux photos downscaled 4x the self-calibrated focal came closer to K.txt
-  // (+1.59 % instead of +2.16 % with SIMPLE_RADIAL, +2.12 % instead of +2.77 % with RADIAL), but
-  // at full size hardly (+2.21 % instead of +2.30 %) for 2.4x the matching time (1447 s instead
-  // of 600 s on 2 loaded cores), and with known intrinsics it was not better (the synthetic room:
-  // worst pose 0.042 degrees / 2.8 mm instead of 0.015-0.022 / 0.8-1.5 mm, one run). Off by
-  // default (COLMAP's default); bench/RESULTS.md "Registration".
+  // again along it, which keeps more correct matches, for a longer matching step. Off by
+  // default (COLMAP's default).
   bool guided_matching = false;
   bool allow_other_version = false;  // accept a COLMAP other than 3.8 (with a warning)
   // The mapper registers a photo when its pose has this many 2D-3D inliers (COLMAP's
   // --Mapper.abs_pose_min_num_inliers and its default). Lower values let close-ups that share
-  // few points with the rest register, but measured on the synthetic room's close-up of a
-  // highlight (25-33 verified matches per pair) at 15: registered in 3 of 3 runs, 1.7-23
-  // degrees off; at 30 left out in 3 runs of 5, registered 18 and 0.9 degrees off in two. With
+  // few points with the rest register, but a pose from few inliers can be far off. With
   // markers igi-register poses such a photo from them instead (RePoseImagesFromMarkers).
   int min_pose_inliers = 30;
 

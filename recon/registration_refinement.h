@@ -39,6 +39,7 @@ struct BundleRefinementOptions {
                                    // points given a mesh term chosen again
   double max_error_px = 4.0;       // COLMAP's own filter (--Mapper.filter_max_reproj_error)
   int max_iterations = 200;        // per solve
+  // Ceres threads (values below 1 count as 1).
   int threads = 1;
   void Validate() const;  // throws igi::Error (a programming error)
 };

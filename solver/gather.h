@@ -100,10 +100,13 @@ struct GatherOptions {
   // Per delta light (point, spot, directional) at a query with a footprint: the points of the
   // pixel it is sampled at (stratified). Extended lights spread their light_samples over it.
   int footprint_samples = 4;
+  // Stratified hemisphere rays per query for the light arriving from other surfaces.
   int indirect_rays = 64;
   double lobe_alpha = 0.2;       // roughness of the mixed-in Ward lobe
   bool specular_bounces = true;  // trace a specular bounce at each glossy indirect hit
+  // Seed of the random numbers: each query has its own stream, whatever the threads.
   uint64_t seed = 1;
+  // Worker threads; 0 = the process default.
   int num_threads = 0;
   // A progress bar with its label (tools/common/progress.h) on a terminal; empty: none.
   std::string progress_label;

@@ -86,14 +86,18 @@ struct ObservationDraw {
 };
 
 struct ObservationDrawOptions {
+  // Every pixel_stride-th pixel in x and y is a candidate (SolveOptions::pixel_stride).
   int pixel_stride = 2;
   double budget = 0;  // observations; 0 or infinity: no budget
+  // Each region's needs, kept first: its highlight candidates up to max_highlight_samples and
+  // its other pixels up to max_fit_samples (SolveOptions).
   int max_highlight_samples = 100000;
   int max_fit_samples = 6000;
   // Blocks (above): at most this many stride cells on a side (1: single pixels only).
   int max_block = 8;
   // Census grid: at most this many centre rays per photo.
   int census_rays_per_photo = 16384;
+  // Worker threads; 0 = the process default.
   int num_threads = 0;
 };
 

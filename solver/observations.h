@@ -53,6 +53,7 @@ struct ObservationOptions {
   // Keeps a pixel that sees a reflective surface only where the draw does
   // (solver/observation_draw.h); null: every such pixel.
   const ObservationDraw* draw = nullptr;
+  // Worker threads; 0 = the process default.
   int num_threads = 0;
 };
 

@@ -22,7 +22,7 @@ struct SolveOptions {
   // drawn observation the mean of a block of pixels (max_observation_block). What a solve costs
   // is set by this, not by the photos' size: a room's fits (every region's highlight candidates
   // and fit samples, a few observations per patch) need a few hundred thousand; photos that
-  // offer fewer (stride 2: up to ~1.2 MP in all) are collected whole.
+  // offer fewer are collected whole.
   int64_t max_observations = 300000;
   // Where observations are drawn (above), each class kept with probability p stands for the mean
   // of a block of up to this many stride cells on a side (⌊1/√p⌋; 1 = single pixels), so that
@@ -34,37 +34,40 @@ struct SolveOptions {
   // Patch size, metres: 0 = auto (the scene's length scale / 96: its bounding-box diagonal, or
   // 3.5 mean free paths from the seen surfaces where that is shorter; solver/scene_scale.h).
   double patch_size_m = 0;
-  // Gathering at each observation and patch: samples per extended light (sphere, area) and
-  // stratified hemisphere rays for the light arriving from other surfaces.
+  // Gathering at each observation and patch: samples per extended light (sphere, area; 1..1024)
+  // and stratified hemisphere rays for the light arriving from other surfaces (0..4096). More:
+  // less gathering noise, proportionally more gathering time.
   int light_samples = 16;
   int indirect_rays = 64;
   // Where an indirect ray meets a glossy surface, trace one more ray about its mirror direction
   // so that the surface's specular reflection of the rest of the room joins the light it sends
   // (solver/gather.h). Off (--specular-bounces false): glossy patches send only their diffuse
-  // radiance and the direct light's highlight (the ceiling of igi-synth's room gathers 2 % too
-  // little; bench/solver/bench_solve_truth bounce=0).
+  // radiance and the direct light's highlight, and the surfaces they light gather too little
+  // (measured: docs/solve.md).
   bool specular_bounces = true;
   // Sample each observation's direct light over its pixel's footprint on the surface (a pixel
   // records the mean over it; solver/gather.h GatherQuery::Footprint), with footprint_samples
   // points per delta light, and widen each observation's lobe by the spread of the normals over
-  // that footprint (Observation::lobe_blur2: α² + the spread; on igi-synth's 0.35 m sphere seen
-  // at 3–4 cm per pixel the fit otherwise takes α +4 % and ρd −1.5 %, bench/RESULTS.md). Off
-  // (--pixel-footprint false): at the centre ray's point only, with the centre's normal.
+  // that footprint (Observation::lobe_blur2: α² + the spread), so that a curved glossy surface's
+  // highlight is not fitted as a rougher lobe. Off (--pixel-footprint false): at the centre
+  // ray's point only, with the centre's normal.
   bool pixel_footprint = true;
+  // With pixel_footprint: stratified points of the footprint per delta light (point, spot,
+  // directional), >= 1; extended lights spread their light_samples over it.
   int footprint_samples = 4;
   // Radius (metres) over which the indirect irradiance of neighbouring observations of the same
   // surface is averaged to remove gathering noise; 0 = auto (the scene's length scale / 96, as
   // the patch size).
   double smoothing_radius_m = 0;
-  // Adaptive smoothing (0 = off: every observation averages over smoothing_radius_m): each
-  // observation's radius is this factor times the harmonic mean distance of its indirect rays'
-  // hits (the validity radius of Ward's irradiance cache: the irradiance changes on the scale
-  // of the nearby geometry), held within [1/4, 2] × smoothing_radius_m. Near a contact or a
-  // corner the light changes fast and the radius shrinks; in the open it grows, averaging more
-  // of the gathering noise. 0.3: igi-synth's smooth-floor capture's albedo map 33.13 → 33.50 dB
-  // over the seen texels, 35.01 → 36.33 dB two texels inside (bench/RESULTS.md).
+  // Adaptive smoothing, in [0, 10] (0 = off: every observation averages over
+  // smoothing_radius_m): each observation's radius is this factor times the harmonic mean
+  // distance of its indirect rays' hits (the validity radius of Ward's irradiance cache: the
+  // irradiance changes on the scale of the nearby geometry), held within [1/4, 2] ×
+  // smoothing_radius_m. Near a contact or a corner the light changes fast and the radius
+  // shrinks; in the open it grows, averaging more of the gathering noise.
   double smoothing_accuracy = 0.3;
-  // The paper's alternation: fit, recompute specular differences, refit.
+  // The paper's alternation (fit, recompute specular differences, refit): at most this many
+  // rounds, 1..100.
   int max_iterations = 8;
   double tolerance = 2e-3;  // largest relative parameter change that counts as converged
   // "grey": one ρs for all channels (dielectrics, RADIANCE plastic); "rgb": coloured (metals).
@@ -85,45 +88,35 @@ struct SolveOptions {
   bool held_out_albedo = true;
   // Fit samples per region: up to this many of the observations near a highlight (tanθh < 0.6
   // toward a light), drawn evenly by a hash of their photo and pixel; they carry a lobe's ρs
-  // and α. igi-synth's textured floor (ρs 0.04, α 0.15, ~60 000 such observations in the demo at
-  // stride 3): with 16 000 drawn its ρs came out anywhere in −9..+3 % as the draw changed, with
-  // all of them within −4.2..−3.8 % over HDR, registered or true poses (bench/RESULTS.md, session
-  // 33), for 6 s more of the demo's 40 s solve.
+  // and α (>= 1). More: a steadier ρs and α where a faint lobe lies on a texture, for a longer
+  // fit (measured: docs/solve.md).
   int max_highlight_samples = 100000;
   // ... and the rest (which mostly carry the albedo): this many in all, at least a third of it.
   int max_fit_samples = 6000;
   // Beyond the paper: re-render the light arriving at every observation with the full path
-  // tracer and refit all parameters, `refine_iterations` times (0 = off).
+  // tracer and refit all parameters, `refine_iterations` times (0 = off; at most 20).
   int refine_iterations = 2;
   int refine_rays = 32;  // path-traced directions per observation in each refinement round
-  // The same in the last round, whose gather sets the written values: their Monte Carlo noise
-  // is this round's (igi-synth's 1024-spp room, 2 rounds of 32: wall_x0's written ρd −1.2,
-  // −0.7 and −0.2 % for solver seeds 1–3; last round 128: +0.0..+0.3 %; bench/RESULTS.md).
-  // A region with fewer than kFinalRoundRegionObservations observations gets proportionally
-  // more (FinalRoundRays, up to 8×), so that every region's written values rest on as many
-  // gathered directions as a region of that many observations (the 1024-spp room's ceiling,
-  // 149 observations: +1.26 % for solver seed 3 at 128, +0.55 % at 512).
+  // The same in the last round (1..4096), whose gather sets the written values: their Monte
+  // Carlo noise is this round's (more: less noise, proportionally more time; measured:
+  // docs/solve.md). A region with fewer than kFinalRoundRegionObservations observations gets
+  // proportionally more (FinalRoundRays, up to 8×), so that every region's written values rest
+  // on as many gathered directions as a region of that many observations.
   int refine_final_rays = 128;
-  // How each refinement round updates the albedos. The rounds gather all indirect light from
-  // the model, so its albedos feed back on themselves: a too bright model darkens the next fit.
-  // "independent": each region's albedo is refitted alone as πL/E with E rendered at the current
-  // albedos; a round maps an error e to about −2·e + 0.8 points and overshoots (bench/
-  // RESULTS.md). "joint": the renderer also returns each gathered irradiance's derivative with
-  // respect to every region's albedo scale (Renderer::ReflectedRadiance), and the round solves
-  // for all regions' albedo scales at once so that the photos are matched with the light those
-  // new albedos would send (a Newton step on the fixed point; ρs and α are refitted as before;
-  // albedo maps keep stage 1's texel detail, scaled to the new region means). On igi-synth's
-  // 1024-spp room the joint rounds relight as well as the paper stage (1.53 / 1.49 % beyond the
-  // noise floor for two seeds, paper 1.53 / 1.33 %, independent 3.25 / 3.02 %). The default:
-  // solve_e2e_test's small room, where the independent update looked better (floor −3.03 % vs
-  // −2.83 %), owes its −3 % to the noise of its 64-spp photos, not to the update
-  // (bench/RESULTS.md).
+  // How each refinement round updates the materials: "joint", "joint_albedo" or "independent".
+  // The rounds gather all indirect light from the model, so its albedos feed back on themselves:
+  // a too bright model darkens the next fit. "independent": each region is refitted alone (its
+  // albedo πL/E with E rendered at the current values), which can overshoot. "joint": the
+  // renderer also returns each gathered irradiance's derivative with respect to every region's
+  // albedo, ρs and α (Renderer::ReflectedRadiance), and the round solves for every unknown
+  // albedo and ρs at once so that the photos are matched with the light those new values would
+  // send (a Newton step on the fixed point; α is refitted per region and its change enters the
+  // others' light; albedo maps keep stage 1's texel detail, scaled to the new region means).
+  // "joint_albedo": the same for the albedos only. Measured: docs/solve.md.
   std::string refine_update = "joint";
-  // Share of each refinement round's albedo change that is applied (1 = the full step). Half
-  // steps damp the independent update's swing where stage 1 is already right (igi-synth's
-  // converged room: 2.47 % beyond the floor after one round, 1.82 % after two, against 3.15 %
-  // for one full round) but correct a biased stage 1 more slowly (solve_e2e_test's small room:
-  // floor −3.04 % after one half round, −2.83 % after one full round, from −3.25 %).
+  // Share of each refinement round's albedo change that is applied, in (0, 1] (1 = the full
+  // step). Smaller steps damp a round's swing about the answer where stage 1 is already right,
+  // but correct a biased stage 1 more slowly (measured: docs/solve.md).
   double refine_albedo_step = 1.0;
   // The photos' absolute scale. "given": their values are radiance in the scene's units (after
   // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance
@@ -132,13 +125,16 @@ struct SolveOptions {
   // paper's stage (solver/photometric_scale.h); the solved scene.json multiplies every photo's
   // exposure_scale by k.
   std::string photo_scale = "given";
+  // Seed of the random numbers of the gathering and the refinement's path tracing.
   uint64_t seed = 1;
   // Pixels left out of every fit (igi-diagnose measures its held-out residual on them): square
-  // blocks of holdout_block_px, a `holdout_fraction` share of them (0 = none).
+  // blocks of holdout_block_px, a `holdout_fraction` share of them in [0, 1) (0 = none), chosen
+  // by holdout_seed.
   double holdout_fraction = 0;
   int holdout_block_px = 16;
   uint64_t holdout_seed = 7;
   int num_threads = 0;  // 0 = the process default
+  // Progress bars on stderr (only when it is a terminal).
   bool show_progress = true;
 
   // Throws InputError naming the flag and the rule.

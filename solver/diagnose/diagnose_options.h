@@ -27,14 +27,13 @@ struct DiagnoseOptions {
   double min_gain = 0.02;
   double min_z = 2.5;
   // A candidate is refitted (the real test above) when its predicted held-out gain reaches
-  // these; at most `max_tries` candidates per step, best predicted first (the two best of
-  // different effects are both refitted, further ones only while none passes: RankForTrials). 5:
-  // the predictions come from direct-light records and can be far off where a region's reflected
-  // room dominates (a sphere lit by a bright ceiling: its lobe-shape change predicted 2.3 %,
-  // measured 59 %); with 3, a floor's two rival lobe changes and a false missing-geometry blob took
-  // every try. 0.5 %: the predictions of a change that the re-solve's albedos follow
-  // fall short too; the full-size light_source_extent capture (seed 113) predicted
-  // the lamp's extent at 0.64 % (z 1.6), never tried at 1 %, and kept it, tried, at 2.7 % (z 3.9).
+  // candidate_min_gain (a share) and candidate_min_z (standard errors); at most `max_tries`
+  // candidates per step, best predicted first (the two best of different effects are both
+  // refitted, further ones only while none passes: RankForTrials). The predictions come from
+  // direct-light records and can fall far short of the refit's gain where a region's reflected
+  // room dominates or the re-solve's albedos follow the change, so the thresholds are low and
+  // several tries are allowed; each try costs a re-solve and a partial re-render (measured:
+  // docs/diagnose.md).
   double candidate_min_gain = 0.005;
   // The same for missing_geometry's trial before the maps: a rejected trial there keeps the
   // object out of every later round, so it waits for a larger predicted share.
@@ -42,14 +41,16 @@ struct DiagnoseOptions {
   double candidate_min_z = 1.5;
   int max_tries = 5;
   int light_samples = 8;  // per extended light, for the direct-light features
+  // Seed of the re-renders (the same for every model, so that their differences are not Monte
+  // Carlo noise) and of the pixel records' light samples.
   uint64_t seed = 1;
+  // Worker threads; 0 = the process default.
   int num_threads = 0;
+  // Progress bars on stderr (only when it is a terminal).
   bool show_progress = true;
   // Used when materials are unknown (refits re-solve them). Every pixel is an observation: an
   // albedo map's texel is the pixel footprint times the stride, and at igi-solve's default of 2
-  // the maps cannot follow a texture the photos resolve (the full-size light_emission_profile
-  // capture: the final residual 1.53 → 1.09 × the true model's, 86 → 93 s; bench/RESULTS.md,
-  // Diagnosis).
+  // the maps cannot follow a texture the photos resolve.
   SolveOptions solve = [] {
     SolveOptions s;
     s.pixel_stride = 1;

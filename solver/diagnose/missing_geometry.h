@@ -55,6 +55,7 @@ struct MissingGeometryOptions {
   double min_relative = 0.12;         // blob threshold on the smoothed relative residual, at least
   double median_factor = 4;           // ... and this many times the photo's median
   double min_area_fraction = 0.0015;  // a blob covers at least this share of the image
+  // ... and at least this many pixels, >= 1.
   int min_area_px = 12;
   int min_views = 2;        // photos that see a carved voxel in a blob
   int min_core_voxels = 8;  // an object has at least this many off-surface voxels
@@ -65,13 +66,14 @@ struct MissingGeometryOptions {
   int folds = 4;
   // The residual² per pixel inside the masks, pooled over the folds, at least this many times the
   // level outside them: a missing object's pixels differ from the model by far more than the
-  // noise (18x and 11x on igi-synth's objects at the CI and the full size); a phantom carved
-  // from a few blobs on a grazing floor's highlights does not (0.5x, with a rank z of 3.8).
+  // noise; a phantom carved from a few blobs on a grazing floor's highlights does not, though
+  // its rank test may pass.
   double min_contrast = 2;
   // Where other photos see the modelled surface behind the object (unoccluded by it, outside its
   // shadow), their residual regressed on the residual inside its projections: a slope of at least
-  // this is a change on the surface, not an object (a tiled floor's blobs carved to a phantom:
-  // 0.94; igi-synth's objects −0.11..0.01). Judged over at least min_agreement_pairs pixel pairs.
+  // this is a change on the surface, not an object: an object hides the surface from one side
+  // only, a change on it shows alike from every side (measured: docs/diagnose.md). Judged over
+  // at least min_agreement_pairs pixel pairs.
   double max_surface_slope = 0.5;
   int min_agreement_pairs = 30;
 

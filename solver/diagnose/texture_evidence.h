@@ -33,12 +33,10 @@ struct TextureEvidenceOptions {
   // when it passes at one of them. A coarser scale is tried only while the region's cells are
   // starved: their median count of records (the smaller of the two photo sets') is below
   // `dense_records`. One fine scale is blind to a texture of large flat tiles seen sparsely:
-  // their high-pass lives only along the tiles' edges, and at full size (160 × 120 photos of a
-  // 4 m room, 6.5 cm cells) few cells hold two records of each photo set; the suite's floor of
-  // 1 m tiles passed at 6.5 cm in 1 of 19 captures, at 13 or 20 cm in 15, and no
-  // untextured region reached z 3.7 at any of the three. Coarse cells are where a few long
-  // edges (a shadow the model lacks) become a larger share of the cells: on records dense enough
-  // for the fine scale they are not tried.
+  // their high-pass lives only along the tiles' edges, and in small photos few fine cells hold
+  // two records of each photo set. Coarse cells are where a few long edges (a shadow the model
+  // lacks) become a larger share of the cells: on records dense enough for the fine scale they
+  // are not tried.
   std::vector<double> scales = {1, 2, 3};
   int dense_records = 8;
   int min_cells = 30;            // cells seen by both photo sets with enough neighbours

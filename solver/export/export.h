@@ -31,6 +31,7 @@ std::string_view ExportFormatName(ExportFormat format);
 std::optional<ExportFormat> ExportFormatFromName(std::string_view name);
 
 struct ExportOptions {
+  // The target: radiance, mitsuba or gltf (see the top of this file).
   ExportFormat format = ExportFormat::kGltf;
   // RADIANCE: radius (metres) of the small emitting sphere a point or spot light becomes.
   double point_light_radius_m = 0.01;

@@ -31,6 +31,7 @@ enum class LobeTarget {
 std::string_view LobeTargetName(LobeTarget target);
 
 struct LobeFitOptions {
+  // The lobe model the Ward lobe is fitted by (LobeTarget).
   LobeTarget target = LobeTarget::kWardGmd;
   // kBeckmannDielectric only: relative index of refraction of the target's Fresnel term.
   double target_ior = 1.5;

@@ -51,9 +51,11 @@ struct SensorOptions {
 struct BracketOptions {
   int count = 0;       // brackets per photo; 0 = none
   double stops = 2.0;  // EV between neighbouring brackets, > 0
+  // How a bracket's levels follow x = e/full_well: kGamma, kSigmoid or kFile (below).
   ResponseKind response = ResponseKind::kGamma;
   double gamma = 2.2;             // kGamma: level = x^(1/gamma) for x = e/full_well
   double sigmoid_contrast = 1.6;  // kSigmoid: x^c/(x^c + m^c), normalised to 1 at x = 1
+  // kSigmoid: m, the x at which the curve before normalisation is ½, in (0, 1).
   double sigmoid_mid = 0.18;
   std::filesystem::path response_file;  // kFile: an igi-response JSON (CONTRACT.md §5)
   int bits = 8;                         // 8 or 16
@@ -87,9 +89,14 @@ struct SynthOptions {
   std::vector<std::string> unknowns = {"rho_d", "rho_s", "alpha"};
   std::vector<std::string> photo_lightings = {"L0"};       // photographed (in scene.json)
   std::vector<std::string> validation_lightings = {"L1"};  // truth.json "validation"
+  // kNone: the photos are the rendered radiance; kRealistic: seen through `sensor` (noise,
+  // clipping, quantisation), clipped pixels masked.
   NoiseModel noise = NoiseModel::kNone;
+  // The sensor of kRealistic noise and of the brackets.
   SensorOptions sensor;
+  // LDR exposure brackets of every photo, under brackets/ (count 0: none).
   BracketOptions brackets;
+  // The --effect switches: what the photos show that scene.json does not declare.
   std::vector<EffectSpec> effects;
   int num_threads = 0;  // 0 = process default
   // Every region (walls, ceiling, floor, boxes, sphere) gets a high-frequency albedo texture

@@ -72,6 +72,7 @@ struct WriteImageOptions {
   PixelType type = PixelType::kAuto;
   // Passed to OpenImageIO ("zip", "piz", "none" for EXR; "lzw" for TIFF). Empty = its default.
   std::string compression;
+  // JPEG only: OpenImageIO's "CompressionQuality", 1..100 (higher: larger, truer files).
   int jpeg_quality = 95;
 };
 
