@@ -36,7 +36,8 @@ struct MaterialState {
   Eigen::Vector3d map_scale = Eigen::Vector3d::Ones();
   int observations = 0;
   // A region no photo sees whose ρd was fitted to the light it bounces onto the seen regions
-  // (SolverState::FitUnobservedAlbedos): its relative uncertainty per channel (NaN: not fitted).
+  // (FitUnobservedAlbedos in solver/paper_stage.h): its relative uncertainty per channel (NaN: not
+  // fitted).
   Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
   bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
 };

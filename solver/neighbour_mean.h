@@ -1,7 +1,7 @@
 #pragma once
 // The mean of per-point values over each point's neighbours on the same surface: same region,
 // normals within ~25° (dot >= 0.9), within a radius, and optionally from the same photo. The
-// solver smooths its gathered indirect irradiance with it (solver/solve_stages.cpp).
+// solver smooths its gathered indirect irradiance with it (solver/paper_stage.cpp).
 
 #include <Eigen/Core>
 #include <vector>

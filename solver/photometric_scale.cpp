@@ -215,7 +215,7 @@ void FollowPhotoUnits(SolverState* s) {
       if (m.reflective && m.unknown_rho_d && m.observations == 0) m.params.rho_d = sum / area;
     }
   }
-  s->UpdateIrradiance();
+  UpdateIrradiance(s->Stage(), s->materials, &s->light);
 }
 
 }  // namespace

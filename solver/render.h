@@ -74,7 +74,7 @@ class Renderer {
   // included), its ρs, and its roughness (α, or αx and αy together). Each is the part of the
   // radiance whose paths reflect off the region, weighted at each such reflection by the share
   // of the BRDF value (or ∂ln f) that the parameter makes. The inverse solver's joint
-  // refinement uses them (solver/solve_stages.cpp).
+  // refinement uses them (solver/refine_stage.cpp).
   static constexpr int kDerivativeKinds = 3;
   enum DerivativeKind { kLnRhoD = 0, kLnRhoS = 1, kLnAlpha = 2 };
   Eigen::Vector3d ReflectedRadiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,

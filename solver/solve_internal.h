@@ -1,9 +1,10 @@
 #pragma once
-// Internal to igi_solver: the state of one solve (solve.cpp: set-up and stage 1's image-based
-// model; solve_stages.cpp: the iterations, stage 2, residuals and albedo maps). Its data are the
-// observation set, the material estimate and the light model (solver/observation_set.h,
-// solver/material_estimate.h, solver/light_model.h); the stages that only read and write those
-// are functions of them there and in solver/fit_inputs.h.
+// Internal to igi_solver: the state of one solve, which orchestrates its stages (solve.cpp: the
+// set-up, reading the photos and the gather; solve_model.cpp: the refinement's rounds, the
+// residual renders and the albedo maps). Its data are the observation set, the material estimate
+// and the light model (solver/observation_set.h, solver/material_estimate.h,
+// solver/light_model.h); the stages are functions of them: solver/paper_stage.h,
+// solver/fit_stage.h, solver/refine_stage.h, solver/albedo_map_stage.h.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include "solver/light_model.h"
 #include "solver/material_estimate.h"
 #include "solver/observation_set.h"
+#include "solver/paper_stage.h"
 #include "solver/patches.h"
 #include "solver/region_fit.h"
 #include "solver/render_internal.h"
@@ -28,13 +30,6 @@
 #include "solver/uv_charts.h"
 
 namespace igi {
-
-// The joint update's result per fitted region (NaN where the region's own refit stands):
-// its albedo, its ρs, and per channel the relative change of its fitted light per unit relative
-// change of every region's albedo ("feedback").
-struct JointUpdate {
-  std::vector<Eigen::Vector3d> rho_d, rho_s, feedback;
-};
 
 // An albedo map as scene.json holds it when its region's fitted ρd exceeds 1 in some channel
 // (BoundReflectances): scaled by `factor` per channel (1/ρd where ρd > 1, else 1) and its texels
@@ -87,33 +82,29 @@ struct SolverState {
   void GatherAll();
   GatherQuery::Footprint PixelFootprint(const Observation& o) const;
 
-  // solve_stages.cpp
-  void IncidentFromRenderer(const Scene& model, uint64_t round);
-  // light.e (SmoothIrradiance in solver/light_model.h), the smoothing radii computed first
-  // where there are none yet.
-  void SmoothIrradiance();
-  // light.smoothing_radius: per observation, its smoothing radius (the adaptive smoothing's,
-  // SolveOptions::smoothing_accuracy, from stage 1's gather).
-  void ComputeSmoothingRadii(double radius);
-  std::vector<float> DrawnSmoothingRadii(double radius) const;
-  // light.t at the current materials (SpecularTerms in solver/light_model.h).
-  void ComputeSpecularTerms() {
-    light.t = SpecularTerms(obs, materials, light.incident, options.num_threads);
+  // What the stages read besides the estimate they update (solver/fit_stage.h).
+  StageData Stage() const {
+    return {scene,
+            options,
+            obs,
+            patches,
+            summary.scene_scale_m,
+            summary.patch_size_m,
+            summary.texel_size_m};
   }
-  double FitAll(int stage, int iteration);  // returns the largest relative change
-  // The joint update (per entry of `regions`, from their fits `fits`): the solution of the
-  // fixed point p_r = fit_r(light(p)) with the light linearised by joint_sums.
-  JointUpdate JointParams(const std::vector<int>& regions,
-                          const std::vector<RegionFitResult>& fits) const;
-  void RunStage1();
-  // Every active lighting's patch radiances, the observations' indirect irradiance and its
-  // smoothing from the current materials (light.e).
-  void UpdateIrradiance();
-  // The ρd of regions no photo sees, from the light they bounce onto the regions the photos show
-  // (stage 1, from its second iteration): returns the largest relative change.
-  double FitUnobservedAlbedos();
+  // Per lighting, the offset of a ray's origin from the surface (0 where the lighting is unused).
+  std::vector<double> RayEpsilons() const {
+    std::vector<double> eps(lighting_scenes.size(), 0.0);
+    for (size_t l = 0; l < eps.size(); ++l) {
+      if (lighting_scenes[l]) eps[l] = lighting_scenes[l]->ray_epsilon;
+    }
+    return eps;
+  }
+  // The paper's stage (RunPaperStage in solver/paper_stage.h) on the solve's data.
+  void RunStage1() { RunPaperStage(Stage(), &materials, &light, &summary); }
   // One refinement round: the model as it stands (its albedo maps written under temp_dir),
-  // rendered incident light, smoothing, FitAll(2, round), specular terms.
+  // its light at the observations (RenderIncident), smoothing, FitRegions(stage 2), specular
+  // terms.
   void RefineRound(int round, const std::filesystem::path& temp_dir);
   void RunStage2();
   // The model as it stands. Per-patch albedo maps (written under temp_dir) go to the regions

@@ -10,6 +10,7 @@
 
 #include "solver/albedo_map.h"
 #include "solver/albedo_map_stage.h"
+#include "solver/refine_stage.h"
 #include "solver/render.h"
 #include "solver/solve_internal.h"
 #include "tools/common/error.h"
@@ -199,16 +200,20 @@ void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) 
   std::vector<Image> maps;
   std::filesystem::create_directories(temp_dir);
   const Scene model = CompleteScene(&atlases, &maps, temp_dir);
-  IncidentFromRenderer(model, uint64_t(round));
+  const StageData stage = Stage();
+  const RenderCost cost =
+      RenderIncident(stage, model, RayEpsilons(), materials, uint64_t(round), &light);
+  summary.seconds_rays += cost.seconds;
+  summary.rays += cost.rays;
   if (spdlog::should_log(spdlog::level::debug)) {
     size_t entries = 0, lists = 0;
     for (const auto& inc : light.incident) entries += inc.capacity(), lists += !inc.empty();
     spdlog::debug("round {}: {} incident lists, {:.2f} GiB; peak so far {:.2f} GiB", round, lists,
                   entries * sizeof(IncidentLocal) / kGiB, PeakResidentBytes() / kGiB);
   }
-  SmoothIrradiance();
-  FitAll(2, round);
-  ComputeSpecularTerms();
+  SmoothStageIrradiance(stage, materials.size(), &light);
+  FitRegions(stage, light, 2, round, &materials, &summary);
+  UpdateSpecularTerms(stage, materials, &light);
   summary.stage2_iterations = round;
 }
 
@@ -248,7 +253,7 @@ void SolverState::RunStage2() {
         materials[r].last_fit = stage1[r].last_fit;
         materials[r].map_scale = stage1[r].map_scale;
       }
-      ComputeSpecularTerms();
+      UpdateSpecularTerms(Stage(), materials, &light);
       spdlog::warn(
           "the refinement explains the photos worse ({:.4f} vs {:.4f}): the paper stage's "
           "parameters are kept",

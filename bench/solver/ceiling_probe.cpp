@@ -34,6 +34,7 @@
 #include <string>
 
 #include "recon/scene.h"
+#include "solver/refine_stage.h"
 #include "solver/render.h"
 #include "solver/render_internal.h"
 #include "solver/solve_internal.h"
@@ -277,8 +278,9 @@ int main(int argc, char** argv) {
         t[6][1] / t[5][1], t[6][2] / t[5][2]);
   }
   if (kv["stage2"] != "0") {
-    // (e) stage 2's gathering (the path tracer over a scene, SolverState::IncidentFromRenderer)
-    // at the same points, over the true scene and over the stage-1 model the refinement renders.
+    // (e) stage 2's gathering (the path tracer over a scene, RenderIncident in
+    // solver/refine_stage.h) at the same points, over the true scene and over the stage-1 model the
+    // refinement renders.
     const fs::path tmp =
         fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));
     fs::create_directories(tmp);
@@ -287,23 +289,32 @@ int main(int argc, char** argv) {
     const Scene model = s.CompleteScene(&atlases, &maps, tmp);
     s.options.refine_rays = std::stoi(kv["stage2"]);
     s.options.seed = std::stoull(kv["seed2"]);
-    for (int variant = 0; variant < 2; ++variant) {
-      s.IncidentFromRenderer(variant == 0 ? truth_scene : model, std::stoull(kv["round"]));
+    // The scenes rendered: the true scene, the stage-1 model, and the model with one region at a
+    // time as the truth has it (which region's model sends the difference), or without its map.
+    std::vector<std::pair<std::string, Scene>> variants = {{"true scene", truth_scene},
+                                                           {"stage-1 model", model}};
+    for (size_t r = 0; r < model.materials.size(); ++r) {
+      Scene one = model;
+      one.materials[r] = truth_scene.materials[r];
+      variants.emplace_back("model, " + model.materials[r].name + " true", std::move(one));
+      if (model.materials[r].rho_d_map) {
+        Scene flat = model;
+        flat.materials[r].rho_d_map.reset();
+        flat.materials[r].rho_d = s.materials[r].params.rho_d;
+        variants.emplace_back("model, " + model.materials[r].name + " without its map",
+                              std::move(flat));
+      }
+    }
+    for (const auto& [name, scene_v] : variants) {
+      RenderIncident(s.Stage(), scene_v, s.RayEpsilons(), s.materials, std::stoull(kv["round"]),
+                     &s.light);
       Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
       for (size_t k = 0; k < rows.size(); ++k) {
         sum += s.light.e_indirect[subset[k]];
         ref_sum += rows[k].e_ind_ref;
       }
-      {
-        std::vector<std::pair<double, size_t>> r;
-        for (size_t k = 0; k < rows.size(); ++k)
-          r.emplace_back(s.light.e_indirect[subset[k]].sum() / rows[k].e_ind_ref.sum(), k);
-        std::sort(r.rbegin(), r.rend());
-        for (int j = 0; j < 5 && j < int(r.size()); ++j)
-          std::printf("  top ratio %.3f obs %d\n", r[j].first, subset[r[j].second]);
-      }
-      std::printf("stage 2's E_ind over the %s / reference (true scene): %.4f\n",
-                  variant == 0 ? "true scene" : "stage-1 model", sum.sum() / ref_sum.sum());
+      std::printf("stage 2's E_ind over the %s / reference (true scene): %.4f %.4f %.4f\n",
+                  name.c_str(), sum[0] / ref_sum[0], sum[1] / ref_sum[1], sum[2] / ref_sum[2]);
     }
     std::error_code ec;
     fs::remove_all(tmp, ec);

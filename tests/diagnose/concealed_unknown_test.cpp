@@ -23,8 +23,8 @@ using test::ExpectReachesTheFloor;
 // basis is then the ambient light's first reflection: the solved albedos already carry its share
 // of the interreflections. Its whole response (bounces too) had fitted about a third of the
 // radiance on the full-size suite's capture (0.11–0.13 for 0.4), and a false exposure_scale
-// followed (bench/RESULTS.md, Diagnosis, "Session 17"). Measured 2026-11-25: passes in 237 s on
-// 2 cores; with the whole response as the basis it fails (camera_response is kept first).
+// followed (bench/RESULTS.md, "The suite, materials unknown"). With the whole response as the
+// basis it fails (camera_response is kept first); it passes in about 4 minutes on 2 cores.
 TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
   const ConcealedOutcome o = DiagnoseConcealed("ambient_light:kind=uniform", 11, nullptr,
                                                " --photo-lightings L0,L1", false);

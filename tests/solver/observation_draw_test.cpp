@@ -278,12 +278,13 @@ TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
   full.Prepare();
   full.GatherAll();
   const double r0 = full.summary.scene_scale_m / 96;
-  for (float r : full.DrawnSmoothingRadii(r0)) ASSERT_EQ(r, float(r0));
+  for (float r : DrawnSmoothingRadii(full.Stage(), full.materials.size(), r0))
+    ASSERT_EQ(r, float(r0));
   o.max_observations = 1000;
   SolverState thin(scene, o);
   thin.Prepare();
   thin.GatherAll();
-  const std::vector<float> radii = thin.DrawnSmoothingRadii(r0);
+  const std::vector<float> radii = DrawnSmoothingRadii(thin.Stage(), thin.materials.size(), r0);
   // Within [r0, 4 r0]; below 4 r0 the radius holds 32 observations of the region (itself and its
   // 31 nearest, normals within ~25°), above r0 it holds no more than 31 just inside.
   auto within = [&](size_t i, double r) {

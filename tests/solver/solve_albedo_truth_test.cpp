@@ -359,7 +359,7 @@ TEST(SolveAlbedoTruth, AWrongLobeShapeIsNoTexture) {
 
 // With the lamp 0.6 m above the floor no camera sees the ceiling (the cameras look down at the
 // lit floor), yet half the light on the walls is the ceiling's: its ρd is fitted to the light it
-// bounces onto the regions the photos show (solver/solve_stages.cpp FitUnobservedAlbedos). Before,
+// bounces onto the regions the photos show (solver/paper_stage.h FitUnobservedAlbedos). Before,
 // it kept a placeholder (the seen regions' mean albedo, 0.495 against the true 0.8), and the walls'
 // albedos absorbed the missing light.
 TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {

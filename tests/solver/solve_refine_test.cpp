@@ -1,4 +1,4 @@
-// Stage 2 of igi-solve (solver/solve_stages.cpp, SolverState::RefineRound): the light arriving
+// Stage 2 of igi-solve (solver/refine_stage.h, SolverState::RefineRound): the light arriving
 // at every observation is rendered by the path tracer from the current model, so the albedos
 // light their own next fit. Refitting each region alone (πL/E at that E: "independent") then
 // overshoots in a bright closed room: albedos 5 % too high make the rendered room too bright,
@@ -97,7 +97,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
       for (Eigen::Vector3d& p : m.patch_rho_d) p *= start_scale;  // NaN stays NaN
       if (m.unknown_rho_s) m.params.rho_s *= rho_s_scale;
     }
-    s.ComputeSpecularTerms();
+    UpdateSpecularTerms(s.Stage(), s.materials, &s.light);
     const Json truth = BrightMaterials(GetParam());
     auto worst = [&]() {
       double w = 0;
