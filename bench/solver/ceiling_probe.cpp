@@ -2,7 +2,7 @@
 // photos"): where a region's stage-1 albedo bias comes from, against the true scene.
 //   build/bench/ceiling_probe CAPTURE [region=ceiling] [stride=2] [every=4] [ref_rays=1024]
 //       [paths=8] [pixel_paths=256] [spec_rays=32] [smooth=0] [patch=0] [bounce=1]
-//       [stage2=0] [seed2=1] [round=1]
+//       [stage2=0] [seed2=1] [round=1] [variants=REGION,REGION...] [model_maps=DIR]
 // Runs stage 1 on an igi-synth capture (2 threads; smooth, patch: SolveOptions' smoothing radius
 // and patch size, 0 = auto; bounce: SolveOptions::specular_bounces) and, for every `every`-th
 // observation of `region`, compares:
@@ -22,8 +22,10 @@
 //  (e) stage2=N > 0: stage 2's gathering (SolverState::IncidentFromRenderer, N rays, seed seed2,
 //      refinement round `round`) over the true scene and over the stage-1 model, against the same
 //      reference, with the five observations whose gathered E_ind is the largest multiple of
-//      their reference (a firefly shows as one far above the rest).
-// Prints the ratios and the albedo πΣL/ΣE with each irradiance.
+//      their reference (a firefly shows as one far above the rest); per region named in
+//      `variants`, also the model with that region as the truth has it (and without its map).
+// Prints the ratios and the albedo πΣL/ΣE with each irradiance. model_maps=DIR: only writes the
+// stage-1 model's albedo maps (those the refinement renders) into DIR.
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -73,10 +75,10 @@ int main(int argc, char** argv) {
   }
   const fs::path dir = argv[1];
   std::map<std::string, std::string> kv = {
-      {"region", "ceiling"}, {"stride", "2"},        {"every", "4"},  {"ref_rays", "1024"},
-      {"paths", "8"},        {"pixel_paths", "256"}, {"smooth", "0"}, {"patch", "0"},
-      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"}, {"seed2", "1"},
-      {"round", "1"}};
+      {"region", "ceiling"}, {"stride", "2"},        {"every", "4"},    {"ref_rays", "1024"},
+      {"paths", "8"},        {"pixel_paths", "256"}, {"smooth", "0"},   {"patch", "0"},
+      {"spec_rays", "32"},   {"bounce", "1"},        {"stage2", "0"},   {"seed2", "1"},
+      {"round", "1"},        {"variants", ""},       {"model_maps", ""}};
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     const size_t eq = a.find('=');
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
     }
     kv[a.substr(0, eq)] = a.substr(eq + 1);
   }
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each line as it is printed
   SetDefaultThreads(2);
   const Scene scene = LoadScene(dir / "scene.json");
   SolveOptions options;
@@ -100,6 +103,37 @@ int main(int argc, char** argv) {
   s.Prepare();
   s.GatherAll();
   s.RunStage1();
+  if (!kv["model_maps"].empty()) {
+    // The stage-1 model's albedo maps (the ones the refinement renders), into that folder.
+    std::vector<RegionAtlas> atlases;
+    std::vector<Image> maps;
+    fs::create_directories(kv["model_maps"]);
+    const Scene model = s.CompleteScene(&atlases, &maps, kv["model_maps"]);
+    for (size_t r = 0; r < model.materials.size(); ++r) {
+      if (!model.materials[r].rho_d_map) continue;
+      std::printf("model map %s\n", model.materials[r].rho_d_map->c_str());
+      // The region's observations of the largest red albedo πL/E: what makes a map's outliers.
+      std::vector<std::pair<double, size_t>> top;
+      for (size_t i = 0; i < s.obs.size(); ++i) {
+        if (s.obs[i].region != int(r)) continue;
+        top.emplace_back(kPi * s.obs[i].radiance[0] / s.light.e[i][0], i);
+      }
+      std::sort(top.rbegin(), top.rend());
+      for (size_t k = 0; k < 8 && k < top.size(); ++k) {
+        const size_t i = top[k].second;
+        const Observation& o = s.obs[i];
+        std::printf(
+            "  albedo %.2f photo %d px (%.0f, %.0f) size %d pos (%.3f %.3f %.3f) L (%.4g %.4g "
+            "%.4g) "
+            "E_dir (%.4g %.4g %.4g) E (%.4g %.4g %.4g)\n",
+            top[k].first, o.photo, double(o.x), double(o.y), o.size, o.position.x(), o.position.y(),
+            o.position.z(), o.radiance[0], o.radiance[1], o.radiance[2], s.light.e_direct[i][0],
+            s.light.e_direct[i][1], s.light.e_direct[i][2], s.light.e[i][0], s.light.e[i][1],
+            s.light.e[i][2]);
+      }
+    }
+    return 0;
+  }
   const int region = scene.FindMaterial(kv["region"]);
   const Json truth = ReadJsonFile(dir / "truth.json")["materials"];
   const Eigen::Vector3d rho_true(truth[kv["region"]]["rho_d"][0].get<double>(),
@@ -294,6 +328,7 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, Scene>> variants = {{"true scene", truth_scene},
                                                            {"stage-1 model", model}};
     for (size_t r = 0; r < model.materials.size(); ++r) {
+      if (kv["variants"].find(model.materials[r].name) == std::string::npos) continue;
       Scene one = model;
       one.materials[r] = truth_scene.materials[r];
       variants.emplace_back("model, " + model.materials[r].name + " true", std::move(one));
