@@ -1,6 +1,6 @@
 #pragma once
-// camera.json (CONTRACT.md §5, "format": "igi-camera", "version": 1): a camera's intrinsics as
-// igi-calib intrinsics measures them and igi-register uses them.
+// camera.json (docs/file-formats.md, "format": "igi-camera", "version": 1): a camera's
+// intrinsics as igi-calib intrinsics measures them and igi-register uses them.
 //
 //   {"format": "igi-camera", "version": 1, "model": "OPENCV", "width": 640, "height": 480,
 //    "params": [fx, fy, cx, cy, k1, k2, p1, p2], "rms_px": 0.39, "views": ["left01.jpg", …],

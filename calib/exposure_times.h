@@ -1,7 +1,7 @@
 #pragma once
-// Exposure times of a bracket (CONTRACT.md §5): an exposure file lists one time in seconds per
-// line, as a decimal ("0.004") or a fraction ("1/250"), in the order of the images; '#' starts a
-// comment. `--exposures` takes the same values comma-separated. Times can also come from the
+// Exposure times of a bracket (docs/file-formats.md): an exposure file lists one time in seconds
+// per line, as a decimal ("0.004") or a fraction ("1/250"), in the order of the images; '#' starts
+// a comment. `--exposures` takes the same values comma-separated. Times can also come from the
 // images' EXIF (ExposureTime).
 //
 // Bad input (a value that is not a positive time, a count that does not match the images, two

@@ -3,10 +3,10 @@
 // each pixel level z in [0, levels), g(z) = ln(exposure) = ln(E * t) up to an additive constant.
 // Pixel values are normalised to [0, 1] (level / (levels - 1)); between levels g is linear.
 //
-// response.json (CONTRACT.md §5): {"format": "igi-response", "version": 1, "method", "levels",
-// "channels", "g": [[levels numbers] per channel]} plus an optional free-form "info" object.
-// Reading is strict: a wrong key, type, count or a g that decreases is an InputError naming the
-// file and the key path.
+// response.json (docs/file-formats.md): {"format": "igi-response", "version": 1, "method",
+// "levels", "channels", "g": [[levels numbers] per channel]} plus an optional free-form "info"
+// object. Reading is strict: a wrong key, type, count or a g that decreases is an InputError naming
+// the file and the key path.
 
 #include <filesystem>
 #include <string>

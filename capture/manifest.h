@@ -1,5 +1,5 @@
 #pragma once
-// DIR/manifest.jsonl (CONTRACT.md §4): append-only, one JSON object per frame,
+// DIR/manifest.jsonl (docs/file-formats.md): append-only, one JSON object per frame,
 // written after the frame's file is complete, each line flushed to disk before
 // the next frame. Keys: file (relative to DIR), camera, exposure_us, gain,
 // pixel_format, timestamp (ISO 8601 UTC), and igi's additions: bracket, frame,

@@ -1,6 +1,6 @@
 #pragma once
-// Reading igi-capture's manifest.jsonl (CONTRACT.md §4): one JSON object per line and frame with
-// "file" (relative to the manifest's folder), "camera", "exposure_us", "gain", "pixel_format",
+// Reading igi-capture's manifest.jsonl (docs/file-formats.md): one JSON object per line and frame
+// with "file" (relative to the manifest's folder), "camera", "exposure_us", "gain", "pixel_format",
 // "timestamp". An optional "bracket" key (string or integer) separates brackets of one camera.
 //
 // Frames are grouped into brackets by (camera, gain, bracket): frames with another gain are

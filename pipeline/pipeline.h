@@ -1,5 +1,5 @@
 #pragma once
-// igi-run's chain (CONTRACT.md §4): response -> HDR -> registration -> solve -> diagnose ->
+// igi-run's chain (docs/run.md): response -> HDR -> registration -> solve -> diagnose ->
 // report, each stage in its own folder of RunOptions::out with a marker (stage_marker.h), so a
 // rerun resumes from the first unfinished stage and redoes a stage whose inputs changed.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Options of igi-run (CONTRACT.md §4): the end-to-end chain from a folder of photos.
+// Options of igi-run (docs/run.md): the end-to-end chain from a folder of photos.
 
 #include <filesystem>
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// Cameras of a scene (CONTRACT.md §1): COLMAP's models and parameter order, COLMAP's frames
+// Cameras of a scene (docs/scene-format.md): COLMAP's models and parameter order, COLMAP's frames
 // (x right, y down, z forward; pose `cam_from_world`), and continuous pixel coordinates whose
 // top-left pixel centre is (0.5, 0.5).
 //

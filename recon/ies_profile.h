@@ -1,6 +1,6 @@
 #pragma once
 // IESNA LM-63 photometric files: the candela distribution of a luminaire, used as the emission
-// profile of a spot light ("profile": {"ies": file} in scene.json, CONTRACT.md §3).
+// profile of a spot light ("profile": {"ies": file} in scene.json, docs/scene-format.md).
 //
 // Reads LM-63-1986 (no header line), LM-63-1991 ("IESNA91"), LM-63-1995, LM-63-2002 and LM-63-2019
 // ("IES:LM-63-2019"). Keyword lines ([KEY] value, [MORE] continues the previous keyword),

@@ -1,6 +1,6 @@
 #pragma once
-// Triangle meshes of a scene (CONTRACT.md §3): any format Assimp reads. Each triangle's material
-// name (OBJ `usemtl`, glTF material name) is its region. UVs (u right, v up: v = 0 is a
+// Triangle meshes of a scene (docs/scene-format.md): any format Assimp reads. Each triangle's
+// material name (OBJ `usemtl`, glTF material name) is its region. UVs (u right, v up: v = 0 is a
 // texture's bottom row) and vertex normals are kept where the file has them; without normals
 // faces are shaded flat. Positions are in the scene's world frame, metres.
 

@@ -1,7 +1,7 @@
 #pragma once
-// The calibrated scene of scene.json (CONTRACT.md §3): geometry with regions, materials, lights,
-// lightings, cameras and photos. LoadScene validates everything and reports every problem it
-// finds (as one igi::InputError carrying one line per problem), not just the first.
+// The calibrated scene of scene.json (docs/scene-format.md): geometry with regions, materials,
+// lights, lightings, cameras and photos. LoadScene validates everything and reports every problem
+// it finds (as one igi::InputError carrying one line per problem), not just the first.
 //
 // Units: metres, radiance in W·sr⁻¹·m⁻² (or any scale consistent between lights and photos),
 // point/spot intensity in W·sr⁻¹, directional irradiance in W·m⁻². Directions are unit vectors

@@ -1,5 +1,5 @@
-// LoadScene: strict reading and validation of scene.json (CONTRACT.md §3). Every problem found
-// is collected; the load fails at the end with all of them.
+// LoadScene: strict reading and validation of scene.json (docs/scene-format.md). Every problem
+// found is collected; the load fails at the end with all of them.
 #include <spdlog/spdlog.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// LoadScene, part 2: lights (every type of CONTRACT.md §3, spot profiles with IES files) and
-// lightings.
+// LoadScene, part 2: lights (every type of docs/scene-format.md, spot profiles with IES files)
+// and lightings.
 #include <set>
 
 #include "recon/scene_loader.h"

@@ -1,5 +1,5 @@
 #pragma once
-// The reflectance models of CONTRACT.md §2 and their importance sampling.
+// The reflectance models of docs/scene-format.md and their importance sampling.
 //
 // Frame and directions: every direction is a unit vector in the LOCAL shading frame of a Frame
 // (solver/sampling.h): x along the tangent t, y along b = n × t, z along the normal n. Build the
@@ -51,7 +51,7 @@
 
 namespace igi {
 
-// The `"brdf"` names of CONTRACT.md §2 that are reflectance models ("emitter" and "black" are
+// The `"brdf"` names of docs/scene-format.md that are reflectance models ("emitter" and "black" are
 // not: the renderer handles them).
 // BrdfModel, IsAnisotropic, IsGmd, HasSpecularLobe: recon/brdf_model.h. Only the reflective
 // models (IsReflective) are evaluated here.

@@ -81,10 +81,10 @@ bool TraceBounce(const Renderer::Impl& scene, const PatchSet& patches, const Sur
   return true;
 }
 
-// The contract's ambient light (uniform radiance L from every direction, never occluded): its
-// irradiance is exactly πL. It is kept as k stratified cosine-weighted directions about the
-// shading normal, each carrying πL/k, so that the irradiance is exact (no light samples, no
-// rays) and the glossy fits still see the directions it arrives from.
+// The ambient light of docs/scene-format.md (uniform radiance L from every direction, never
+// occluded): its irradiance is exactly πL. It is kept as k stratified cosine-weighted directions
+// about the shading normal, each carrying πL/k, so that the irradiance is exact (no light samples,
+// no rays) and the glossy fits still see the directions it arrives from.
 void GatherAmbient(const Eigen::Vector3d& radiance, const GatherQuery& q, int k, Pcg32& rng,
                    PointSamples* out) {
   const Frame frame = Frame::FromNormal(q.n_s);

@@ -2,9 +2,9 @@
 // The photographed radiance samples the solver fits (Yu et al. 1999 §4): one per photo pixel that
 // sees a reflective surface cleanly. A pixel is kept when its centre ray and four rays at
 // (±¼, ±¼) of a pixel hit the same region with normals within a few degrees (so the pixel's mean
-// radiance, CONTRACT.md §1, and its centre's agree), the mask allows it, every channel is finite
-// and non-negative, and no channel is clipped. Where the observations are drawn to a budget, one
-// may stand for a square block of pixels instead (solver/observation_draw.h): their mean, kept
+// radiance, docs/scene-format.md, and its centre's agree), the mask allows it, every channel is
+// finite and non-negative, and no channel is clipped. Where the observations are drawn to a budget,
+// one may stand for a square block of pixels instead (solver/observation_draw.h): their mean, kept
 // when every pixel of it is usable and the rays through the centres of its stride cells and its
 // quarter points meet one smooth piece of one region.
 //

@@ -1,11 +1,11 @@
 #pragma once
 // The forward model: a physically based path tracer on Embree 3 (next-event estimation with
-// multiple importance sampling, every BRDF of CONTRACT.md §2, every light type, albedo
+// multiple importance sampling, every BRDF of docs/scene-format.md, every light type, albedo
 // textures, PINHOLE/OPENCV cameras, unbiased Russian roulette). Results are deterministic for
 // a given seed, whatever the number of threads.
 //
 // Output: linear radiance in the scene's units (W·sr⁻¹·m⁻² per channel), RGB, each pixel the
-// mean over its square (CONTRACT.md §1). Lights not in the rendered lighting are absent,
+// mean over its square (docs/scene-format.md). Lights not in the rendered lighting are absent,
 // geometry included (area and sphere emitters), as in the RADIANCE references.
 
 #include <cstdint>

@@ -96,8 +96,8 @@ inline Pcg32 PixelSampleRng(uint64_t seed, uint64_t pixel_index, uint64_t sample
 // ---------------------------------------------------------------------------------------------
 // Orthonormal frames.
 
-// A right-handed orthonormal frame (t, b, n) with b = n × t (CONTRACT.md §2): local coordinates
-// are (x along t, y along b, z along n).
+// A right-handed orthonormal frame (t, b, n) with b = n × t (docs/scene-format.md, "Reflectance
+// models"): local coordinates are (x along t, y along b, z along n).
 struct Frame {
   Eigen::Vector3d t = Eigen::Vector3d::UnitX();
   Eigen::Vector3d b = Eigen::Vector3d::UnitY();

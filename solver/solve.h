@@ -1,5 +1,5 @@
 #pragma once
-// igi-solve (CONTRACT.md §4): inverse global illumination after Yu, Debevec, Malik and Hawkins
+// igi-solve (docs/solve.md): inverse global illumination after Yu, Debevec, Malik and Hawkins
 // (SIGGRAPH 1999), then a joint refinement against the path tracer.
 //
 // Stage 1, the paper's method: the surfaces are split into patches (region → triangle → patch);
@@ -108,7 +108,8 @@ struct SolveIteration {
   double albedo_step = 1;  // SolveOptions::refine_albedo_step
 };
 
-// Per photo: the residual of CONTRACT.md §6 at the observed pixels, the photo and the model.
+// Per photo: the residual of docs/file-formats.md (diagnosis.json) at the observed pixels, the
+// photo and the model.
 struct PhotoResidual {
   std::string file;
   double stage1 = 0, stage2 = 0;  // path-traced render vs photo, relative RMS

@@ -1,5 +1,5 @@
 #pragma once
-// Options of igi-solve (CONTRACT.md §4): the inverse global illumination solver of Yu, Debevec,
+// Options of igi-solve (docs/solve.md): the inverse global illumination solver of Yu, Debevec,
 // Malik and Hawkins (SIGGRAPH 1999) followed by a joint refinement against the path tracer.
 // Every field has a default, a unit and a flag of the same name (--pixel-stride, ...).
 

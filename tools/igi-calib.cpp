@@ -1,4 +1,5 @@
-// igi-calib: camera calibration (CONTRACT.md §4). Subcommands, one per calibration:
+// igi-calib: camera calibration (its files: docs/file-formats.md). Subcommands, one per
+// calibration:
 //   igi-calib response IMAGES… (--exposures LIST | --exposure-file FILE | EXIF) --out response.json
 //             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N]
 //             [--plot FILE]

@@ -1,6 +1,6 @@
 // igi-capture: exposure brackets from GigE Vision / USB3 Vision cameras through
-// Aravis, or a folder of raw files imported into the same layout (CONTRACT.md
-// §4).
+// Aravis, or a folder of raw files imported into the same layout
+// (docs/file-formats.md).
 //   igi-capture --list
 //   igi-capture --camera ID_OR_ADDRESS --out DIR [--exposures-us LIST | --auto]
 //   [--frames N]

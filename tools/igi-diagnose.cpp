@@ -1,4 +1,4 @@
-// igi-diagnose (CONTRACT.md §4, §6): find, name and model what the simulation leaves out. Thin
+// igi-diagnose (docs/diagnose.md): find, name and model what the simulation leaves out. Thin
 // main: flags → DiagnoseOptions, load the scene, diagnose, write diagnosis.json, report.html and
 // the improved scene.json.
 #include <CLI/CLI.hpp>

@@ -1,4 +1,5 @@
-// igi-hdr: assembles exposure brackets into linear radiance maps (CONTRACT.md §4).
+// igi-hdr: assembles exposure brackets into linear radiance maps (docs/file-formats.md,
+// docs/memory.md).
 //   igi-hdr IMAGES… --out radiance.exr [--response response.json] [--exposures LIST |
 //           --exposure-file FILE] [--linear] [--weighting noise|hat] [--align] [--mask-out FILE]
 //   igi-hdr RAW_FILES… --out radiance.exr          (DNG, CR2, NEF, …: decoded linearly)

@@ -1,4 +1,5 @@
-// igi-register: photos -> camera poses with COLMAP 3.8 (CONTRACT.md §4).
+// igi-register: photos -> camera poses with COLMAP 3.8 (report.json, markers:
+// docs/file-formats.md).
 //   igi-register --images DIR [--camera camera.json] [--scene scene.json [--markers markers.json]]
 //                --out DIR
 // With --scene the model is brought into the scene's frame: by the markers' control points when

@@ -1,5 +1,5 @@
 // igi-render: renders any camera of a scene under any of its lightings with the path tracer,
-// to a linear OpenEXR in the scene's radiance units (CONTRACT.md §4).
+// to a linear OpenEXR in the scene's radiance units (docs/scene-format.md).
 #include <spdlog/spdlog.h>
 
 #include "recon/scene.h"

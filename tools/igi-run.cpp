@@ -1,4 +1,4 @@
-// igi-run: end to end from a folder of photos (CONTRACT.md §4).
+// igi-run: end to end from a folder of photos (docs/run.md).
 //   igi-run PHOTOS_DIR --scene scene.json --out DIR
 //   igi-run --hdr-photos --scene scene.json --out DIR     (photos and cameras in the scene)
 //   igi-run --demo --out DIR                              (a synthetic capture, then the chain)

@@ -1,4 +1,4 @@
-// igi-solve: inverse global illumination (CONTRACT.md §4). Thin main: flags → SolveOptions,
+// igi-solve: inverse global illumination (docs/solve.md). Thin main: flags → SolveOptions,
 // load the scene, solve, write DIR/scene.json, albedo maps, report.json and report.html.
 #include <CLI/CLI.hpp>
 #include <filesystem>

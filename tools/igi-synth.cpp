@@ -1,6 +1,6 @@
-// igi-synth: writes a synthetic capture with known truth (CONTRACT.md §4): a room scene folder
-// (scene.json, geometry, photos, optional LDR brackets) plus truth.json, with optional effects
-// that the photos show and scene.json does not declare.
+// igi-synth: writes a synthetic capture with known truth (docs/file-formats.md, truth.json): a
+// room scene folder (scene.json, geometry, photos, optional LDR brackets) plus truth.json, with
+// optional effects that the photos show and scene.json does not declare.
 #include <cstdio>
 #include <optional>
 

@@ -9,7 +9,7 @@
 # 1.5 px) and no denoising. Writes DIR/photos/<file>.exr
 # (32-bit linear) for every photo of the scene, the files its "photos" entries name.
 #
-# EFFECT (CONTRACT.md §6 names; "none" for a control):
+# EFFECT (docs/diagnose-effects.md names; "none" for a control):
 #   light_intensity:light=NAME,factor=F       the light's radiance times F
 #   light_source_extent:light=NAME,radius=R   the sphere light of radius R, the same intensity
 #   light_emission_profile:light=NAME,power=N[,axis=X/Y/Z][,peak=P]

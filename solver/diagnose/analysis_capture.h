@@ -3,7 +3,7 @@
 // re-renders cost paths per pixel, so photos of many megapixels are analysed at a reduced size:
 // each camera whose photos exceed `max_megapixels` gets the smallest integer factor f that brings
 // them within it, and each of its photos is replaced by the means of its f × f pixel blocks (the
-// radiance a camera with f× larger pixels records, CONTRACT.md §1), with the camera's width,
+// radiance a camera with f× larger pixels records, docs/scene-format.md), with the camera's width,
 // height and focal lengths and principal point divided by f (continuous coordinates scale by 1/f;
 // the distortion terms are in normalised coordinates and stay). A block is valid only when every
 // pixel in it is (finite, under the photo's clip level, inside its mask); the others are masked.

@@ -1,8 +1,9 @@
 #pragma once
-// A candidate: one effect (CONTRACT.md §6 names) fitted to the residual of the current model on
-// the fitted (not held-out) samples, with the residual it predicts on the held-out samples; and
-// the ranking that decides which candidates a step refits (solver/diagnose/diagnose.cpp). The
-// effects that make candidates: solver/diagnose/effect.h, solver/diagnose/effects/.
+// A candidate: one effect (docs/diagnose-effects.md names) fitted to the residual of the current
+// model on the fitted (not held-out) samples, with the residual it predicts on the held-out
+// samples; and the ranking that decides which candidates a step refits
+// (solver/diagnose/diagnose.cpp). The effects that make candidates: solver/diagnose/effect.h,
+// solver/diagnose/effects/.
 
 #include <array>
 #include <string>

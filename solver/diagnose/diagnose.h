@@ -1,5 +1,5 @@
 #pragma once
-// igi-diagnose (CONTRACT.md §4, §6): when the simulation and the photos differ, locate the
+// igi-diagnose (docs/diagnose.md): when the simulation and the photos differ, locate the
 // mismatch, name the physics left out, model it, refit the whole scene, and keep the step only
 // when the residual on held-out pixels improves; repeat until nothing significant is left.
 //
@@ -64,7 +64,7 @@ struct DiagnosisSummary {
 DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& options,
                           const std::filesystem::path& out_dir);
 
-// diagnosis.json (CONTRACT.md §6), with igi's additions (noise floor, rejected steps).
+// diagnosis.json (docs/file-formats.md), with igi's additions (noise floor, rejected steps).
 Json DiagnosisJson(const DiagnosisSummary& summary, const DiagnoseOptions& options);
 
 // Writes out_dir/diagnosis.json, out_dir/report.html and out_dir/scene.json (last), atomically.

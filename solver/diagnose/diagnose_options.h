@@ -1,5 +1,5 @@
 #pragma once
-// Options of igi-diagnose (CONTRACT.md §4, §6).
+// Options of igi-diagnose (docs/diagnose.md).
 
 #include <cstdint>
 

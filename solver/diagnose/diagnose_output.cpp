@@ -1,4 +1,4 @@
-// diagnosis.json (CONTRACT.md §6) and report.html of igi-diagnose.
+// diagnosis.json (docs/file-formats.md) and report.html of igi-diagnose.
 #include <fmt/format.h>
 
 #include "solver/diagnose/diagnose.h"

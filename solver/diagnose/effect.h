@@ -1,7 +1,7 @@
 #pragma once
-// An effect of CONTRACT.md §6 as igi-diagnose models it, as one object: what it targets, how its
-// candidates are fitted to the residual (or located in the photos), how a candidate's trial is
-// set up and judged, and how the candidate is written into the scene document. The driver
+// An effect of docs/diagnose-effects.md as igi-diagnose models it, as one object: what it targets,
+// how its candidates are fitted to the residual (or located in the photos), how a candidate's trial
+// is set up and judged, and how the candidate is written into the scene document. The driver
 // (diagnose.cpp) runs every effect of MakeEffects() through the same loop and names none of them;
 // each effect is one file under solver/diagnose/effects/ (the list: effects/effects.h).
 
@@ -113,7 +113,7 @@ class Effect {
  public:
   virtual ~Effect() = default;
 
-  // The effect's name (CONTRACT.md §6).
+  // The effect's name (docs/diagnose-effects.md).
   virtual std::string Name() const = 0;
 
   // Adds the fits of its candidates on the round's records: one per target it applies to (a

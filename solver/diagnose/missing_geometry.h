@@ -1,5 +1,5 @@
 #pragma once
-// missing_geometry (CONTRACT.md §6): an object in the photos that the geometry lacks.
+// missing_geometry (docs/diagnose-effects.md): an object in the photos that the geometry lacks.
 //
 // 1. Blobs: per photo, coherent regions where the photo and the model differ by much more than
 //    the noise (a 3×3-smoothed relative residual above a threshold, isolated pixels removed,

@@ -119,7 +119,7 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
 // Marks the records whose residual lies far in the tail (see PixelRecord::outlier).
 void FlagOutliers(std::vector<PixelRecord>* records);
 
-// CONTRACT.md §6 residual over records (held_out selects the set).
+// The residual of diagnosis.json (docs/file-formats.md) over records (held_out selects the set).
 struct ResidualSums {
   double sq_err = 0, sq_photo = 0;
   double Relative() const { return sq_photo > 0 ? std::sqrt(sq_err / sq_photo) : 0; }

@@ -5,7 +5,7 @@
 //   lighting_<L>.rad     the lights of lighting L;
 //   <camera>.vf          one view per camera (`rview -vtv -vp -vd -vu -vh -vv -vs -vl`).
 //
-// Materials (contract §2 → RADIANCE; "exact" = the same BRDF):
+// Materials (docs/scene-format.md → RADIANCE; "exact" = the same BRDF):
 //   lambert             plastic R G B 0 0 with RGB = rho_d                               exact
 //   black               plastic 0 0 0 0 0                                                exact
 //   emitter             light R G B = radiance                                           exact

@@ -219,7 +219,7 @@ Json Ambient(Params& p, const SynthRoom& room, SynthScenes* s) {
   const double radiance = p.Number("radiance", 0.4, 0.0, 1e6);
   const std::string kind = p.Name("kind", "uniform", {"uniform", "panel"});
   p.Finish();
-  if (kind == "uniform") {  // the contract's ambient light: the same radiance from everywhere
+  if (kind == "uniform") {  // scene.json's ambient light: the same radiance from everywhere
     s->true_scene["lights"]["ambient"] =
         Json{{"type", "ambient"}, {"radiance", Vec(Vector3d::Constant(radiance))}};
     for (auto& [name, list] : s->true_scene["lightings"].items()) list.push_back("ambient");

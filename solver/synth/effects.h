@@ -1,8 +1,8 @@
 #pragma once
 // The effects igi-synth puts into the photos while scene.json stays silent about them
-// (CONTRACT.md §6 names). Each effect changes the TRUE scene (what is rendered) or the photos
-// after rendering, never the DECLARED scene — except pose_error and specular_reflection, whose
-// declared value is the wrong one. Each returns its truth.json entry
+// (docs/diagnose-effects.md names). Each effect changes the TRUE scene (what is rendered) or the
+// photos after rendering, never the DECLARED scene — except pose_error and specular_reflection,
+// whose declared value is the wrong one. Each returns its truth.json entry
 // {"effect": NAME, "params": {...}} with every number needed to undo it.
 //
 //   vignetting              photo × (1 + k1 r² + k2 r⁴), r = distance to the principal point
@@ -14,8 +14,8 @@
 //   light_source_extent     the lamp is truly a sphere of radius 0.25 m with the same intensity
 //   missing_geometry        a box (0.35×0.35×0.45 m, lambert 0.6) stands on the floor
 //   ambient_light           an undeclared "ambient" light (radiance 0.4: the same from every
-//                           direction, never occluded; CONTRACT.md's ambient light), on in
-//                           every lighting; kind=panel: a dim 1.6×1.2 m area emitter of that
+//                           direction, never occluded; docs/scene-format.md's ambient light),
+//                           on in every lighting; kind=panel: a dim 1.6×1.2 m area emitter of that
 //                           radiance 2 mm in front of wall_x4 instead (stray light from a
 //                           source, which also shades the wall from the lamp)
 //   exposure_scale          one photo (photo=second photo) is scaled by `scale` (1.3)

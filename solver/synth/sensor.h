@@ -26,8 +26,8 @@ class ResponseCurve {
  public:
   static ResponseCurve Gamma(double gamma);
   static ResponseCurve Sigmoid(double contrast, double mid);
-  // An igi-response JSON (CONTRACT.md §5): x(level) = exp(g(level) − g(levels−1)) per channel;
-  // g must increase with the level. Throws InputError naming the file and key.
+  // An igi-response JSON (docs/file-formats.md): x(level) = exp(g(level) − g(levels−1)) per
+  // channel; g must increase with the level. Throws InputError naming the file and key.
   static ResponseCurve FromFile(const std::filesystem::path& path);
   static ResponseCurve FromOptions(const BracketOptions& options);
 

@@ -1,8 +1,8 @@
 #pragma once
 // A small triangle-mesh builder for synthetic scenes: quads, boxes and spheres with a region
 // (material name) per triangle, per-vertex normals and UVs, written as Wavefront OBJ with
-// `usemtl` regions (CONTRACT.md §3). Also a brute-force ray caster, enough for the few thousand
-// triangles of a synthetic room (camera placement and visibility checks).
+// `usemtl` regions (docs/scene-format.md). Also a brute-force ray caster, enough for the few
+// thousand triangles of a synthetic room (camera placement and visibility checks).
 //
 // Units: metres, world frame. Counter-clockwise winding seen from the front = front face.
 

@@ -1,11 +1,11 @@
 #pragma once
-// Options of igi-synth: a synthetic capture with known truth (CONTRACT.md §4, §5 truth.json).
+// Options of igi-synth: a synthetic capture with known truth (truth.json: docs/file-formats.md).
 //
 // A cubical room (metres, z up) with Lambertian and glossy regions, a textured floor, a small
 // lamp (lighting L0) and a second lamp (lighting L1, for relighting checks), rendered by the
 // forward model from cameras placed so that each glossy region shows the lamp's highlight.
-// Effects (CONTRACT.md §6 names) make the photos differ from what scene.json declares; each is
-// listed with its parameters in truth.json.
+// Effects (docs/diagnose-effects.md names) make the photos differ from what scene.json declares;
+// each is listed with its parameters in truth.json.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -27,7 +27,7 @@ struct EffectSpec {
 // Parses the text of one --effect flag. Throws InputError "--effect: TEXT: RULE".
 EffectSpec ParseEffectSpec(const std::string& text);
 
-// The effects igi-synth can put into the photos (CONTRACT.md §6 names).
+// The effects igi-synth can put into the photos (docs/diagnose-effects.md names).
 const std::vector<std::string>& SupportedEffects();
 
 enum class NoiseModel { kNone, kRealistic };
@@ -57,7 +57,7 @@ struct BracketOptions {
   double sigmoid_contrast = 1.6;  // kSigmoid: x^c/(x^c + m^c), normalised to 1 at x = 1
   // kSigmoid: m, the x at which the curve before normalisation is ½, in (0, 1).
   double sigmoid_mid = 0.18;
-  std::filesystem::path response_file;  // kFile: an igi-response JSON (CONTRACT.md §5)
+  std::filesystem::path response_file;  // kFile: an igi-response JSON (docs/file-formats.md)
   int bits = 8;                         // 8 or 16
   std::string format = "png";           // png or tif
   void Validate() const;

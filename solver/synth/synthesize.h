@@ -1,5 +1,5 @@
 #pragma once
-// igi-synth's job: writes a scene folder with known truth (CONTRACT.md §4, §5):
+// igi-synth's job: writes a scene folder with known truth (docs/file-formats.md, truth.json):
 //   scene.json               the DECLARED scene: unknown material values left out, effects
 //                            silent; every lighting (L0, L1), cameras, photos
 //   geometry/room.obj        regions by usemtl, UVs, normals

@@ -18,7 +18,7 @@
 //   1.3, the rest absorbed by the vignetting's different mean in each photo), then vignetting
 //   (k1 0.113, k2 −0.419; truth −0.25, −0.05), which had passed the first round too but explained
 //   less; final 0.1516 against 0.1436 (1.06×; baseline 0.1858).
-// - ambient_light:kind=uniform (the contract's ambient light, radiance 0.4, in every lighting;
+// - ambient_light:kind=uniform (scene.json's ambient light, radiance 0.4, in every lighting;
 //   measured): ambient_light first and alone, radiance 0.394 (each
 //   channel), final residual 0.1260 against the true model's 0.1260 (1.00×; baseline 0.2461).
 //   It passes since the renderer evaluates the ambient light exactly (before, its uniform-sphere
@@ -30,7 +30,7 @@
 //   2.2915). The profile is searched with the response as a nuisance (before: axis 11° off,
 //   power 2.38, the response then not provable, 3.2× the floor).
 // Not proven here (bench/RESULTS.md): ambient_light as a stray-light panel (igi-synth's
-// ambient_light:kind=panel: an area light, not the contract's ambient light). fresnel is proven
+// ambient_light:kind=panel: an area light, not scene.json's ambient light). fresnel is proven
 // in concealed_test.cpp, on a capture with a grazing view (at the default views it is invisible:
 // the true model's residual is 0.991× the declared one's).
 #include <gtest/gtest.h>

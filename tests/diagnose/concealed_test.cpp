@@ -1,9 +1,9 @@
 // igi-diagnose on concealed data (CI size): igi-synth captures each hiding one effect
 // that scene.json does not declare, and a control hiding none. For each: the first step
-// igi-diagnose keeps names the hidden effect (CONTRACT.md §6 names), and its final residual comes
-// within 1.2× the noise floor — the residual of the TRUE model (truth/scene.json plus the photo
-// effects of truth.json) rendered at the same samples per pixel, over the same pixels. The control
-// reports no effect.
+// igi-diagnose keeps names the hidden effect (docs/diagnose-effects.md names), and its final
+// residual comes within 1.2× the noise floor — the residual of the TRUE model (truth/scene.json
+// plus the photo effects of truth.json) rendered at the same samples per pixel, over the same
+// pixels. The control reports no effect.
 //
 // Size: 4 cameras of 160×120, photos at 64 paths per pixel, a point lamp (its glossy reflections
 // are sampled by next-event estimation only, so the photos carry no fireflies), materials given

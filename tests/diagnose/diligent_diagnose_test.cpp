@@ -5,7 +5,7 @@
 // step).
 //
 // Real data has no truth to compare with, so what is checked is what physics allows:
-//  - igi-diagnose finishes (exit 0) and writes a valid diagnosis.json (CONTRACT.md §6), the
+//  - igi-diagnose finishes (exit 0) and writes a valid diagnosis.json (docs/file-formats.md), the
 //    report and the improved scene;
 //  - every kept step lowered the held-out residual, and the final held-out residual is not above
 //    the baseline's (below it when a step was kept);

@@ -24,7 +24,7 @@ namespace {
 
 using namespace test::room;
 
-// The effect names of CONTRACT.md §6's table.
+// The effect names of docs/diagnose-effects.md's table, albedo_texture aside.
 const std::vector<std::string> kContractEffects = {"indirect_illumination",
                                                    "specular_reflection",
                                                    "specular_lobe_shape",
@@ -57,10 +57,10 @@ const std::vector<std::string> kModelled = {"missing_geometry",
                                             "specular_reflection"};
 
 // MakeEffects makes each modelled effect once, in the driver's order (the effects tried alone
-// first: a missing object before any albedo map). Every name is one of CONTRACT.md §6's table
-// except albedo_texture, the name igi adds (the contract allows new names) for the albedo maps
-// its step gives the refit; indirect_illumination is the one name of the table no effect models
-// (the renderer's model has the bounces).
+// first: a missing object before any albedo map). Every name is one of the shared table
+// (docs/diagnose-effects.md) except albedo_texture, the name igi adds (new names are allowed) for
+// the albedo maps its step gives the refit; indirect_illumination is the one name of the table no
+// effect models (the renderer's model has the bounces).
 TEST(EffectRegistryTest, NamesAreUniqueAndTheContracts) {
   const std::vector<std::unique_ptr<Effect>> effects = MakeEffects();
   std::vector<std::string> names;

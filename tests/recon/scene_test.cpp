@@ -130,7 +130,7 @@ TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
   fs::remove_all(dir);
 }
 
-// The Fresnel-weighted models (igi's additions to CONTRACT.md §2) take an optional "ior" in
+// The Fresnel-weighted models (igi's additions, docs/scene-format.md) take an optional "ior" in
 // (1, 5], default 1.5; the plain models do not accept the key.
 TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
   const fs::path dir =

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 # Reference values for tests/solver/brdf_test.cpp (MatchesLiteralValuesFromTheContractFormulas):
-# CONTRACT.md §2 transcribed directly, with θh and φh as angles (acos/atan2). Prints S and f.
+# docs/scene-format.md's models transcribed directly, with θh and φh as angles (acos/atan2). Prints
+# S and f.
 from math import *
 def d(t,p):
     t,p=radians(t),radians(p); return (sin(t)*cos(p),sin(t)*sin(p),cos(t))

@@ -55,7 +55,7 @@ BrdfParams Grey(BrdfModel model, double rho_d, double rho_s, double alpha_x, dou
               alpha_y);
 }
 
-// The specular part of CONTRACT.md §2 written a second way: through the angles θh, φh of the
+// The specular part of docs/scene-format.md written a second way: through the angles θh, φh of the
 // normalised half vector, and for Ward-GMD through (h·h)/(h·n)⁴ = 1/(4 (wi·ĥ)² cos⁴θh). For a
 // *_fresnel model: the plain model's (the Fresnel weight is ReferenceFresnelWeight).
 double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vector3d& wo,
@@ -151,7 +151,7 @@ TEST(BrdfParamsTest, SpecularLobeProbabilityFollowsMeanAlbedos) {
 // ---- values ---------------------------------------------------------------------------------
 
 TEST(BrdfEvalTest, MatchesLiteralValuesFromTheContractFormulas) {
-  // Printed by tests/solver/brdf_reference_values.py (Python, math module only: CONTRACT.md §2
+  // Printed by tests/solver/brdf_reference_values.py (Python, math module only: the models
   // transcribed with θh = acos(ĥ·n), φh = atan2(ĥ·b, ĥ·t)): rho_d = (0.5, 0.4, 0.3), rho_s = (0.05,
   // 0.1, 0.2), α = 0.2, (αx, αy) = (0.15, 0.3). Tolerance 1e-13 relative: double rounding of ~30
   // operations.

@@ -151,7 +151,7 @@ void ExpectOrthonormalRightHanded(const Frame& f) {
   EXPECT_NEAR(f.t.dot(f.n), 0.0, 1e-12);
   EXPECT_NEAR(f.b.dot(f.n), 0.0, 1e-12);
   EXPECT_NEAR(f.t.dot(f.b), 0.0, 1e-12);
-  EXPECT_NEAR((f.n.cross(f.t) - f.b).norm(), 0.0, 1e-12);  // b = n × t (CONTRACT.md §2)
+  EXPECT_NEAR((f.n.cross(f.t) - f.b).norm(), 0.0, 1e-12);  // b = n × t (docs/scene-format.md)
   EXPECT_NEAR((f.t.cross(f.b) - f.n).norm(), 0.0, 1e-12);
 }
 

@@ -89,10 +89,11 @@ TEST_F(SolveGather, GlossySurfacesPassOnTheirSpecularReflectionOfTheRoom) {
   EXPECT_GT(without, 0.03);
 }
 
-// The contract's ambient light (uniform radiance, never occluded) in the solver's gathering: its
-// irradiance is exactly πL wherever the point is, in the open or in a corner (the renderer adds
-// ρd·L exactly too, solver/render.cpp), and its samples keep the directions it arrives from. It
-// was estimated from uniform-sphere light samples (noise of several percent per point).
+// The ambient light of docs/scene-format.md (uniform radiance, never occluded) in the solver's
+// gathering: its irradiance is exactly πL wherever the point is, in the open or in a corner (the
+// renderer adds ρd·L exactly too, solver/render.cpp), and its samples keep the directions it
+// arrives from. It was estimated from uniform-sphere light samples (noise of several percent per
+// point).
 TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {
   Json doc = ReadJsonFile(dir_ / "truth.json");
   doc["lights"]["amb"] = {{"type", "ambient"}, {"radiance", {0.3, 0.2, 0.1}}};

@@ -5,7 +5,7 @@
 // key path or pixel, the value and the rule broken; the executable's main prints one line per
 // problem and exits with 2. Context is chained as the error travels up ("while loading X").
 //
-// Exit codes (CONTRACT.md §4): 0 ok, 1 failed, 2 bad usage or bad input (nothing written),
+// Exit codes (docs/ARCHITECTURE.md): 0 ok, 1 failed, 2 bad usage or bad input (nothing written),
 // 3 partial (some items failed and are listed; the rest is written).
 
 #include <stdexcept>

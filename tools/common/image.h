@@ -1,5 +1,6 @@
 #pragma once
-// Image: float pixels, N interleaved channels, row-major with the top row first (CONTRACT.md §1).
+// Image: float pixels, N interleaved channels, row-major with the top row first
+// (docs/file-formats.md).
 // Reading and writing go through OpenImageIO: OpenEXR (half or float), PNG, TIFF and JPEG, with
 // their metadata. Whether the values are linear radiance depends on the file: EXR renders and
 // radiance maps are linear; 8/16-bit PNG/TIFF/JPEG values are the camera's encoded levels,

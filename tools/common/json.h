@@ -1,6 +1,6 @@
 #pragma once
-// Strict JSON reading for igi's files (CONTRACT.md §1): an unknown key, a wrong type, a missing
-// required key or an out-of-range value is a problem that names the file, the key path
+// Strict JSON reading for igi's files (docs/file-formats.md): an unknown key, a wrong type, a
+// missing required key or an out-of-range value is a problem that names the file, the key path
 // (e.g. `lights.lamp.intensity[2]`) and the rule broken. Problems are collected in a
 // ProblemList so that one load reports every problem, not only the first.
 //
@@ -90,7 +90,7 @@ class JsonCursor {
   std::optional<Eigen::Vector3d> Vec3(const NumberRule& rule = {}) const;
   // A non-zero 3-vector, returned normalised.
   std::optional<Eigen::Vector3d> Direction() const;
-  // An RGB triple, or one number meaning grey (CONTRACT.md §2).
+  // An RGB triple, or one number meaning grey (docs/scene-format.md).
   std::optional<Eigen::Vector3d> Rgb(const NumberRule& rule = {}) const;
 
   // Reports a problem about this value: "FILE: PATH: VALUE: RULE".

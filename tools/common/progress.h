@@ -1,7 +1,7 @@
 #pragma once
 // A progress bar for long work: drawn on stderr when stderr is a terminal, silent in pipes, in
 // CI (CI set) and when IGI_NO_PROGRESS is set. It appears only once the work has run for
-// `delay_s` (about two seconds, CONTRACT.md §4), so quick jobs stay quiet. Thread-safe.
+// `delay_s` (about two seconds, docs/ARCHITECTURE.md), so quick jobs stay quiet. Thread-safe.
 
 #include <atomic>
 #include <chrono>

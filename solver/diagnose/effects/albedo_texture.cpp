@@ -1,6 +1,6 @@
-// albedo_texture (CONTRACT.md §6): regions whose albedo varies over the surface. Its step is a
-// change of the solver's albedo maps, not of the document: the refit solves maps for the regions
-// it names (or, as a last resort, wherever the solver finds the albedo varies).
+// albedo_texture (docs/diagnose-effects.md): regions whose albedo varies over the surface. Its step
+// is a change of the solver's albedo maps, not of the document: the refit solves maps for the
+// regions it names (or, as a last resort, wherever the solver finds the albedo varies).
 //
 // Textured regions are tested first: on them the texture is most of a constant-albedo model's
 // residual, and a smooth candidate correlated with it by chance would earn a false gain

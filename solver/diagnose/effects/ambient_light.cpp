@@ -1,4 +1,5 @@
-// ambient_light (CONTRACT.md §6): light from no declared source, the same from every direction.
+// ambient_light (docs/diagnose-effects.md): light from no declared source, the same from every
+// direction.
 
 #include <fmt/format.h>
 

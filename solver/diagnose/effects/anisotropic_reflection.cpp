@@ -1,5 +1,5 @@
-// anisotropic_reflection (CONTRACT.md §6): a glossy region whose highlight is stretched along a
-// surface direction.
+// anisotropic_reflection (docs/diagnose-effects.md): a glossy region whose highlight is stretched
+// along a surface direction.
 
 #include <fmt/format.h>
 

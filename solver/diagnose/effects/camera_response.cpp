@@ -1,4 +1,5 @@
-// camera_response (CONTRACT.md §6): the photos follow the model's value through a power.
+// camera_response (docs/diagnose-effects.md): the photos follow the model's value through a
+// power.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

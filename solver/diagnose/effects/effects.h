@@ -1,11 +1,11 @@
 #pragma once
-// The effects igi-diagnose models (CONTRACT.md §6), one file each in this folder, and the fits
-// their files expose for tests. Each candidate fit studies the residual of the current model in
-// the frame where its physics shows itself, fits a model of it on the fitted (not held-out)
-// records, and predicts the residual it would leave on the held-out ones (candidates.h). Fits are
-// linear in their amplitudes; nonlinear parameters (a response exponent, an emission axis, a lobe
-// width) are searched on a grid, with the global scale free as a nuisance where the materials are
-// solved (the refit's albedos absorb it).
+// The effects igi-diagnose models (docs/diagnose-effects.md), one file each in this folder, and
+// the fits their files expose for tests. Each candidate fit studies the residual of the current
+// model in the frame where its physics shows itself, fits a model of it on the fitted (not
+// held-out) records, and predicts the residual it would leave on the held-out ones (candidates.h).
+// Fits are linear in their amplitudes; nonlinear parameters (a response exponent, an emission axis,
+// a lobe width) are searched on a grid, with the global scale free as a nuisance where the
+// materials are solved (the refit's albedos absorb it).
 //
 // An effect's Write puts a candidate's params into the scene document; the params name
 // everything it writes, so diagnosis.json's steps say what each did to the scene.

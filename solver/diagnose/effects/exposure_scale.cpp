@@ -1,5 +1,5 @@
-// exposure_scale (CONTRACT.md §6): one photo (or a few) brighter or darker than the model as a
-// whole, on every surface alike.
+// exposure_scale (docs/diagnose-effects.md): one photo (or a few) brighter or darker than the
+// model as a whole, on every surface alike.
 
 #include <fmt/format.h>
 

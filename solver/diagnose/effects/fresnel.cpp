@@ -1,5 +1,5 @@
-// fresnel (CONTRACT.md §6): a glossy region whose highlights grow toward grazing angles as
-// Schlick's Fresnel weight (plain -> *_fresnel). The fit: LobeChange (lobe_change.cpp).
+// fresnel (docs/diagnose-effects.md): a glossy region whose highlights grow toward grazing angles
+// as Schlick's Fresnel weight (plain -> *_fresnel). The fit: LobeChange (lobe_change.cpp).
 
 #include <memory>
 #include <string>

@@ -1,4 +1,5 @@
-// light_emission_profile (CONTRACT.md §6): a light brighter in some directions than others.
+// light_emission_profile (docs/diagnose-effects.md): a light brighter in some directions than
+// others.
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-// light_intensity (CONTRACT.md §6): a light brighter or dimmer than declared.
+// light_intensity (docs/diagnose-effects.md): a light brighter or dimmer than declared.
 
 #include <fmt/format.h>
 

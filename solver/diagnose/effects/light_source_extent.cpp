@@ -1,5 +1,5 @@
-// light_source_extent (CONTRACT.md §6): a point (or small sphere) light that is really a larger
-// sphere of the same intensity.
+// light_source_extent (docs/diagnose-effects.md): a point (or small sphere) light that is really a
+// larger sphere of the same intensity.
 
 #include <fmt/format.h>
 

@@ -1,6 +1,6 @@
-// missing_geometry (CONTRACT.md §6): an object in the photos that the geometry lacks. Located, not
-// fitted: the residual's blobs carved from every photo (missing_geometry.h); the step excludes
-// the object and its shadow from the photos (masks) and refits without them.
+// missing_geometry (docs/diagnose-effects.md): an object in the photos that the geometry lacks.
+// Located, not fitted: the residual's blobs carved from every photo (missing_geometry.h); the step
+// excludes the object and its shadow from the photos (masks) and refits without them.
 
 #include "solver/diagnose/missing_geometry.h"
 

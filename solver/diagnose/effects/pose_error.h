@@ -1,7 +1,7 @@
 #pragma once
-// pose_error (CONTRACT.md §6): a photo's camera pose is off. The photo is then the model seen from
-// a slightly moved camera, so the residual follows the model image's gradient along the flow of a
-// small rotation ω (camera frame) and translation δ: photo − sim ≈ −∇sim · J(ω, δ).
+// pose_error (docs/diagnose-effects.md): a photo's camera pose is off. The photo is then the model
+// seen from a slightly moved camera, so the residual follows the model image's gradient along the
+// flow of a small rotation ω (camera frame) and translation δ: photo − sim ≈ −∇sim · J(ω, δ).
 //
 // FitPoseError fits that motion. Given the photos and the model's renders, it aligns them
 // coarse to fine (both blurred, a Gaussian of 4, 2 and 1 pixels, Gauss–Newton on the render

@@ -1,5 +1,6 @@
-// specular_lobe_shape (CONTRACT.md §6): a glossy region whose highlight falls off away from its
-// peak as the other Ward lobe does (ward <-> ward_gmd). The fit: LobeChange (lobe_change.cpp).
+// specular_lobe_shape (docs/diagnose-effects.md): a glossy region whose highlight falls off away
+// from its peak as the other Ward lobe does (ward <-> ward_gmd). The fit: LobeChange
+// (lobe_change.cpp).
 
 #include <memory>
 #include <string>

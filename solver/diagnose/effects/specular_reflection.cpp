@@ -1,4 +1,4 @@
-// specular_reflection (CONTRACT.md §6): a region declared diffuse that has a highlight.
+// specular_reflection (docs/diagnose-effects.md): a region declared diffuse that has a highlight.
 
 #include <fmt/format.h>
 

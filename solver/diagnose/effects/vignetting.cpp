@@ -1,4 +1,4 @@
-// vignetting (CONTRACT.md §6): an image-fixed radial fall-off, the same in every photo.
+// vignetting (docs/diagnose-effects.md): an image-fixed radial fall-off, the same in every photo.
 
 #include <fmt/format.h>
 
