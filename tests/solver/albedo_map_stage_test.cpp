@@ -9,7 +9,7 @@
 #include <functional>
 #include <random>
 
-#include "tests/solver/test_scenes.h"
+#include "tests/solver/stage_fixture.h"
 
 namespace igi {
 namespace {
@@ -19,66 +19,18 @@ constexpr double kIrradiance = 3.0;
 // A checker of 0.1 m cells, ±30 % about 0.5.
 double Checker(double u, double v) { return 0.5 * ((int(u * 10) + int(v * 10)) % 2 ? 1.3 : 0.7); }
 
-// The stage's inputs and what it reads from them.
-struct StageFixture {
-  Scene scene;
-  SolveOptions options;
-  PatchSet patches;
-  MaterialEstimate materials;
-  ObservationSet obs;
-  LightModel light;
-
-  // `albedo(u, v)` on the square, `per_texel` observations per 2 cm texel on average, each
-  // observation's radiance times (1 + noise) with 3 % of them fireflies of 8×.
-  StageFixture(const std::function<double(double, double)>& albedo, int per_texel, unsigned seed) {
-    const auto dir = test::TempSceneDir("map_stage");
-    test::WriteText(dir / "square.obj", test::SquareObj("floor", 0.5));
-    WriteJsonFile(
-        dir / "scene.json",
-        Json{{"format", "igi-scene"},
-             {"version", 1},
-             {"geometry", Json::array({Json{{"file", "square.obj"}}})},
-             {"materials", {{"floor", {{"brdf", "lambert"}}}}},
-             {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 2}}, {"intensity", 1}}}}},
-             {"lightings", {{"L", {"l"}}}},
-             {"cameras", Json::object()},
-             {"photos", Json::array()}});
-    scene = LoadScene(dir / "scene.json");
-    patches = BuildPatches(scene.mesh, 0.1);
-    materials = MaterialEstimate::FromScene(scene, patches);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u01(0.0, 1.0);
-    std::normal_distribution<double> gauss(0.0, 0.1);
-    const int n = 2500 * per_texel;
-    light.lightings.resize(1);
-    light.lightings[0].active = true;
-    for (int i = 0; i < n; ++i) {
-      // A point of the square, uniform: the triangle by area, barycentrics uniform in it.
-      const int tri = u01(rng) < 0.5 ? 0 : 1;
-      double b1 = u01(rng), b2 = u01(rng);
-      if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
-      const auto& t = scene.mesh.triangles[tri];
-      const Eigen::Vector3f p0 = scene.mesh.positions[t[0]], p1 = scene.mesh.positions[t[1]],
-                            p2 = scene.mesh.positions[t[2]];
-      const Eigen::Vector3f p = p0 + float(b1) * (p1 - p0) + float(b2) * (p2 - p0);
-      const double u = p.x() + 0.5, v = p.y() + 0.5;
-      Observation o;
-      o.photo = i % 2;
-      o.triangle = tri;
-      o.b1 = float(b1);
-      o.b2 = float(b2);
-      o.region = 0;
-      o.patch = patches.PatchOf(tri, b1, b2);
-      o.position = p;
-      const double noise = 1 + gauss(rng) + (u01(rng) < 0.03 ? 8.0 : 0.0);
-      o.radiance = Eigen::Vector3f::Constant(float(albedo(u, v) * kIrradiance / kPi * noise));
-      light.lightings[0].obs.push_back(i);
-      obs.items.push_back(o);
-    }
-    materials[0].observations = n;
-    light.e.assign(n, Eigen::Vector3d::Constant(kIrradiance));
-    light.t.assign(n, Eigen::Vector3d::Zero());
-  }
+// The stage's inputs (tests/solver/stage_fixture.h): `albedo(u, v)` on the square, `per_texel`
+// observations per 2 cm texel on average, each observation's radiance times (1 + noise) with 3 %
+// of them fireflies of 8×.
+struct StageFixture : test::SquareStage {
+  StageFixture(const std::function<double(double, double)>& albedo, int per_texel, unsigned seed)
+      : SquareStage("map_stage", 2500 * per_texel, kIrradiance, seed,
+                    [&albedo, gauss = std::normal_distribution<double>(0.0, 0.1),
+                     u01 = std::uniform_real_distribution<double>(0.0, 1.0)](
+                        double u, double v, std::mt19937& rng) mutable {
+                      const double noise = 1 + gauss(rng) + (u01(rng) < 0.03 ? 8.0 : 0.0);
+                      return albedo(u, v) * kIrradiance / kPi * noise;
+                    }) {}
 
   MapStageData Data() const {
     return MapStageData{scene, options, obs, materials, patches, light, 0.02, 1.0};

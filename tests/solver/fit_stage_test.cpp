@@ -9,72 +9,25 @@
 #include <random>
 
 #include "solver/paper_stage.h"
-#include "tests/solver/test_scenes.h"
+#include "tests/solver/stage_fixture.h"
 
 namespace igi {
 namespace {
 
 constexpr double kIrradiance = 3.0;
 
-// The stage's inputs: `n` observations of the square (two photos), radiance albedo·E/π with 5 %
-// Gaussian noise, every one a fit sample; the light model's irradiance E everywhere.
-struct FitFixture {
-  Scene scene;
-  SolveOptions options;
-  PatchSet patches;
-  MaterialEstimate materials;
-  ObservationSet obs;
-  LightModel light;
+// The stage's inputs (tests/solver/stage_fixture.h): `n` observations of the square, radiance
+// albedo·E/π with 5 % Gaussian noise, every one a fit sample; the light model's irradiance E
+// everywhere.
+struct FitFixture : test::SquareStage {
   SolveSummary summary;
 
-  FitFixture(double albedo, int n, unsigned seed) {
-    const auto dir = test::TempSceneDir("fit_stage");
-    test::WriteText(dir / "square.obj", test::SquareObj("floor", 0.5));
-    WriteJsonFile(
-        dir / "scene.json",
-        Json{{"format", "igi-scene"},
-             {"version", 1},
-             {"geometry", Json::array({Json{{"file", "square.obj"}}})},
-             {"materials", {{"floor", {{"brdf", "lambert"}}}}},
-             {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 2}}, {"intensity", 1}}}}},
-             {"lightings", {{"L", {"l"}}}},
-             {"cameras", Json::object()},
-             {"photos", Json::array()}});
-    scene = LoadScene(dir / "scene.json");
-    patches = BuildPatches(scene.mesh, 0.1);
-    materials = MaterialEstimate::FromScene(scene, patches);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u01(0.0, 1.0);
-    std::normal_distribution<double> gauss(0.0, 0.05);
-    light.lightings.resize(1);
-    light.lightings[0].active = true;
-    for (int i = 0; i < n; ++i) {
-      const int tri = u01(rng) < 0.5 ? 0 : 1;
-      double b1 = u01(rng), b2 = u01(rng);
-      if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
-      const auto& t = scene.mesh.triangles[tri];
-      const Eigen::Vector3f p0 = scene.mesh.positions[t[0]], p1 = scene.mesh.positions[t[1]],
-                            p2 = scene.mesh.positions[t[2]];
-      Observation o;
-      o.photo = i % 2;
-      o.triangle = tri;
-      o.b1 = float(b1);
-      o.b2 = float(b2);
-      o.region = 0;
-      o.patch = patches.PatchOf(tri, b1, b2);
-      o.position = p0 + float(b1) * (p1 - p0) + float(b2) * (p2 - p0);
-      o.normal = Eigen::Vector3f(0, 0, 1);
-      o.view = Eigen::Vector3f(0, 0, 1);
-      o.radiance = Eigen::Vector3f::Constant(float(albedo * kIrradiance / kPi * (1 + gauss(rng))));
-      light.lightings[0].obs.push_back(i);
-      obs.items.push_back(o);
-    }
-    obs.in_fit.assign(n, 1);
-    materials[0].observations = n;
-    light.e.assign(n, Eigen::Vector3d::Constant(kIrradiance));
-    light.t.assign(n, Eigen::Vector3d::Zero());
-    light.incident.resize(n);
-  }
+  FitFixture(double albedo, int n, unsigned seed)
+      : SquareStage("fit_stage", n, kIrradiance, seed,
+                    [albedo, gauss = std::normal_distribution<double>(0.0, 0.05)](
+                        double, double, std::mt19937& rng) mutable {
+                      return albedo * kIrradiance / kPi * (1 + gauss(rng));
+                    }) {}
 
   StageData Data() const { return StageData{scene, options, obs, patches, 1.0, 0.1, 0.02}; }
 };
