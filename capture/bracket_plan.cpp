@@ -61,6 +61,8 @@ std::vector<double> ParseExposureList(const std::string& text) {
 
 Json PlanToJson(const BracketPlan& plan) {
   Json json;
+  json["format"] = "igi-capture-plan";
+  json["version"] = 1;
   json["camera"] = plan.camera;
   json["exposures_us"] = plan.exposures_us;
   json["frames"] = plan.frames;
@@ -77,8 +79,16 @@ BracketPlan ReadPlan(const std::filesystem::path& path) {
   ProblemList problems;
   const JsonCursor root = JsonCursor::Root(json, path.string(), &problems);
   BracketPlan plan;
-  root.ExpectObject({"camera", "exposures_us", "frames", "settle_frames", "pixel_format", "gain",
-                     "file_format", "auto_metered"});
+  root.ExpectObject({"format", "version", "camera", "exposures_us", "frames", "settle_frames",
+                     "pixel_format", "gain", "file_format", "auto_metered"});
+  // "format" and "version" are checked where present: a plan written before they were added
+  // (a capture to be resumed) has neither.
+  if (root["format"].present()) root["format"].Enum({"igi-capture-plan"});
+  if (root["version"].present()) {
+    if (const auto version = root["version"].Integer(); version && *version != 1) {
+      root["version"].Problem("must be 1");
+    }
+  }
   plan.camera = root["camera"].String().value_or("");
   const size_t count = root["exposures_us"].ArraySize(1);
   for (size_t i = 0; i < count; ++i) {

@@ -1,6 +1,7 @@
 #include "hdr/manifest.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -31,9 +32,16 @@ bool ParseFrame(const Json& object, const std::string& source, const std::filesy
   if (const auto us = root["exposure_us"].Number(NumberRule::Positive())) {
     frame->exposure_s = *us * 1e-6;
   }
-  if (const auto gain = root["gain"].Number(NumberRule::Any())) frame->gain = *gain;
+  // "gain" and "timestamp" are required keys whose value may be null: igi-capture writes null
+  // where the camera or the raw file does not record them (frames of unknown gain share gain 0).
+  const JsonCursor gain = root["gain"];
+  if (gain.raw() == nullptr) {
+    gain.Problem("required key is missing");
+  } else if (gain.present()) {
+    if (const auto g = gain.Number(NumberRule::Any())) frame->gain = *g;
+  }
   if (const auto format = root["pixel_format"].String()) frame->pixel_format = *format;
-  if (!root["timestamp"].present()) root["timestamp"].Problem("required key is missing");
+  if (root["timestamp"].raw() == nullptr) root["timestamp"].Problem("required key is missing");
   const JsonCursor bracket = root["bracket"];
   if (bracket.IsString()) {
     frame->bracket = bracket.raw()->get<std::string>();
@@ -56,7 +64,8 @@ std::vector<ManifestBracket> ReadManifest(const std::filesystem::path& path) {
   int line = 0;
   while (start < text.size()) {
     size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
+    const bool unterminated = end == std::string::npos;
+    if (unterminated) end = text.size();
     const std::string content(Trim(std::string_view(text).substr(start, end - start)));
     start = end + 1;
     ++line;
@@ -66,6 +75,13 @@ std::vector<ManifestBracket> ReadManifest(const std::filesystem::path& path) {
     try {
       if (!ParseFrame(ParseJson(content, source), source, dir, line, &problems, &frame)) continue;
     } catch (const Error& e) {
+      // igi-capture appends whole lines: a last line without its newline that is not JSON was
+      // cut short by a capture that stopped mid-write, and lists no frame.
+      if (unterminated) {
+        spdlog::warn("{}: the last line was cut short (a capture stopped mid-write): skipped",
+                     source);
+        continue;
+      }
       problems.Append(e);
       continue;
     }

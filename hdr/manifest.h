@@ -5,9 +5,11 @@
 //
 // Frames are grouped into brackets by (camera, gain, bracket): frames with another gain are
 // another bracket, since the gain's unit is the camera's own. Within a bracket, frames keep the
-// file's order. Keys other than these are ignored (igi-capture may add some). A line that is
-// not a JSON object, a missing or wrongly typed required key, or a non-positive exposure is an
-// InputError "MANIFEST: line N: KEY: VALUE: RULE"; every bad line is reported.
+// file's order. Keys other than these are ignored (igi-capture may add some). "gain" and
+// "timestamp" may be null (unknown: frames of unknown gain share gain 0). A line that is not a
+// JSON object, a missing or wrongly typed required key, or a non-positive exposure is an
+// InputError "MANIFEST: line N: KEY: VALUE: RULE"; every bad line is reported, but a last line
+// without its newline that is not JSON (a capture stopped mid-write) is skipped with a warning.
 
 #include <filesystem>
 #include <string>

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "tools/common/error.h"
+#include "tools/common/json.h"
 
 namespace igi::capture {
 namespace {
@@ -49,6 +50,22 @@ TEST(BracketPlan, RoundTripsThroughPlanJson) {
   WritePlan(path, plan);
   const BracketPlan read = ReadPlan(path);
   EXPECT_EQ(PlanToJson(read), PlanToJson(plan));
+  EXPECT_EQ(ReadJsonFile(path)["format"], "igi-capture-plan");
+  EXPECT_EQ(ReadJsonFile(path)["version"], 1);
+  std::filesystem::remove(path);
+}
+
+TEST(BracketPlan, ReadsAPlanWithoutFormatButNotOneOfAnotherFormat) {
+  const auto path = std::filesystem::temp_directory_path() / "igi_plan_format.json";
+  const std::string body = R"("camera": "x", "exposures_us": [1000], "frames": 1,
+      "settle_frames": 0, "pixel_format": "Mono8", "gain": 0, "file_format": "png",
+      "auto_metered": false})";
+  std::ofstream(path) << "{" << body;
+  EXPECT_EQ(ReadPlan(path).camera, "x");
+  std::ofstream(path) << R"({"format": "igi-response", "version": 1, )" << body;
+  EXPECT_THROW(ReadPlan(path), InputError);
+  std::ofstream(path) << R"({"format": "igi-capture-plan", "version": 2, )" << body;
+  EXPECT_THROW(ReadPlan(path), InputError);
   std::filesystem::remove(path);
 }
 

@@ -54,6 +54,34 @@ TEST_F(ManifestTest, GroupsByCameraGainAndBracketKey) {
   EXPECT_EQ(brackets[3].label, "camB_2");
 }
 
+TEST_F(ManifestTest, ANullGainOrTimestampIsUnknownNotMissing) {
+  // As igi-capture imports raw files that record no ISO and no time.
+  const std::string line0 =
+      R"({"file":"r0.dng","camera":"raw","exposure_us":1000,"gain":null,"pixel_format":"raw",)"
+      R"("timestamp":null})";
+  const std::string line1 =
+      R"({"file":"r1.dng","camera":"raw","exposure_us":4000,"gain":null,"pixel_format":"raw",)"
+      R"("timestamp":null})";
+  const auto brackets = ReadManifest(Write(line0 + "\n" + line1 + "\n"));
+  ASSERT_EQ(brackets.size(), 1u);
+  ASSERT_EQ(brackets[0].frames.size(), 2u);
+  EXPECT_EQ(brackets[0].gain, 0.0);
+  // The keys themselves stay required.
+  EXPECT_THROW(ReadManifest(Write(R"({"file":"r0.dng","camera":"raw","exposure_us":1000,)"
+                                  R"("pixel_format":"raw","timestamp":null})"
+                                  "\n")),
+               InputError);
+}
+
+TEST_F(ManifestTest, ALastLineCutShortIsSkippedButABadLineIsNot) {
+  const std::string whole = Frame("a0.png", "c", 1000, 0) + Frame("a1.png", "c", 4000, 0);
+  const auto brackets = ReadManifest(Write(whole + R"({"file":"a2.png","camera":"c","expo)"));
+  ASSERT_EQ(brackets.size(), 1u);
+  EXPECT_EQ(brackets[0].frames.size(), 2u);
+  EXPECT_THROW(ReadManifest(Write(whole + R"({"file":"a2.png","camera":"c","expo)" + "\n")),
+               InputError);
+}
+
 TEST_F(ManifestTest, ReportsEveryBadLine) {
   const fs::path path =
       Write(Frame("a.png", "c", 1000, 0) + "not json\n" + Frame("b.png", "c", -5, 0) +
