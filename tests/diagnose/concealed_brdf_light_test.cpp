@@ -27,12 +27,13 @@ using test::ExpectReachesTheFloor;
 // The candidate finds glossy_box's stretch (seed 11: tangent (0.911, 0.413, 0) against the true
 // (0.906, 0.423, 0), alpha 0.029 / 0.147 against 0.03 / 0.15) and its refit lowers the held-out
 // residual² by 75.2 %, nearly all of it in the 4 held-out blocks of cam0 that show the highlight
-// (each 90–99 % down). Measured 2026-11-22: the step gate's mean relative gain per block puts that
-// at 2.2 standard errors (changing a lobe's sampling changes the path tracer's random paths in
-// every block whose paths meet the box, and those blocks score noise), the error-weighted gain at
-// 6.3, the gate's combination (BlockGainZ) at 6.2: kept, the only step; final residual 0.1484
-// against the true model's 0.1481 (1.00×). Since the gate of a region's material change counts
-// only the held-out blocks that see the region: 45.2 standard errors (same gain and residual).
+// (each 90–99 % down). Measured with a gate over every held-out block: the step gate's mean
+// relative gain per block puts that at 2.2 standard errors (changing a lobe's sampling changes the
+// path tracer's random paths in every block whose paths meet the box, and those blocks score
+// noise), the error-weighted gain at 6.3, the gate's combination (BlockGainZ) at 6.2: kept, the
+// only step; final residual 0.1484 against the true model's 0.1481 (1.00×). The gate of a
+// region's material change counts only the held-out blocks that see the region: 45.2 standard
+// errors (same gain and residual).
 TEST(ConcealedBrdfLightTest, AnisotropicReflection) {
   const ConcealedOutcome o = DiagnoseConcealed("anisotropic_reflection", 11);
   const Json& d = o.diagnosis;
@@ -67,12 +68,10 @@ TEST(ConcealedBrdfLightTest, LightSourceExtent) {
 // The lamp is a spot, I·cos²(angle from −z): the room is 4× darker than the model, its ceiling lit
 // only by bounces. The candidate fits the lamp's whole direct term (diffuse and specular) as
 // cos^n with a free scale per region for what the light sends after a bounce (and, in the search
-// of the axis and n only, a camera response as a nuisance); seed 11 measured (session
-// 7): axis 1.1° from −z, cos power 1.92, held-out residual² down 99.9 %, then a small vignetting
-// step (k1 −0.07, k2 0.05: what the power's error leaves), which this test allows; final residual
-// 0.0502 against the true model's 0.0482 (1.04×). (Session 6: axis 0.7°, power 2.14, then
-// light_intensity and a spurious broad lobe on wall_y0, α 0.35, that specular_reflection now
-// refuses.)
+// of the axis and n only, a camera response as a nuisance); seed 11 measured: axis 1.1° from −z,
+// cos power 1.92, held-out residual² down 99.9 %, then a small vignetting step (k1 −0.07,
+// k2 0.05: what the power's error leaves), which this test allows; final residual 0.0502 against
+// the true model's 0.0482 (1.04×).
 TEST(ConcealedBrdfLightTest, LightEmissionProfile) {
   const ConcealedOutcome o = DiagnoseConcealed("light_emission_profile", 11);
   const Json& d = o.diagnosis;

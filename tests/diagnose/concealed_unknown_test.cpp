@@ -30,8 +30,8 @@ TEST(ConcealedUnknownMaterialsTest, AmbientLightIsNamedFirstAtItsRadiance) {
                                                " --photo-lightings L0,L1", false);
   const Json& d = o.diagnosis;
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
-  // igi-synth's floor is textured: since session 29 its maps come first here (the texture test's
-  // coarser cells), and the hidden effect is the first step after them.
+  // igi-synth's floor is textured: its maps come first here (the texture test's coarser cells),
+  // and the hidden effect is the first step after them.
   size_t k = 0;
   while (k + 1 < d["steps"].size() && d["steps"][k]["effect"] == "albedo_texture") ++k;
   const Json& first = d["steps"][k];
@@ -88,7 +88,7 @@ TEST(ConcealedUnknownMaterialsTest, EmissionProfileIsNamedFirstUnderTwoLightings
 
 // specular_lobe_shape with the materials unknown (ρs and α solved at every step): at the default
 // views a Ward lobe refitted in ρs and α stands in for the true Ward-GMD lobe (the full-size
-// suite's capture of session 19 named nothing and ended at 1.07× the floor held out). On a capture
+// suite's capture named nothing and ended at 1.07× the floor held out). On a capture
 // that sees the floor at grazing incidence (the lamp 0.6 m high, one camera on the mirror view of
 // its highlight at 60-80°, as for fresnel) the lobes differ where the photos look. Every glossy
 // region is truly Ward-GMD. The first step after the real textures (albedo maps, which the

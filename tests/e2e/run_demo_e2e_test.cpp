@@ -45,25 +45,23 @@ using test::RunTool;
 // "reference" (k = 1.030, the scale solved −3.1 %): ρd −9.4..+4.7 % (wall_x4 −9.4 %, the ceiling
 // −0.9 %), ρs −6.3..+1.6 %, α −1.5..+1.6 %; "measured" (k = 1.009): ρd −8.4..+5.6 %, ρs
 // −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
-// textured floor): +16.4 % (+1.6 % with "reference": weakly determined). Since 2026-11-22 a
-// textured region's true ρd is its texture's mean over the surface the photos see (pipeline/demo.h
-// SeenTrueAlbedo), not over the whole texture: on the same solve that took wall_x4 from −7.7 % to
-// −5.1 % and the glossy objects from +3.2 / +4.9 % to +1.8 / +0.0 %; every other region within
-// 2.7 % (solve from every third pixel, as the demo now does: the same within 1.5 points). Regions
-// no photo sees ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are
-// reported by igi-solve and not compared. Since 2026-11-26 (session 22; bench/RESULTS.md "End to
-// end"), with every photo registered, the truth over the solved maps' seen
-// texels and the glossy box and sphere mapped (their texture is finer than the solver's patches):
-// ρd −0.6..+1.25 % (wall_y4 +1.1 and +1.25 %: half of wall_x4, unseen, is brighter than its seen
-// half), ρs −3.1..+0.2 % and −2.5..−0.5 %, α −0.7..+3.3 % and −0.7..+1.1 %, k 1.001 and 0.999. The
-// bounds keep about twice that: an error several times larger fails. 2026-11-28 (session 32,
-// bench/solver/run_demo_split.sh: the solve repeated from the true poses and the true radiance):
-// ρd −0.4..+0.2 % but wall_y4 +1.2 % (the solver's on this capture: +1.4 % from the true
-// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. That
-// spread of the floor's lobe was the fit's sample draw (keyed by the observation's index, redrawn
-// by any change to an earlier photo), not the registration; every highlight sample fitted and 4
-// ceiling cameras: ρd −0.7..+0.8 % (wall_y4 +0.8 %), ρs and α −3.4..+0.5 %, poses within
-// 0.069° and 2.4 mm.
+// textured floor): +16.4 % (+1.6 % with "reference": weakly determined). A textured region's true
+// ρd is its texture's mean over the surface the photos see (pipeline/demo.h SeenTrueAlbedo), not
+// over the whole texture: on the same solve that takes wall_x4 from −7.7 % to −5.1 % and the glossy
+// objects from +3.2 / +4.9 % to +1.8 / +0.0 %; every other region within 2.7 % (solve from every
+// third pixel, as the demo now does: the same within 1.5 points). Regions no photo sees
+// ("unobserved") and lobes whose highlight no photo shows ("no_highlight") are reported by
+// igi-solve and not compared. With every photo registered (bench/RESULTS.md "End to end"), the
+// truth over the solved maps' seen texels and the glossy box and sphere mapped (their texture is
+// finer than the solver's patches): ρd −0.6..+1.25 % (wall_y4 +1.1 and +1.25 %: half of wall_x4,
+// unseen, is brighter than its seen half), ρs −3.1..+0.2 % and −2.5..−0.5 %, α −0.7..+3.3 % and
+// −0.7..+1.1 %, k 1.001 and 0.999. The bounds keep about twice that: an error several times larger
+// fails. With bench/solver/run_demo_split.sh (the solve repeated from the true poses and the true
+// radiance): ρd −0.4..+0.2 % but wall_y4 +1.2 % (the solver's on this capture: +1.4 % from the true
+// radiance), the floor's faint lobe ρs −6.6 % and α −5.1 %. That spread of the floor's lobe was the
+// fit's sample draw (keyed by the observation's index, redrawn by any change to an earlier photo),
+// not the registration; every highlight sample fitted and 4 ceiling cameras: ρd −0.7..+0.8 %
+// (wall_y4 +0.8 %), ρs and α −3.4..+0.5 %, poses within 0.069° and 2.4 mm.
 constexpr double kRhoDTolerance = 0.03;  // region-mean albedo after k (seen part)
 // Specular reflectance after k and lobe width (scale-free): COLMAP's poses differ slightly run to
 // run, which moves the floor's narrow highlight by about a pixel between views (measured up to
@@ -71,7 +69,7 @@ constexpr double kRhoDTolerance = 0.03;  // region-mean albedo after k (seen par
 constexpr double kRhoSTolerance = 0.08;
 constexpr double kAlphaTolerance = 0.08;
 // The ceiling, seen by the 2 cameras that look up (measured −0.9 % after k with "reference",
-// −1.0 % with "measured", +0.0 % and +0.3 % in sessions 19 and 22; 40 % low when no photo saw it
+// −1.0 % with "measured", +0.0 % and +0.3 % in two other solves; 40 % low when no photo saw it
 // and it kept a placeholder).
 constexpr double kCeilingRhoDTolerance = 0.03;
 // Registration against the true cameras: the targets, 0.1° and 0.5 % of the scene's size (the

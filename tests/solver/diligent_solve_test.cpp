@@ -93,10 +93,10 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   options.refine_iterations = 0;
   options.albedo_maps = "none";  // compare region-constant models
   // Every observation fitted (23 423): the fit's choice between one albedo and one per patch
-  // (which, under Lambert, soaks up the highlights) flips with which 6000 are drawn (session 33,
-  // the draw keyed by photo and pixel instead of the observation's index: Lambert per patch,
-  // region rms 0.091; 3000 drawn: Lambert per patch; 12 000: Ward per patch; all: both one
-  // albedo), and the comparison is of the two models, not of a draw.
+  // (which, under Lambert, soaks up the highlights) flips with which 6000 are drawn (the draw
+  // keyed by photo and pixel instead of the observation's index: Lambert per patch, region rms
+  // 0.091; 3000 drawn: Lambert per patch; 12 000: Ward per patch; all: both one albedo), and the
+  // comparison is of the two models, not of a draw.
   options.max_fit_samples = 100000;
   options.num_threads = 2;
   options.show_progress = false;
@@ -127,16 +127,14 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   return fit;
 }
 
-// Measured (Release, 2 threads, shared 2-core machine; the whole test 3 s), session 33, every
-// observation fitted, one albedo in both fits:
+// Measured (Release, 2 threads, shared 2-core machine; the whole test 3 s), every observation
+// fitted, one albedo in both fits:
 //   ward:    rho_d (0.496 0.420 0.275), rho_s 0.0092, alpha 0.027; fit render residual 0.0955,
 //            region rms 0.0947, held-out residual 0.0960
 //   lambert: rho_d (0.498 0.422 0.277);               fit render residual 0.1546,
 //            region rms 0.1542, held-out residual 0.1417
-// (Session 30, 6000 drawn by the observation's index: ward 0.096 / 0.096 / 0.097, lambert
+// (With 6000 drawn by the observation's index: ward 0.096 / 0.096 / 0.097, lambert
 // 0.154 / 0.210 / 0.141.)
-// (Before session 30 the fit render residual was of the ball with its per-patch albedo map,
-// which --albedo-maps none does not write: ward 0.067, lambert 0.126.)
 TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   const fs::path out = test::UniqueTempDir("igi_diligent_solve");
   const BallFit ward = FitBall(BrdfModel::kWard, "ward", out);

@@ -84,7 +84,7 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   // two texels (9 cm) inside them (32.9 / 34.4 dB before the specular bounces; 33.8 and 35.3 dB
   // with 512-spp photos then, bench/RESULTS.md): the rest is the photos' Monte Carlo noise (about
   // 7 % per pixel at 256 spp), the gathered indirect irradiance's noise, and its bias near the
-  // walls and the boxes' and sphere's contacts. Session 12's adaptive smoothing of the indirect
+  // walls and the boxes' and sphere's contacts. The adaptive smoothing of the indirect
   // irradiance (SolveOptions::smoothing_accuracy: a radius from the harmonic mean distance of
   // each observation's indirect hits) gives 33.50 and 36.33 dB (with a fixed radius 33.13 and
   // 35.01); the same capture at 2048 spp (nearly noise-free: the slow NoiseFree case below)
@@ -96,16 +96,15 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
               100 * (floor.stage1.rho_s.mean() / truth["floor"]["rho_s"].get<double>() - 1),
               100 * (floor.stage1.alpha / truth["floor"]["alpha"].get<double>() - 1));
   // The floor's lobe, fitted with each sample's albedo from the other photos (held-out, texel
-  // scale): measured rho_s -2.0 %, alpha -1.5 % in session 12 (-0.4 %, -0.2 % in an earlier
-  // session; -1.5 %, -0.6 % before the specular bounces;
+  // scale): measured rho_s -2.0 %, alpha -1.5 % (-1.5 %, -0.6 % before the specular bounces;
   // -1.0 %, -0.3 % before rho_s was fitted through the held-out samples' own lobe and the
   // off-highlight test took the region's mean albedo); guarded at the 5 % target.
   EXPECT_LT(RelErr(floor.stage1.rho_s.mean(), truth["floor"]["rho_s"].get<double>()), 0.05);
   EXPECT_LT(RelErr(floor.stage1.alpha, truth["floor"]["alpha"].get<double>()), 0.05);
   // Target: region-mean albedos within 1 %. The floor's (scene.json's rho_d) is its map's mean
   // over the texels the photos show, against the true texture's over the same texels: measured
-  // -0.18..-0.33 % in session 18 (the fit's patch-area mean, kept in report.json, +1.73 %: it
-  // weights each patch's texture by where its samples crowd).
+  // -0.18..-0.33 % (the fit's patch-area mean, kept in report.json, +1.73 %: it weights each
+  // patch's texture by where its samples crowd).
   {
     ASSERT_TRUE(floor.rho_d_from_map);
     const Eigen::Vector3d over_map = TextureMeanOverSeenTexels(want, *floor.albedo_map_seen);
@@ -118,11 +117,11 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
           << "floor rho_d[" << c << "]";
     }
   }
-  // The regions of one
-  // albedo (all but the textured floor), paper stage: measured -0.56..+0.83 % (glossy_box's red,
-  // rho_d 0.1, +0.83 %; the ceiling +0.27..+0.60 %; +0.59..+0.87 % with session 12's adaptive
-  // smoothing, where the wider mean over the open ceiling moved it). Without the specular bounces
-  // (SolveOptions::specular_bounces, solver/gather.h) the ceiling is +2.0..+2.3 % and this fails.
+  // The regions of one albedo (all but the textured floor), paper stage: measured -0.56..+0.83 %
+  // (glossy_box's red, rho_d 0.1, +0.83 %; the ceiling +0.27..+0.60 %; +0.59..+0.87 % with the
+  // adaptive smoothing of the indirect irradiance, where the wider mean over the open ceiling
+  // moved it). Without the specular bounces (SolveOptions::specular_bounces, solver/gather.h) the
+  // ceiling is +2.0..+2.3 % and this fails.
   for (const RegionSolution& r : s.regions) {
     if (r.name == "floor" || !truth.contains(r.name)) continue;
     const Json& t = truth[r.name];
@@ -142,7 +141,7 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolve) {
 }
 
 // The 35 dB target is for noise-free photos: the same capture at 2048 paths per pixel (123 s alone
-// on 2 threads; labelled slow, run with IGI_SLOW=1). Measured (session 31, as in session 12):
+// on 2 threads; labelled slow, run with IGI_SLOW=1). Measured:
 // 35.49 dB over the seen texels, 39.81 dB two texels inside; every region's rho_d within 0.57 %.
 TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolveNoiseFree) {
   CheckMapOfAResolvedTexture(2048, 35.0, 37.0);

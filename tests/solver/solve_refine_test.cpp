@@ -157,7 +157,7 @@ INSTANTIATE_TEST_SUITE_P(Room, SolveRefineLambert, ::testing::Values(false));
 // that light, come out low while the floor's own refit of ρs comes back down. The joint update
 // knows from the renderer's derivatives with respect to the floor's ρs (and α) how much of the
 // others' light goes with it, so their albedos land on the truth (within 0.1 %); the
-// albedo-only joint update ("joint_albedo", session 11's) treats the light of the floor's lobe
+// albedo-only joint update ("joint_albedo") treats the light of the floor's lobe
 // as fixed and leaves them 1.3–1.8 % low. The floor's own ρd and ρs are not checked to 1 %: in
 // this 64 × 48 room its wide lobe trades ρs against ρd by ±4 % from one round to another
 // (stage 1's floor: ρd −1.3 %); its ρs is checked to have come back from +40 %.

@@ -98,13 +98,14 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
 // Σ(r1 − p)(r2 − p) over the observed pixels estimates its residual without the renders' own
 // noise, as the report's two halves do; the two must agree.
 // - "no_maps": with --albedo-maps none a region the fit treats per patch (its albedo varies from
-//   patch to patch) is written with one albedo, and the report had rendered it with its
-//   per-patch map (on session 30's two-lighting capture: reported 0.153, 0.48 as written).
-//   Measured: reported 0.1604, the written model 0.1608; before session 30, 0.108 reported.
+//   patch to patch) is written with one albedo, and the report renders that albedo, not its
+//   per-patch map (rendered with the map on a two-lighting capture: reported 0.153, 0.48 as
+//   written). Measured: reported 0.1604, the written model 0.1608; with the fit's per-patch
+//   albedo map instead, 0.108 reported.
 // - "texel_maps": every region textured finer than the patches, --albedo-maps auto: three
 //   regions whose fit keeps one albedo get a map from the texel test (BuildAlbedoMaps), which the
-//   report had rendered with that one albedo. Measured: reported 0.1766, the written model
-//   0.1708 (1.034); before session 31, 0.1844 reported (1.080).
+//   report renders, not that one albedo. Measured: reported 0.1766, the written model 0.1708
+//   (1.034); with the one albedo instead, 0.1844 reported (1.080).
 struct WrittenCase {
   std::string name;
   std::string albedo_maps;
@@ -217,7 +218,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
           100 * (f.rho_d[2] / seen_mean[2] - 1),
           100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
           100 * (f.alpha / t["alpha"].get<double>() - 1));
-      // Measured (paper stage), session 26 (256-spp photos): rho_d +0.73..+1.19 % (clean),
+      // Measured (paper stage, 256-spp photos): rho_d +0.73..+1.19 % (clean),
       // +0.42..+0.82 % (noisy), the fit's area mean over the patches (it weights each patch's
       // texture by where its samples crowd); guarded at 2 %: the region's final rho_d is the
       // map's (below), which meets the 1 % target. The lobe is fitted with each highlight
@@ -235,8 +236,8 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
       // The region's final rho_d (scene.json's) is its albedo map's mean over the texels the
       // photos show, compared with the true texture's mean over the same texels. The 1 % target:
-      // measured +0.01..+0.16 % (clean), +0.22..+0.34 % (noisy) in session 26 (256-spp
-      // photos; -0.17..-0.23 % and -0.5..-0.8 % from 64-spp photos in session 18).
+      // measured +0.01..+0.16 % (clean), +0.22..+0.34 % (noisy) from 256-spp photos
+      // (-0.17..-0.23 % and -0.5..-0.8 % from 64-spp photos).
       ASSERT_TRUE(r.rho_d_from_map);
       const Eigen::Vector3d over_map = TextureMeanOverSeenTexels(
           ReadImage(so.out / t["rho_d_map"].get<std::string>(), 3), *r.albedo_map_seen);
@@ -296,19 +297,20 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // than a box-filtered 1024-path render of the true scene (bench/solver/ceiling_probe);
       // from 1024-spp photos (0.1 % off) the sphere comes to -0.5..-0.9 % and from another
       // scene seed's 256-spp photos to within 0.1 % (bench/RESULTS.md). The sphere
-      // is guarded at 2 % from 256-spp photos. (64-spp photos, sessions 18-25: -2.30..+1.75 %.)
+      // is guarded at 2 % from 256-spp photos. (From 64-spp photos: -2.30..+1.75 %.)
       // The "converged" cases' 1024-spp photos are within 0.1 % of the true scene's radiance
       // (the noise-free capture; "converged_noisy" adds the realistic sensor noise): there
       // the sphere too has the 1 %. Measured, the worst written rho_d:
       // converged the sphere -0.80 %, the ceiling +0.60 %, the rest within 0.46 %;
       // converged_noisy the sphere -0.79 %, the glossy box +0.62 %, the rest within 0.40 %.
-      // (The "noisy" case at 256 spp, sessions 26-30, was replaced by converged_noisy.)
+      // (The "noisy" figures at 256 spp are of 256-spp photos with the sensor noise, a case not
+      // run here: converged_noisy covers the noise.)
       const double bar = r.name == "glossy_sphere" && GetParam().spp < 1024 ? 0.02 : 0.01;
       EXPECT_LT(RelErr(r.final_params.rho_d[c], t["rho_d"][c].get<double>()), bar)
           << r.name << " final rho_d[" << c << "]";
     }
     if (t.contains("rho_s")) {
-      // Target: within 5 %; measured (256-spp photos, session 26; rho_s / alpha, clean and
+      // Target: within 5 %; measured (256-spp photos; rho_s / alpha, clean and
       // noisy): glossy_box -0.1 / +0.3 % and -1.4 / +0.5 %, wall_y4 -0.0 / +1.5 % and
       // -1.2 / +2.6 %, glossy_sphere +1.4 / +0.6 % and +3.4 / +1.5 %. 5 % (the bar)
       // guards them.
@@ -399,7 +401,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
   // Target: within 2 % relative RMS plus the noise floor (added in quadrature here), the
-  // issue's bar. Session 26, 256-spp photos, igi-solve's defaults: 1.39 % beyond (clean: model
+  // issue's bar. Measured (256-spp photos, igi-solve's defaults): 1.39 % beyond (clean: model
   // 0.0267, floor 0.0228), 1.35 % (noisy: 0.0265, 0.0228). From 64-spp photos
   // it was 2.63 %: 78 % of the squared error sat on the floor's blocks, the texel noise of a map
   // from photos that noisy (bench/solver/relight_probe, bench/RESULTS.md).
