@@ -300,7 +300,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // is guarded at 2 % from 256-spp photos. (From 64-spp photos: -2.30..+1.75 %.)
       // The "converged" cases' 1024-spp photos are within 0.1 % of the true scene's radiance
       // (the noise-free capture; "converged_noisy" adds the realistic sensor noise): there
-      // the sphere too has the 1 %. Measured, the worst written rho_d:
+      // the sphere too has the 1 % accuracy target. Measured, the worst written rho_d:
       // converged the sphere -0.80 %, the ceiling +0.60 %, the rest within 0.46 %;
       // converged_noisy the sphere -0.79 %, the glossy box +0.62 %, the rest within 0.40 %.
       // (The "noisy" figures at 256 spp are of 256-spp photos with the sensor noise, a case not
@@ -312,7 +312,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     if (t.contains("rho_s")) {
       // Target: within 5 %; measured (256-spp photos; rho_s / alpha, clean and
       // noisy): glossy_box -0.1 / +0.3 % and -1.4 / +0.5 %, wall_y4 -0.0 / +1.5 % and
-      // -1.2 / +2.6 %, glossy_sphere +1.4 / +0.6 % and +3.4 / +1.5 %. 5 % (the bar)
+      // -1.2 / +2.6 %, glossy_sphere +1.4 / +0.6 % and +3.4 / +1.5 %. 5 % (the accuracy target)
       // guards them.
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05) << r.name;
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05) << r.name;
@@ -401,7 +401,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   const double floor = rel_rms(again), err = rel_rms(mine);
   std::printf("relighting cam0/L1: model %.4f, noise floor %.4f\n", err, floor);
   // Target: within 2 % relative RMS plus the noise floor (added in quadrature here), the
-  // issue's bar. Measured (256-spp photos, igi-solve's defaults): 1.39 % beyond (clean: model
+  // accuracy target. Measured (256-spp photos, igi-solve's defaults): 1.39 % beyond (clean: model
   // 0.0267, floor 0.0228), 1.35 % (noisy: 0.0265, 0.0228). From 64-spp photos
   // it was 2.63 %: 78 % of the squared error sat on the floor's blocks, the texel noise of a map
   // from photos that noisy (bench/solver/relight_probe, bench/RESULTS.md).
