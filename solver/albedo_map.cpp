@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "solver/render_internal.h"
@@ -206,15 +207,18 @@ Image AlbedoMapBuilder::Finish(const Eigen::Vector3d& fallback) const {
   return out;
 }
 
-double AlbedoMapBuilder::Coverage() const {
+void AlbedoMapBuilder::ForEachTexelCentre(
+    const std::function<void(int triangle, int x, int y, double b1, double b2)>& f) const {
   const int width = atlas_->width, height = atlas_->height;
-  std::vector<char> inside(size_t(width) * height, 0);
   for (int t : atlas_->triangles) {
     std::array<Eigen::Vector2d, 3> p;  // pixel coordinates: x right, y down, texel i = [i, i+1)
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector2f& uv = atlas_->corner_uv[t][k];
       p[k] = Eigen::Vector2d(uv.x() * width, (1.0 - uv.y()) * height);
     }
+    const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
+    const double det = e1.x() * e2.y() - e1.y() * e2.x();
+    if (!(std::abs(det) > 0)) continue;  // a triangle of no area in UV holds no texel centre
     const Eigen::Vector2d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
     const Eigen::Vector2d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
     const int x_begin = std::max(0, static_cast<int>(std::floor(lo.x() - 0.5)));
@@ -223,10 +227,35 @@ double AlbedoMapBuilder::Coverage() const {
     const int y_end = std::min(height - 1, static_cast<int>(std::ceil(hi.y() - 0.5)));
     for (int y = y_begin; y <= y_end; ++y) {
       for (int x = x_begin; x <= x_end; ++x) {
-        if (Inside(p, x + 0.5, y + 0.5)) inside[size_t(y) * width + x] = 1;
+        if (!Inside(p, x + 0.5, y + 0.5)) continue;
+        const Eigen::Vector2d d(x + 0.5 - p[0].x(), y + 0.5 - p[0].y());
+        const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
+        const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
+        f(t, x, y, b1, b2);
       }
     }
   }
+}
+
+void AlbedoMapBuilder::AddTexelCentres(
+    const std::function<Eigen::Vector3d(int triangle, double b1, double b2)>& value) {
+  ForEachTexelCentre([&](int t, int x, int y, double b1, double b2) {
+    const Eigen::Vector3d v = value(t, b1, b2);
+    if (!v.allFinite()) return;
+    double* texel = TileAt(x, y)->texel(x, y);
+    for (int c = 0; c < 3; ++c) {
+      texel[c] += v[c];
+      texel[3 + c] += 1;
+    }
+    texel[kWeightSlot] += 1;
+    ++num_samples_;
+  });
+}
+
+double AlbedoMapBuilder::Coverage() const {
+  const int width = atlas_->width, height = atlas_->height;
+  std::vector<char> inside(size_t(width) * height, 0);
+  ForEachTexelCentre([&](int, int x, int y, double, double) { inside[size_t(y) * width + x] = 1; });
   int64_t total = 0, direct = 0;
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {

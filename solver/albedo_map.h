@@ -9,6 +9,7 @@
 // whose lookups would read it.
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -38,6 +39,12 @@ class AlbedoMapBuilder {
   // thread-safe: use one builder per thread and Merge().
   void Add(int triangle, double b1, double b2, const Eigen::Vector3d& numerator,
            const Eigen::Vector3d& denominator);
+  // Every texel whose centre lies inside one of the atlas region's triangles: value(triangle,
+  // b1, b2) at that centre, as one sample of weight 1 (numerator value, denominator 1). For a
+  // quantity known everywhere on the surface, such as the fit's per-patch albedos; non-finite
+  // values are left out.
+  void AddTexelCentres(
+      const std::function<Eigen::Vector3d(int triangle, double b1, double b2)>& value);
   // Adds another builder's sums (same atlas size; throws igi::Error otherwise).
   void Merge(const AlbedoMapBuilder& other);
 
@@ -64,6 +71,10 @@ class AlbedoMapBuilder {
   Tile* TileAt(int x, int y);  // allocates
   const Tile* TileAt(int x, int y) const;
   bool Direct(int x, int y, int channel) const;
+  // Calls f for every texel centre inside one of the atlas region's triangles, with the
+  // barycentrics of that centre (a texel on an edge shared by two triangles: for each).
+  void ForEachTexelCentre(
+      const std::function<void(int triangle, int x, int y, double b1, double b2)>& f) const;
 
   const RegionAtlas* atlas_;
   double min_texel_weight_;

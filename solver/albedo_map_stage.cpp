@@ -83,6 +83,14 @@ Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const 
   return builder.Finish(m.params.rho_d);
 }
 
+Image PatchAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas) {
+  AlbedoMapBuilder builder(atlas);
+  builder.AddTexelCentres([&](int triangle, double b1, double b2) {
+    return d.materials.PatchAlbedo(d.patches, d.patches.PatchOf(triangle, b1, b2));
+  });
+  return builder.Finish(d.materials[r].params.rho_d);
+}
+
 bool WritesMap(const MapStageData& d, size_t r, const RegionAtlas& atlas, const MapLight& light,
                TexelDetail* detail) {
   const MaterialState& m = d.materials[r];

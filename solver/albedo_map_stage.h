@@ -61,6 +61,14 @@ RegionAtlas MapAtlas(const MapStageData& d, int r);
 Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const MapLight& light,
                   double* coverage = nullptr, Image* seen = nullptr, int photo_parity = -1);
 
+// Region r's per-patch albedos as a map on `atlas`: each texel the albedo of the patch holding
+// its centre (MaterialEstimate::PatchAlbedo: a patch without observations has the region's ρd).
+// The model the refinement renders a region fitted per patch with: the fit's own, where a patch
+// is the mean of all its observations, while a map from the observations gives a texel seen by
+// one edge pixel that pixel's value (a 1-path pixel can be many times the albedo) and fills the
+// unseen texels around from it.
+Image PatchAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas);
+
 // A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
 // texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.
 // 0.1: a constant sphere's smooth shading errors read 5 %, the demo's noise-textured box and

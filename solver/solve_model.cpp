@@ -55,7 +55,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
                                  const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
   const MapStageData data = MapData();
-  const MapLight map_light = MapLightOf(data);
+  const MapLight map_light = as_written ? MapLightOf(data) : MapLight{};
   atlases->clear();
   maps->clear();
   bool generated = false;
@@ -83,10 +83,12 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
     RegionAtlas atlas = MapAtlas(data, int(r));
     if (!as_written || WritesMap(data, r, atlas, map_light, nullptr)) {
       atlases->push_back(std::move(atlas));
-      maps->push_back(AlbedoMapOf(data, int(r), atlases->back(), map_light));
       if (as_written) {
+        maps->push_back(AlbedoMapOf(data, int(r), atlases->back(), map_light));
         const Eigen::Vector3d rho = m.params.rho_d;
         ScaleMapHeldAtOne((rho.array() > 1).select(rho.cwiseInverse(), 1.0), &maps->back());
+      } else {
+        maps->push_back(PatchAlbedoMap(data, int(r), atlases->back()));
       }
       const std::filesystem::path file = temp_dir / (out.name + ".exr");
       WriteImage(file, maps->back());

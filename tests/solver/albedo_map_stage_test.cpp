@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -100,6 +101,37 @@ TEST(AlbedoMapStage, TheOptionsDecideWhichRegionsMayHaveAMap) {
   EXPECT_TRUE(WritesMap(f.Data(), 0, MapAtlas(f.Data(), 0), MapLightOf(f.Data()), nullptr));
   f.options.albedo_map_regions = {"wall"};
   EXPECT_FALSE(MapCandidate(f.Data(), 0));
+}
+
+TEST(AlbedoMapStage, TheRefinementsMapHoldsThePerPatchAlbedos) {
+  // The fit's per-patch albedos (every third patch without observations: the region's ρd): each
+  // observation's point reads its own patch's albedo from the map, but where its texel's centre
+  // lies in the next patch (texels of 2 cm, patches with legs of 6.7 cm: about a quarter).
+  StageFixture f(Checker, 1, 5);
+  MaterialState& m = f.materials[0];
+  m.params.rho_d = Eigen::Vector3d(0.5, 0.4, 0.3);
+  for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
+    m.patch_rho_d[s] = s % 3 == 2 ? Eigen::Vector3d::Constant(NAN)
+                                  : Eigen::Vector3d(0.1 + 0.01 * s, 0.2, 0.9 - 0.01 * s);
+  }
+  const MapStageData d = f.Data();
+  const RegionAtlas atlas = MapAtlas(d, 0);
+  const Image map = PatchAlbedoMap(d, 0, atlas);
+  int same = 0, unseen = 0;
+  for (const Observation& o : f.obs.items) {
+    const Eigen::Vector2d uv = atlas.UvAt(o.triangle, o.b1, o.b2);
+    const int x = std::clamp(int(uv.x() * map.width), 0, map.width - 1);
+    const int y = std::clamp(int((1 - uv.y()) * map.height), 0, map.height - 1);
+    const Eigen::Vector3d want = f.materials.PatchAlbedo(f.patches, o.patch);
+    const Eigen::Vector3d got(map.at(x, y, 0), map.at(x, y, 1), map.at(x, y, 2));
+    if ((got - want).cwiseAbs().maxCoeff() < 1e-6) {
+      ++same;
+      unseen += want == m.params.rho_d;
+    }
+  }
+  const int n = int(f.obs.size());
+  EXPECT_GT(same, n * 3 / 5);
+  EXPECT_GT(unseen, same / 5);  // the region's ρd where a patch has none of its own
 }
 
 }  // namespace
