@@ -493,6 +493,7 @@ int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map) {
   for (int y = 0; y < map->height; ++y) {
     for (int x = 0; x < map->width; ++x) {
       for (int c = 0; c < std::min(map->channels, 3); ++c) {
+        if (factor[c] == 1.0) continue;
         float& v = map->at(x, y, c);
         v = float(v * factor[c]);
         if (v > 1.0f) {

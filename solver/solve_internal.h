@@ -32,8 +32,11 @@
 namespace igi {
 
 // An albedo map as scene.json holds it when its region's fitted ρd exceeds 1 in some channel
-// (BoundReflectances): scaled by `factor` per channel (1/ρd where ρd > 1, else 1) and its texels
-// clipped at 1. Returns how many texel channels were clipped.
+// (BoundReflectances): each channel whose `factor` is not 1 (1/ρd where ρd > 1) scaled by it and
+// its texels clipped at 1. A channel of factor 1 is left as it is: its texels above 1 are the
+// photos' noise about a level below 1 (a texel seen by one pixel of a few paths), and clipping
+// them would darken the map's mean below the ρd scene.json gives the region. Returns how many
+// texel channels were clipped.
 int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map);
 
 // The report's images of a photo (PhotoResidual) are at most this many pixels on a side: one

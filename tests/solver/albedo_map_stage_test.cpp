@@ -10,6 +10,7 @@
 #include <functional>
 #include <random>
 
+#include "solver/solve_internal.h"
 #include "tests/solver/stage_fixture.h"
 
 namespace igi {
@@ -132,6 +133,22 @@ TEST(AlbedoMapStage, TheRefinementsMapHoldsThePerPatchAlbedos) {
   const int n = int(f.obs.size());
   EXPECT_GT(same, n * 3 / 5);
   EXPECT_GT(unseen, same / 5);  // the region's ρd where a patch has none of its own
+}
+
+TEST(AlbedoMapStage, TheWrittenMapIsScaledAndClippedOnlyInAChannelHeldAtOne) {
+  // Red fitted at 1.25 (held at 1: scaled by 0.8, then clipped); green and blue within 1 keep
+  // their texels, noise above 1 included, so that their mean stays the written ρd.
+  Image map(2, 1, 3);
+  const float texels[2][3] = {{1.5f, 1.4f, 0.2f}, {1.0f, 0.6f, 0.4f}};
+  for (int x = 0; x < 2; ++x) {
+    for (int c = 0; c < 3; ++c) map.at(x, 0, c) = texels[x][c];
+  }
+  EXPECT_EQ(ScaleMapHeldAtOne(Eigen::Vector3d(0.8, 1, 1), &map), 1);
+  EXPECT_FLOAT_EQ(map.at(0, 0, 0), 1.0f);  // 1.2 clipped
+  EXPECT_FLOAT_EQ(map.at(1, 0, 0), 0.8f);
+  EXPECT_FLOAT_EQ(map.at(0, 0, 1), 1.4f);
+  EXPECT_FLOAT_EQ(map.at(1, 0, 1), 0.6f);
+  EXPECT_FLOAT_EQ(map.at(0, 0, 2), 0.2f);
 }
 
 }  // namespace
