@@ -237,9 +237,10 @@ void AlbedoMapBuilder::ForEachTexelCentre(
   }
 }
 
-void AlbedoMapBuilder::AddTexelCentres(
+void AlbedoMapBuilder::FillTexelCentres(
     const std::function<Eigen::Vector3d(int triangle, double b1, double b2)>& value) {
   ForEachTexelCentre([&](int t, int x, int y, double b1, double b2) {
+    if (Direct(x, y, 0) && Direct(x, y, 1) && Direct(x, y, 2)) return;
     const Eigen::Vector3d v = value(t, b1, b2);
     if (!v.allFinite()) return;
     double* texel = TileAt(x, y)->texel(x, y);

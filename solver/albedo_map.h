@@ -39,11 +39,12 @@ class AlbedoMapBuilder {
   // thread-safe: use one builder per thread and Merge().
   void Add(int triangle, double b1, double b2, const Eigen::Vector3d& numerator,
            const Eigen::Vector3d& denominator);
-  // Every texel whose centre lies inside one of the atlas region's triangles: value(triangle,
-  // b1, b2) at that centre, as one sample of weight 1 (numerator value, denominator 1). For a
-  // quantity known everywhere on the surface, such as the fit's per-patch albedos; non-finite
+  // Every texel whose centre lies inside one of the atlas region's triangles and that is not yet
+  // estimated directly in every channel: value(triangle, b1, b2) at that centre, as one sample
+  // of weight 1 (numerator value, denominator 1). For a quantity known everywhere on the
+  // surface, such as the fit's per-patch albedos, in place of the push-pull fill; non-finite
   // values are left out.
-  void AddTexelCentres(
+  void FillTexelCentres(
       const std::function<Eigen::Vector3d(int triangle, double b1, double b2)>& value);
   // Adds another builder's sums (same atlas size; throws igi::Error otherwise).
   void Merge(const AlbedoMapBuilder& other);

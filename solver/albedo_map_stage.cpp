@@ -50,9 +50,12 @@ RegionAtlas MapAtlas(const MapStageData& d, int r) {
   return BuildRegionAtlas(d.scene.mesh, r, ao);
 }
 
-Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const MapLight& light,
-                  double* coverage, Image* seen, int photo_parity) {
-  AlbedoMapBuilder builder(atlas);
+namespace {
+
+// Adds region r's observations (of the photos of parity photo_parity, or all with -1) to
+// `builder`: π(L − ρs·T)/E, each weighted by its diffuse share.
+void AddObservations(const MapStageData& d, int r, const MapLight& light, int photo_parity,
+                     AlbedoMapBuilder* builder) {
   const MaterialState& m = d.materials[r];
   for (size_t i = 0; i < d.obs.size(); ++i) {
     const Observation& o = d.obs[i];
@@ -76,16 +79,26 @@ Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const 
     // evens out over the texel's observations instead of dominating.
     const Eigen::Vector3d& e_i = light.e[i];
     if (!(e_i.minCoeff() > 0)) continue;
-    builder.Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e_i);
+    builder->Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e_i);
   }
-  if (coverage != nullptr) *coverage = builder.Coverage();
-  if (seen != nullptr) *seen = builder.DirectMask();
-  return builder.Finish(m.params.rho_d);
 }
 
-Image PatchAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas) {
+}  // namespace
+
+Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const MapLight& light,
+                  double* coverage, Image* seen, int photo_parity) {
   AlbedoMapBuilder builder(atlas);
-  builder.AddTexelCentres([&](int triangle, double b1, double b2) {
+  AddObservations(d, r, light, photo_parity, &builder);
+  if (coverage != nullptr) *coverage = builder.Coverage();
+  if (seen != nullptr) *seen = builder.DirectMask();
+  return builder.Finish(d.materials[r].params.rho_d);
+}
+
+Image RefinementAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas,
+                          const MapLight& light) {
+  AlbedoMapBuilder builder(atlas);
+  AddObservations(d, r, light, -1, &builder);
+  builder.FillTexelCentres([&](int triangle, double b1, double b2) {
     return d.materials.PatchAlbedo(d.patches, d.patches.PatchOf(triangle, b1, b2));
   });
   return builder.Finish(d.materials[r].params.rho_d);

@@ -61,13 +61,15 @@ RegionAtlas MapAtlas(const MapStageData& d, int r);
 Image AlbedoMapOf(const MapStageData& d, int r, const RegionAtlas& atlas, const MapLight& light,
                   double* coverage = nullptr, Image* seen = nullptr, int photo_parity = -1);
 
-// Region r's per-patch albedos as a map on `atlas`: each texel the albedo of the patch holding
-// its centre (MaterialEstimate::PatchAlbedo: a patch without observations has the region's ρd).
-// The model the refinement renders a region fitted per patch with: the fit's own, where a patch
-// is the mean of all its observations, while a map from the observations gives a texel seen by
-// one edge pixel that pixel's value (a 1-path pixel can be many times the albedo) and fills the
-// unseen texels around from it.
-Image PatchAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas);
+// The albedo map the refinement renders a region fitted per patch with: the map of its
+// observations (as AlbedoMapOf) at the texels they estimate directly, and at every other texel
+// of the region the fit's albedo of the patch holding the texel's centre
+// (MaterialEstimate::PatchAlbedo: a patch without observations has the region's ρd). The
+// push-pull fill of AlbedoMapOf would instead carry a texel seen only by a single edge pixel
+// (one path of a few-path photo can be many times the albedo) over the unseen surface around
+// it, which is much of what the other regions see of it.
+Image RefinementAlbedoMap(const MapStageData& d, int r, const RegionAtlas& atlas,
+                          const MapLight& light);
 
 // A region whose fit keeps a constant albedo still gets a map (and its ρd from the map) when its
 // texture's relative standard deviation at the texel scale, beyond the noise, exceeds this.

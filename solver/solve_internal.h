@@ -111,9 +111,10 @@ struct SolverState {
   void RefineRound(int round, const std::filesystem::path& temp_dir);
   void RunStage2();
   // The model as it stands, its albedo maps written under temp_dir. For the refinement's rounds
-  // the regions fitted per patch get their per-patch albedos (PatchAlbedoMap), whatever the
-  // options write; as_written, exactly the regions BuildAlbedoMaps gives a map (WritesMap) get
-  // the map from the observations (AlbedoMapOf): the report renders the model scene.json holds.
+  // the regions fitted per patch get RefinementAlbedoMap's (the unseen texels at their patches'
+  // albedos), whatever the options write; as_written, exactly the regions BuildAlbedoMaps gives
+  // a map (WritesMap) get the map from the observations (AlbedoMapOf): the report renders the
+  // model scene.json holds.
   Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
                       const std::filesystem::path& temp_dir, bool as_written = false) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and

@@ -55,7 +55,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
                                  const std::filesystem::path& temp_dir, bool as_written) const {
   Scene model = scene;
   const MapStageData data = MapData();
-  const MapLight map_light = as_written ? MapLightOf(data) : MapLight{};
+  const MapLight map_light = MapLightOf(data);
   atlases->clear();
   maps->clear();
   bool generated = false;
@@ -88,7 +88,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
         const Eigen::Vector3d rho = m.params.rho_d;
         ScaleMapHeldAtOne((rho.array() > 1).select(rho.cwiseInverse(), 1.0), &maps->back());
       } else {
-        maps->push_back(PatchAlbedoMap(data, int(r), atlases->back()));
+        maps->push_back(RefinementAlbedoMap(data, int(r), atlases->back(), map_light));
       }
       const std::filesystem::path file = temp_dir / (out.name + ".exr");
       WriteImage(file, maps->back());

@@ -104,35 +104,53 @@ TEST(AlbedoMapStage, TheOptionsDecideWhichRegionsMayHaveAMap) {
   EXPECT_FALSE(MapCandidate(f.Data(), 0));
 }
 
-TEST(AlbedoMapStage, TheRefinementsMapHoldsThePerPatchAlbedos) {
-  // The fit's per-patch albedos (every third patch without observations: the region's ρd): each
-  // observation's point reads its own patch's albedo from the map, but where its texel's centre
-  // lies in the next patch (texels of 2 cm, patches with legs of 6.7 cm: about a quarter).
-  StageFixture f(Checker, 1, 5);
+TEST(AlbedoMapStage, TheRefinementsMapIsTheObservationsWhereSeenAndThePatchesElsewhere) {
+  // The checker seen on the square's left half only (the right half's observations have no
+  // irradiance, so the map leaves them out); the fit's per-patch albedos set by hand, every
+  // third patch without one (the region's ρd).
+  StageFixture f(Checker, 32, 5);
+  for (size_t i = 0; i < f.obs.size(); ++i) {
+    if (f.obs[i].position.x() > 0) f.light.e[i].setZero();
+  }
   MaterialState& m = f.materials[0];
   m.params.rho_d = Eigen::Vector3d(0.5, 0.4, 0.3);
   for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
     m.patch_rho_d[s] = s % 3 == 2 ? Eigen::Vector3d::Constant(NAN)
-                                  : Eigen::Vector3d(0.1 + 0.01 * s, 0.2, 0.9 - 0.01 * s);
+                                  : Eigen::Vector3d(0.1 + 0.001 * s, 0.2, 0.9 - 0.001 * s);
   }
   const MapStageData d = f.Data();
   const RegionAtlas atlas = MapAtlas(d, 0);
-  const Image map = PatchAlbedoMap(d, 0, atlas);
-  int same = 0, unseen = 0;
-  for (const Observation& o : f.obs.items) {
-    const Eigen::Vector2d uv = atlas.UvAt(o.triangle, o.b1, o.b2);
-    const int x = std::clamp(int(uv.x() * map.width), 0, map.width - 1);
-    const int y = std::clamp(int((1 - uv.y()) * map.height), 0, map.height - 1);
-    const Eigen::Vector3d want = f.materials.PatchAlbedo(f.patches, o.patch);
-    const Eigen::Vector3d got(map.at(x, y, 0), map.at(x, y, 1), map.at(x, y, 2));
-    if ((got - want).cwiseAbs().maxCoeff() < 1e-6) {
-      ++same;
-      unseen += want == m.params.rho_d;
+  const Image map = RefinementAlbedoMap(d, 0, atlas, MapLightOf(d));
+  // Texel (x, y) of the square's UVs (u = x + 0.5 m, v = y + 0.5 m): its centre's triangle and
+  // barycentrics (triangle 0: corners (0,0), (1,0), (1,1) in UV; triangle 1: (0,0), (1,1), (0,1)).
+  int right = 0, patch_albedo = 0, unseen = 0;
+  double left_ratio = 0;
+  int left = 0;
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      const double u = (x + 0.5) / map.width, v = 1 - (y + 0.5) / map.height;
+      const Eigen::Vector3d got(map.at(x, y, 0), map.at(x, y, 1), map.at(x, y, 2));
+      if (u < 0.45) {  // seen: the observations' albedo (the checker times the noise's mean)
+        left_ratio += got[0] / Checker(u, v);
+        ++left;
+        continue;
+      }
+      if (u < 0.55) continue;
+      ++right;
+      const int q = u >= v ? f.patches.PatchOf(0, u - v, v) : f.patches.PatchOf(1, u, v - u);
+      const Eigen::Vector3d want = f.materials.PatchAlbedo(f.patches, q);
+      if ((got - want).cwiseAbs().maxCoeff() < 1e-6) {
+        ++patch_albedo;
+        unseen += want == m.params.rho_d;
+      }
     }
   }
-  const int n = int(f.obs.size());
-  EXPECT_GT(same, n * 3 / 5);
-  EXPECT_GT(unseen, same / 5);  // the region's ρd where a patch has none of its own
+  // Unseen: each texel its patch's albedo (texels on the diagonal belong to both triangles).
+  EXPECT_GT(patch_albedo, right * 95 / 100);
+  EXPECT_GT(unseen, patch_albedo / 5);  // the region's ρd where a patch has none of its own
+  // Seen: the observations' checker in a constant ratio (the fireflies' mean, 1.24), not the
+  // patches' values (0.1-0.35 in red).
+  EXPECT_NEAR(left_ratio / left, 1.24, 0.1);
 }
 
 TEST(AlbedoMapStage, TheWrittenMapIsScaledAndClippedOnlyInAChannelHeldAtOne) {

@@ -188,7 +188,7 @@ TEST(AlbedoMap, TexelCentresTakeTheValueAtTheirSurfacePoint) {
                             b1 * mesh.positions[tri[1]].cast<double>() +
                             b2 * mesh.positions[tri[2]].cast<double>()));
   };
-  builder.AddTexelCentres([&](int t, double b1, double b2) {
+  builder.FillTexelCentres([&](int t, double b1, double b2) {
     const Eigen::Vector3d p = point(t, b1, b2);
     return Albedo(p.x() + p.z(), p.y());
   });
