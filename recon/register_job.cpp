@@ -48,35 +48,17 @@ std::string Relative(const fs::path& target, const fs::path& base) {
   return fs::relative(fs::absolute(target), fs::absolute(base)).generic_string();
 }
 
-// Rewrites the relative file paths of a scene read from `from` so they hold in `to`.
-void RebasePaths(Json* scene, const fs::path& from, const fs::path& to) {
-  auto rebase = [&](Json& value) {
-    if (value.is_string() && fs::path(value.get<std::string>()).is_relative()) {
-      value = Relative(from / value.get<std::string>(), to);
-    }
-  };
-  if (scene->contains("geometry")) {
-    for (auto& g : (*scene)["geometry"]) rebase(g["file"]);
-  }
-  if (scene->contains("materials")) {
-    for (auto& [name, m] : (*scene)["materials"].items()) {
-      if (m.contains("rho_d_map")) rebase(m["rho_d_map"]);
-    }
-  }
-  if (scene->contains("lights")) {
-    for (auto& [name, l] : (*scene)["lights"].items()) {
-      if (l.contains("file")) rebase(l["file"]);
-      if (l.contains("profile") && l["profile"].contains("ies")) rebase(l["profile"]["ies"]);
-    }
-  }
-}
-
 // The input scene with a camera per registered photo and its photos (lighting taken from the
 // input scene's photo of the same file name, else its only lighting).
 Json SceneWithCameras(const RegisterOptions& options, Json scene, const ColmapModel& model,
                       Json* report) {
+  // Every relative path of the input scene (read from `from`) made to hold in the output folder.
   const fs::path from = fs::path(options.scene).parent_path();
-  RebasePaths(&scene, from.empty() ? fs::path(".") : from, options.out);
+  ForEachScenePath(&scene, [&](const std::string& path) {
+    return fs::path(path).is_relative()
+               ? Relative((from.empty() ? fs::path(".") : from) / path, options.out)
+               : path;
+  });
   std::map<std::string, Json> old_photos;
   if (scene.contains("photos")) {
     for (const auto& p : scene["photos"]) {
@@ -91,15 +73,8 @@ Json SceneWithCameras(const RegisterOptions& options, Json scene, const ColmapMo
   Json photos = Json::array();
   Json no_lighting = Json::array();
   for (const auto& [id, image] : model.images) {
-    const ColmapCamera& cam = model.cameras.at(image.camera_id);
-    const Camera camera = CameraOfImage(model, image);
     const std::string key = fs::path(image.name).stem().string();
-    cameras[key] = {{"model", std::string(CameraModelName(camera.model))},
-                    {"width", cam.width},
-                    {"height", cam.height},
-                    {"params", camera.params},
-                    {"qvec", {image.qvec[0], image.qvec[1], image.qvec[2], image.qvec[3]}},
-                    {"tvec", {image.tvec[0], image.tvec[1], image.tvec[2]}}};
+    cameras[key] = CameraJson(CameraOfImage(model, image));
     Json photo = {{"file", Relative(fs::path(options.images) / image.name, options.out)},
                   {"camera", key}};
     const auto old = old_photos.find(image.name);
