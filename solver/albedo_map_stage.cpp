@@ -12,7 +12,16 @@ MapLight MapLightOf(const MapStageData& d) {
   const LightModel& light = d.light;
   const double radius = o.smoothing_radius_m > 0 ? o.smoothing_radius_m : d.scene_scale_m / 96;
   MapLight out;
-  out.t = NeighbourMean(d.obs, light.lightings, light.t, d.scene_scale_m / 96, true, o.num_threads);
+  const std::vector<Eigen::Vector3d> t_direct =
+      DirectSpecularTerms(d.scene, d.obs, d.materials, light, o.num_threads);
+  std::vector<Eigen::Vector3d> t_indirect(d.obs.size());
+  for (size_t i = 0; i < d.obs.size(); ++i) t_indirect[i] = light.t[i] - t_direct[i];
+  out.t_indirect =
+      NeighbourMean(d.obs, light.lightings, t_indirect, d.scene_scale_m / 96, true, o.num_threads);
+  out.t.resize(d.obs.size());
+  for (size_t i = 0; i < d.obs.size(); ++i) {
+    out.t[i] = (t_direct[i] + out.t_indirect[i]).cwiseMax(0.0);
+  }
   const bool have_stage1 = light.e_stage1.size() == d.obs.size() && d.stage2_iterations > 0;
   if (!have_stage1 || !IsJointUpdate(o.refine_update)) {
     out.e = light.e;

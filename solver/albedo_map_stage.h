@@ -40,10 +40,13 @@ struct MapStageData {
 // rounds' few path-traced directions) times the ratio of the rounds' to stage 1's irradiance
 // averaged over 4 smoothing radii, so that the maps' texel detail keeps stage 1's noise while
 // their level follows the path tracer; after a rejected refinement stage 1's; else the light
-// model's. `t`: the specular term T averaged over neighbours in the same photo (few incident
-// samples carry the reflected room, so T is noisy; the same view, nearly).
+// model's. `t`: the specular term T, its direct part the observation's own and its indirect part
+// (`t_indirect`) averaged over neighbours in the same photo: few incident samples carry the
+// reflected room, so the indirect part is noisy (the same view, nearly), while the direct part
+// from the light samples is not, and near a highlight it varies within a smoothing radius, where
+// a mean over neighbours would subtract the highlight's flanks from the albedo.
 struct MapLight {
-  std::vector<Eigen::Vector3d> t, e;
+  std::vector<Eigen::Vector3d> t, t_indirect, e;
 };
 MapLight MapLightOf(const MapStageData& d);
 

@@ -9,14 +9,14 @@
 // light from other surfaces, smooth on the scale of the drawn observations' spacing) comes from
 // the nearest observation of the same region under the same lighting (normals within ~25°):
 //   E = E_map(o) · (E_direct(p) + E_indirect(o)) / (E_direct(o) + E_indirect(o)),
-//   T = T_direct(p) + (T(o) − T_direct(o)),
-// E_map(o) being the irradiance the maps divide by at the observation (MapLightOf) and T the
-// lobe term of the written ρs (smoothed, as the maps from the observations use it).
+//   T = T_direct(p) + T_indirect(o'),
+// E_map(o) being the irradiance the maps divide by at the observation and T_indirect(o') the
+// indirect part of the lobe term of the written ρs, averaged over neighbours (MapLightOf), at
+// the nearest observation o' of the pixel's own photo: it depends on the view.
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include "solver/albedo_map.h"
 #include "solver/brdf.h"
@@ -39,20 +39,6 @@ struct MapSample {
   Eigen::Vector3d numerator = Eigen::Vector3d::Zero(), denominator = Eigen::Vector3d::Zero();
 };
 
-// Σ W(wo, wi)·v over direct samples, in the frame `frame`, at the widened roughness (ax, ay):
-// the direct part of an observation's lobe term T.
-Eigen::Vector3d DirectLobe(const BrdfParams& p, double ax, double ay, const Frame& frame,
-                           const Eigen::Vector3d& view, const DirectSample* d, int64_t n) {
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  const Eigen::Vector3d wo = frame.ToLocal(view);
-  for (int64_t k = 0; k < n; ++k) {
-    const double w =
-        SpecularWeight(p.model, ax, ay, p.ior, wo, frame.ToLocal(d[k].wi.cast<double>()));
-    if (w > 0) t += w * d[k].value.cast<double>();
-  }
-  return t;
-}
-
 }  // namespace
 
 std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions,
@@ -60,7 +46,6 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
                                                  const MapLight& map_light,
                                                  std::vector<Image>* seen,
                                                  std::vector<double>* coverage) const {
-  const std::vector<Eigen::Vector3d>& smooth_t = map_light.t;
   const std::vector<Eigen::Vector3d>& map_e = map_light.e;
   std::vector<char> mapped(materials.size(), 0);
   std::vector<int> map_of(materials.size(), -1);
@@ -69,6 +54,10 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
   const double radius =
       options.smoothing_radius_m > 0 ? options.smoothing_radius_m : summary.scene_scale_m / 96;
   const ObservationGrid grid(scene, obs, mapped, radius);
+  // T's indirect part depends on the view (the room reflected toward the camera): it comes from
+  // the nearest observation in the same photo, in cells of three radii (a photo holds a
+  // fraction of the observations).
+  const ObservationGrid grid_in_photo(scene, obs, mapped, 3 * radius, true);
   std::vector<AlbedoMapBuilder> builders;
   for (const RegionAtlas& atlas : atlases) builders.emplace_back(atlas);
   const double cos_edge = std::cos(10.0 * kPi / 180.0);
@@ -80,7 +69,6 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
     const Camera& cam = scene.cameras[photo.camera];
     const int l = photo.lighting;
     const Renderer::Impl& geometry = *lighting_scenes[l];
-    const LightingState& st = light.lightings[l];
     const LoadedPhoto loaded = LoadPhoto(int(i));
     const std::vector<uint8_t>* mask = loaded.mask.empty() ? nullptr : &loaded.mask;
     const double saturation =
@@ -124,24 +112,14 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             const Eigen::Vector3d e = map_e[j].cwiseProduct(ratio);
             Eigen::Vector3d t = Eigen::Vector3d::Zero();
             if (HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
-              // The pixel's direct lobe, and the observation's other light from its T.
-              const Observation& oj = obs[j];
-              const GatherPoint& gp = st.gather.points[light.point[j]];
+              // The pixel's own direct lobe, and the indirect part of T at the nearest
+              // observation of the same photo (of any photo when it has none near).
               const double spread =
                   options.pixel_footprint ? PixelNormalSpread(*quarter, hit->n_s) : 0.0;
-              auto widened = [&](double spread2) {
-                return std::make_pair(WidenedAlpha(m.params.AlphaX(), spread2),
-                                      WidenedAlpha(m.params.AlphaY(), spread2));
-              };
-              const auto [ax, ay] = widened(spread);
-              const auto [axj, ayj] = widened(oj.lobe_blur2);
-              const Eigen::Vector3d t_direct_j = DirectLobe(
-                  m.params, axj, ayj, materials.LocalFrame(oj.region, oj.normal.cast<double>()),
-                  oj.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
-                  gp.direct_end - gp.direct_begin);
-              t = DirectLobe(m.params, ax, ay, materials.LocalFrame(hit->region, hit->n_s), -dir,
-                             direct.data(), int64_t(direct.size())) +
-                  (smooth_t[j] - t_direct_j).cwiseMax(0.0);
+              const int jv = grid_in_photo.Nearest(int(i), hit->region, hit->position, hit->n_s);
+              t = DirectSpecularTerm(m.params, spread, materials.LocalFrame(hit->region, hit->n_s),
+                                     -dir, direct.data(), int64_t(direct.size())) +
+                  map_light.t_indirect[jv >= 0 ? jv : j].cwiseMax(0.0);
             }
             const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t);
             const Eigen::Vector3d diffuse = value.cast<double>() - spec;

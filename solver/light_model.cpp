@@ -2,7 +2,9 @@
 
 #include <algorithm>
 
+#include "solver/brdf.h"
 #include "solver/neighbour_mean.h"
+#include "solver/observations.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
@@ -57,6 +59,40 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
           if (w > 0) t += w * inc.Value().cast<double>();
         }
         out[i] = t;
+      },
+      num_threads);
+  return out;
+}
+
+Eigen::Vector3d DirectSpecularTerm(const BrdfParams& p, double blur2, const Frame& frame,
+                                   const Eigen::Vector3d& view, const DirectSample* d, int64_t n) {
+  const double ax = WidenedAlpha(p.AlphaX(), blur2), ay = WidenedAlpha(p.AlphaY(), blur2);
+  const Eigen::Vector3d wo = frame.ToLocal(view);
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (int64_t k = 0; k < n; ++k) {
+    const double w =
+        SpecularWeight(p.model, ax, ay, p.ior, wo, frame.ToLocal(d[k].wi.cast<double>()));
+    if (w > 0) t += w * d[k].value.cast<double>();
+  }
+  return t;
+}
+
+std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const ObservationSet& obs,
+                                                 const MaterialEstimate& materials,
+                                                 const LightModel& light, int num_threads) {
+  std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
+  ParallelFor(
+      0, int64_t(obs.size()),
+      [&](int64_t i) {
+        const Observation& o = obs[i];
+        const BrdfParams& p = materials[o.region].params;
+        if (!HasSpecularLobe(p.model)) return;
+        const LightingState& st = light.lightings[scene.photos[o.photo].lighting];
+        const GatherPoint& gp = st.gather.points[light.point[i]];
+        out[i] = DirectSpecularTerm(
+            p, o.lobe_blur2, materials.LocalFrame(o.region, o.normal.cast<double>()),
+            o.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
+            gp.direct_end - gp.direct_begin);
       },
       num_threads);
   return out;

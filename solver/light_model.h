@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "recon/scene.h"
 #include "solver/gather.h"
 #include "solver/material_estimate.h"
 #include "solver/observation_set.h"
@@ -100,6 +101,18 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
                                            const MaterialEstimate& materials,
                                            const std::vector<std::vector<IncidentLocal>>& incident,
                                            int num_threads);
+
+// The direct part of a point's specular term T: Σ S·W·v over its direct samples d[0..n) (world
+// directions) with the lobe of `p` widened by the spread of normals `blur2` (as SpecularTerms),
+// in `frame`, seen from `view` (world, unit).
+Eigen::Vector3d DirectSpecularTerm(const BrdfParams& p, double blur2, const Frame& frame,
+                                   const Eigen::Vector3d& view, const DirectSample* d, int64_t n);
+
+// Per observation: DirectSpecularTerm over its gather point's direct samples; zero for regions
+// without a lobe.
+std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const ObservationSet& obs,
+                                                 const MaterialEstimate& materials,
+                                                 const LightModel& light, int num_threads);
 
 // Each patch's direct samples (its gather point's) grouped into at most four representative
 // directions, for the specular part of the radiance it sends toward other points.

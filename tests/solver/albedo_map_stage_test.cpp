@@ -153,6 +153,64 @@ TEST(AlbedoMapStage, TheRefinementsMapIsTheObservationsWhereSeenAndThePatchesEls
   EXPECT_NEAR(left_ratio / left, 1.24, 0.1);
 }
 
+TEST(AlbedoMapStage, TheSpecularTermIsTheOwnDirectLobeAndTheNeighboursIndirectLight) {
+  // A glossy square (Ward, α 0.1) seen from straight above, its observations each with one direct
+  // sample of 1 W/m²: from the light's mirror direction within 0.1 m of the centre (a
+  // highlight), 45° off it elsewhere (no lobe); each T is that direct lobe plus 0.02 of indirect
+  // light. Over a smoothing radius of about 0.1 m, a mean of the whole T would raise the
+  // highlight's flanks and lower its core; the maps subtract each observation's own direct lobe
+  // and the neighbours' mean of the indirect part.
+  StageFixture f([](double, double) { return 0.5; }, 4, 3);
+  BrdfParams& p = f.materials[0].params;
+  p.model = BrdfModel::kWard;
+  p.rho_s = Eigen::Vector3d::Constant(0.05);
+  p.alpha = 0.1;
+  for (int k = 0; k < 2; ++k) {
+    Photo photo;
+    photo.lighting = 0;
+    f.scene.photos.push_back(photo);
+  }
+  GatherSet& gather = f.light.lightings[0].gather;
+  const Eigen::Vector3d view(0, 0, 1);
+  const Frame frame = f.materials.LocalFrame(0, view);
+  std::vector<bool> in_highlight(f.obs.size());
+  std::vector<Eigen::Vector3d> direct_lobe(f.obs.size());
+  for (size_t i = 0; i < f.obs.size(); ++i) {
+    const Observation& o = f.obs[i];
+    in_highlight[i] = o.position.head<2>().norm() < 0.1;
+    DirectSample sample;
+    sample.wi = in_highlight[i] ? Eigen::Vector3f(0, 0, 1) : Eigen::Vector3f(1, 0, 1).normalized();
+    sample.value = Eigen::Vector3f::Ones();
+    GatherPoint point;
+    point.direct_begin = int64_t(gather.direct.size());
+    point.direct_end = point.direct_begin + 1;
+    gather.direct.push_back(sample);
+    gather.points.push_back(point);
+    f.light.point.push_back(int(i));
+    direct_lobe[i] = DirectSpecularTerm(p, 0.0, frame, view, &sample, 1);
+    f.light.t[i] = direct_lobe[i] + Eigen::Vector3d::Constant(0.02);
+  }
+  const MapStageData d{f.scene, f.options, f.obs, f.materials, f.patches, f.light, 0.02, 10.0};
+  const MapLight light = MapLightOf(d);
+  int highlight = 0, flank = 0;
+  for (size_t i = 0; i < f.obs.size(); ++i) {
+    const double r = f.obs[i].position.head<2>().norm();
+    if (in_highlight[i]) {
+      EXPECT_GT(direct_lobe[i][0], 1.0);
+      ++highlight;
+    } else if (r < 0.2) {
+      EXPECT_LT(direct_lobe[i][0], 1e-6);
+      ++flank;
+    }
+    if (in_highlight[i] || r < 0.2) {
+      ASSERT_NEAR(light.t[i][0], direct_lobe[i][0] + 0.02, 1e-6) << "observation " << i;
+      ASSERT_NEAR(light.t_indirect[i][0], 0.02, 1e-9) << "observation " << i;
+    }
+  }
+  EXPECT_GT(highlight, 50);
+  EXPECT_GT(flank, 100);
+}
+
 TEST(AlbedoMapStage, TheWrittenMapIsScaledAndClippedOnlyInAChannelHeldAtOne) {
   // Red fitted at 1.25 (held at 1: scaled by 0.8, then clipped); green and blue within 1 keep
   // their texels, noise above 1 included, so that their mean stays the written ρd.
