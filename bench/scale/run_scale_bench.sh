@@ -105,10 +105,13 @@ run() {
 }
 
 # errors OUT TRUTH: "rho_d_max% rho_s_max% alpha_max% observations available" (a diagnosis:
-# "... kept_steps final/baseline"; igi-run: its diagnosis's).
+# "... kept_steps final/baseline"; igi-run: its diagnosis's). A region given an albedo map whose
+# truth is a texture is scored against the texture's mean over the texels the map's photos see
+# (its seen_file), as its written rho_d is that map's mean over them: what the photos do not
+# show of a texture is no error of the solve.
 errors() {
   $PY - "$1" "$2" <<'PYEOF'
-import json, os, sys
+import json, os, subprocess, sys
 out, truth = sys.argv[1], sys.argv[2]
 if os.path.isdir(out + "/05-diagnose"):
     out += "/05-diagnose"
@@ -124,6 +127,27 @@ try:
 except Exception:
     print("nan nan nan nan nan"); raise SystemExit
 true = json.load(open(truth))["materials"]
+def stats_avg(args):
+    text = subprocess.run(["oiiotool"] + args + ["--printstats"], check=True,
+                          capture_output=True, text=True).stdout
+    line = next(l for l in text.splitlines() if "Stats Avg:" in l)
+    return [float(v) for v in line.split(":", 1)[1].replace("(float)", "").split()]
+truth_scene = os.path.join(os.path.dirname(truth), json.load(open(truth)).get("scene", ""))
+def seen_truth(name):
+    # The true texture's mean over the map's seen texels, or None.
+    tex = json.load(open(truth_scene))["materials"].get(name, {}).get("rho_d_map")
+    region = next((r for r in report.get("regions", []) if r.get("name") == name), {})
+    seen = region.get("albedo_map", {}).get("seen_file")
+    if not tex or not seen:
+        return None
+    seen = os.path.join(out, seen)
+    info = subprocess.run(["oiiotool", "--info", seen], check=True, capture_output=True,
+                          text=True).stdout
+    w, h = (int(v) for v in info.split(":", 1)[1].split(",")[0].split(" x "))
+    mask = stats_avg([seen, "--ch", "0", "--mulc", "1"])[0]
+    texel = stats_avg([os.path.join(os.path.dirname(truth_scene), tex), "--resize:filter=box",
+                       f"{w}x{h}", seen, "--ch", "0,0,0", "--mul"])
+    return [v / mask for v in texel] if mask > 0 else None
 def rel(a, b):
     a = a if isinstance(a, list) else [a] * 3
     b = b if isinstance(b, list) else [b] * 3
@@ -131,9 +155,11 @@ def rel(a, b):
 worst = {"rho_d": 0.0, "rho_s": 0.0, "alpha": 0.0}
 for name, t in true.items():
     s = solved.get(name, {})
+    seen = seen_truth(name) if "rho_d" in s else None
     for k in worst:
-        if k in t and k in s and isinstance(t[k], (list, float, int)):
-            worst[k] = max(worst[k], rel(s[k], t[k]))
+        want = seen if k == "rho_d" and seen else t.get(k)
+        if k in s and isinstance(want, (list, float, int)):
+            worst[k] = max(worst[k], rel(s[k], want))
 d = report.get("observation_draw", {})
 print(f"{100*worst['rho_d']:.2f} {100*worst['rho_s']:.2f} {100*worst['alpha']:.2f} "
       f"{report['observations']} {d.get('available', 'nan')}")
