@@ -35,12 +35,6 @@ std::string Rebase(const Scene& scene, const std::string& path, const fs::path& 
   return rel.generic_string();
 }
 
-void RebaseKey(const Scene& scene, Json* j, const char* key, const fs::path& out) {
-  if (j->is_object() && j->contains(key) && (*j)[key].is_string()) {
-    (*j)[key] = Rebase(scene, (*j)[key].get<std::string>(), out);
-  }
-}
-
 Json FitJson(const RegionFitResult& f, BrdfModel model) {
   Json j;
   if (!f.fitted) {
@@ -75,31 +69,17 @@ Json FitJson(const RegionFitResult& f, BrdfModel model) {
 
 Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const fs::path& out) {
   Json doc = scene.document;
-  if (doc.contains("geometry")) {
-    for (Json& g : doc["geometry"]) RebaseKey(scene, &g, "file", out);
-  }
+  ForEachScenePath(&doc, [&](const std::string& path) { return Rebase(scene, path, out); });
   if (summary.charted_mesh) doc["geometry"] = Json::array({Json{{"file", "geometry/solved.obj"}}});
-  if (doc.contains("lights")) {
-    for (auto& [name, l] : doc["lights"].items()) {
-      RebaseKey(scene, &l, "file", out);
-      if (l.contains("profile")) RebaseKey(scene, &l["profile"], "ies", out);
-    }
-  }
-  if (doc.contains("photos")) {
+  if (summary.photo_scale && doc.contains("photos")) {
     for (Json& p : doc["photos"]) {
-      RebaseKey(scene, &p, "file", out);
-      RebaseKey(scene, &p, "mask", out);
-      if (summary.photo_scale) {
-        const double given = p.contains("exposure_scale") ? p["exposure_scale"].get<double>() : 1.0;
-        p["exposure_scale"] = given * summary.photo_scale->scale;
-      }
+      const double given = p.contains("exposure_scale") ? p["exposure_scale"].get<double>() : 1.0;
+      p["exposure_scale"] = given * summary.photo_scale->scale;
     }
   }
-  if (doc.contains("cameras")) RebaseKey(scene, &doc["cameras"], "colmap", out);
   for (size_t r = 0; r < scene.materials.size(); ++r) {
     const std::string& name = scene.materials[r].name;
     Json& m = doc["materials"][name];
-    RebaseKey(scene, &m, "rho_d_map", out);
     const RegionSolution& rs = summary.regions[r];
     const BrdfParams& p = rs.final_params;
     if (!IsReflective(scene.materials[r].brdf)) continue;
