@@ -55,33 +55,27 @@ TEST(ObservationGrid, TheNearestIsTheNearestOfItsLightingOrOfItsPhoto) {
   const auto photo_of = [](const Observation& o) { return o.photo; };
   const Eigen::Vector3d up(0, 0, 1);
   int checked = 0;
+  // The grid's nearest of group g against the brute force's: equal when that lies within a cell
+  // of p (then among the 27 cells searched), and never of another group or region.
+  const auto check = [&](const ObservationGrid& grid, int g, int region, const Eigen::Vector3d& p,
+                         auto group_of, int q) {
+    double d = 0;
+    const int want = BruteForceNearest(obs, g, region, p, up, group_of, &d);
+    const int got = grid.Nearest(g, region, p, up);
+    if (d < cell) {
+      EXPECT_EQ(got, want) << "query " << q;
+      ++checked;
+    }
+    if (got >= 0) {
+      EXPECT_EQ(group_of(obs[got]), g);
+      EXPECT_EQ(obs[got].region, region);
+    }
+  };
   for (int q = 0; q < 500; ++q) {
     const Eigen::Vector3d p(u01(rng), u01(rng), 0.05);
     const int region = q % 2;
-    double d = 0;
-    // Lighting groups: anything within a cell of p is among the 27 cells searched.
-    const int l = q % 2;
-    const int want_l = BruteForceNearest(obs, l, region, p, up, lighting_of, &d);
-    const int got_l = by_lighting.Nearest(l, region, p, up);
-    if (d < cell) {
-      EXPECT_EQ(got_l, want_l) << "query " << q;
-      ++checked;
-    }
-    if (got_l >= 0) {
-      EXPECT_EQ(lighting_of(obs[got_l]), l);
-    }
-    // Photo groups: the nearest of that photo, never another photo's.
-    const int photo = q % 4;
-    const int want_p = BruteForceNearest(obs, photo, region, p, up, photo_of, &d);
-    const int got_p = by_photo.Nearest(photo, region, p, up);
-    if (d < cell) {
-      EXPECT_EQ(got_p, want_p) << "query " << q;
-      ++checked;
-    }
-    if (got_p >= 0) {
-      EXPECT_EQ(obs[got_p].photo, photo);
-      EXPECT_EQ(obs[got_p].region, region);
-    }
+    check(by_lighting, q % 2, region, p, lighting_of, q);
+    check(by_photo, q % 4, region, p, photo_of, q);
   }
   EXPECT_GT(checked, 400);
 }
