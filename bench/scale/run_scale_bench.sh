@@ -133,9 +133,10 @@ def stats_avg(args):
     line = next(l for l in text.splitlines() if "Stats Avg:" in l)
     return [float(v) for v in line.split(":", 1)[1].replace("(float)", "").split()]
 truth_scene = os.path.join(os.path.dirname(truth), json.load(open(truth)).get("scene", ""))
+truth_materials = json.load(open(truth_scene))["materials"]
 def seen_truth(name):
     # The true texture's mean over the map's seen texels, or None.
-    tex = json.load(open(truth_scene))["materials"].get(name, {}).get("rho_d_map")
+    tex = truth_materials.get(name, {}).get("rho_d_map")
     region = next((r for r in report.get("regions", []) if r.get("name") == name), {})
     seen = region.get("albedo_map", {}).get("seen_file")
     if not tex or not seen:
