@@ -190,10 +190,14 @@ void BindRegions(const SceneLoader& ld, const JsonCursor& root,
 }  // namespace
 
 Scene LoadScene(const fs::path& path, const SceneLoadOptions& options) {
+  return LoadSceneDocument(ReadJsonFile(path), path, options);
+}
+
+Scene LoadSceneDocument(Json document, const fs::path& path, const SceneLoadOptions& options) {
   Scene scene;
   scene.file = fs::absolute(path).lexically_normal();
   scene.dir = scene.file.parent_path();
-  scene.document = ReadJsonFile(path);
+  scene.document = std::move(document);
   ProblemList problems;
   const SceneLoader ld{options, scene.dir, path.string(), &problems};
   const JsonCursor root = JsonCursor::Root(scene.document, ld.file, &problems);
