@@ -1,8 +1,7 @@
 #include "calib/camera_file.h"
 
-#include <array>
+#include <optional>
 #include <string_view>
-#include <utility>
 
 #include "tools/common/error.h"
 #include "tools/common/json.h"
@@ -10,31 +9,42 @@
 namespace igi::calib {
 namespace {
 
-// The COLMAP perspective models a camera.json may name, with their parameter counts. (Fisheye
-// models are left out: nothing in igi calibrates them.)
-constexpr std::array<std::pair<std::string_view, size_t>, 6> kModels = {{{"SIMPLE_PINHOLE", 3},
-                                                                         {"PINHOLE", 4},
-                                                                         {"SIMPLE_RADIAL", 4},
-                                                                         {"RADIAL", 5},
-                                                                         {"OPENCV", 8},
-                                                                         {"FULL_OPENCV", 12}}};
+// Every model of the enum.
+constexpr ColmapCameraModel kModels[] = {
+    ColmapCameraModel::kSimplePinhole, ColmapCameraModel::kPinhole,
+    ColmapCameraModel::kSimpleRadial,  ColmapCameraModel::kRadial,
+    ColmapCameraModel::kOpenCv,        ColmapCameraModel::kFullOpenCv};
 
-size_t NumParams(std::string_view model) {
-  for (const auto& [name, count] : kModels) {
-    if (name == model) return count;
+// 0 for a value outside the enum.
+size_t NumParams(ColmapCameraModel model) {
+  switch (model) {
+    case ColmapCameraModel::kSimplePinhole:
+      return 3;
+    case ColmapCameraModel::kPinhole:
+    case ColmapCameraModel::kSimpleRadial:
+      return 4;
+    case ColmapCameraModel::kRadial:
+      return 5;
+    case ColmapCameraModel::kOpenCv:
+      return 8;
+    case ColmapCameraModel::kFullOpenCv:
+      return 12;
   }
   return 0;
 }
 
-void Validate(const CameraFile& camera, const std::string& file) {
+// `unknown_model`: the "model" text of a file that names no model of ColmapCameraModel.
+void Validate(const CameraFile& camera, const std::string& file,
+              const std::optional<std::string>& unknown_model = std::nullopt) {
   ProblemList problems;
-  const size_t count = NumParams(camera.model);
+  const std::string model(ColmapCameraModelName(camera.model));
+  const size_t count = unknown_model ? 0 : NumParams(camera.model);
   if (count == 0) {
-    problems.Add(file, "model", camera.model,
+    problems.Add(file, "model", unknown_model.value_or(model),
                  "must be SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV");
   } else if (camera.params.size() != count) {
     problems.Add(file, "params", std::to_string(camera.params.size()) + " values",
-                 camera.model + " needs " + std::to_string(count));
+                 model + " needs " + std::to_string(count));
   }
   if (camera.width <= 0) problems.Add(file, "width", std::to_string(camera.width), "must be > 0");
   if (camera.height <= 0) {
@@ -48,12 +58,37 @@ void Validate(const CameraFile& camera, const std::string& file) {
 
 }  // namespace
 
+std::string_view ColmapCameraModelName(ColmapCameraModel model) {
+  switch (model) {
+    case ColmapCameraModel::kSimplePinhole:
+      return "SIMPLE_PINHOLE";
+    case ColmapCameraModel::kPinhole:
+      return "PINHOLE";
+    case ColmapCameraModel::kSimpleRadial:
+      return "SIMPLE_RADIAL";
+    case ColmapCameraModel::kRadial:
+      return "RADIAL";
+    case ColmapCameraModel::kOpenCv:
+      return "OPENCV";
+    case ColmapCameraModel::kFullOpenCv:
+      return "FULL_OPENCV";
+  }
+  return "?";
+}
+
+std::optional<ColmapCameraModel> ColmapCameraModelFromName(std::string_view name) {
+  for (ColmapCameraModel m : kModels) {
+    if (ColmapCameraModelName(m) == name) return m;
+  }
+  return std::nullopt;
+}
+
 void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera) {
   Validate(camera, path.string());
   Json json;
   json["format"] = "igi-camera";
   json["version"] = 1;
-  json["model"] = camera.model;
+  json["model"] = std::string(ColmapCameraModelName(camera.model));
   json["width"] = camera.width;
   json["height"] = camera.height;
   json["params"] = camera.params;
@@ -85,7 +120,14 @@ CameraFile ReadCameraFile(const std::filesystem::path& path) {
   }
   if (auto format = root["format"].Enum({"igi-camera"})) (void)format;
   if (root["version"].present()) root["version"].Integer(NumberRule::Between(1, 1));
-  if (auto model = root["model"].NonEmptyString()) camera.model = *model;
+  std::optional<std::string> unknown_model;
+  if (auto model = root["model"].NonEmptyString()) {
+    if (const auto known = ColmapCameraModelFromName(*model)) {
+      camera.model = *known;
+    } else {
+      unknown_model = *model;
+    }
+  }
   if (auto w = root["width"].Integer(NumberRule::Positive())) camera.width = static_cast<int>(*w);
   if (auto h = root["height"].Integer(NumberRule::Positive())) camera.height = static_cast<int>(*h);
   if (auto params = root["params"].Numbers(0)) camera.params = *params;
@@ -124,7 +166,7 @@ CameraFile ReadCameraFile(const std::filesystem::path& path) {
     }
   }
   problems.ThrowIfAny();
-  Validate(camera, file);
+  Validate(camera, file, unknown_model);
   return camera;
 }
 

@@ -12,10 +12,28 @@
 // the file and key).
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace igi::calib {
+
+// The COLMAP perspective camera models a camera.json may name (fisheye models are left out:
+// nothing in igi calibrates them), with their parameter counts: SIMPLE_PINHOLE 3, PINHOLE 4,
+// SIMPLE_RADIAL 4, RADIAL 5, OPENCV 8, FULL_OPENCV 12.
+enum class ColmapCameraModel {
+  kSimplePinhole,
+  kPinhole,
+  kSimpleRadial,
+  kRadial,
+  kOpenCv,
+  kFullOpenCv,
+};
+// COLMAP's name: "SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV".
+std::string_view ColmapCameraModelName(ColmapCameraModel model);
+// The model a COLMAP name spells (exact case); nullopt for any other name.
+std::optional<ColmapCameraModel> ColmapCameraModelFromName(std::string_view name);
 
 struct RejectedView {
   std::string file;
@@ -23,10 +41,10 @@ struct RejectedView {
 };
 
 struct CameraFile {
-  std::string model = "PINHOLE";        // COLMAP model name
-  int width = 0;                        // pixels
-  int height = 0;                       // pixels
-  std::vector<double> params;           // COLMAP order, pixels
+  ColmapCameraModel model = ColmapCameraModel::kPinhole;  // "model": the COLMAP model name
+  int width = 0;                                          // pixels
+  int height = 0;                                         // pixels
+  std::vector<double> params;                             // COLMAP order, pixels
   double rms_px = -1;                   // RMS reprojection error over every used view; -1 = unknown
   std::vector<std::string> views;       // files used
   std::vector<double> per_view_rms_px;  // one per used view (may be empty)

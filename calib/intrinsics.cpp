@@ -109,7 +109,7 @@ Detection DetectBoard(const std::filesystem::path& path, const IntrinsicsOptions
   detection.width = image.width;
   detection.height = image.height;
   const cv::Mat grey = GreyImage(image);
-  if (options.board_type == "charuco") {
+  if (options.board_type == BoardType::kCharuco) {
     DetectCharuco(grey, options, &detection);
     return detection;
   }
@@ -129,23 +129,24 @@ Detection DetectBoard(const std::filesystem::path& path, const IntrinsicsOptions
 int CalibrationFlags(const IntrinsicsOptions& options) {
   int flags = 0;
   if (options.fix_aspect_ratio) flags |= cv::CALIB_FIX_ASPECT_RATIO;
-  if (options.zero_tangent_dist || options.model == "PINHOLE") flags |= cv::CALIB_ZERO_TANGENT_DIST;
+  const bool pinhole = options.model == ColmapCameraModel::kPinhole;
+  if (options.zero_tangent_dist || pinhole) flags |= cv::CALIB_ZERO_TANGENT_DIST;
   if (options.fix_principal_point) flags |= cv::CALIB_FIX_PRINCIPAL_POINT;
-  if (options.model == "PINHOLE") {
+  if (pinhole) {
     flags |= cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
-  } else if (options.model == "OPENCV") {
+  } else if (options.model == ColmapCameraModel::kOpenCv) {
     flags |= cv::CALIB_FIX_K3;
   }
   return flags;
 }
 
 // OpenCV's K and distortion -> COLMAP params (pixel centre convention shifted by 0.5).
-std::vector<double> ColmapParams(const std::string& model, const cv::Mat& k, const cv::Mat& d) {
+std::vector<double> ColmapParams(ColmapCameraModel model, const cv::Mat& k, const cv::Mat& d) {
   std::vector<double> params = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2) + 0.5,
                                 k.at<double>(1, 2) + 0.5};
-  if (model == "PINHOLE") return params;
+  if (model == ColmapCameraModel::kPinhole) return params;
   for (int i = 0; i < 4; ++i) params.push_back(d.at<double>(i));
-  if (model == "FULL_OPENCV") {
+  if (model == ColmapCameraModel::kFullOpenCv) {
     params.push_back(d.at<double>(4));
     params.insert(params.end(), {0.0, 0.0, 0.0});
   }
@@ -162,6 +163,23 @@ std::vector<std::string> FlagNames(const IntrinsicsOptions& options) {
 
 }  // namespace
 
+std::string_view BoardTypeName(BoardType type) {
+  switch (type) {
+    case BoardType::kChessboard:
+      return "chessboard";
+    case BoardType::kCharuco:
+      return "charuco";
+  }
+  return "?";
+}
+
+std::optional<BoardType> BoardTypeFromName(std::string_view name) {
+  for (BoardType t : {BoardType::kChessboard, BoardType::kCharuco}) {
+    if (BoardTypeName(t) == name) return t;
+  }
+  return std::nullopt;
+}
+
 void IntrinsicsOptions::Validate() const {
   ProblemList problems;
   if (board_cols < 2) problems.Add("", "--board", std::to_string(board_cols), "cols must be >= 2");
@@ -169,13 +187,16 @@ void IntrinsicsOptions::Validate() const {
   if (!(square_m > 0) || !std::isfinite(square_m)) {
     problems.Add("", "--square", std::to_string(square_m), "must be > 0 (metres)");
   }
-  if (model != "PINHOLE" && model != "OPENCV" && model != "FULL_OPENCV") {
-    problems.Add("", "--model", model, "must be PINHOLE, OPENCV or FULL_OPENCV");
+  if (model != ColmapCameraModel::kPinhole && model != ColmapCameraModel::kOpenCv &&
+      model != ColmapCameraModel::kFullOpenCv) {
+    problems.Add("", "--model", std::string(ColmapCameraModelName(model)),
+                 "must be PINHOLE, OPENCV or FULL_OPENCV");
   }
-  if (board_type != "chessboard" && board_type != "charuco") {
-    problems.Add("", "--board-type", board_type, "must be chessboard or charuco");
+  if (!BoardTypeFromName(BoardTypeName(board_type))) {
+    problems.Add("", "--board-type", std::to_string(int(board_type)),
+                 "must be chessboard or charuco");
   }
-  if (board_type == "charuco") {
+  if (board_type == BoardType::kCharuco) {
     if (Dictionaries().count(dictionary) == 0) {
       problems.Add("", "--dictionary", dictionary,
                    "is not an OpenCV predefined ArUco dictionary (e.g. DICT_4X4_50)");
@@ -219,7 +240,7 @@ IntrinsicsSummary CalibrateIntrinsics(const std::vector<std::filesystem::path>& 
     if (!detections[i].corners) {
       camera.rejected_views.push_back({name, detections[i].reason});
       spdlog::warn("{}: {}x{} {}: {}; view rejected", images[i].string(), options.board_cols,
-                   options.board_rows, options.board_type, detections[i].reason);
+                   options.board_rows, BoardTypeName(options.board_type), detections[i].reason);
       continue;
     }
     image_points.push_back(*detections[i].corners);

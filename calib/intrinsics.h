@@ -10,7 +10,9 @@
 // (OpenCV puts it at (0, 0), so cx, cy are OpenCV's + 0.5).
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calib/camera_file.h"
@@ -22,8 +24,14 @@ inline constexpr int kMinCalibrationViews = 3;
 // A ChArUco view needs this many interpolated chessboard corners to be used.
 inline constexpr int kMinCharucoCorners = 6;
 
+// The calibration target: a chessboard, or a ChArUco board (a chessboard with ArUco markers).
+enum class BoardType { kChessboard, kCharuco };
+// "chessboard", "charuco" (the --board-type flag's spelling).
+std::string_view BoardTypeName(BoardType type);
+std::optional<BoardType> BoardTypeFromName(std::string_view name);
+
 struct IntrinsicsOptions {
-  std::string board_type = "chessboard";  // chessboard or charuco
+  BoardType board_type = BoardType::kChessboard;  // kChessboard (default) or kCharuco
   // chessboard: inner corners along a row / a column (OpenCV's board size), e.g. 9 x 6.
   // charuco: squares along X / Y (OpenCV's CharucoBoard squaresX, squaresY), e.g. 5 x 7.
   int board_cols = 0;
@@ -31,9 +39,9 @@ struct IntrinsicsOptions {
   double square_m = 0;                     // side of one square in metres
   std::string dictionary = "DICT_4X4_50";  // charuco: OpenCV predefined ArUco dictionary name
   double marker_m = 0;                     // charuco: side of a marker in metres (< square_m)
-  // COLMAP model of the result: PINHOLE (no distortion), OPENCV (k1, k2, p1, p2) or FULL_OPENCV
-  // (k1, k2, p1, p2, k3; k4..k6 = 0 — OpenCV's default 5-coefficient model).
-  std::string model = "OPENCV";
+  // COLMAP model of the result: kPinhole (no distortion), kOpenCv (k1, k2, p1, p2; the default)
+  // or kFullOpenCv (k1, k2, p1, p2, k3; k4..k6 = 0 — OpenCV's default 5-coefficient model).
+  ColmapCameraModel model = ColmapCameraModel::kOpenCv;
   bool fix_aspect_ratio = false;     // fx = fy (OpenCV CALIB_FIX_ASPECT_RATIO with ratio 1)
   bool zero_tangent_dist = false;    // p1 = p2 = 0
   bool fix_principal_point = false;  // cx, cy at the image centre

@@ -17,7 +17,10 @@
 namespace igi::calib {
 
 struct ResponseCurve {
-  std::string method = "debevec";      // "debevec", "robertson" or "linear"
+  // How the curve was made, as the file's "method" text: igi writes "debevec", "robertson"
+  // (calib/response_recovery.h) or "linear" (LinearResponse); other writers put their own text
+  // (igi-synth: "igi-synth truth"), so any non-empty text is read.
+  std::string method = "debevec";
   int levels = 256;                    // number of pixel levels (256 for 8-bit)
   std::vector<std::string> channels;   // e.g. {"R", "G", "B"}
   std::vector<std::vector<double>> g;  // [channel][level]: ln exposure, any additive constant

@@ -265,10 +265,28 @@ double ParseLambda(const std::string& text) {
   return *value;
 }
 
+std::string_view ResponseRecoveryMethodName(ResponseRecoveryMethod method) {
+  switch (method) {
+    case ResponseRecoveryMethod::kDebevec:
+      return "debevec";
+    case ResponseRecoveryMethod::kRobertson:
+      return "robertson";
+  }
+  return "?";
+}
+
+std::optional<ResponseRecoveryMethod> ResponseRecoveryMethodFromName(std::string_view name) {
+  for (ResponseRecoveryMethod m :
+       {ResponseRecoveryMethod::kDebevec, ResponseRecoveryMethod::kRobertson}) {
+    if (ResponseRecoveryMethodName(m) == name) return m;
+  }
+  return std::nullopt;
+}
+
 void ResponseOptions::Validate() const {
   ProblemList problems;
-  if (method != "debevec" && method != "robertson") {
-    problems.Add("--method", "", method, "must be debevec or robertson");
+  if (!ResponseRecoveryMethodFromName(ResponseRecoveryMethodName(method))) {
+    problems.Add("--method", "", std::to_string(int(method)), "must be debevec or robertson");
   }
   if (lambda != kLambdaAuto && (!(lambda >= 0.0) || !std::isfinite(lambda))) {
     problems.Add("--lambda", "", fmt::format("{}", lambda), "must be auto or >= 0");
@@ -294,7 +312,8 @@ void ResponseOptions::Validate() const {
 ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& options) {
   options.Validate();
   const int levels = ResolveLevels(bracket, options);
-  if (options.method == "robertson") return RecoverRobertson(bracket, options, levels);
+  if (options.method == ResponseRecoveryMethod::kRobertson)
+    return RecoverRobertson(bracket, options, levels);
   const int p = int(bracket.images.size());
   SamplingOptions sampling;
   sampling.samples = options.samples > 0
@@ -306,7 +325,7 @@ ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& o
   ResponseSummary summary;
   summary.samples = int(pixels.size());
   summary.equations = 1 << 30;
-  summary.curve.method = "debevec";
+  summary.curve.method = ResponseRecoveryMethodName(ResponseRecoveryMethod::kDebevec);
   summary.curve.levels = levels;
   summary.curve.channels = DefaultChannelNames(bracket.channels());
   for (int c = 0; c < bracket.channels(); ++c) {

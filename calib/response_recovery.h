@@ -26,7 +26,9 @@
 // Too few usable pixels is an InputError naming the images and the rule.
 
 #include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calib/bracket.h"
@@ -42,8 +44,16 @@ inline constexpr double kAutoLambdaSlack = 1.25;
 // "auto" -> kLambdaAuto, else a number >= 0. Throws InputError "--lambda: TEXT: RULE".
 double ParseLambda(const std::string& text);
 
+// The recovery method (see the top of this file): kDebevec, Debevec & Malik's least squares;
+// kRobertson, Robertson et al.'s maximum likelihood.
+enum class ResponseRecoveryMethod { kDebevec, kRobertson };
+// "debevec", "robertson" (the --method flag's spelling and the ResponseCurve::method it writes).
+std::string_view ResponseRecoveryMethodName(ResponseRecoveryMethod method);
+std::optional<ResponseRecoveryMethod> ResponseRecoveryMethodFromName(std::string_view name);
+
 struct ResponseOptions {
-  std::string method = "debevec";  // "debevec" or "robertson"
+  // kDebevec (default) or kRobertson.
+  ResponseRecoveryMethod method = ResponseRecoveryMethod::kDebevec;
   // Smoothness weight (Debevec's lambda; same scale as OpenCV's, whose default is 10), or
   // kLambdaAuto: chosen per channel (see above).
   double lambda = kLambdaAuto;

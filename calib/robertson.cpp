@@ -134,7 +134,7 @@ ResponseSummary RecoverRobertson(const Bracket& bracket, const ResponseOptions& 
                                  int levels) {
   const std::vector<double> w = Weights(levels, options);
   ResponseSummary summary;
-  summary.curve.method = "robertson";
+  summary.curve.method = ResponseRecoveryMethodName(ResponseRecoveryMethod::kRobertson);
   summary.curve.levels = levels;
   summary.curve.channels = DefaultChannelNames(bracket.channels());
   for (int c = 0; c < bracket.channels(); ++c) {

@@ -10,6 +10,23 @@
 
 namespace igi::capture {
 
+std::string_view PlanFileFormatName(PlanFileFormat format) {
+  switch (format) {
+    case PlanFileFormat::kPng:
+      return "png";
+    case PlanFileFormat::kTiff:
+      return "tiff";
+  }
+  return "?";
+}
+
+std::optional<PlanFileFormat> PlanFileFormatFromName(std::string_view name) {
+  for (PlanFileFormat f : {PlanFileFormat::kPng, PlanFileFormat::kTiff}) {
+    if (PlanFileFormatName(f) == name) return f;
+  }
+  return std::nullopt;
+}
+
 void BracketPlan::Validate(const std::string& source) const {
   ProblemList problems;
   if (exposures_us.empty()) problems.Add(source, "exposures_us", "[]", "must list exposures");
@@ -23,8 +40,8 @@ void BracketPlan::Validate(const std::string& source) const {
   if (settle_frames < 0) {
     problems.Add(source, "settle_frames", std::to_string(settle_frames), "must be >= 0");
   }
-  if (file_format != "png" && file_format != "tiff") {
-    problems.Add(source, "file_format", file_format, "must be png or tiff");
+  if (!PlanFileFormatFromName(PlanFileFormatName(file_format))) {
+    problems.Add(source, "file_format", std::to_string(int(file_format)), "must be png or tiff");
   }
   problems.ThrowIfAny();
 }
@@ -33,7 +50,7 @@ std::string SlotFileName(const BracketPlan& plan, const PlanSlot& slot) {
   const double exposure = plan.exposures_us.at(size_t(slot.bracket));
   return fmt::format("frames/b{:02d}_e{:09d}us_f{:03d}.{}", slot.bracket,
                      static_cast<long long>(std::llround(exposure)), slot.frame,
-                     plan.file_format == "tiff" ? "tif" : "png");
+                     plan.file_format == PlanFileFormat::kTiff ? "tif" : "png");
 }
 
 std::vector<double> ParseExposureList(const std::string& text) {
@@ -69,7 +86,7 @@ Json PlanToJson(const BracketPlan& plan) {
   json["settle_frames"] = plan.settle_frames;
   json["pixel_format"] = plan.pixel_format;
   json["gain"] = plan.gain;
-  json["file_format"] = plan.file_format;
+  json["file_format"] = std::string(PlanFileFormatName(plan.file_format));
   json["auto_metered"] = plan.auto_metered;
   return json;
 }
@@ -98,7 +115,9 @@ BracketPlan ReadPlan(const std::filesystem::path& path) {
   plan.settle_frames = int(root["settle_frames"].Integer(NumberRule::Between(0, 1e6)).value_or(0));
   plan.pixel_format = root["pixel_format"].String().value_or("");
   plan.gain = root["gain"].Number().value_or(0.0);
-  plan.file_format = root["file_format"].Enum({"png", "tiff"}).value_or("png");
+  if (const auto format = root["file_format"].Enum({"png", "tiff"})) {
+    plan.file_format = PlanFileFormatFromName(*format).value_or(PlanFileFormat::kPng);
+  }
   plan.auto_metered = root["auto_metered"].Bool().value_or(false);
   problems.ThrowIfAny();
   plan.Validate(path.string());

@@ -5,12 +5,21 @@
 // metered once, not again on resume).
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tools/common/json.h"
 
 namespace igi::capture {
+
+// The file format of a plan's frames, both 16-bit and lossless: PNG (".png") or TIFF (".tif").
+enum class PlanFileFormat { kPng, kTiff };
+// "png", "tiff" (the --format flag's and plan.json's spelling).
+std::string_view PlanFileFormatName(PlanFileFormat format);
+// The format a name spells; nullopt for anything but "png" and "tiff".
+std::optional<PlanFileFormat> PlanFileFormatFromName(std::string_view name);
 
 struct BracketPlan {
   std::string camera;                // CameraInfo::id of the camera the plan was made for
@@ -19,8 +28,9 @@ struct BracketPlan {
   int settle_frames = 1;             // frames dropped after each exposure change
   std::string pixel_format;          // GenICam name as the camera reported it
   double gain = 0.0;                 // camera units, as read back
-  std::string file_format = "png";   // "png" or "tiff": 16-bit, lossless
-  bool auto_metered = false;         // the exposures came from --auto
+  // Frame files: kPng (default) or kTiff, 16-bit lossless.
+  PlanFileFormat file_format = PlanFileFormat::kPng;
+  bool auto_metered = false;  // the exposures came from --auto
 
   // InputError (one line per problem, `source` as the file) when a field is out
   // of range.

@@ -29,7 +29,7 @@ BracketPlan MakePlan(const CaptureOptions& options, Camera& camera, CaptureSumma
   plan.settle_frames = options.settle_frames;
   plan.pixel_format = camera.pixel_format().name;
   plan.gain = camera.gain();
-  plan.file_format = options.file_format.value_or("png");
+  plan.file_format = options.file_format.value_or(PlanFileFormat::kPng);
   double min_us = 0, max_us = 0;
   camera.ExposureBoundsUs(&min_us, &max_us);
   if (options.auto_expose) {
@@ -70,7 +70,8 @@ void CheckResumeFlags(const CaptureOptions& options, const BracketPlan& plan,
                  "--frames " + std::to_string(*options.frames) + " differs from the plan");
   }
   if (options.file_format && *options.file_format != plan.file_format) {
-    problems.Add(source, "file_format", plan.file_format, "--format differs from the plan");
+    problems.Add(source, "file_format", std::string(PlanFileFormatName(plan.file_format)),
+                 "--format differs from the plan");
   }
   problems.ThrowIfAny();
 }
@@ -213,8 +214,8 @@ void CaptureOptions::Validate() const {
   if (settle_frames < 0) {
     problems.Add("", "--settle-frames", std::to_string(settle_frames), "must be >= 0");
   }
-  if (file_format && *file_format != "png" && *file_format != "tiff") {
-    problems.Add("", "--format", *file_format, "must be png or tiff");
+  if (file_format && !PlanFileFormatFromName(PlanFileFormatName(*file_format))) {
+    problems.Add("", "--format", std::to_string(int(*file_format)), "must be png or tiff");
   }
   problems.ThrowIfAny();
   writing.Validate();

@@ -31,15 +31,15 @@
 namespace igi::capture {
 
 struct CaptureOptions {
-  std::filesystem::path out_dir;           // DIR
-  CameraOptions camera;                    // which camera and its settings
-  std::vector<double> exposures_us;        // explicit bracket (µs); empty with auto_expose
-  bool auto_expose = false;                // meter the scene and choose the bracket
-  AutoMeterOptions auto_meter;             // how --auto chooses
-  std::optional<int> frames;               // frames per exposure (default 1; resume: the plan's)
-  int settle_frames = 1;                   // frames dropped after each exposure change
-  std::optional<std::string> file_format;  // "png" (default) or "tiff"
-  bool resume = false;                     // finish the plan in DIR
+  std::filesystem::path out_dir;              // DIR
+  CameraOptions camera;                       // which camera and its settings
+  std::vector<double> exposures_us;           // explicit bracket (µs); empty with auto_expose
+  bool auto_expose = false;                   // meter the scene and choose the bracket
+  AutoMeterOptions auto_meter;                // how --auto chooses
+  std::optional<int> frames;                  // frames per exposure (default 1; resume: the plan's)
+  int settle_frames = 1;                      // frames dropped after each exposure change
+  std::optional<PlanFileFormat> file_format;  // kPng (default) or kTiff
+  bool resume = false;                        // finish the plan in DIR
   // true: each frame file and manifest line is fsynced as it is written
   // (survives a power cut; the disk's flush time then caps the sustained rate).
   // false (--no-fsync): written and renamed/appended at once (survive a crash of

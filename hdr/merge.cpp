@@ -42,7 +42,7 @@ ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int l
   for (int q = 0; q < levels; ++q) {
     const double v = double(q) / (levels - 1);
     if (v <= options.black || v >= options.saturated) continue;
-    if (options.weighting == "hat") {
+    if (options.weighting == MergeWeighting::kHat) {
       // Debevec & Malik's hat over the levels (+1, as OpenCV's triangleWeights).
       t.weight[size_t(q)] = float((std::min(q, levels - 1 - q) + 1) / (0.5 * levels));
       continue;
@@ -54,7 +54,7 @@ ChannelTables BuildTables(const calib::ResponseCurve& response, int curve, int l
     t.weight[size_t(q)] = float(1.0 / variance);
   }
   t.weighted.resize(size_t(levels));
-  const bool hat = options.weighting == "hat";
+  const bool hat = options.weighting == MergeWeighting::kHat;
   for (size_t q = 0; q < size_t(levels); ++q) {
     t.weighted[q] = {t.weight[q] * (hat ? t.ln[q] : t.lin[q]), t.weight[q]};
   }
@@ -85,10 +85,27 @@ void CheckInputs(const std::vector<Image>& images, const std::vector<double>& ex
 
 }  // namespace
 
+std::string_view MergeWeightingName(MergeWeighting weighting) {
+  switch (weighting) {
+    case MergeWeighting::kNoise:
+      return "noise";
+    case MergeWeighting::kHat:
+      return "hat";
+  }
+  return "?";
+}
+
+std::optional<MergeWeighting> MergeWeightingFromName(std::string_view name) {
+  for (MergeWeighting w : {MergeWeighting::kNoise, MergeWeighting::kHat}) {
+    if (MergeWeightingName(w) == name) return w;
+  }
+  return std::nullopt;
+}
+
 void MergeOptions::Validate() const {
   ProblemList problems;
-  if (weighting != "noise" && weighting != "hat") {
-    problems.Add("--weighting", "", weighting, "must be noise or hat");
+  if (!MergeWeightingFromName(MergeWeightingName(weighting))) {
+    problems.Add("--weighting", "", std::to_string(int(weighting)), "must be noise or hat");
   }
   if (!(black >= 0.0 && black < saturated && saturated <= 1.0)) {
     problems.Add("--black/--saturated", "", fmt::format("{}/{}", black, saturated),
@@ -114,7 +131,7 @@ class MergeKernel {
         levels_(1 << options.bits),
         channels_(channels),
         scale_(float(levels_ - 1)),
-        hat_(options.weighting == "hat") {
+        hat_(options.weighting == MergeWeighting::kHat) {
     for (int c = 0; c < channels_; ++c) {
       tables_.push_back(
           BuildTables(response, response.num_channels() == 1 ? 0 : c, levels_, options));
@@ -357,7 +374,7 @@ MergeResult MergeBracket(const std::vector<Image>& images, const std::vector<dou
   result.black_pixels = counts.black_pixels;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::debug("merge: {}x{}x{}, {} images, {} weights, {:.3f} s", width, height, channels,
-                images.size(), options.weighting, result.seconds);
+                images.size(), MergeWeightingName(options.weighting), result.seconds);
   return result;
 }
 

@@ -3,7 +3,7 @@
 //
 // Each value z of image j (exposure t_j) gives a radiance estimate x = I(z) / t_j, where
 // I(z) = exp(g(z)) is the inverse response (calib/response_curve.h). The estimates of a pixel are
-// averaged with weights:
+// averaged with weights (MergeWeighting):
 // - "noise" (default): inverse variance, w = t_j^2 / var(I(z)), with the variance of a sensor
 //   with shot noise, read noise and the quantisation of the levels mapped through the response:
 //   var = shot_noise * I + read_noise^2 + (I'(z) / 2^bits)^2 / 12, I in units of full scale
@@ -22,7 +22,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calib/response_curve.h"
@@ -31,12 +33,19 @@
 
 namespace igi::hdr {
 
+// The weights of a merge (see the top of this file): kNoise, inverse variance; kHat, Debevec &
+// Malik's hat.
+enum class MergeWeighting { kNoise, kHat };
+// "noise", "hat" (the --weighting flag's spelling and the radiance map's igi:weighting).
+std::string_view MergeWeightingName(MergeWeighting weighting);
+std::optional<MergeWeighting> MergeWeightingFromName(std::string_view name);
+
 struct MergeOptions {
-  std::string weighting = "noise";  // "noise" or "hat"
-  double black = 0.02;              // normalised value at or below which a value is unusable
-  double saturated = 0.98;          // normalised value at or above which a value is unusable
-  double shot_noise = 1.0 / 4000;   // variance per unit signal (1 / full well in electrons)
-  double read_noise = 1.0 / 2000;   // standard deviation, units of full scale
+  MergeWeighting weighting = MergeWeighting::kNoise;  // kNoise (default) or kHat
+  double black = 0.02;             // normalised value at or below which a value is unusable
+  double saturated = 0.98;         // normalised value at or above which a value is unusable
+  double shot_noise = 1.0 / 4000;  // variance per unit signal (1 / full well in electrons)
+  double read_noise = 1.0 / 2000;  // standard deviation, units of full scale
   // One weight per pixel and exposure, the mean of the channels' weights (as OpenCV's
   // MergeDebevec does), instead of one per channel.
   bool shared_weights = false;

@@ -30,24 +30,60 @@ void SetLinearParams(LibRaw* raw, const RawDecodeOptions& options) {
   p.highlight = 0;              // clip at the white level
   p.adjust_maximum_thr = 0.0f;  // keep the file's white level (no lowering to the data maximum)
   p.use_auto_wb = 0;
-  p.use_camera_wb = options.white_balance == "camera" ? 1 : 0;
-  if (options.white_balance == "none") {
+  p.use_camera_wb = options.white_balance == RawWhiteBalance::kCamera ? 1 : 0;
+  if (options.white_balance == RawWhiteBalance::kNone) {
     for (float& m : p.user_mul) m = 1.0f;
   }
-  p.output_color = options.color == "raw" ? 0 : 1;
+  p.output_color = options.color == RawColor::kRaw ? 0 : 1;
   p.half_size = options.half_size ? 1 : 0;
   p.user_qual = 3;  // AHD demosaicing
 }
 
 }  // namespace
 
+std::string_view RawWhiteBalanceName(RawWhiteBalance white_balance) {
+  switch (white_balance) {
+    case RawWhiteBalance::kCamera:
+      return "camera";
+    case RawWhiteBalance::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+std::optional<RawWhiteBalance> RawWhiteBalanceFromName(std::string_view name) {
+  for (RawWhiteBalance w : {RawWhiteBalance::kCamera, RawWhiteBalance::kNone}) {
+    if (RawWhiteBalanceName(w) == name) return w;
+  }
+  return std::nullopt;
+}
+
+std::string_view RawColorName(RawColor color) {
+  switch (color) {
+    case RawColor::kSrgb:
+      return "srgb";
+    case RawColor::kRaw:
+      return "raw";
+  }
+  return "?";
+}
+
+std::optional<RawColor> RawColorFromName(std::string_view name) {
+  for (RawColor c : {RawColor::kSrgb, RawColor::kRaw}) {
+    if (RawColorName(c) == name) return c;
+  }
+  return std::nullopt;
+}
+
 void RawDecodeOptions::Validate() const {
   ProblemList problems;
-  if (white_balance != "camera" && white_balance != "none") {
-    problems.Add("--raw-white-balance", "", white_balance, "must be camera or none");
+  if (!RawWhiteBalanceFromName(RawWhiteBalanceName(white_balance))) {
+    problems.Add("--raw-white-balance", "", std::to_string(int(white_balance)),
+                 "must be camera or none");
   }
-  if (color != "srgb" && color != "raw")
-    problems.Add("--raw-color", "", color, "must be srgb or raw");
+  if (!RawColorFromName(RawColorName(color))) {
+    problems.Add("--raw-color", "", std::to_string(int(color)), "must be srgb or raw");
+  }
   problems.ThrowIfAny();
 }
 

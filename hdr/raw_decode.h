@@ -7,17 +7,31 @@
 // A file LibRaw cannot open or decode is an InputError "FILE: raw: REASON".
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "tools/common/image.h"
 
 namespace igi::hdr {
 
+// The white balance of a decode: kCamera, the multipliers the camera recorded; kNone, unity
+// multipliers (the raw channel ratios).
+enum class RawWhiteBalance { kCamera, kNone };
+// "camera", "none" (the --raw-white-balance flag's spelling).
+std::string_view RawWhiteBalanceName(RawWhiteBalance white_balance);
+std::optional<RawWhiteBalance> RawWhiteBalanceFromName(std::string_view name);
+
+// The primaries of a decode: kSrgb, linear sRGB (LibRaw's colour matrix); kRaw, the camera's own
+// RGB.
+enum class RawColor { kSrgb, kRaw };
+// "srgb", "raw" (the --raw-color flag's spelling).
+std::string_view RawColorName(RawColor color);
+std::optional<RawColor> RawColorFromName(std::string_view name);
+
 struct RawDecodeOptions {
-  // "camera": the white balance the camera recorded; "none": unity multipliers (raw ratios).
-  std::string white_balance = "camera";
-  // "srgb": linear sRGB primaries (LibRaw's colour matrix); "raw": the camera's own RGB.
-  std::string color = "srgb";
+  RawWhiteBalance white_balance = RawWhiteBalance::kCamera;  // kCamera (default) or kNone
+  RawColor color = RawColor::kSrgb;                          // kSrgb (default) or kRaw
   bool half_size = false;  // 2x2 binning instead of demosaicing (faster, half resolution)
 
   void Validate() const;

@@ -33,6 +33,7 @@ struct ResponseCommand {
   std::string plot;  // empty = OUT with the extension .svg
   bool no_plot = false;
   std::string lambda = "auto";
+  std::string method = "debevec";  // checked against debevec|robertson when parsed
   igi::calib::ResponseOptions options;
 };
 
@@ -48,7 +49,7 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
   sub->add_option("--out", cmd->out, "Output response.json")->required();
   sub->add_option("--plot", cmd->plot, "Plot of the curves (SVG); default OUT with .svg");
   sub->add_flag("--no-plot", cmd->no_plot, "Do not write the plot");
-  sub->add_option("--method", cmd->options.method, "debevec or robertson")
+  sub->add_option("--method", cmd->method, "debevec or robertson")
       ->check(CLI::IsMember({"debevec", "robertson"}));
   sub->add_option("--lambda", cmd->lambda,
                   "Debevec smoothness weight, or auto (default): the smallest whose curve is "
@@ -67,6 +68,7 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
 }
 
 int RunResponse(ResponseCommand cmd) {
+  cmd.options.method = igi::calib::ResponseRecoveryMethodFromName(cmd.method).value();
   cmd.options.lambda = igi::calib::ParseLambda(cmd.lambda);
   cmd.options.Validate();
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
@@ -78,11 +80,11 @@ int RunResponse(ResponseCommand cmd) {
   info["bits_per_sample"] = bracket.bits_per_sample;
   info["samples"] = summary.samples;
   info["equations"] = summary.equations;
-  if (cmd.options.method == "debevec") {
+  if (cmd.options.method == igi::calib::ResponseRecoveryMethod::kDebevec) {
     info["lambda"] = summary.lambda;  // per channel
     info["lambda_mode"] = cmd.options.lambda == igi::calib::kLambdaAuto ? "auto" : "given";
   }
-  if (cmd.options.method == "robertson") {
+  if (cmd.options.method == igi::calib::ResponseRecoveryMethod::kRobertson) {
     info["iterations"] = summary.iterations;
     info["converged"] = summary.converged;
   }
@@ -104,6 +106,9 @@ struct IntrinsicsCommand {
   std::vector<std::string> images;
   std::string board;  // COLSxROWS
   std::string out;
+  // Checked against their choices when parsed.
+  std::string board_type = "chessboard";
+  std::string model = "OPENCV";
   igi::calib::IntrinsicsOptions options;
 };
 
@@ -114,14 +119,14 @@ CLI::App* AddIntrinsicsCommand(CLI::App& app, IntrinsicsCommand* cmd) {
   sub->add_option("--board", cmd->board,
                   "chessboard: inner corners COLSxROWS, e.g. 9x6; charuco: squares X x Y, e.g. 5x7")
       ->required();
-  sub->add_option("--board-type", cmd->options.board_type, "chessboard (default) or charuco")
+  sub->add_option("--board-type", cmd->board_type, "chessboard (default) or charuco")
       ->check(CLI::IsMember({"chessboard", "charuco"}));
   sub->add_option("--dictionary", cmd->options.dictionary,
                   "charuco: OpenCV ArUco dictionary (default DICT_4X4_50)");
   sub->add_option("--marker", cmd->options.marker_m, "charuco: side of a marker in metres");
   sub->add_option("--square", cmd->options.square_m, "Side of one square in metres")->required();
   sub->add_option("--out", cmd->out, "Output camera.json")->required();
-  sub->add_option("--model", cmd->options.model, "PINHOLE, OPENCV (default) or FULL_OPENCV")
+  sub->add_option("--model", cmd->model, "PINHOLE, OPENCV (default) or FULL_OPENCV")
       ->check(CLI::IsMember({"PINHOLE", "OPENCV", "FULL_OPENCV"}));
   sub->add_flag("--fix-aspect-ratio", cmd->options.fix_aspect_ratio, "Constrain fx = fy");
   sub->add_flag("--zero-tangent-dist", cmd->options.zero_tangent_dist, "Constrain p1 = p2 = 0");
@@ -153,15 +158,17 @@ void ParseBoard(const std::string& text, igi::calib::IntrinsicsOptions* options)
 
 int RunIntrinsics(IntrinsicsCommand& cmd) {
   ParseBoard(cmd.board, &cmd.options);
+  cmd.options.board_type = igi::calib::BoardTypeFromName(cmd.board_type).value();
+  cmd.options.model = igi::calib::ColmapCameraModelFromName(cmd.model).value();
   cmd.options.Validate();
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
   const igi::calib::IntrinsicsSummary summary = igi::calib::CalibrateIntrinsics(paths, cmd.options);
   const igi::calib::CameraFile& camera = summary.camera;
   igi::calib::WriteCameraFile(cmd.out, camera);
   std::printf("%s: %s %dx%d, fx %.3f fy %.3f cx %.3f cy %.3f, RMS %.4f px over %zu views\n",
-              cmd.out.c_str(), camera.model.c_str(), camera.width, camera.height, camera.params[0],
-              camera.params[1], camera.params[2], camera.params[3], camera.rms_px,
-              camera.views.size());
+              cmd.out.c_str(), std::string(igi::calib::ColmapCameraModelName(camera.model)).c_str(),
+              camera.width, camera.height, camera.params[0], camera.params[1], camera.params[2],
+              camera.params[3], camera.rms_px, camera.views.size());
   if (camera.rejected_views.empty()) return 0;
   std::vector<std::string> problems;
   for (const auto& view : camera.rejected_views) {

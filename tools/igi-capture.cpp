@@ -74,7 +74,10 @@ int Capture(const Flags& flags, igi::capture::CaptureOptions options) {
   }
   options.auto_expose = flags.auto_expose;
   if (flags.frames != 0) options.frames = flags.frames;
-  if (!flags.format.empty()) options.file_format = flags.format;
+  // --format is checked against png|tiff when parsed.
+  if (!flags.format.empty()) {
+    options.file_format = igi::capture::PlanFileFormatFromName(flags.format).value();
+  }
   options.resume = flags.resume;
   options.stop_requested = &g_stop;
   // Frames (up to a few MiB each) are allocated on reception and freed by the

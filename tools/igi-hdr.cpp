@@ -38,6 +38,10 @@ struct Flags {
   igi::hdr::HdrInputOptions input;
   igi::hdr::MergeOptions merge;
   igi::hdr::HdrStreamOptions stream;
+  // The choice flags as typed; Validate parses them into `merge` and `input.raw`.
+  std::string weighting = "noise";
+  std::string raw_white_balance = "camera";
+  std::string raw_color = "srgb";
 };
 
 struct Job {
@@ -51,8 +55,30 @@ fs::path MaskPath(const fs::path& out, const std::string& mask_out, bool single)
   return mask.replace_filename(out.stem().string() + "_mask.png");
 }
 
-void Validate(const Flags& flags) {
+// The raw decode choices from their flags' text; InputError "--FLAG: VALUE: RULE" for each bad one.
+igi::hdr::RawDecodeOptions ParseRawChoices(const Flags& flags) {
+  igi::hdr::RawDecodeOptions raw = flags.input.raw;
+  igi::ProblemList problems;
+  if (const auto wb = igi::hdr::RawWhiteBalanceFromName(flags.raw_white_balance)) {
+    raw.white_balance = *wb;
+  } else {
+    problems.Add("--raw-white-balance", "", flags.raw_white_balance, "must be camera or none");
+  }
+  if (const auto color = igi::hdr::RawColorFromName(flags.raw_color)) {
+    raw.color = *color;
+  } else {
+    problems.Add("--raw-color", "", flags.raw_color, "must be srgb or raw");
+  }
+  problems.ThrowIfAny();
+  return raw;
+}
+
+// Parses the choice flags into the options (--weighting was checked against noise|hat when the
+// command line was parsed), then validates every option.
+void Validate(Flags& flags) {
+  flags.merge.weighting = igi::hdr::MergeWeightingFromName(flags.weighting).value();
   flags.merge.Validate();
+  flags.input.raw = ParseRawChoices(flags);
   flags.input.raw.Validate();
   flags.stream.Validate();
   if (flags.images.empty() == flags.manifest.empty()) {
@@ -140,7 +166,7 @@ MergeCounts MergeWhole(Job& job, const igi::hdr::MergeOptions& merge, const Flag
       igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
   igi::Image radiance = result.radiance;
   radiance.metadata["igi:response"] = job.input.response_source;
-  radiance.metadata["igi:weighting"] = merge.weighting;
+  radiance.metadata["igi:weighting"] = std::string(igi::hdr::MergeWeightingName(merge.weighting));
   igi::WriteImage(job.out, radiance);
   igi::WriteImageOptions mask_options;
   mask_options.type = igi::PixelType::kUInt8;
@@ -161,7 +187,8 @@ MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, c
   igi::hdr::StreamOutputs outputs;
   outputs.radiance = job.out;
   outputs.radiance_metadata["igi:response"] = job.input.response_source;
-  outputs.radiance_metadata["igi:weighting"] = merge.weighting;
+  outputs.radiance_metadata["igi:weighting"] =
+      std::string(igi::hdr::MergeWeightingName(merge.weighting));
   outputs.mask = mask;
   const igi::hdr::StreamMergeSummary summary =
       igi::hdr::MergeBracketStreamed(job.input.paths, job.input.exposures_s, shifts,
@@ -169,7 +196,7 @@ MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, c
   return {int64_t(summary.width) * summary.height, summary.saturated_pixels, summary.black_pixels};
 }
 
-int Run(const Flags& flags) {
+int Run(Flags& flags) {
   Validate(flags);
   std::vector<Job> jobs = LoadJobs(flags);
   for (Job& job : jobs) {
@@ -185,8 +212,9 @@ int Run(const Flags& flags) {
         "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
         "(%.3f %%), black in every exposure: %lld px (%.3f %%), masked in %s\n",
         job.out.string().c_str(), int(job.input.names.size()), job.input.response_source.c_str(),
-        merge.weighting.c_str(), (long long)counts.saturated, 100.0 * counts.saturated / total,
-        (long long)counts.black, 100.0 * counts.black / total, mask.string().c_str());
+        std::string(igi::hdr::MergeWeightingName(merge.weighting)).c_str(),
+        (long long)counts.saturated, 100.0 * counts.saturated / total, (long long)counts.black,
+        100.0 * counts.black / total, mask.string().c_str());
   }
   return 0;
 }
@@ -207,7 +235,7 @@ int main(int argc, char** argv) {
   app.add_option("--exposure-file", flags.input.exposures.file, "One exposure time per line")
       ->excludes(list);
   app.add_flag("--linear", flags.input.linear, "Non-raw input is linear (no response needed)");
-  app.add_option("--weighting", flags.merge.weighting, "noise (inverse variance) or hat")
+  app.add_option("--weighting", flags.weighting, "noise (inverse variance) or hat")
       ->check(CLI::IsMember({"noise", "hat"}));
   app.add_option("--shot-noise", flags.merge.shot_noise, "Variance per unit signal (full scale 1)");
   app.add_option("--read-noise", flags.merge.read_noise, "Read noise std, full scale 1");
@@ -217,8 +245,8 @@ int main(int argc, char** argv) {
   app.add_option("--saturated", flags.merge.saturated, "Normalised level at or above = saturated");
   app.add_flag("--align", flags.align, "Align hand-held brackets (median threshold bitmaps)");
   app.add_option("--mask-out", flags.mask_out, "Mask of bad pixels (default OUT_mask.png)");
-  app.add_option("--raw-white-balance", flags.input.raw.white_balance, "camera or none");
-  app.add_option("--raw-color", flags.input.raw.color, "srgb (linear) or raw (camera RGB)");
+  app.add_option("--raw-white-balance", flags.raw_white_balance, "camera or none");
+  app.add_option("--raw-color", flags.raw_color, "srgb (linear) or raw (camera RGB)");
   app.add_flag("--half-size", flags.input.raw.half_size, "Raw: 2x2 binning, no demosaicing");
   app.add_option("--band-rows", flags.stream.band_rows,
                  "Rows of every frame held in memory when merging band by band (default 64)");

@@ -42,7 +42,8 @@ int Run(const std::string& camera, bool multi_camera, const igi::CommonFlags& fl
   if (!camera.empty()) {
     const igi::calib::CameraFile file = igi::calib::ReadCameraFile(camera);
     options->colmap.intrinsics =
-        igi::KnownIntrinsics{file.model, file.width, file.height, file.params};
+        igi::KnownIntrinsics{std::string(igi::calib::ColmapCameraModelName(file.model)), file.width,
+                             file.height, file.params};
     options->camera_file = camera;
   }
   options->colmap.threads = flags.threads;

@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   igi::hdr::MergeOptions noise;
   noise.num_threads = threads;
   igi::hdr::MergeOptions hat = noise;
-  hat.weighting = "hat";
+  hat.weighting = igi::hdr::MergeWeighting::kHat;
   cv::Ptr<cv::MergeDebevec> merge = cv::createMergeDebevec();
   cv::Mat hdr;
   // Interleaved: each repeat times OpenCV, igi noise-aware and igi hat back to back, so a busy

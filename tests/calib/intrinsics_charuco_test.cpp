@@ -107,13 +107,13 @@ std::vector<fs::path> WriteViews(const fs::path& dir) {
 
 IntrinsicsOptions CharucoOptions() {
   IntrinsicsOptions o;
-  o.board_type = "charuco";
+  o.board_type = BoardType::kCharuco;
   o.board_cols = kSquaresX;
   o.board_rows = kSquaresY;
   o.square_m = kSquareM;
   o.marker_m = kMarkerM;
   o.dictionary = "DICT_4X4_50";
-  o.model = "OPENCV";
+  o.model = ColmapCameraModel::kOpenCv;
   return o;
 }
 

@@ -34,7 +34,7 @@ TEST(IntrinsicsE2eTest, WritesCameraJson) {
                                           Quote(out.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const CameraFile camera = ReadCameraFile(out);
-  EXPECT_EQ(camera.model, "OPENCV");
+  EXPECT_EQ(camera.model, ColmapCameraModel::kOpenCv);
   EXPECT_EQ(camera.width, 640);
   EXPECT_EQ(camera.views.size(), 9u);
   EXPECT_EQ(camera.per_view_rms_px.size(), 9u);

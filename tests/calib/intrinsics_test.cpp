@@ -16,6 +16,7 @@
 #include "calib/camera_file.h"
 #include "tests/temp_dir.h"
 #include "tools/common/error.h"
+#include "tools/common/json.h"
 
 namespace igi::calib {
 namespace {
@@ -57,7 +58,8 @@ IntrinsicsOptions ReferenceOptions() {
   options.board_cols = 9;
   options.board_rows = 6;
   options.square_m = 0.025;
-  options.model = "FULL_OPENCV";  // OpenCV's default k1 k2 p1 p2 k3, as the reference
+  options.model =
+      ColmapCameraModel::kFullOpenCv;  // OpenCV's default k1 k2 p1 p2 k3, as the reference
   options.fix_aspect_ratio = true;
   return options;
 }
@@ -90,7 +92,7 @@ TEST(IntrinsicsTest, MatchesOpenCvReferenceOnRealChessboard) {
 
 TEST(IntrinsicsTest, OpenCvModelWithoutK3IsCloseToReference) {
   IntrinsicsOptions options = ReferenceOptions();
-  options.model = "OPENCV";
+  options.model = ColmapCameraModel::kOpenCv;
   const CameraFile camera = CalibrateIntrinsics(BoardImages(), options).camera;
   ASSERT_EQ(camera.params.size(), 8u);
   // Without k3 the fit has one distortion term fewer: fx within 1 %, RMS within 0.1 px.
@@ -111,14 +113,22 @@ TEST(IntrinsicsTest, OptionsAreValidated) {
   options.square_m = 0;
   EXPECT_THROW(options.Validate(), InputError);
   options = ReferenceOptions();
-  options.model = "FISHEYE";
+  options.model = ColmapCameraModel::kSimpleRadial;  // a model intrinsics does not calibrate
   EXPECT_THROW(options.Validate(), InputError);
+  options = ReferenceOptions();
+  options.board_type = static_cast<BoardType>(7);  // no such board
+  EXPECT_THROW(options.Validate(), InputError);
+  for (BoardType t : {BoardType::kChessboard, BoardType::kCharuco}) {
+    EXPECT_EQ(BoardTypeFromName(BoardTypeName(t)), t);
+  }
+  EXPECT_EQ(BoardTypeName(BoardType::kCharuco), "charuco");
+  EXPECT_FALSE(BoardTypeFromName("Chessboard"));
 }
 
 TEST(CameraFileTest, RoundTripsAndRejectsBadFiles) {
   const auto dir = test::UniqueTempDir("igi_camera_file");
   CameraFile camera;
-  camera.model = "OPENCV";
+  camera.model = ColmapCameraModel::kOpenCv;
   camera.width = 640;
   camera.height = 480;
   camera.params = {500, 500, 320, 240, -0.1, 0.01, 0.001, -0.001};
@@ -146,6 +156,37 @@ TEST(CameraFileTest, RoundTripsAndRejectsBadFiles) {
     FAIL() << "unknown key accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("colour"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CameraFileTest, ModelNamesAreCOLMAPsAndUnknownModelsAreRejected) {
+  for (ColmapCameraModel m : {ColmapCameraModel::kSimplePinhole, ColmapCameraModel::kPinhole,
+                              ColmapCameraModel::kSimpleRadial, ColmapCameraModel::kRadial,
+                              ColmapCameraModel::kOpenCv, ColmapCameraModel::kFullOpenCv}) {
+    EXPECT_EQ(ColmapCameraModelFromName(ColmapCameraModelName(m)), m);
+  }
+  EXPECT_EQ(ColmapCameraModelName(ColmapCameraModel::kFullOpenCv), "FULL_OPENCV");
+  EXPECT_FALSE(ColmapCameraModelFromName("opencv"));
+  const auto dir = test::UniqueTempDir("igi_camera_file_model");
+  CameraFile camera;
+  camera.model = ColmapCameraModel::kSimpleRadial;
+  camera.width = 64;
+  camera.height = 48;
+  camera.params = {50, 32, 24, 0.01};
+  WriteCameraFile(dir / "camera.json", camera);
+  EXPECT_EQ(ReadJsonFile(dir / "camera.json")["model"], "SIMPLE_RADIAL");
+  EXPECT_EQ(ReadCameraFile(dir / "camera.json").model, ColmapCameraModel::kSimpleRadial);
+  std::ofstream(dir / "fisheye.json")
+      << R"({"format": "igi-camera", "model": "OPENCV_FISHEYE", "width": 4, "height": 4,
+             "params": [1, 1, 2, 2, 0, 0, 0, 0]})";
+  try {
+    ReadCameraFile(dir / "fisheye.json");
+    FAIL() << "unknown model accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("model: OPENCV_FISHEYE: must be SIMPLE_PINHOLE"),
+              std::string::npos)
+        << e.what();
   }
   std::filesystem::remove_all(dir);
 }

@@ -128,7 +128,7 @@ TEST(ResponseRecovery, RobertsonRecoversKnownResponseWithin1Percent) {
   o.exposures_s = {1.0 / 50, 1.0 / 13, 1.0 / 4, 1.2, 3.7};
   const testing::SyntheticBracket s = testing::MakeSyntheticBracket(o);
   ResponseOptions options;
-  options.method = "robertson";
+  options.method = ResponseRecoveryMethod::kRobertson;
   const ResponseSummary summary = RecoverResponse(s.bracket, options);
   for (int c = 0; c < 3; ++c) {
     const double error = MaxExposureError(summary.curve, c, kLo, kHi);
@@ -141,7 +141,7 @@ TEST(ResponseRecovery, RobertsonRecoversKnownResponseWithin1Percent) {
 TEST(ResponseRecovery, RobertsonSmoothingDampsConstantRatioRipples) {
   const testing::SyntheticBracket s = testing::MakeSyntheticBracket();
   ResponseOptions options;
-  options.method = "robertson";
+  options.method = ResponseRecoveryMethod::kRobertson;
   double plain = 0.0, smoothed = 0.0;
   const ResponseCurve plain_curve = RecoverResponse(s.bracket, options).curve;
   options.robertson_smoothing = 30;
@@ -171,8 +171,14 @@ TEST(ResponseRecovery, TooFewUsablePixelsIsInputError) {
 
 TEST(ResponseRecovery, OptionsAreValidated) {
   ResponseOptions options;
-  options.method = "magic";
+  options.method = static_cast<ResponseRecoveryMethod>(7);  // no such method
   EXPECT_THROW(options.Validate(), InputError);
+  for (ResponseRecoveryMethod m :
+       {ResponseRecoveryMethod::kDebevec, ResponseRecoveryMethod::kRobertson}) {
+    EXPECT_EQ(ResponseRecoveryMethodFromName(ResponseRecoveryMethodName(m)), m);
+  }
+  EXPECT_EQ(ResponseRecoveryMethodName(ResponseRecoveryMethod::kRobertson), "robertson");
+  EXPECT_FALSE(ResponseRecoveryMethodFromName("magic"));
   options = {};
   options.lambda = -2;  // -1 is kLambdaAuto
   EXPECT_THROW(options.Validate(), InputError);

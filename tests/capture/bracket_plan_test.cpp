@@ -32,8 +32,17 @@ TEST(SlotFileName, NamesBracketExposureAndFrame) {
   BracketPlan plan;
   plan.exposures_us = {125.4, 1e6};
   EXPECT_EQ(SlotFileName(plan, {0, 2}), "frames/b00_e000000125us_f002.png");
-  plan.file_format = "tiff";
+  plan.file_format = PlanFileFormat::kTiff;
   EXPECT_EQ(SlotFileName(plan, {1, 0}), "frames/b01_e001000000us_f000.tif");
+}
+
+TEST(PlanFileFormat, NamesRoundTripAndOthersAreRejected) {
+  for (PlanFileFormat f : {PlanFileFormat::kPng, PlanFileFormat::kTiff}) {
+    EXPECT_EQ(PlanFileFormatFromName(PlanFileFormatName(f)), f);
+  }
+  EXPECT_EQ(PlanFileFormatName(PlanFileFormat::kTiff), "tiff");
+  EXPECT_FALSE(PlanFileFormatFromName("tif"));
+  EXPECT_FALSE(PlanFileFormatFromName("PNG"));
 }
 
 TEST(BracketPlan, RoundTripsThroughPlanJson) {
@@ -44,7 +53,7 @@ TEST(BracketPlan, RoundTripsThroughPlanJson) {
   plan.settle_frames = 2;
   plan.pixel_format = "Mono16";
   plan.gain = 1.5;
-  plan.file_format = "tiff";
+  plan.file_format = PlanFileFormat::kTiff;
   plan.auto_metered = true;
   const auto path = std::filesystem::temp_directory_path() / "igi_plan_roundtrip.json";
   WritePlan(path, plan);
@@ -52,6 +61,7 @@ TEST(BracketPlan, RoundTripsThroughPlanJson) {
   EXPECT_EQ(PlanToJson(read), PlanToJson(plan));
   EXPECT_EQ(ReadJsonFile(path)["format"], "igi-capture-plan");
   EXPECT_EQ(ReadJsonFile(path)["version"], 1);
+  EXPECT_EQ(ReadJsonFile(path)["file_format"], "tiff");
   std::filesystem::remove(path);
 }
 

@@ -109,7 +109,7 @@ TEST(MergeStream, SyntheticPngBracketEqualsWholeMergeBitForBit) {
   for (const std::string weighting : {"noise", "hat"}) {
     for (bool shared : {false, true}) {
       MergeOptions options;
-      options.weighting = weighting;
+      options.weighting = MergeWeightingFromName(weighting).value();
       options.shared_weights = shared;
       SCOPED_TRACE(weighting + (shared ? " shared" : ""));
       ExpectSameAsWhole(dir, paths, exposures_s, {}, response, options, 16);

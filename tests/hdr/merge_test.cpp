@@ -97,7 +97,7 @@ TEST(Merge, NoiseAwareWeightsBeatTheHat) {
   noise.shot_noise = 1.0 / 5000;
   noise.read_noise = 10.0 / 5000;
   MergeOptions hat = noise;
-  hat.weighting = "hat";
+  hat.weighting = MergeWeighting::kHat;
   const Errors e_noise = Compare(
       MergeBracket(s.bracket.images, s.bracket.exposures_s, response, noise).radiance, s.radiance);
   const Errors e_hat = Compare(
@@ -126,8 +126,16 @@ TEST(Merge, RejectsMismatchedInputs) {
   EXPECT_THROW(MergeBracket({a, b}, {1.0, 2.0}, linear, {}), InputError);
   EXPECT_THROW(MergeBracket({a}, {1.0, 2.0}, linear, {}), InputError);
   MergeOptions bad;
-  bad.weighting = "box";
+  bad.weighting = static_cast<MergeWeighting>(7);  // no such weighting
   EXPECT_THROW(bad.Validate(), InputError);
+}
+
+TEST(Merge, WeightingNamesRoundTripAndOthersAreRejected) {
+  for (MergeWeighting w : {MergeWeighting::kNoise, MergeWeighting::kHat}) {
+    EXPECT_EQ(MergeWeightingFromName(MergeWeightingName(w)), w);
+  }
+  EXPECT_EQ(MergeWeightingName(MergeWeighting::kHat), "hat");
+  EXPECT_FALSE(MergeWeightingFromName("box"));
 }
 
 // Memorial: igi's hat merge against cv::MergeDebevec, both with OpenCV's CalibrateDebevec
@@ -162,7 +170,7 @@ TEST(Merge, MemorialAgreesWithOpenCvMergeDebevec) {
   const calib::ResponseCurve ours = calib::RecoverResponse(bracket, response_options).curve;
   const calib::ResponseCurve& theirs = theirs_curve;
   MergeOptions hat;
-  hat.weighting = "hat";
+  hat.weighting = MergeWeighting::kHat;
   hat.black = 0.0;
   hat.saturated = 1.0;
   hat.shared_weights = true;  // as MergeDebevec: one weight per pixel, the channels' mean

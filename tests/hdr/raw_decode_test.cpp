@@ -54,10 +54,26 @@ TEST(RawDecode, RecognisesRawExtensions) {
 // the black patch; a gamma-encoded decode misses by tens of %), and the offset must stay below
 // 2 % of the white patch. Forced through the origin the dark patches miss by up to 8 % because
 // of that glare.
+TEST(RawDecode, ChoiceNamesRoundTripAndOthersAreRejected) {
+  for (RawWhiteBalance w : {RawWhiteBalance::kCamera, RawWhiteBalance::kNone}) {
+    EXPECT_EQ(RawWhiteBalanceFromName(RawWhiteBalanceName(w)), w);
+  }
+  for (RawColor c : {RawColor::kSrgb, RawColor::kRaw}) {
+    EXPECT_EQ(RawColorFromName(RawColorName(c)), c);
+  }
+  EXPECT_EQ(RawWhiteBalanceName(RawWhiteBalance::kNone), "none");
+  EXPECT_EQ(RawColorName(RawColor::kSrgb), "srgb");
+  EXPECT_FALSE(RawWhiteBalanceFromName("auto"));
+  EXPECT_FALSE(RawColorFromName("sRGB"));
+  RawDecodeOptions bad;
+  bad.color = static_cast<RawColor>(7);
+  EXPECT_THROW(bad.Validate(), InputError);
+}
+
 TEST(RawDecode, ColorCheckerGreyPatchesAreLinearInLuminance) {
   RawDecodeOptions options;
-  options.white_balance = "none";
-  options.color = "raw";
+  options.white_balance = RawWhiteBalance::kNone;
+  options.color = RawColor::kRaw;
   const RawImage raw = DecodeRaw(kRawDir + "colorchart.dng", options);
   ASSERT_EQ(raw.image.width, 1734);
   ASSERT_EQ(raw.image.height, 1156);
