@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <utility>
 
+#include "recon/scene_document.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/observations.h"
 #include "tools/common/image.h"
@@ -68,61 +70,51 @@ AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double m
   }
   if (capture.cameras.empty()) return capture;
   capture.reduced = true;
-  Json doc = declared;
-  doc["cameras"] = Json::object();
+  SceneDocument doc(declared);
+  doc.SetCameras(Json::object());
   for (size_t k = 0; k < scene.cameras.size(); ++k) {
     Camera cam = scene.cameras[k];
     const int f = factor[k];
     cam.width /= f;
     cam.height /= f;
     for (int i = 0; i < 4; ++i) cam.params[i] /= f;
-    doc["cameras"][cam.name] = CameraJson(cam);
+    doc.SetCamera(cam.name, cam);
   }
   fs::create_directories(dir);
   Progress progress("igi-diagnose: reducing the photos", int64_t(scene.photos.size()), 2.0,
                     show_progress && ProgressAllowed());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
     const Photo& p = scene.photos[i];
-    Json& j = doc["photos"][i];
-    j["camera"] = scene.cameras[p.camera].name;
+    doc.SetPhotoCamera(i, scene.cameras[p.camera].name);
     const int f = factor[p.camera];
     if (f == 1) continue;
     const fs::path sub = dir / "photos" / std::to_string(i);
     fs::create_directories(sub);
     const fs::path file = fs::absolute(sub / p.file.filename().replace_extension(".exr"));
     const fs::path mask = fs::absolute(sub / "mask.png");
-    j["file"] = file.string();
-    if (ReducePhoto(p, f, file, mask)) {
-      j["mask"] = mask.string();
-    } else {
-      j.erase("mask");
-    }
+    const bool masked = ReducePhoto(p, f, file, mask);
+    doc.SetPhotoFile(i, file);
+    doc.SetPhotoMask(i, masked ? std::optional<fs::path>(mask) : std::nullopt);
     progress.Add();
   }
   progress.Finish();
   capture.scene_file = dir / "scene.json";
-  WriteJsonFile(capture.scene_file, doc, 1);
+  WriteJsonFile(capture.scene_file, doc.json(), 1);
   return capture;
 }
 
-Json AtDeclaredSize(Json doc, const Scene& declared) {
+Json AtDeclaredSize(Json document, const Scene& declared) {
+  SceneDocument doc(std::move(document));
   for (const Camera& cam : declared.cameras) {
-    if (!doc["cameras"].contains(cam.name)) continue;
-    Json& j = doc["cameras"][cam.name];
-    const Json full = CameraJson(cam);
-    for (const char* key : {"model", "width", "height", "params"}) j[key] = full[key];
+    if (doc.HasCamera(cam.name)) doc.SetCameraIntrinsics(cam.name, cam);
   }
-  for (size_t i = 0; i < declared.photos.size() && i < doc["photos"].size(); ++i) {
+  for (size_t i = 0; i < declared.photos.size() && i < doc.NumPhotos(); ++i) {
     const Photo& p = declared.photos[i];
-    Json& j = doc["photos"][i];
-    j["file"] = fs::absolute(p.file).lexically_normal().string();
-    if (p.mask) {
-      j["mask"] = fs::absolute(*p.mask).lexically_normal().string();
-    } else {
-      j.erase("mask");
-    }
+    doc.SetPhotoFile(i, fs::absolute(p.file).lexically_normal());
+    doc.SetPhotoMask(i, p.mask ? std::optional<fs::path>(fs::absolute(*p.mask).lexically_normal())
+                               : std::nullopt);
   }
-  return doc;
+  return std::move(doc).json();
 }
 
 Json AnalysisCaptureJson(const AnalysisCapture& capture, double max_megapixels) {

@@ -26,9 +26,9 @@ std::optional<CandidateResult> Effect::TryFirst(const DiagnosisModel&, int) { re
 std::optional<CandidateResult> Effect::TryLast(const DiagnosisModel&) { return std::nullopt; }
 
 TrialPlan Effect::PlanTrial(CandidateResult* c, const DiagnosisModel& m) {
-  TrialPlan plan{m.declared, m.maps, std::nullopt};
-  Write(*c, &plan.document);
-  return plan;
+  SceneDocument doc(m.declared);
+  Write(*c, &doc);
+  return {std::move(doc).json(), m.maps, std::nullopt};
 }
 
 std::optional<Refinement> Effect::Refine(const CandidateResult&, const Json&, const Scene&,

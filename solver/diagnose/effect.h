@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "recon/scene.h"
+#include "recon/scene_document.h"
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/diagnose_options.h"
 #include "solver/diagnose/pixel_records.h"
@@ -157,7 +158,7 @@ class Effect {
   virtual void DescribeKept(CandidateResult* c, const Scene& refit) const;
 
   // Writes candidate `c` (its params) into the scene document `doc`.
-  virtual void Write(const CandidateResult& c, Json* doc) const = 0;
+  virtual void Write(const CandidateResult& c, SceneDocument* doc) const = 0;
 };
 
 // Every effect igi-diagnose models, in the order the driver consults them (effects/effects.cpp).

@@ -4,7 +4,9 @@
 // sim and recorded are left to the caller.
 
 #include <Eigen/Core>
+#include <utility>
 
+#include "recon/scene_document.h"
 #include "solver/diagnose/effect.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/photo_model.h"
@@ -37,7 +39,9 @@ inline PixelRecord OneLightRecord(int photo, int x, int y, int region,
 
 // Candidate `c` written into `doc` by its effect (Effect::Write).
 inline void WriteCandidate(const CandidateResult& c, Json* doc) {
-  FindEffect(MakeEffects(), c.effect)->Write(c, doc);
+  SceneDocument written(std::move(*doc));
+  FindEffect(MakeEffects(), c.effect)->Write(c, &written);
+  *doc = std::move(written).json();
 }
 
 }  // namespace igi::test

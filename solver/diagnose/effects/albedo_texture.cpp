@@ -121,7 +121,7 @@ class AlbedoTextureEffect final : public Effect {
   }
 
   // Nothing: the maps are the refit's (PlanTrial), written by the solver into its scene.
-  void Write(const CandidateResult&, Json*) const override {}
+  void Write(const CandidateResult&, SceneDocument*) const override {}
 
  private:
   bool judged_ = false;  // the texture test has named textured regions

@@ -157,11 +157,9 @@ class AmbientLightEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return AmbientLight(cx, f); }});
   }
   // A new "ambient" light (a name no light has) of the fitted radiance, in every lighting.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    std::string name = "ambient";
-    while ((*doc)["lights"].contains(name)) name += "_";
-    (*doc)["lights"][name] = {{"type", "ambient"}, {"radiance", c.params.at("radiance")}};
-    for (auto& [lighting, list] : (*doc)["lightings"].items()) list.push_back(name);
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    doc->AddLightToEveryLighting("ambient",
+                                 {{"type", "ambient"}, {"radiance", c.params.at("radiance")}});
   }
 };
 

@@ -277,20 +277,17 @@ class AnisotropicReflectionEffect final : public Effect {
   }
   // The region's model becomes its *_aniso form with the fitted tangent; where the declared
   // region has α and ρs, they become the fitted α_x, α_y and the scaled ρs.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    Json& j = (*doc)["materials"][c.params.at("region").get<std::string>()];
-    j["brdf"] = c.params.at("to");
-    j["tangent"] = c.params.at("tangent");
-    const bool known_alpha = j.contains("alpha");
-    j.erase("alpha");
-    if (known_alpha) j["alpha_x"] = c.params.at("alpha_x"), j["alpha_y"] = c.params.at("alpha_y");
-    const double k = c.params.at("rho_s_factor").get<double>();
-    if (j.contains("rho_s")) {
-      if (j["rho_s"].is_number()) j["rho_s"] = j["rho_s"].get<double>() * k;
-      if (j["rho_s"].is_array()) {
-        for (Json& v : j["rho_s"]) v = v.get<double>() * k;
-      }
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    const std::string region = c.params.at("region").get<std::string>();
+    doc->SetMaterialBrdf(region, BrdfModelFromName(c.params.at("to").get<std::string>()).value());
+    doc->SetMaterialValue(region, "tangent", c.params.at("tangent"));
+    const bool known_alpha = doc->Material(region).contains("alpha");
+    doc->EraseMaterialValue(region, "alpha");
+    if (known_alpha) {
+      doc->SetMaterialValue(region, "alpha_x", c.params.at("alpha_x"));
+      doc->SetMaterialValue(region, "alpha_y", c.params.at("alpha_y"));
     }
+    doc->ScaleMaterialValue(region, "rho_s", c.params.at("rho_s_factor").get<double>());
   }
 };
 

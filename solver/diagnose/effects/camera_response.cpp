@@ -163,16 +163,14 @@ class CameraResponseEffect final : public Effect {
     if (!(g1 * g0 > 0) || !(kappa >= 0.1 && kappa <= 1)) return std::nullopt;
     const double x = x1 + g1 / kappa, e = std::exp(x);
     const double reference = again.params.value("reference", c.params.value("reference", 1.0));
-    Refinement out{document, c};
     // The document's exponents carry the first step's: it is taken back and the fixed point
     // written in its place.
-    for (Json& p : out.document["photos"]) {
-      const double declared = p.contains("response") && p["response"].contains("exponent") &&
-                                      p["response"]["exponent"].is_number()
-                                  ? p["response"]["exponent"].get<double>() / e1
-                                  : 1.0;
-      p["response"] = {{"exponent", declared * e}, {"reference", reference}};
+    SceneDocument doc(document);
+    for (size_t i = 0; i < doc.NumPhotos(); ++i) {
+      const std::optional<double> exponent = doc.PhotoResponseExponent(i);
+      doc.SetPhotoResponse(i, (exponent ? *exponent / e1 : 1.0) * e, reference);
     }
+    Refinement out{std::move(doc).json(), c};
     CandidateResult& revised = out.candidate;
     revised.params["first_exponent"] = e1;
     revised.params["exponent"] = e;
@@ -186,12 +184,11 @@ class CameraResponseEffect final : public Effect {
 
   // Every photo's response is composed with the fitted power: exponents multiply, the reference
   // is the fitted one.
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     const double e = c.params.at("exponent").get<double>();
-    for (Json& p : (*doc)["photos"]) {
-      double old = 1;
-      if (p.contains("response")) old = p["response"].value("exponent", 1.0);
-      p["response"] = {{"exponent", old * e}, {"reference", c.params.at("reference")}};
+    const double reference = c.params.at("reference").get<double>();
+    for (size_t i = 0; i < doc->NumPhotos(); ++i) {
+      doc->SetPhotoResponse(i, doc->PhotoResponseExponent(i).value_or(1.0) * e, reference);
     }
   }
 };

@@ -165,12 +165,12 @@ class ExposureScaleEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return ExposureScale(cx, f); }});
   }
   // Each photo's exposure_scale is multiplied by its fitted scale.
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     const Json& scales = c.params.at("scale");
-    for (Json& photo : (*doc)["photos"]) {
-      const std::string file = std::filesystem::path(photo.value("file", "")).filename().string();
+    for (size_t i = 0; i < doc->NumPhotos(); ++i) {
+      const std::string file = std::filesystem::path(doc->PhotoFile(i)).filename().string();
       if (!scales.contains(file)) continue;
-      photo["exposure_scale"] = photo.value("exposure_scale", 1.0) * scales[file].get<double>();
+      doc->SetPhotoExposure(i, doc->PhotoExposure(i).value_or(1.0) * scales[file].get<double>());
     }
   }
 };

@@ -25,10 +25,10 @@ class FresnelEffect final : public Effect {
     return RegionScope(c, m);
   }
   // The region's model becomes its *_fresnel form with the fitted index.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    Json& m = (*doc)["materials"][c.params.at("region").get<std::string>()];
-    m["brdf"] = c.params.at("to");
-    m["ior"] = c.params.at("ior");
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    const std::string region = c.params.at("region").get<std::string>();
+    doc->SetMaterialBrdf(region, BrdfModelFromName(c.params.at("to").get<std::string>()).value());
+    doc->SetMaterialValue(region, "ior", c.params.at("ior"));
   }
 };
 

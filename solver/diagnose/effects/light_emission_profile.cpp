@@ -383,13 +383,13 @@ class LightEmissionProfileEffect final : public Effect {
     }
   }
   // The light becomes a spot at its position, with its intensity, the fitted axis and cos^n.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    (*doc)["lights"][c.params.at("light").get<std::string>()] = {
-        {"type", "spot"},
-        {"position", c.params.at("position")},
-        {"direction", c.params.at("direction")},
-        {"intensity", c.params.at("intensity")},
-        {"profile", {{"cos_power", c.params.at("cos_power")}}}};
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    doc->SetLight(c.params.at("light").get<std::string>(),
+                  {{"type", "spot"},
+                   {"position", c.params.at("position")},
+                   {"direction", c.params.at("direction")},
+                   {"intensity", c.params.at("intensity")},
+                   {"profile", {{"cos_power", c.params.at("cos_power")}}}});
   }
 };
 

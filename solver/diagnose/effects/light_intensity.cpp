@@ -114,13 +114,9 @@ class LightIntensityEffect final : public Effect {
     }
   }
   // The light's intensity (or radiance, or irradiance) is multiplied by the fitted factor.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    Json& j = (*doc)["lights"][c.params.at("light").get<std::string>()];
-    const double factor = c.params.at("factor").get<double>();
-    for (const char* key : {"intensity", "radiance", "irradiance"}) {
-      if (!j.contains(key)) continue;
-      for (Json& v : j[key]) v = v.get<double>() * factor;
-    }
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    doc->ScaleLightEmission(c.params.at("light").get<std::string>(),
+                            c.params.at("factor").get<double>());
   }
 };
 

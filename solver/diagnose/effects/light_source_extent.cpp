@@ -554,15 +554,15 @@ class LightSourceExtentEffect final : public Effect {
     }
   }
   // The light becomes a sphere of the fitted radius at its position, with its intensity.
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     const double radius = c.params.at("radius").get<double>();
     const Json& intensity = c.params.at("intensity");
     Json radiance = Json::array();
     for (const Json& v : intensity) radiance.push_back(v.get<double>() / (kPi * radius * radius));
-    (*doc)["lights"][c.params.at("light").get<std::string>()] = {{"type", "sphere"},
-                                                                 {"center", c.params.at("center")},
-                                                                 {"radius", radius},
-                                                                 {"radiance", radiance}};
+    doc->SetLight(c.params.at("light").get<std::string>(), {{"type", "sphere"},
+                                                            {"center", c.params.at("center")},
+                                                            {"radius", radius},
+                                                            {"radiance", radiance}});
   }
 };
 

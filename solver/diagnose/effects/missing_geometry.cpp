@@ -43,9 +43,9 @@ class MissingGeometryEffect final : public Effect {
 
   // The refit and its comparison use the pixels outside the located object's masks.
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
-    TrialPlan plan{m.declared, m.maps, MaskedPhotoSet(m.photos, located_.excluded)};
-    Write(*c, &plan.document);
-    return plan;
+    SceneDocument doc(m.declared);
+    Write(*c, &doc);
+    return {std::move(doc).json(), m.maps, MaskedPhotoSet(m.photos, located_.excluded)};
   }
 
   // Excluding pixels cannot be scored by the residual it removes alone. The masks come from the
@@ -68,9 +68,10 @@ class MissingGeometryEffect final : public Effect {
   }
 
   // Each photo with pixels of the object gets the mask that excludes them.
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     for (const Json& m : c.params.at("mask_files")) {
-      (*doc)["photos"][m.at("photo").get<size_t>()]["mask"] = m.at("file");
+      doc->SetPhotoMask(m.at("photo").get<size_t>(),
+                        std::filesystem::path(m.at("file").get<std::string>()));
     }
   }
 

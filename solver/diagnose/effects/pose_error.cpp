@@ -111,18 +111,13 @@ Vec6 DampedPoseStep(const CandidateContext& cx, const ResidualFitter& f, const F
 }  // namespace
 
 void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
-                     const Eigen::Vector3d& delta, Json* doc) {
-  Json& j = (*doc)["cameras"][camera];
-  const std::vector<double> q = j["qvec"].get<std::vector<double>>();
-  const std::vector<double> t = j["tvec"].get<std::vector<double>>();
-  const Eigen::Quaterniond r0(q[0], q[1], q[2], q[3]);
+                     const Eigen::Vector3d& delta, SceneDocument* doc) {
+  const Rigid3d pose = doc->CameraPose(camera);
   const double a = omega.norm();
   const Eigen::Quaterniond dr(a > 0 ? Eigen::AngleAxisd(a, omega / a)
                                     : Eigen::AngleAxisd::Identity());
-  const Eigen::Quaterniond r1 = (dr * r0).normalized();
-  const Eigen::Vector3d t1 = dr * Eigen::Vector3d(t[0], t[1], t[2]) + delta;
-  j["qvec"] = {r1.w(), r1.x(), r1.y(), r1.z()};
-  j["tvec"] = {t1.x(), t1.y(), t1.z()};
+  doc->SetCameraPose(camera,
+                     Rigid3d((dr * pose.rotation).normalized(), dr * pose.translation + delta));
 }
 
 double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, int camera) {
@@ -361,16 +356,10 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
   return out;
 }
 
-Rigid3d PoseOfCameraJson(const Json& j) {
-  const std::vector<double> q = j["qvec"].get<std::vector<double>>();
-  const std::vector<double> t = j["tvec"].get<std::vector<double>>();
-  return Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(),
-                 Eigen::Vector3d(t[0], t[1], t[2]));
-}
-
 PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& o,
-                          bool materials_solved, double cell_m, int max_iterations, Json* doc) {
+                          bool materials_solved, double cell_m, int max_iterations,
+                          SceneDocument* doc) {
   PoseRefinement out;
   Scene m = model;
   const std::string name = m.cameras[camera].name;
@@ -378,11 +367,11 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
   std::vector<Image> current = sims;
   std::vector<std::unique_ptr<Renderer>> renderers(m.lightings.size());
   double last_train = std::numeric_limits<double>::infinity();
-  Json last_doc = *doc;
+  SceneDocument last_doc = *doc;
   Eigen::Vector3d last_omega = Eigen::Vector3d::Zero(), last_delta = Eigen::Vector3d::Zero();
   int halvings = 0;
   for (int it = 0; it < max_iterations; ++it) {
-    m.cameras[camera].cam_from_world = PoseOfCameraJson((*doc)["cameras"][name]);
+    m.cameras[camera].cam_from_world = doc->CameraPose(name);
     for (size_t i = 0; i < m.photos.size(); ++i) {
       const Photo& p = m.photos[i];
       if (p.camera != camera) continue;
@@ -405,7 +394,7 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
     std::vector<int> cells = RecordCells(m, records, cell_m, &num_cells);
     const ResidualFitter f(records, std::move(cells), num_cells, materials_solved,
                            o.holdout_block_px);
-    CandidateContext cx{m, *doc, materials_solved, cell_m, o.holdout_block_px};
+    CandidateContext cx{m, doc->json(), materials_solved, cell_m, o.holdout_block_px};
     cx.photos = &photos;
     cx.sims = &current;
     const CandidateResult step = FitPoseError(cx, f, camera);
@@ -452,7 +441,7 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
     const double depth = MedianDepth(records, m, camera);
     if (out.last_step_deg < 0.005 && out.last_step_m < 3e-5 * depth) break;
   }
-  const Rigid3d end = PoseOfCameraJson((*doc)["cameras"][name]);
+  const Rigid3d end = doc->CameraPose(name);
   out.rotation_deg = Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / kPi;
   const Eigen::Vector3d c0 = -(start.rotation.inverse() * start.translation);
   const Eigen::Vector3d c1 = -(end.rotation.inverse() * end.translation);
@@ -532,27 +521,27 @@ class PoseErrorEffect final : public Effect {
   // Gauss–Newton on re-renders of the camera (RefinePose), and the candidate becomes the pose
   // found.
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
-    TrialPlan plan{m.declared, m.maps, std::nullopt};
     const int camera = CameraOf(*c, m.model);
-    if (camera < 0) return plan;
+    if (camera < 0) return {m.declared, m.maps, std::nullopt};
+    SceneDocument doc(m.declared);
     const PoseRefinement pr = RefinePose(m.model, camera, m.photos, m.sims, m.options,
-                                         m.materials_solved, m.cell_m, 8, &plan.document);
+                                         m.materials_solved, m.cell_m, 8, &doc);
     Json& p = c->params;
     p["iterations"] = pr.iterations;
     p["rotation_deg"] = pr.rotation_deg;
     p["center_shift_m"] = pr.translation_m;
     p.erase("rotation_vector");
     p.erase("translation_m");
-    const Json& cam = plan.document["cameras"][p["camera"].get<std::string>()];
-    p["qvec"] = cam["qvec"];
-    p["tvec"] = cam["tvec"];
+    const Json& cam = doc.json().at("cameras").at(p["camera"].get<std::string>());
+    p["qvec"] = cam.at("qvec");
+    p["tvec"] = cam.at("tvec");
     c->evidence = fmt::format(
         "camera {}: the residual follows the model image's edges, as a shift of the view: {} "
         "Gauss-Newton steps on re-renders move its pose by {:.3f} deg and its centre by {:.1f} "
         "mm (last step {:.4f} deg, {:.2f} mm)",
         p["camera"].get<std::string>(), pr.iterations, pr.rotation_deg, 1000 * pr.translation_m,
         pr.last_step_deg, 1000 * pr.last_step_m);
-    return plan;
+    return {std::move(doc).json(), m.maps, std::nullopt};
   }
 
   // A pose error shows on edges: the significance counts the pixels of the camera's held-out
@@ -567,11 +556,13 @@ class PoseErrorEffect final : public Effect {
   }
 
   // The camera's pose: the one found (qvec, tvec), or the fitted step composed with the pose.
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     const std::string camera = c.params.at("camera").get<std::string>();
     if (c.params.contains("qvec") && c.params.contains("tvec")) {
-      (*doc)["cameras"][camera]["qvec"] = c.params["qvec"];
-      (*doc)["cameras"][camera]["tvec"] = c.params["tvec"];
+      const std::vector<double> q = c.params["qvec"].get<std::vector<double>>();
+      const std::vector<double> t = c.params["tvec"].get<std::vector<double>>();
+      doc->SetCameraPose(camera, Rigid3d(Eigen::Quaterniond(q.at(0), q.at(1), q.at(2), q.at(3)),
+                                         Eigen::Vector3d(t.at(0), t.at(1), t.at(2))));
       return;
     }
     const std::vector<double> w = c.params.at("rotation_vector").get<std::vector<double>>();

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "recon/scene.h"
+#include "recon/scene_document.h"
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/diagnose_options.h"
 #include "solver/diagnose/pixel_records.h"
@@ -52,7 +53,7 @@ constexpr double kPoseMinStepGain = 0.002;
 // Composes a small rotation ω (camera frame, radians) and shift δ (scene units) with the pose of
 // camera entry `camera` in *doc: R ← exp(ω) R, t ← exp(ω) t + δ.
 void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
-                     const Eigen::Vector3d& delta, Json* doc);
+                     const Eigen::Vector3d& delta, SceneDocument* doc);
 
 // The median depth (camera z, scene units) of `camera`'s records; 0 when it has none.
 double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, int camera);
@@ -60,9 +61,6 @@ double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, 
 // Blocks whose model-image gradient energy reaches this many times the median block's are the
 // edges where a pose error is scored.
 constexpr double kEdgeFactor = 4;
-
-// The pose of a camera entry of a scene document (qvec w, x, y, z; tvec).
-Rigid3d PoseOfCameraJson(const Json& camera);
 
 struct PoseRefinement {
   int iterations = 0;        // Gauss–Newton steps made
@@ -79,6 +77,7 @@ struct PoseRefinement {
 // (halvings included) were made.
 PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& options,
-                          bool materials_solved, double cell_m, int max_iterations, Json* doc);
+                          bool materials_solved, double cell_m, int max_iterations,
+                          SceneDocument* doc);
 
 }  // namespace igi

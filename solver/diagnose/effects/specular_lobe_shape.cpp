@@ -26,8 +26,9 @@ class SpecularLobeShapeEffect final : public Effect {
     return RegionScope(c, m);
   }
   // The region's model becomes the other lobe; its rho_s and alpha stay (or are solved).
-  void Write(const CandidateResult& c, Json* doc) const override {
-    (*doc)["materials"][c.params.at("region").get<std::string>()]["brdf"] = c.params.at("to");
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    doc->SetMaterialBrdf(c.params.at("region").get<std::string>(),
+                         BrdfModelFromName(c.params.at("to").get<std::string>()).value());
   }
 };
 

@@ -101,8 +101,9 @@ class SpecularReflectionEffect final : public Effect {
   }
   // The region becomes "ward". Where its albedo is declared (materials given, nothing is
   // solved), the lobe gets the fitted values; otherwise igi-solve fits them with the albedo.
-  void Write(const CandidateResult& c, Json* doc) const override {
-    Json& m = (*doc)["materials"][c.params.at("region").get<std::string>()];
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+    const std::string region = c.params.at("region").get<std::string>();
+    const Json& m = doc->Material(region);
     Json fresh = {{"brdf", "ward"}};
     if (m.contains("rho_d")) fresh["rho_d"] = m["rho_d"];
     if (m.contains("rho_d_map")) fresh["rho_d_map"] = m["rho_d_map"];
@@ -110,7 +111,7 @@ class SpecularReflectionEffect final : public Effect {
       fresh["rho_s"] = c.params.at("rho_s");
       fresh["alpha"] = c.params.at("alpha");
     }
-    m = fresh;
+    doc->SetMaterial(region, std::move(fresh));
   }
 };
 

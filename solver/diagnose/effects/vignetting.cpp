@@ -61,15 +61,11 @@ class VignettingEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return Vignetting(cx, f); }});
   }
   // Every camera's fall-off becomes the product of its declared one and the fitted one (to r⁴).
-  void Write(const CandidateResult& c, Json* doc) const override {
+  void Write(const CandidateResult& c, SceneDocument* doc) const override {
     const double k1 = c.params.at("k1").get<double>(), k2 = c.params.at("k2").get<double>();
-    for (auto& [name, cam] : (*doc)["cameras"].items()) {
-      double o1 = 0, o2 = 0;
-      if (cam.contains("vignetting")) {
-        o1 = cam["vignetting"].value("k1", 0.0);
-        o2 = cam["vignetting"].value("k2", 0.0);
-      }
-      cam["vignetting"] = {{"k1", o1 + k1}, {"k2", o2 + k2 + o1 * k1}};
+    for (const std::string& name : doc->CameraNames()) {
+      const Eigen::Vector2d old = doc->CameraVignetting(name);
+      doc->SetCameraVignetting(name, old[0] + k1, old[1] + k2 + old[0] * k1);
     }
   }
 };

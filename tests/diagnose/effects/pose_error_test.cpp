@@ -68,13 +68,13 @@ TEST(PoseErrorTest, WriteComposesTheFittedStepWithTheDeclaredPose) {
   const Json declared = TwoCameras();
   Json doc = declared;
   test::WriteCandidate(c, &doc);
-  Json expected = declared;
+  SceneDocument expected(declared);
   ComposePoseStep("cam0", omega, delta, &expected);
-  EXPECT_EQ(doc, expected) << doc.dump();
+  EXPECT_EQ(doc, expected.json()) << doc.dump();
   EXPECT_NE(doc["cameras"]["cam0"], declared["cameras"]["cam0"]);
   EXPECT_EQ(doc["cameras"]["cam1"], declared["cameras"]["cam1"]);
-  const Rigid3d before = PoseOfCameraJson(declared["cameras"]["cam0"]);
-  const Rigid3d after = PoseOfCameraJson(doc["cameras"]["cam0"]);
+  const Rigid3d before = SceneDocument(declared).CameraPose("cam0");
+  const Rigid3d after = SceneDocument(doc).CameraPose("cam0");
   const Eigen::Quaterniond step(Eigen::AngleAxisd(omega.norm(), omega.normalized()));
   EXPECT_LT(after.rotation.angularDistance(step * before.rotation), 1e-12);
   EXPECT_LT((after.translation - (step * before.translation + delta)).norm(), 1e-12);
