@@ -2,8 +2,11 @@
 // The report stage is in run_report.cpp.
 #include <spdlog/spdlog.h>
 
+#include <optional>
+
 #include "pipeline/pipeline_internal.h"
 #include "pipeline/scene_assembly.h"
+#include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
@@ -102,13 +105,12 @@ fs::path SolveScene(const Context& ctx, const fs::path& stage_dir) {
   const fs::path input = ctx.SolveInput();
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  Json scene = RebaseScenePaths(ReadJsonFile(input), input.parent_path(), dir);
-  for (Json& photo : scene["photos"]) {
-    const double given =
-        photo.contains("exposure_scale") ? photo["exposure_scale"].get<double>() : 1.0;
-    photo["exposure_scale"] = given * ctx.options.radiance_scale;
+  SceneDocument scene(ReadJsonFile(input));
+  scene.RebasePaths(input.parent_path(), dir);
+  for (size_t i = 0; i < scene.NumPhotos(); ++i) {
+    scene.SetPhotoExposure(i, scene.PhotoExposure(i).value_or(1.0) * ctx.options.radiance_scale);
   }
-  WriteJsonFile(dir / "scene.json", scene);
+  WriteJsonFile(dir / "scene.json", scene.json());
   return dir / "scene.json";
 }
 
@@ -128,21 +130,22 @@ void SolveStage(const Context& ctx, StageRun* run) {
 // itself would make its refits hold every albedo fixed and let the held-out pixels into the fit.
 fs::path DiagnoseScene(const Context& ctx, const fs::path& stage_dir) {
   const fs::path input = ctx.SolveInput();
-  const Json solved = ReadJsonFile(ctx.Dir("04-solve") / "scene.json");
+  const SceneDocument solved(ReadJsonFile(ctx.Dir("04-solve") / "scene.json"));
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  Json scene = RebaseScenePaths(ReadJsonFile(input), input.parent_path(), dir);
-  if (scene["photos"].size() != solved["photos"].size()) {
+  SceneDocument scene(ReadJsonFile(input));
+  scene.RebasePaths(input.parent_path(), dir);
+  if (scene.NumPhotos() != solved.NumPhotos()) {
     throw Error("stage 05-diagnose: " + (ctx.Dir("04-solve") / "scene.json").string() + " has " +
-                std::to_string(solved["photos"].size()) + " photos, its input " +
-                std::to_string(scene["photos"].size()));
+                std::to_string(solved.NumPhotos()) + " photos, its input " +
+                std::to_string(scene.NumPhotos()));
   }
-  for (size_t i = 0; i < scene["photos"].size(); ++i) {
-    if (solved["photos"][i].contains("exposure_scale")) {
-      scene["photos"][i]["exposure_scale"] = solved["photos"][i]["exposure_scale"];
+  for (size_t i = 0; i < scene.NumPhotos(); ++i) {
+    if (const std::optional<double> scale = solved.PhotoExposure(i)) {
+      scene.SetPhotoExposure(i, *scale);
     }
   }
-  WriteJsonFile(dir / "scene.json", scene);
+  WriteJsonFile(dir / "scene.json", scene.json());
   return dir / "scene.json";
 }
 

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 
@@ -54,72 +55,33 @@ std::string RelativeTo(const fs::path& target, const fs::path& base) {
   return rel.empty() ? abs.string() : rel.generic_string();
 }
 
-std::string Rebase(const std::string& path, const fs::path& from, const fs::path& to) {
-  const fs::path p(path);
-  if (p.is_absolute()) return path;
-  std::error_code ec;
-  const fs::path abs = fs::weakly_canonical(fs::absolute(from / p), ec);
-  const fs::path base = fs::weakly_canonical(fs::absolute(to), ec);
-  const fs::path rel = abs.lexically_relative(base);
-  return rel.empty() ? abs.string() : rel.generic_string();
-}
-
-void RebaseKey(Json* j, const char* key, const fs::path& from, const fs::path& to) {
-  if (j->is_object() && j->contains(key) && (*j)[key].is_string()) {
-    (*j)[key] = Rebase((*j)[key].get<std::string>(), from, to);
-  }
-}
-
 }  // namespace
 
-Json RebaseScenePaths(Json scene, const fs::path& from, const fs::path& to) {
-  if (scene.contains("geometry")) {
-    for (Json& g : scene["geometry"]) RebaseKey(&g, "file", from, to);
-  }
-  if (scene.contains("materials")) {
-    for (auto& [name, m] : scene["materials"].items()) RebaseKey(&m, "rho_d_map", from, to);
-  }
-  if (scene.contains("lights")) {
-    for (auto& [name, l] : scene["lights"].items()) {
-      RebaseKey(&l, "file", from, to);
-      if (l.contains("profile")) RebaseKey(&l["profile"], "ies", from, to);
-    }
-  }
-  if (scene.contains("cameras")) RebaseKey(&scene["cameras"], "colmap", from, to);
-  if (scene.contains("photos")) {
-    for (Json& p : scene["photos"]) {
-      RebaseKey(&p, "file", from, to);
-      RebaseKey(&p, "mask", from, to);
-    }
-  }
-  return scene;
-}
-
 Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unregistered) {
-  Json scene = RebaseScenePaths(in.input_scene, in.input_dir, in.out_dir);
+  SceneDocument scene(in.input_scene);
+  scene.RebasePaths(in.input_dir, in.out_dir);
   const Json& registered =
       in.registered_scene.contains("cameras") ? in.registered_scene["cameras"] : Json::object();
   if (!registered.is_object()) {
     throw Error("igi-register's scene.json has no camera list (\"cameras\" is not an object)");
   }
   Json cameras = Json::object();
-  Json photos = Json::array();
+  std::vector<ScenePhotoEntry> photos;
   for (const PhotoSource& p : in.photos) {
     if (!registered.contains(p.name)) {
       unregistered->push_back(p.name);
       continue;
     }
     cameras[p.name] = registered[p.name];
-    Json photo = {{"file", RelativeTo(in.hdr_dir / (p.name + ".exr"), in.out_dir)},
-                  {"camera", p.name},
-                  {"lighting", p.lighting}};
+    ScenePhotoEntry photo{RelativeTo(in.hdr_dir / (p.name + ".exr"), in.out_dir), p.name,
+                          p.lighting, std::nullopt};
     const fs::path mask = in.hdr_dir / (p.name + "_mask.png");
-    if (fs::exists(mask)) photo["mask"] = RelativeTo(mask, in.out_dir);
-    photos.push_back(photo);
+    if (fs::exists(mask)) photo.mask = RelativeTo(mask, in.out_dir);
+    photos.push_back(std::move(photo));
   }
-  scene["cameras"] = cameras;
-  scene["photos"] = photos;
-  return scene;
+  scene.SetCameras(std::move(cameras));
+  scene.SetPhotos(photos);
+  return std::move(scene).json();
 }
 
 }  // namespace igi

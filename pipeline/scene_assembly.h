@@ -16,11 +16,6 @@ namespace igi {
 void TonemapForRegistration(const std::filesystem::path& radiance,
                             const std::filesystem::path& png);
 
-// `scene` (read from the folder `from`) with every relative file path (geometry, rho_d_map,
-// light files, IES profiles, photos, masks, a COLMAP folder) rewritten to hold from `to`.
-Json RebaseScenePaths(Json scene, const std::filesystem::path& from,
-                      const std::filesystem::path& to);
-
 struct SolvableSceneInputs {
   Json input_scene;                 // the user's scene.json
   std::filesystem::path input_dir;  // its folder

@@ -15,6 +15,7 @@
 #include "recon/mesh.h"
 #include "recon/mesh_alignment.h"
 #include "recon/registration_refinement.h"
+#include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/strings.h"
@@ -54,45 +55,43 @@ Json SceneWithCameras(const RegisterOptions& options, Json scene, const ColmapMo
                       Json* report) {
   // Every relative path of the input scene (read from `from`) made to hold in the output folder.
   const fs::path from = fs::path(options.scene).parent_path();
-  ForEachScenePath(&scene, [&](const std::string& path) {
-    return fs::path(path).is_relative()
-               ? Relative((from.empty() ? fs::path(".") : from) / path, options.out)
-               : path;
-  });
+  SceneDocument doc(std::move(scene));
+  doc.RebasePaths(from.empty() ? fs::path(".") : from, options.out);
   std::map<std::string, Json> old_photos;
-  if (scene.contains("photos")) {
-    for (const auto& p : scene["photos"]) {
+  if (doc.json().contains("photos")) {
+    for (const auto& p : doc.json()["photos"]) {
       old_photos[fs::path(p["file"].get<std::string>()).filename().string()] = p;
     }
   }
   std::optional<std::string> only_lighting;
-  if (scene.contains("lightings") && scene["lightings"].size() == 1) {
-    only_lighting = scene["lightings"].begin().key();
+  if (doc.json().contains("lightings") && doc.json()["lightings"].size() == 1) {
+    only_lighting = doc.json()["lightings"].begin().key();
   }
-  Json cameras = Json::object();
-  Json photos = Json::array();
+  doc.SetCameras(Json::object());
+  std::vector<ScenePhotoEntry> photos;
   Json no_lighting = Json::array();
   for (const auto& [id, image] : model.images) {
     const std::string key = fs::path(image.name).stem().string();
-    cameras[key] = CameraJson(CameraOfImage(model, image));
-    Json photo = {{"file", Relative(fs::path(options.images) / image.name, options.out)},
-                  {"camera", key}};
+    doc.SetCamera(key, CameraOfImage(model, image));
+    ScenePhotoEntry photo{Relative(fs::path(options.images) / image.name, options.out), key, "",
+                          std::nullopt};
     const auto old = old_photos.find(image.name);
     if (old != old_photos.end() && old->second.contains("lighting")) {
-      photo["lighting"] = old->second["lighting"];
-      if (old->second.contains("mask")) photo["mask"] = old->second["mask"];
+      photo.lighting = old->second["lighting"].get<std::string>();
+      if (old->second.contains("mask") && old->second["mask"].is_string()) {
+        photo.mask = old->second["mask"].get<std::string>();
+      }
     } else if (only_lighting) {
-      photo["lighting"] = *only_lighting;
+      photo.lighting = *only_lighting;
     } else {
       no_lighting.push_back(image.name);
       continue;
     }
-    photos.push_back(photo);
+    photos.push_back(std::move(photo));
   }
-  scene["cameras"] = cameras;
-  scene["photos"] = photos;
+  doc.SetPhotos(photos);
   (*report)["photos_without_lighting"] = no_lighting;
-  return scene;
+  return std::move(doc).json();
 }
 
 Json BaseReport(const ColmapRunSummary& run, const RegisterOptions& options) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "recon/scene_document.h"
 #include "solver/uv_charts.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -22,18 +23,6 @@ std::string SeenFile(const std::string& map_file) {
 
 Json Num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json Vec(const Eigen::Vector3d& v) { return Json::array({Num(v[0]), Num(v[1]), Num(v[2])}); }
-
-// A path of the input document (relative to the scene's folder) expressed relative to `out`.
-std::string Rebase(const Scene& scene, const std::string& path, const fs::path& out) {
-  const fs::path p(path);
-  if (p.is_absolute()) return path;
-  std::error_code ec;
-  const fs::path abs = fs::weakly_canonical(fs::absolute(scene.dir / p), ec);
-  const fs::path base = fs::weakly_canonical(fs::absolute(out), ec);
-  fs::path rel = abs.lexically_relative(base);
-  if (rel.empty()) return abs.string();
-  return rel.generic_string();
-}
 
 Json FitJson(const RegionFitResult& f, BrdfModel model) {
   Json j;
@@ -68,35 +57,33 @@ Json FitJson(const RegionFitResult& f, BrdfModel model) {
 }  // namespace
 
 Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const fs::path& out) {
-  Json doc = scene.document;
-  ForEachScenePath(&doc, [&](const std::string& path) { return Rebase(scene, path, out); });
-  if (summary.charted_mesh) doc["geometry"] = Json::array({Json{{"file", "geometry/solved.obj"}}});
-  if (summary.photo_scale && doc.contains("photos")) {
-    for (Json& p : doc["photos"]) {
-      const double given = p.contains("exposure_scale") ? p["exposure_scale"].get<double>() : 1.0;
-      p["exposure_scale"] = given * summary.photo_scale->scale;
+  SceneDocument doc(scene.document);
+  doc.RebasePaths(scene.dir, out);
+  if (summary.charted_mesh) doc.SetGeometryFiles({"geometry/solved.obj"});
+  if (summary.photo_scale) {
+    for (size_t i = 0; i < doc.NumPhotos(); ++i) {
+      doc.SetPhotoExposure(i, doc.PhotoExposure(i).value_or(1.0) * summary.photo_scale->scale);
     }
   }
   for (size_t r = 0; r < scene.materials.size(); ++r) {
     const std::string& name = scene.materials[r].name;
-    Json& m = doc["materials"][name];
     const RegionSolution& rs = summary.regions[r];
     const BrdfParams& p = rs.final_params;
     if (!IsReflective(scene.materials[r].brdf)) continue;
-    m["rho_d"] = Vec(p.rho_d);
-    if (!rs.albedo_map_file.empty()) m["rho_d_map"] = rs.albedo_map_file;
+    doc.SetMaterialValue(name, "rho_d", Vec(p.rho_d));
+    if (!rs.albedo_map_file.empty()) doc.SetMaterialValue(name, "rho_d_map", rs.albedo_map_file);
     if (HasSpecularLobe(p.model)) {
       const bool grey = p.rho_s[0] == p.rho_s[1] && p.rho_s[1] == p.rho_s[2];
-      m["rho_s"] = grey ? Json(p.rho_s[0]) : Vec(p.rho_s);
+      doc.SetMaterialValue(name, "rho_s", grey ? Json(p.rho_s[0]) : Vec(p.rho_s));
       if (IsAnisotropic(p.model)) {
-        m["alpha_x"] = p.alpha_x;
-        m["alpha_y"] = p.alpha_y;
+        doc.SetMaterialValue(name, "alpha_x", p.alpha_x);
+        doc.SetMaterialValue(name, "alpha_y", p.alpha_y);
       } else {
-        m["alpha"] = p.alpha;
+        doc.SetMaterialValue(name, "alpha", p.alpha);
       }
     }
   }
-  return doc;
+  return std::move(doc).json();
 }
 
 Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
