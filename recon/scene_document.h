@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "recon/brdf_model.h"
@@ -45,8 +46,9 @@ class SceneDocument {
   // `dir`); throws LoadScene's InputError, one line per problem, naming that file.
   void Validate(const std::filesystem::path& dir, const SceneLoadOptions& options = {}) const;
 
-  // Rewrites every relative path (one relative to `from_dir`) to hold from `to_dir` (generic
-  // form, through symlinks resolved); absolute paths are left as they are.
+  // Rewrites every relative path (relative to `from_dir`) as the same file relative to `to_dir`
+  // (symlinks resolved, generic form; absolute where it has no relative form); absolute paths
+  // are left as they are.
   void RebasePaths(const std::filesystem::path& from_dir, const std::filesystem::path& to_dir);
   // Makes every path absolute (a relative one taken from `dir`) and normal (AbsoluteScenePaths).
   void AbsolutePaths(const std::filesystem::path& dir);
