@@ -175,7 +175,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
   const std::vector<std::string> args = SynthArgs(o, synth);
   Fingerprint fp;
   for (const std::string& a : args) fp.AddText(a);
-  if (o.calibration == "reference") fp.AddText("reference " + o.reference_region);
+  if (o.calibration == DemoCalibration::kReference) fp.AddText("reference " + o.reference_region);
   fp.AddText(fmt::format("marker noise {}", o.marker_noise_px));
   const auto marker = ReadStageMarker(dir);
   *kept = marker && marker->fingerprint == fp.Hex();
@@ -204,7 +204,7 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
                                                          {"params", c0.params}});
   WriteJsonFile(synth / "brackets" / "markers.json",
                 MarkersOfTruth(truth, photos, o.marker_noise_px));
-  if (o.calibration == "reference") GiveReference(synth, o.reference_region);
+  if (o.calibration == DemoCalibration::kReference) GiveReference(synth, o.reference_region);
   WriteStageMarker(dir, StageMarker{"00-capture",
                                     fp.Hex(),
                                     "done",
@@ -268,24 +268,58 @@ Json ComparePoses(const fs::path& registered_scene, const fs::path& truth_scene)
           {"cameras", cameras}};
 }
 
-void DemoOptions::Validate() const {
+namespace {
+
+// Every problem of `o`; with `typed`, each choice is judged by its flag's text.
+ProblemList DemoProblems(const DemoOptions& o, const DemoChoiceFlags* typed) {
   ProblemList p;
-  if (calibration != "reference" && calibration != "measured" && calibration != "none") {
-    p.Add("", "--demo-calibration", calibration, "must be reference, measured or none");
+  if (typed ? !DemoCalibrationFromName(typed->calibration)
+            : !DemoCalibrationFromName(DemoCalibrationName(o.calibration))) {
+    p.Add("", "--demo-calibration", typed ? typed->calibration : std::to_string(int(o.calibration)),
+          "must be reference, measured or none");
   }
-  if (out.empty()) p.Add("", "--out", "", "is required");
-  if (cameras < 3) p.Add("", "--demo-cameras", std::to_string(cameras), "must be >= 3");
-  if (ceiling_cameras < 0) {
-    p.Add("", "--demo-ceiling-cameras", std::to_string(ceiling_cameras), "must be >= 0");
+  if (o.out.empty()) p.Add("", "--out", "", "is required");
+  if (o.cameras < 3) p.Add("", "--demo-cameras", std::to_string(o.cameras), "must be >= 3");
+  if (o.ceiling_cameras < 0) {
+    p.Add("", "--demo-ceiling-cameras", std::to_string(o.ceiling_cameras), "must be >= 0");
   }
-  if (width < 64 || height < 48) {
-    p.Add("", "--demo-size", fmt::format("{}x{}", width, height), "must be at least 64x48");
+  if (o.width < 64 || o.height < 48) {
+    p.Add("", "--demo-size", fmt::format("{}x{}", o.width, o.height), "must be at least 64x48");
   }
-  if (spp < 1) p.Add("", "--demo-spp", std::to_string(spp), "must be >= 1");
-  if (!(marker_noise_px >= 0 && marker_noise_px <= 10)) {
-    p.Add("", "--demo-marker-noise", fmt::format("{}", marker_noise_px), "must be in [0, 10] px");
+  if (o.spp < 1) p.Add("", "--demo-spp", std::to_string(o.spp), "must be >= 1");
+  if (!(o.marker_noise_px >= 0 && o.marker_noise_px <= 10)) {
+    p.Add("", "--demo-marker-noise", fmt::format("{}", o.marker_noise_px), "must be in [0, 10] px");
   }
-  p.ThrowIfAny();
+  return p;
+}
+
+}  // namespace
+
+std::string_view DemoCalibrationName(DemoCalibration calibration) {
+  switch (calibration) {
+    case DemoCalibration::kReference:
+      return "reference";
+    case DemoCalibration::kMeasured:
+      return "measured";
+    case DemoCalibration::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+std::optional<DemoCalibration> DemoCalibrationFromName(std::string_view name) {
+  for (DemoCalibration c :
+       {DemoCalibration::kReference, DemoCalibration::kMeasured, DemoCalibration::kNone}) {
+    if (DemoCalibrationName(c) == name) return c;
+  }
+  return std::nullopt;
+}
+
+void DemoOptions::Validate() const { DemoProblems(*this, nullptr).ThrowIfAny(); }
+
+void DemoOptions::SetChoices(const DemoChoiceFlags& flags) {
+  if (const auto c = DemoCalibrationFromName(flags.calibration)) calibration = *c;
+  DemoProblems(*this, &flags).ThrowIfAny();
 }
 
 namespace {
@@ -501,8 +535,8 @@ DemoSummary RunDemo(const DemoOptions& o) {
   // The HDR maps' true scale (what an absolute calibration measures): given to the chain with
   // "measured", only compared with the solved scale with "reference".
   const double true_scale = MeasureRadianceScale(o.out / "02-hdr", synth);
-  run.radiance_scale = o.calibration == "measured" ? true_scale : 1.0;
-  if (o.calibration == "reference") {
+  run.radiance_scale = o.calibration == DemoCalibration::kMeasured ? true_scale : 1.0;
+  if (o.calibration == DemoCalibration::kReference) {
     run.solve_args.insert(run.solve_args.end(), {"--photo-scale", "solve"});
   }
   DemoSummary d;
@@ -515,15 +549,15 @@ DemoSummary RunDemo(const DemoOptions& o) {
     }
   }
   d.run.stages.insert(d.run.stages.begin(), capture);
-  d.summary =
-      CompareWithTruth(d.run.solved_scene, synth / "truth.json",
-                       o.calibration == "reference" ? std::vector<std::string>{o.reference_region}
-                                                    : std::vector<std::string>{});
-  d.summary["calibration"] = o.calibration;
+  d.summary = CompareWithTruth(d.run.solved_scene, synth / "truth.json",
+                               o.calibration == DemoCalibration::kReference
+                                   ? std::vector<std::string>{o.reference_region}
+                                   : std::vector<std::string>{});
+  d.summary["calibration"] = std::string(DemoCalibrationName(o.calibration));
   d.summary["radiance_scale"] = run.radiance_scale;
   d.summary["true_radiance_scale"] = true_scale;
   const fs::path solve_report = o.out / "04-solve" / "report.json";
-  if (o.calibration == "reference" && fs::exists(solve_report)) {
+  if (o.calibration == DemoCalibration::kReference && fs::exists(solve_report)) {
     const Json k = ReadJsonFile(solve_report).value("photo_scale", Json());
     if (k.is_object()) {
       d.summary["solved_radiance_scale"] = k;

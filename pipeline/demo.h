@@ -15,13 +15,29 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "pipeline/pipeline.h"
 #include "tools/common/json.h"
 
 namespace igi {
+
+// How the demo gives the HDR maps their absolute scale (DemoOptions::calibration): kReference,
+// kMeasured or kNone.
+enum class DemoCalibration { kReference, kMeasured, kNone };
+// "reference", "measured", "none" (the --demo-calibration flag's spelling and
+// demo_summary.json's "calibration").
+std::string_view DemoCalibrationName(DemoCalibration calibration);
+std::optional<DemoCalibration> DemoCalibrationFromName(std::string_view name);
+
+// The choice options as igi-run's --demo flags spell them, before they are parsed
+// (DemoOptions::SetChoices); each default is the name of the option's default.
+struct DemoChoiceFlags {
+  std::string calibration = "reference";
+};
 
 struct DemoOptions {
   // DIR (required): 00-capture (igi-synth's capture) and igi-run's stages under it.
@@ -50,16 +66,16 @@ struct DemoOptions {
   int ceiling_cameras = 4;
   // The HDR maps' absolute scale (without it the albedos come out in the maps' arbitrary scale,
   // which weakens every bounce):
-  //  - "reference": the capture holds a reference of known reflectance (reference_region, its
+  //  - kReference: the capture holds a reference of known reflectance (reference_region, its
   //    material given in scene.json as if measured with a spectrophotometer) and igi-solve
   //    solves the photos' scale from it (--photo-scale solve);
-  //  - "measured": the camera calibrated absolutely (igi-run --radiance-scale), as a lab camera
+  //  - kMeasured: the camera calibrated absolutely (igi-run --radiance-scale), as a lab camera
   //    measured against a radiance standard (simulated with igi-synth's noise-free radiance);
-  //  - "none".
-  // "reference" by default: it is what a user without a lab does (a grey card, a measured
+  //  - kNone.
+  // kReference by default: it is what a user without a lab does (a grey card, a measured
   // wall) and needs no truth. Measured: docs/run.md.
-  std::string calibration = "reference";
-  // With "reference": the region whose true material is given (and left out of the comparison).
+  DemoCalibration calibration = DemoCalibration::kReference;
+  // With kReference: the region whose true material is given (and left out of the comparison).
   std::string reference_region = "matte_box";
   // The control points' pixels are their true projections plus Gaussian noise of this standard
   // deviation (pixels, per axis, in [0, 10]; fixed seed), as a detector of printed targets
@@ -81,7 +97,12 @@ struct DemoOptions {
                                             "--solve-stride", "4"};
   // Samples per pixel of the report's renders (RunOptions::report_spp), >= 1.
   int report_spp = 16;
+  // Throws InputError naming the flag and the rule (a choice outside its enum: by its number).
   void Validate() const;
+  // Sets the choice options from their flags' text, then validates as Validate does: one
+  // InputError with every problem, a text that names no choice as "--FLAG: TEXT: must be ..." in
+  // its place among them.
+  void SetChoices(const DemoChoiceFlags& flags);
 };
 
 struct DemoSummary {

@@ -90,10 +90,12 @@ std::vector<std::string> ExtractorArgs(const std::filesystem::path& images_dir,
                                 "--ImageReader.single_camera",
                                 o.single_camera || o.intrinsics ? "1" : "0"};
   if (o.intrinsics) {
-    a.insert(a.end(), {"--ImageReader.camera_model", o.intrinsics->model,
+    a.insert(a.end(), {"--ImageReader.camera_model",
+                       std::string(calib::ColmapCameraModelName(o.intrinsics->model)),
                        "--ImageReader.camera_params", ParamsList(o.intrinsics->params)});
   } else {
-    a.insert(a.end(), {"--ImageReader.camera_model", o.camera_model});
+    a.insert(a.end(), {"--ImageReader.camera_model",
+                       std::string(calib::ColmapCameraModelName(o.camera_model))});
   }
   return a;
 }
@@ -160,9 +162,10 @@ void ColmapRunOptions::Validate() const {
   if (min_pose_inliers < 6) {
     problems.Add("", "--min-pose-inliers", std::to_string(min_pose_inliers), "must be >= 6");
   }
-  if (std::find(kSelfCalibratedModels.begin(), kSelfCalibratedModels.end(), camera_model) ==
+  const std::string model(calib::ColmapCameraModelName(camera_model));
+  if (std::find(kSelfCalibratedModels.begin(), kSelfCalibratedModels.end(), model) ==
       kSelfCalibratedModels.end()) {
-    problems.Add("", "--camera-model", camera_model,
+    problems.Add("", "--camera-model", model,
                  "must be one of " + Join(kSelfCalibratedModels, ", "));
   }
   if (max_image_size < 100) {

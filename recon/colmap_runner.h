@@ -14,13 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "calib/camera_file.h"
 #include "recon/colmap_model.h"
 
 namespace igi {
 
 // Known intrinsics to give COLMAP (from camera.json): held fixed during mapping.
 struct KnownIntrinsics {
-  std::string model;  // COLMAP model name
+  calib::ColmapCameraModel model = calib::ColmapCameraModel::kPinhole;  // the COLMAP model
   int width = 0;
   int height = 0;
   std::vector<double> params;  // COLMAP order
@@ -39,11 +40,11 @@ struct ColmapRunOptions {
   // Known intrinsics, held fixed during mapping; absent: COLMAP self-calibrates camera_model.
   std::optional<KnownIntrinsics> intrinsics;
   // The COLMAP camera model self-calibrated when `intrinsics` is not given (ignored with it):
-  // SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV. The pinhole models leave a lens's
-  // distortion in the focal length; each extra distortion term trades off against the focal
-  // length where the photos do not separate them (a few photos of one facade), so the
-  // one-parameter model is the default.
-  std::string camera_model = "SIMPLE_RADIAL";
+  // kSimplePinhole, kPinhole, kSimpleRadial (default), kRadial or kOpenCv (kSelfCalibratedModels).
+  // The pinhole models leave a lens's distortion in the focal length; each extra distortion term
+  // trades off against the focal length where the photos do not separate them (a few photos of
+  // one facade), so the one-parameter model is the default.
+  calib::ColmapCameraModel camera_model = calib::ColmapCameraModel::kSimpleRadial;
   // COLMAP's --SiftMatching.guided_matching: once a pair's two-view geometry is estimated, match
   // again along it, which keeps more correct matches, for a longer matching step. Off by
   // default (COLMAP's default).
@@ -58,7 +59,8 @@ struct ColmapRunOptions {
   void Validate() const;
 };
 
-// The COLMAP camera models ColmapRunOptions::camera_model accepts (those recon/camera.h reads).
+// The names of the COLMAP camera models ColmapRunOptions::camera_model accepts (those
+// recon/camera.h reads; FULL_OPENCV is not among them).
 extern const std::vector<std::string> kSelfCalibratedModels;
 
 struct ColmapRunSummary {

@@ -105,7 +105,10 @@ Json BaseReport(const ColmapRunSummary& run, const RegisterOptions& options) {
   report["known_intrinsics"] = options.colmap.intrinsics.has_value();
   if (options.colmap_model.empty()) {
     report["colmap_guided_matching"] = options.colmap.guided_matching;
-    if (!options.colmap.intrinsics) report["self_calibrated_model"] = options.colmap.camera_model;
+    if (!options.colmap.intrinsics) {
+      report["self_calibrated_model"] =
+          std::string(calib::ColmapCameraModelName(options.colmap.camera_model));
+    }
   }
   Json cameras = Json::array();
   for (const auto& [id, cam] : run.model.cameras) {

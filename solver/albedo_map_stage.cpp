@@ -43,7 +43,7 @@ MapLight MapLightOf(const MapStageData& d) {
 
 bool MapAllowed(const MapStageData& d, size_t r) {
   const std::vector<std::string>& only = d.options.albedo_map_regions;
-  return d.options.albedo_maps != "none" &&
+  return d.options.albedo_maps != AlbedoMaps::kNone &&
          (only.empty() ||
           std::find(only.begin(), only.end(), d.scene.materials[r].name) != only.end());
 }
@@ -117,7 +117,7 @@ bool WritesMap(const MapStageData& d, size_t r, const RegionAtlas& atlas, const 
                TexelDetail* detail) {
   const MaterialState& m = d.materials[r];
   if (!MapCandidate(d, r)) return false;
-  if (d.options.albedo_maps == "all" || m.last_fit.albedo_varies) return true;
+  if (d.options.albedo_maps == AlbedoMaps::kAll || m.last_fit.albedo_varies) return true;
   Image map[2], seen[2];
   for (int k = 0; k < 2; ++k) {
     map[k] = AlbedoMapOf(d, int(r), atlas, light, nullptr, &seen[k], k);

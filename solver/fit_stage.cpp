@@ -54,7 +54,7 @@ JointUpdate JointParams(const StageData& d, const MaterialEstimate& materials,
   out.feedback.assign(regions.size(), none);
   const JointSums& js = light.joint_sums;
   if (js.regions != num_regions) return out;
-  const bool lobes = d.options.refine_update == "joint";
+  const bool lobes = d.options.refine_update == RefineUpdate::kJoint;
   // The unknowns (entry of `regions`, kind), and the known α changes (ln of the ratio).
   struct Unknown {
     int k;
@@ -142,7 +142,7 @@ JointUpdate JointParams(const StageData& d, const MaterialEstimate& materials,
     }
   }
   // A grey lobe stays grey: the channels' mean.
-  if (d.options.specular_colour == "grey") {
+  if (d.options.specular_colour == SpecularColour::kGrey) {
     for (Eigen::Vector3d& v : out.rho_s) {
       if (v.allFinite()) v.setConstant(v.mean());
     }
@@ -158,9 +158,9 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
   const auto start = std::chrono::steady_clock::now();
   HeldOutAlbedos(obs, light.e, light.t, d.scene.mesh, d.texel_size_m, &materials);
   std::vector<int> regions;
-  std::vector<RegionFitInput> inputs =
-      FitInputs(d.scene, d.patches, obs, light, materials, stage, options.specular_colour == "grey",
-                options.held_out_albedo, &regions);
+  std::vector<RegionFitInput> inputs = FitInputs(d.scene, d.patches, obs, light, materials, stage,
+                                                 options.specular_colour == SpecularColour::kGrey,
+                                                 options.held_out_albedo, &regions);
   std::vector<RegionFitResult> results(regions.size());
   for (size_t k = 0; k < regions.size(); ++k) {
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), l = e;
@@ -215,7 +215,7 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
           if (f.rho_d[c] > 0) m.map_scale[c] = m.params.rho_d[c] / f.rho_d[c];
         }
         for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
-          m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
+          m.patch_rho_d[s] = f.albedo_model == AlbedoModel::kPerPatch && f.slot_count[s] > 0
                                  ? Eigen::Vector3d(f.slot_rho_d[s].cwiseProduct(m.map_scale))
                                  : Eigen::Vector3d::Constant(NAN);
         }
@@ -224,7 +224,7 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
         for (size_t s = 0; s < m.patch_rho_d.size(); ++s) {
           const Eigen::Vector3d before =
               m.patch_rho_d[s].allFinite() ? m.patch_rho_d[s] : old.rho_d;
-          m.patch_rho_d[s] = f.albedo_model == "per_patch" && f.slot_count[s] > 0
+          m.patch_rho_d[s] = f.albedo_model == AlbedoModel::kPerPatch && f.slot_count[s] > 0
                                  ? blend(before, f.slot_rho_d[s])
                                  : Eigen::Vector3d::Constant(NAN);
         }

@@ -1,6 +1,6 @@
 #pragma once
 // Internal to igi_solver: the photos' absolute photometric scale from a reference of known
-// reflectance (SolveOptions::photo_scale = "solve").
+// reflectance (SolveOptions::photo_scale = PhotoScaleMode::kSolve).
 //
 // Radiance maps assembled from brackets through a recovered response are known only up to a
 // constant factor k (Debevec–Malik's g carries a free additive constant), while the lights are

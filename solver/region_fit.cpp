@@ -621,6 +621,23 @@ bool FitWithHeldAlbedo(const RegionFitInput& in, RegionFitInput* held) {
 
 }  // namespace
 
+std::string_view AlbedoModelName(AlbedoModel model) {
+  switch (model) {
+    case AlbedoModel::kConstant:
+      return "constant";
+    case AlbedoModel::kPerPatch:
+      return "per_patch";
+  }
+  return "?";
+}
+
+std::optional<AlbedoModel> AlbedoModelFromName(std::string_view name) {
+  for (AlbedoModel m : {AlbedoModel::kConstant, AlbedoModel::kPerPatch}) {
+    if (AlbedoModelName(m) == name) return m;
+  }
+  return std::nullopt;
+}
+
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
   RegionFitResult r;
   r.samples = static_cast<int>(in.samples.size());
@@ -692,7 +709,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
     patch.rho_s = b.linear.rho_s;
     patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
   }
-  r.albedo_model = "per_patch";
+  r.albedo_model = AlbedoModel::kPerPatch;
   r.rho_s = b.linear.rho_s;
   r.alpha = r.alpha_x = b.ax;
   r.alpha_y = b.ay;

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "recon/brdf_model.h"
@@ -126,13 +127,20 @@ struct RegionFitInput : RegionFitSettings {
   std::vector<IncidentLocal> incident;
 };
 
+// How a fit models a region's diffuse albedo: one value over the region (kConstant) or one per
+// patch (kPerPatch).
+enum class AlbedoModel { kConstant, kPerPatch };
+// "constant", "per_patch" (report.json's "albedo_model").
+std::string_view AlbedoModelName(AlbedoModel model);
+std::optional<AlbedoModel> AlbedoModelFromName(std::string_view name);
+
 struct RegionFitResult {
-  bool fitted = false;                              // false: nothing to fit (no samples)
-  std::string albedo_model = "constant";            // "constant" or "per_patch"
-  bool albedo_varies = false;                       // per-patch albedo significantly non-uniform
-  Eigen::Vector3d rho_d = Eigen::Vector3d::Zero();  // region mean (area-weighted)
-  std::vector<Eigen::Vector3d> slot_rho_d;          // per slot (NaN where no sample)
-  std::vector<int> slot_count;                      // samples per slot
+  bool fitted = false;                                // false: nothing to fit (no samples)
+  AlbedoModel albedo_model = AlbedoModel::kConstant;  // kConstant (default) or kPerPatch
+  bool albedo_varies = false;                         // per-patch albedo significantly non-uniform
+  Eigen::Vector3d rho_d = Eigen::Vector3d::Zero();    // region mean (area-weighted)
+  std::vector<Eigen::Vector3d> slot_rho_d;            // per slot (NaN where no sample)
+  std::vector<int> slot_count;                        // samples per slot
   Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
   double alpha = 0, alpha_x = 0, alpha_y = 0;
   // One-sigma uncertainties (NaN where unknown or not fitted).

@@ -34,6 +34,28 @@ double Since(Clock::time_point t) {
 
 }  // namespace
 
+std::string_view RegionStatusName(RegionStatus status) {
+  switch (status) {
+    case RegionStatus::kKnown:
+      return "known";
+    case RegionStatus::kSolved:
+      return "solved";
+    case RegionStatus::kUnobserved:
+      return "unobserved";
+    case RegionStatus::kNoHighlight:
+      return "no_highlight";
+  }
+  return "?";
+}
+
+std::optional<RegionStatus> RegionStatusFromName(std::string_view name) {
+  for (RegionStatus s : {RegionStatus::kKnown, RegionStatus::kSolved, RegionStatus::kUnobserved,
+                         RegionStatus::kNoHighlight}) {
+    if (RegionStatusName(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Set-up: materials, photos, observations, patches, gathering.
 
@@ -394,8 +416,10 @@ void SolverState::SummariseRegions() {
         rs.unknowns.push_back("alpha");
       }
     }
-    rs.status = !m.NeedsFit() ? "known" : (m.observations == 0 ? "unobserved" : "solved");
-    if (rs.status == "unobserved") {
+    rs.status = !m.NeedsFit()         ? RegionStatus::kKnown
+                : m.observations == 0 ? RegionStatus::kUnobserved
+                                      : RegionStatus::kSolved;
+    if (rs.status == RegionStatus::kUnobserved) {
       spdlog::warn("region {} has unknown values but no photo sees it: its values are placeholders",
                    rs.name);
     }
@@ -440,7 +464,7 @@ void SolverState::AnalyseCoverage() {
     if (!(m.unknown_rho_s || m.unknown_alpha) || m.observations == 0) continue;
     m.no_highlight = true;
     m.params.rho_s.setZero();
-    summary.regions[c.region].status = "no_highlight";
+    summary.regions[c.region].status = RegionStatus::kNoHighlight;
     spdlog::warn(
         "region {}: no photo shows its highlight; rho_s and alpha cannot be recovered "
         "(rho_s held at 0)",
@@ -451,12 +475,12 @@ void SolverState::AnalyseCoverage() {
 void SolverState::FinishRegions() {
   for (size_t r = 0; r < materials.size(); ++r) {
     RegionSolution& rs = summary.regions[r];
-    if (rs.status == "unobserved" && materials[r].bounce_fit_sigma.allFinite()) {
+    if (rs.status == RegionStatus::kUnobserved && materials[r].bounce_fit_sigma.allFinite()) {
       // Its ρd fitted to the light it bounces onto the seen regions (FitUnobservedAlbedos); its
       // lobe cannot be known: no gloss.
       rs.bounce_fit_sigma = materials[r].bounce_fit_sigma;
       if (materials[r].unknown_rho_s) materials[r].params.rho_s.setZero();
-    } else if (rs.status == "unobserved") {
+    } else if (rs.status == RegionStatus::kUnobserved) {
       // Placeholders so that the scene renders: the observed regions' mean albedo, no gloss.
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       int n = 0;

@@ -15,7 +15,7 @@
 // full path tracer using the current model (all bounces, every surface, seen or not), all
 // parameters are refitted against the photos with the same model (gradients through the BRDF
 // by Ceres autodiff), and this is repeated. The albedos are refitted per region against the
-// light rendered from the old ones, or (SolveOptions::refine_update "joint") jointly, with the
+// light rendered from the old ones, or (SolveOptions::refine_update kJoint) jointly, with the
 // rendered light's derivatives with respect to every region's albedo, ρs and α scales (the
 // renderer's gradients): each round then solves for the albedos and ρs that match the photos
 // with the light those parameters would send, instead of overshooting in bright rooms or
@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -42,15 +43,20 @@
 
 namespace igi {
 
+// What became of a region: kKnown (nothing to estimate), kSolved, kUnobserved (unknowns but no
+// observation: values are placeholders, or ρd fitted to the light it bounces), kNoHighlight (ρs
+// and α cannot be recovered: no photo shows the highlight; ρs set to 0).
+enum class RegionStatus { kKnown, kSolved, kUnobserved, kNoHighlight };
+// "known", "solved", "unobserved", "no_highlight" (report.json's "status").
+std::string_view RegionStatusName(RegionStatus status);
+std::optional<RegionStatus> RegionStatusFromName(std::string_view name);
+
 struct RegionSolution {
   std::string name;
-  // "known" (nothing to estimate), "solved", "unobserved" (unknowns but no observation: values
-  // are placeholders), "no_highlight" (ρs and α cannot be recovered: no photo shows the
-  // highlight; ρs set to 0).
-  std::string status = "known";
-  std::vector<std::string> unknowns;  // scene.json keys estimated
-  RegionFitResult stage1, stage2;     // stage2 == final (stage1 when refinement is off)
-  BrdfParams final_params;            // every value of the solved material
+  RegionStatus status = RegionStatus::kKnown;  // RegionStatus (above); kKnown by default
+  std::vector<std::string> unknowns;           // scene.json keys estimated
+  RegionFitResult stage1, stage2;              // stage2 == final (stage1 when refinement is off)
+  BrdfParams final_params;                     // every value of the solved material
   int observations = 0;
   // Albedo map (when estimated): the image, its file name under the output folder, coverage.
   std::optional<Image> albedo_map;
@@ -98,13 +104,13 @@ struct SolveIteration {
   double relative_rms = 0;  // over all fitted samples
   double max_change = 0;    // largest relative parameter change from the previous iteration
   Json params;              // per region: rho_d, rho_s, alpha
-  // Stage 2: "joint", "joint_albedo" or "independent" (SolveOptions::refine_update), and per
+  // Stage 2: the round's update (SolveOptions::refine_update; unset in stage 1), and per
   // region in `params` also "rho_d_independent" (the region's own refit, πL/E at the rendered E)
   // and, for a joint update, "rho_d_joint" (the albedo that matches the photos with the light it
   // would send, before the step share) and "feedback" (per channel, the relative change of the
   // region's gathered irradiance per relative change of every fitted albedo together); for
-  // "joint", a region with unknown ρs also has "rho_s_independent" and "rho_s_joint".
-  std::string albedo_update;
+  // kJoint, a region with unknown ρs also has "rho_s_independent" and "rho_s_joint".
+  std::optional<RefineUpdate> albedo_update;
   double albedo_step = 1;  // SolveOptions::refine_albedo_step
 };
 

@@ -77,7 +77,7 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
       if (out.rho_s) out.rho_s = out.rho_s->cwiseMin(1.0);
     }
     if (as_written ? !MapCandidate(data, r)
-                   : !m.unknown_rho_d || m.last_fit.albedo_model != "per_patch") {
+                   : !m.unknown_rho_d || m.last_fit.albedo_model != AlbedoModel::kPerPatch) {
       continue;
     }
     RegionAtlas atlas = MapAtlas(data, int(r));
@@ -295,15 +295,15 @@ void SolverState::BuildAlbedoMaps() {
     rs.texel_variation = detail.variation;
     rs.texel_variation_z = detail.z;
     if (!mapped) continue;
-    if (!m.last_fit.albedo_varies && options.albedo_maps != "all") {
+    if (!m.last_fit.albedo_varies && options.albedo_maps != AlbedoMaps::kAll) {
       spdlog::info(
           "region {}: its albedo varies by {:.0f} % from texel to texel (finer than the "
           "patches; z {:.1f}): given a map",
           rs.name, 100 * rs.texel_variation, rs.texel_variation_z);
     }
     rs.albedo_map_file = "albedo/" + scene.materials[r].name + ".exr";
-    if (options.albedo_map_pass == "always" ||
-        (options.albedo_map_pass == "auto" && obs.draw.census)) {
+    if (options.albedo_map_pass == AlbedoMapPass::kAlways ||
+        (options.albedo_map_pass == AlbedoMapPass::kAuto && obs.draw.census)) {
       AtlasOptions ao;
       ao.texel_size_m = summary.map_texel_size_m;
       streamed.push_back(int(r));
@@ -351,10 +351,12 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
   };
   s.Prepare();
   stage_done("observations");
-  if (options.photo_scale == "solve") PhotoScaleReferenceRegions(s);  // before the rays
+  if (options.photo_scale == PhotoScaleMode::kSolve) {
+    PhotoScaleReferenceRegions(s);  // before the rays
+  }
   s.GatherAll();
   stage_done("gather");
-  if (options.photo_scale == "solve") {
+  if (options.photo_scale == PhotoScaleMode::kSolve) {
     s.summary.photo_scale = RunStage1WithPhotoScale(&s);
   } else {
     s.RunStage1();

@@ -4,10 +4,59 @@
 // Every field has a default, a unit and a flag of the same name (--pixel-stride, ...).
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace igi {
+
+// The specular reflectance's colour: one ρs for every channel (kGrey: dielectrics, RADIANCE
+// plastic) or one per channel (kRgb: metals).
+enum class SpecularColour { kGrey, kRgb };
+// "grey", "rgb" (the --specular-colour flag's spelling).
+std::string_view SpecularColourName(SpecularColour colour);
+std::optional<SpecularColour> SpecularColourFromName(std::string_view name);
+
+// Which regions get an albedo map: kAuto (those whose albedo varies significantly across
+// patches, or that declare UVs and vary), kAll (every region with an unknown albedo) or kNone.
+enum class AlbedoMaps { kAuto, kAll, kNone };
+// "auto", "all", "none" (the --albedo-maps flag's spelling).
+std::string_view AlbedoMapsName(AlbedoMaps maps);
+std::optional<AlbedoMaps> AlbedoMapsFromName(std::string_view name);
+
+// Where the written albedo maps come from: kAuto (their own pass over the photos, every pixel at
+// the stride, when the observations were drawn to a budget and are spaced more coarsely than the
+// photos' pixels; else the observations), kAlways (the pass) or kNever (the observations).
+enum class AlbedoMapPass { kAuto, kAlways, kNever };
+// "auto", "always", "never" (the --albedo-map-pass flag's spelling).
+std::string_view AlbedoMapPassName(AlbedoMapPass pass);
+std::optional<AlbedoMapPass> AlbedoMapPassFromName(std::string_view name);
+
+// How each refinement round updates the materials (SolveOptions::refine_update): kIndependent
+// (each region refitted alone), kJoint (every unknown albedo and ρs at once) or kJointAlbedo
+// (the albedos only, jointly).
+enum class RefineUpdate { kIndependent, kJoint, kJointAlbedo };
+// "independent", "joint", "joint_albedo" (the --refine-update flag's spelling).
+std::string_view RefineUpdateName(RefineUpdate update);
+std::optional<RefineUpdate> RefineUpdateFromName(std::string_view name);
+
+// The photos' absolute scale (SolveOptions::photo_scale): kGiven (their values are radiance in
+// the scene's units) or kSolve (one unknown factor shared by every photo, estimated).
+enum class PhotoScaleMode { kGiven, kSolve };
+// "given", "solve" (the --photo-scale flag's spelling).
+std::string_view PhotoScaleModeName(PhotoScaleMode mode);
+std::optional<PhotoScaleMode> PhotoScaleModeFromName(std::string_view name);
+
+// The choice options as igi-solve's flags spell them, before they are parsed (SolveOptions::
+// SetChoices); each default is the name of the option's default.
+struct SolveChoiceFlags {
+  std::string specular_colour = "grey";
+  std::string albedo_maps = "auto";
+  std::string albedo_map_pass = "auto";
+  std::string refine_update = "joint";
+  std::string photo_scale = "given";
+};
 
 struct SolveOptions {
   // Observations: every pixel_stride-th pixel of each photo in x and y (>= 1).
@@ -70,19 +119,21 @@ struct SolveOptions {
   // rounds, 1..100.
   int max_iterations = 8;
   double tolerance = 2e-3;  // largest relative parameter change that counts as converged
-  // "grey": one ρs for all channels (dielectrics, RADIANCE plastic); "rgb": coloured (metals).
-  std::string specular_colour = "grey";
-  // Albedo maps: "auto" for regions whose albedo varies significantly across patches (or that
-  // declare UVs and vary), "all" for every region with an unknown albedo, "none".
-  std::string albedo_maps = "auto";
-  // With "auto" or "all": only these regions (by name) get a map; empty: every region. (A
+  // kGrey (default): one ρs for all channels (dielectrics, RADIANCE plastic); kRgb: coloured
+  // (metals).
+  SpecularColour specular_colour = SpecularColour::kGrey;
+  // Albedo maps: kAuto (default) for regions whose albedo varies significantly across patches
+  // (or that declare UVs and vary), kAll for every region with an unknown albedo, kNone.
+  AlbedoMaps albedo_maps = AlbedoMaps::kAuto;
+  // With kAuto or kAll: only these regions (by name) get a map; empty: every region. (A
   // library option, used by igi-diagnose to give maps to the regions it found textured first.)
   std::vector<std::string> albedo_map_regions;
   double texel_size_m = 0;  // albedo map texel, metres; 0 = auto (the median pixel footprint)
-  // Where the written albedo maps come from: "auto" (their own pass over the photos, every pixel
-  // at the stride, when the observations were drawn to a budget and are spaced more coarsely than
-  // the photos' pixels; else the observations), "always" (the pass) or "never" (the observations).
-  std::string albedo_map_pass = "auto";
+  // Where the written albedo maps come from: kAuto (default; their own pass over the photos,
+  // every pixel at the stride, when the observations were drawn to a budget and are spaced more
+  // coarsely than the photos' pixels; else the observations), kAlways (the pass) or kNever (the
+  // observations).
+  AlbedoMapPass albedo_map_pass = AlbedoMapPass::kAuto;
   // A textured glossy region's ρs and α are fitted with each sample's albedo as the other photos
   // see that texel off their highlights (false: its patch's off-highlight albedo).
   bool held_out_albedo = true;
@@ -103,28 +154,28 @@ struct SolveOptions {
   // proportionally more (FinalRoundRays, up to 8×), so that every region's written values rest
   // on as many gathered directions as a region of that many observations.
   int refine_final_rays = 128;
-  // How each refinement round updates the materials: "joint", "joint_albedo" or "independent".
-  // The rounds gather all indirect light from the model, so its albedos feed back on themselves:
-  // a too bright model darkens the next fit. "independent": each region is refitted alone (its
-  // albedo πL/E with E rendered at the current values), which can overshoot. "joint": the
-  // renderer also returns each gathered irradiance's derivative with respect to every region's
-  // albedo, ρs and α (Renderer::ReflectedRadiance), and the round solves for every unknown
-  // albedo and ρs at once so that the photos are matched with the light those new values would
-  // send (a Newton step on the fixed point; α is refitted per region and its change enters the
-  // others' light; albedo maps keep stage 1's texel detail, scaled to the new region means).
-  // "joint_albedo": the same for the albedos only. Measured: docs/solve.md.
-  std::string refine_update = "joint";
+  // How each refinement round updates the materials: kJoint (default), kJointAlbedo or
+  // kIndependent. The rounds gather all indirect light from the model, so its albedos feed back
+  // on themselves: a too bright model darkens the next fit. kIndependent: each region is
+  // refitted alone (its albedo πL/E with E rendered at the current values), which can overshoot.
+  // kJoint: the renderer also returns each gathered irradiance's derivative with respect to every
+  // region's albedo, ρs and α (Renderer::ReflectedRadiance), and the round solves for every
+  // unknown albedo and ρs at once so that the photos are matched with the light those new values
+  // would send (a Newton step on the fixed point; α is refitted per region and its change enters
+  // the others' light; albedo maps keep stage 1's texel detail, scaled to the new region means).
+  // kJointAlbedo: the same for the albedos only. Measured: docs/solve.md.
+  RefineUpdate refine_update = RefineUpdate::kJoint;
   // Share of each refinement round's albedo change that is applied, in (0, 1] (1 = the full
   // step). Smaller steps damp a round's swing about the answer where stage 1 is already right,
   // but correct a biased stage 1 more slowly (measured: docs/solve.md).
   double refine_albedo_step = 1.0;
-  // The photos' absolute scale. "given": their values are radiance in the scene's units (after
-  // each photo's exposure_scale). "solve": one unknown factor k shared by every photo (radiance
-  // maps from a recovered response are known up to a constant) is estimated from the observed
-  // regions whose reflectance is given in full and diffuse (a reference target), before the
-  // paper's stage (solver/photometric_scale.h); the solved scene.json multiplies every photo's
-  // exposure_scale by k.
-  std::string photo_scale = "given";
+  // The photos' absolute scale. kGiven (default): their values are radiance in the scene's units
+  // (after each photo's exposure_scale). kSolve: one unknown factor k shared by every photo
+  // (radiance maps from a recovered response are known up to a constant) is estimated from the
+  // observed regions whose reflectance is given in full and diffuse (a reference target), before
+  // the paper's stage (solver/photometric_scale.h); the solved scene.json multiplies every
+  // photo's exposure_scale by k.
+  PhotoScaleMode photo_scale = PhotoScaleMode::kGiven;
   // Seed of the random numbers of the gathering and the refinement's path tracing.
   uint64_t seed = 1;
   // Pixels left out of every fit (igi-diagnose measures its held-out residual on them): square
@@ -137,8 +188,12 @@ struct SolveOptions {
   // Progress bars on stderr (only when it is a terminal).
   bool show_progress = true;
 
-  // Throws InputError naming the flag and the rule.
+  // Throws InputError naming the flag and the rule (a choice outside its enum: by its number).
   void Validate() const;
+  // Sets the choice options from their flags' text, then validates as Validate does: one
+  // InputError with every problem, a text that names no choice as "--FLAG: TEXT: must be ..."
+  // in its place among them.
+  void SetChoices(const SolveChoiceFlags& flags);
 };
 
 // The observation count from which a region's last refinement round gathers
@@ -150,10 +205,10 @@ inline constexpr int kFinalRoundRegionObservations = 1024;
 // 8 times it (and 4096).
 int FinalRoundRays(int refine_final_rays, int observations);
 
-// "joint" (every region's ρd and ρs jointly, the α changes included) or "joint_albedo" (the
+// kJoint (every region's ρd and ρs jointly, the α changes included) or kJointAlbedo (the
 // albedos only).
-inline bool IsJointUpdate(const std::string& update) {
-  return update == "joint" || update == "joint_albedo";
+constexpr bool IsJointUpdate(RefineUpdate update) {
+  return update == RefineUpdate::kJoint || update == RefineUpdate::kJointAlbedo;
 }
 
 }  // namespace igi

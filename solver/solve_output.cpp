@@ -46,7 +46,7 @@ Json FitJson(const RegionFitResult& f, BrdfModel model) {
       j["sigma_alpha"] = Num(f.sigma_alpha);
     }
   }
-  j["albedo_model"] = f.albedo_model;
+  j["albedo_model"] = std::string(AlbedoModelName(f.albedo_model));
   j["albedo_varies"] = f.albedo_varies;
   j["relative_rms"] = Num(f.relative_rms);
   j["samples"] = f.samples;
@@ -123,7 +123,7 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   for (const RegionSolution& r : s.regions) {
     Json rj;
     rj["name"] = r.name;
-    rj["status"] = r.status;
+    rj["status"] = std::string(RegionStatusName(r.status));
     rj["unknowns"] = r.unknowns;
     rj["observations"] = r.observations;
     rj["paper"] = FitJson(r.stage1, r.final_params.model);
@@ -131,10 +131,10 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     // scene.json's rho_d and where it comes from: the albedo map's mean over its seen texels
     // where the region has a map, else the fit's region mean (after the bound at 1).
     rj["rho_d"] = Vec(r.final_params.rho_d);
-    rj["rho_d_source"] = r.rho_d_from_map           ? "albedo_map_seen_mean"
-                         : r.RhoDFromBouncedLight() ? "bounced_light"
-                         : r.status == "unobserved" ? "placeholder"
-                                                    : "fit";
+    rj["rho_d_source"] = r.rho_d_from_map                        ? "albedo_map_seen_mean"
+                         : r.RhoDFromBouncedLight()              ? "bounced_light"
+                         : r.status == RegionStatus::kUnobserved ? "placeholder"
+                                                                 : "fit";
     if (r.RhoDFromBouncedLight()) {
       rj["bounced_light_fit"] = {
           {"relative_sigma", Vec(r.bounce_fit_sigma)},
@@ -201,8 +201,8 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                        {"relative_rms", Num(it.relative_rms)},
                        {"max_change", Num(it.max_change)},
                        {"params", it.params}});
-    if (!it.albedo_update.empty()) {
-      history.back()["albedo_update"] = it.albedo_update;
+    if (it.albedo_update) {
+      history.back()["albedo_update"] = std::string(RefineUpdateName(*it.albedo_update));
       history.back()["albedo_step"] = it.albedo_step;
     }
   }
@@ -240,18 +240,18 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
                   {"indirect_rays", o.indirect_rays},
                   {"max_iterations", o.max_iterations},
                   {"tolerance", o.tolerance},
-                  {"specular_colour", o.specular_colour},
-                  {"albedo_maps", o.albedo_maps},
-                  {"albedo_map_pass", o.albedo_map_pass},
+                  {"specular_colour", std::string(SpecularColourName(o.specular_colour))},
+                  {"albedo_maps", std::string(AlbedoMapsName(o.albedo_maps))},
+                  {"albedo_map_pass", std::string(AlbedoMapPassName(o.albedo_map_pass))},
                   {"refine_iterations", o.refine_iterations},
                   {"refine_rays", o.refine_rays},
                   {"refine_final_rays", o.refine_final_rays},
                   {"seed", o.seed},
                   {"refine_albedo_step", o.refine_albedo_step},
-                  {"refine_update", o.refine_update},
+                  {"refine_update", std::string(RefineUpdateName(o.refine_update))},
                   {"specular_bounces", o.specular_bounces},
                   {"pixel_footprint", o.pixel_footprint},
-                  {"photo_scale", o.photo_scale}};
+                  {"photo_scale", std::string(PhotoScaleModeName(o.photo_scale))}};
   if (!o.albedo_map_regions.empty()) j["options"]["albedo_map_regions"] = o.albedo_map_regions;
   return j;
 }

@@ -37,13 +37,15 @@ void ParameterTable(HtmlReport* page, const SolveSummary& s) {
       alpha2 = FmtPm(p.alpha, f2.sigma_alpha);
     }
     const bool fitted = f2.fitted;
-    rows.push_back({r.name, std::string(BrdfModelName(p.model)), r.status,
-                    std::to_string(r.observations), fitted ? Rgb(f1.rho_d) : "",
-                    Rgb(p.rho_d), spec && fitted ? Fmt(f1.rho_s.mean()) : "",
+    rows.push_back({r.name, std::string(BrdfModelName(p.model)),
+                    std::string(RegionStatusName(r.status)), std::to_string(r.observations),
+                    fitted ? Rgb(f1.rho_d) : "", Rgb(p.rho_d),
+                    spec && fitted ? Fmt(f1.rho_s.mean()) : "",
                     spec ? FmtPm(p.rho_s.mean(), f2.sigma_rho_s) : "", alpha1, alpha2,
-                    fitted ? f2.albedo_model : "", fitted ? Fmt(f2.relative_rms, 3) : "",
-                    r.albedo_map_file});
-    const std::string cls = r.status == "solved" || r.status == "known" ? "good" : "bad";
+                    fitted ? std::string(AlbedoModelName(f2.albedo_model)) : "",
+                    fitted ? Fmt(f2.relative_rms, 3) : "", r.albedo_map_file});
+    const std::string cls =
+        r.status == RegionStatus::kSolved || r.status == RegionStatus::kKnown ? "good" : "bad";
     classes.push_back({"", "", cls});
   }
   page->Table({"region", "brdf", "status", "observations", "ρd paper", "ρd final", "ρs paper",
@@ -113,7 +115,7 @@ void WriteSolveReportHtml(const SolveSummary& s, const Json& /*report*/,
   }
   if (!s.converged) page.Note(fmt::format("Stage 1 did not converge: {}", s.message), "warning");
   for (const RegionSolution& r : s.regions) {
-    if (r.status == "unobserved") {
+    if (r.status == RegionStatus::kUnobserved) {
       page.Note(fmt::format("{}: no photo sees this region; its values are placeholders.", r.name),
                 "error");
     }

@@ -42,8 +42,7 @@ int Run(const std::string& camera, bool multi_camera, const igi::CommonFlags& fl
   if (!camera.empty()) {
     const igi::calib::CameraFile file = igi::calib::ReadCameraFile(camera);
     options->colmap.intrinsics =
-        igi::KnownIntrinsics{std::string(igi::calib::ColmapCameraModelName(file.model)), file.width,
-                             file.height, file.params};
+        igi::KnownIntrinsics{file.model, file.width, file.height, file.params};
     options->camera_file = camera;
   }
   options->colmap.threads = flags.threads;
@@ -70,6 +69,7 @@ int main(int argc, char** argv) {
   igi::AddCommonFlags(app, &flags);
   igi::RegisterOptions options;
   std::string camera;
+  std::string camera_model = "SIMPLE_RADIAL";  // checked against kSelfCalibratedModels when parsed
   bool multi_camera = false;
   app.add_option("--images", options.images, "Folder of photos")->required();
   app.add_option("--out", options.out, "Output folder")->required();
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-features", options.colmap.max_features,
                  "At most this many SIFT keypoints per photo (COLMAP's default 8192; CPU "
                  "matching time grows with it)");
-  app.add_option("--camera-model", options.colmap.camera_model,
+  app.add_option("--camera-model", camera_model,
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
                  "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
       ->check(CLI::IsMember(igi::kSelfCalibratedModels));
@@ -114,6 +114,8 @@ int main(int argc, char** argv) {
   app.add_flag("--multi-camera", multi_camera, "One camera per photo (default: one shared)");
   app.add_flag("--allow-other-colmap", options.colmap.allow_other_version,
                "Accept a COLMAP other than 3.8");
-  return igi::RunMain(app, flags, argc, argv,
-                      [&]() -> int { return Run(camera, multi_camera, flags, &options); });
+  return igi::RunMain(app, flags, argc, argv, [&]() -> int {
+    options.colmap.camera_model = igi::calib::ColmapCameraModelFromName(camera_model).value();
+    return Run(camera, multi_camera, flags, &options);
+  });
 }

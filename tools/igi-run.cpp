@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
   igi::RunOptions o;
   igi::DemoOptions demo;
+  // --demo's choice flags as typed; SetChoices parses them into `demo` and validates it.
+  igi::DemoChoiceFlags demo_choices;
   bool run_demo = false;
   std::string photos, scene, out, bin;
   app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
@@ -92,7 +94,7 @@ int main(int argc, char** argv) {
   app.add_option("--demo-width", demo.width, "--demo: photo width")->capture_default_str();
   app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
   app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();
-  app.add_option("--demo-calibration", demo.calibration,
+  app.add_option("--demo-calibration", demo_choices.calibration,
                  "--demo: the HDR maps' absolute scale: measured (given, as a lab calibration), "
                  "reference (solved from the matte box, its reflectance given) or none")
       ->capture_default_str();
@@ -110,6 +112,7 @@ int main(int argc, char** argv) {
       demo.num_threads = flags.threads;
       if (!o.solve_args.empty()) demo.solve_args = o.solve_args;
       if (!o.diagnose_args.empty()) demo.diagnose_args = o.diagnose_args;
+      demo.SetChoices(demo_choices);
       const igi::DemoSummary d = igi::RunDemo(demo);
       summary = d.run;
       PrintSummary(summary);

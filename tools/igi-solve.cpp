@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
   igi::SolveOptions o;
+  // The choice flags as typed; SetChoices parses them into `o` and validates every option.
+  igi::SolveChoiceFlags choices;
   app.add_option("scene", scene_path, "scene.json (materials with missing values are solved)")
       ->required();
   app.add_option("--out", out_dir, "output folder (scene.json, albedo/, report.json, report.html)")
@@ -58,10 +60,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tolerance", o.tolerance, "relative parameter change that ends iterating")
       ->capture_default_str();
-  app.add_option("--specular-colour", o.specular_colour, "grey or rgb specular reflectance")
+  app.add_option("--specular-colour", choices.specular_colour, "grey or rgb specular reflectance")
       ->capture_default_str();
-  app.add_option("--albedo-maps", o.albedo_maps, "auto, all or none")->capture_default_str();
-  app.add_option("--albedo-map-pass", o.albedo_map_pass,
+  app.add_option("--albedo-maps", choices.albedo_maps, "auto, all or none")->capture_default_str();
+  app.add_option("--albedo-map-pass", choices.albedo_map_pass,
                  "albedo maps from their own pass over the photos at every pixel of the stride: "
                  "auto (when the observations were drawn to a budget), always or never")
       ->capture_default_str();
@@ -83,7 +85,7 @@ int main(int argc, char** argv) {
                  "path-traced directions per observation in the last refinement round (a region "
                  "of fewer than 1024 observations gets proportionally more, up to 8x)")
       ->capture_default_str();
-  app.add_option("--refine-update", o.refine_update,
+  app.add_option("--refine-update", choices.refine_update,
                  "stage 2's update: independent (each region refitted with the light the "
                  "current model sends), joint (every region's albedo and ρs at once, with the "
                  "renderer's derivatives of that light with respect to each region's albedo, "
@@ -101,7 +103,7 @@ int main(int argc, char** argv) {
                  "gathering follows glossy surfaces' reflection of the room (true) or takes only "
                  "their diffuse radiance and the lights' highlights (false)")
       ->capture_default_str();
-  app.add_option("--photo-scale", o.photo_scale,
+  app.add_option("--photo-scale", choices.photo_scale,
                  "given (photos in the scene's radiance units) or solve (one factor for all "
                  "photos, from the regions of known diffuse reflectance)")
       ->capture_default_str();
@@ -109,7 +111,7 @@ int main(int argc, char** argv) {
   return igi::RunMain(app, common, argc, argv, [&]() {
     o.num_threads = common.threads;
     o.show_progress = !common.quiet;
-    o.Validate();
+    o.SetChoices(choices);
     igi::RejectOutputInSceneFolder(out_dir, scene_path);
     igi::SceneLoadOptions lo;
     const igi::Scene scene = igi::LoadScene(scene_path, lo);
@@ -117,7 +119,7 @@ int main(int argc, char** argv) {
     igi::WriteSolveOutputs(summary, o, out_dir);
     std::vector<std::string> failed;
     for (const igi::RegionSolution& r : summary.regions) {
-      if (r.status == "unobserved") {
+      if (r.status == igi::RegionStatus::kUnobserved) {
         failed.push_back(igi::DescribeProblem(
             scene.file.string(), "materials." + r.name, "unknown values",
             r.RhoDFromBouncedLight()

@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
   igi::SynthOptions o;
+  // The choice flags as typed; SetChoices parses them into `o` and validates every option.
+  igi::SynthChoiceFlags choices;
   std::string noise = "none", response = "gamma", unknowns = "rho_d,rho_s,alpha";
   std::string photo_lightings = "L0", validation_lightings = "L1", lamp_position;
   std::vector<std::string> effects;
@@ -44,14 +46,15 @@ int main(int argc, char** argv) {
   app.add_option("--fov", o.fov_deg, "Horizontal field of view, degrees");
   app.add_option("--spp", o.spp, "Render samples per pixel");
   app.add_option("--seed", o.seed, "Random seed (same seed, same files)");
-  app.add_option("--glossy-brdf", o.glossy_brdf, "True model of the glossy regions: ward|ward_gmd");
-  app.add_option("--lamp", o.lamp, "Lamp type: sphere (r = 4 cm) or point");
+  app.add_option("--glossy-brdf", choices.glossy_brdf,
+                 "True model of the glossy regions: ward|ward_gmd");
+  app.add_option("--lamp", choices.lamp, "Lamp type: sphere (r = 4 cm) or point");
   app.add_option("--lamp-position", lamp_position,
                  "Centre of the photographed lamp, x,y,z in metres (default 2.3,1.7,2.4)");
   app.add_option("--grazing-cameras", o.grazing_cameras,
                  "Extra cameras seeing the floor's highlight at 60-80 deg incidence (Fresnel; "
                  "needs a low lamp, e.g. --lamp-position 2,2,0.6)");
-  app.add_option("--floor-texture", o.floor_texture,
+  app.add_option("--floor-texture", choices.floor_texture,
                  "Floor albedo: tiles (grout lines and grain finer than a pixel) or smooth (the "
                  "tiles low-pass filtered, sigma 6 cm, resolved by the photos)");
   app.add_option("--unknowns", unknowns,
@@ -79,7 +82,7 @@ int main(int argc, char** argv) {
                  "Contrast of --response sigmoid");
   app.add_option("--sigmoid-mid", o.brackets.sigmoid_mid, "Mid exposure of --response sigmoid");
   app.add_option("--bracket-bits", o.brackets.bits, "8 or 16");
-  app.add_option("--bracket-format", o.brackets.format, "png or tif");
+  app.add_option("--bracket-format", choices.bracket_format, "png or tif");
   app.add_option("--effect", effects,
                  "Effect in the photos, not in scene.json: NAME[:key=value,...] (repeatable)");
   return igi::RunMain(app, flags, argc, argv, [&] {
@@ -122,6 +125,7 @@ int main(int argc, char** argv) {
     }
     problems.ThrowIfAny();
     o.num_threads = flags.threads;
+    o.SetChoices(choices);
     const igi::SynthSummary s = igi::Synthesize(o);
     std::printf("wrote %s: %zu photos, %zu validation renders, %lld saturated pixels, %.1f s\n",
                 o.out.c_str(), s.photos.size(), s.validation.size(),

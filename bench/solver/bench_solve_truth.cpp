@@ -88,8 +88,10 @@ int main(int argc, char** argv) {
       dump = v != 0;
     else if (key == "step")
       o.refine_albedo_step = v;
-    else if (key == "joint")  // 1: refine_update "joint", 2: "joint_albedo", 0: "independent"
-      o.refine_update = v == 2 ? "joint_albedo" : v != 0 ? "joint" : "independent";
+    else if (key == "joint")  // 1: refine_update kJoint, 2: kJointAlbedo, 0: kIndependent
+      o.refine_update = v == 2   ? igi::RefineUpdate::kJointAlbedo
+                        : v != 0 ? igi::RefineUpdate::kJoint
+                                 : igi::RefineUpdate::kIndependent;
     else if (key == "bounce")
       o.specular_bounces = v != 0;
     else if (key == "smooth")
@@ -114,7 +116,7 @@ int main(int argc, char** argv) {
   std::printf("%-14s %-6s %7s %7s %7s %7s %7s  %s\n", "region", "stage", "rd_r%", "rd_g%", "rd_b%",
               "rs%", "a%", "albedo");
   for (const igi::RegionSolution& r : s.regions) {
-    if (r.status != "solved" || !truth.contains(r.name)) continue;
+    if (r.status != igi::RegionStatus::kSolved || !truth.contains(r.name)) continue;
     const igi::Json& t = truth[r.name];
     for (int stage = 1; stage <= 2; ++stage) {
       const igi::RegionFitResult& f = stage == 1 ? r.stage1 : r.stage2;
@@ -127,7 +129,7 @@ int main(int argc, char** argv) {
       } else {
         std::printf(" %7s %7s", "", "");
       }
-      std::printf("  %s", f.albedo_model.c_str());
+      std::printf("  %s", std::string(igi::AlbedoModelName(f.albedo_model)).c_str());
       if (stage == 2) std::printf("  %d obs", r.observations);
       std::printf("\n");
     }

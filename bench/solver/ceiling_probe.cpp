@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
   std::printf("%s: stage-1 rho_d %+.2f %+.2f %+.2f %% (%s), patch %.4f m\n", kv["region"].c_str(),
               100 * (rho_fit[0] / rho_true[0] - 1), 100 * (rho_fit[1] / rho_true[1] - 1),
               100 * (rho_fit[2] / rho_true[2] - 1),
-              s.materials[region].last_fit.albedo_model.c_str(), s.summary.patch_size_m);
+              std::string(AlbedoModelName(s.materials[region].last_fit.albedo_model)).c_str(),
+              s.summary.patch_size_m);
   const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
   const int lighting = 0;
   const Renderer ref(truth_scene, lighting);

@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
   std::printf("texel %.4f m, floor fit rho_s %.4f (%+.1f %%) alpha %.4f (%+.1f %%) model %s\n",
               s.summary.texel_size_m, m.params.rho_s.mean(),
               100 * (m.params.rho_s.mean() / rs_true - 1), m.params.alpha,
-              100 * (m.params.alpha / a_true - 1), m.last_fit.albedo_model.c_str());
+              100 * (m.params.alpha / a_true - 1),
+              std::string(AlbedoModelName(m.last_fit.albedo_model)).c_str());
   // Held-out albedo variants: A as the solver (current params), B with the true lobe
   // subtracted and the true model deciding off-highlight, C the true texture times E (blur only).
   std::vector<Eigen::Vector3d> t_true(s.obs.size(), Eigen::Vector3d::Zero());

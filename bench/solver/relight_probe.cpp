@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
   if (const char* e = std::getenv("PROBE_REFINE")) o.refine_iterations = std::atoi(e);
   if (const char* e = std::getenv("PROBE_BOUNCE")) o.specular_bounces = std::string(e) == "1";
   if (const char* e = std::getenv("PROBE_STEP")) o.refine_albedo_step = std::atof(e);
-  if (const char* e = std::getenv("PROBE_UPDATE")) o.refine_update = e;
+  if (const char* e = std::getenv("PROBE_UPDATE"))
+    o.refine_update = RefineUpdateFromName(e).value();
   if (const char* e = std::getenv("PROBE_RAYS")) o.refine_rays = std::atoi(e);
   if (const char* e = std::getenv("PROBE_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   if (const char* e = std::getenv("PROBE_TEXEL")) o.texel_size_m = std::atof(e);

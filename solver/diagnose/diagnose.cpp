@@ -331,7 +331,7 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
   // Albedo maps are themselves a model to earn: the baseline (when solving) has constant
   // albedos per region, so that a map cannot absorb an effect of the image or the lights before
   // it is found; an effect's step (albedo_texture) adds them.
-  MapMode maps{solve ? "none" : "auto", {}};
+  MapMode maps{solve ? AlbedoMaps::kNone : AlbedoMaps::kAuto, {}};
   spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
   ModelState st =
       FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos, true);

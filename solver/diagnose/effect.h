@@ -19,6 +19,7 @@
 #include "solver/diagnose/diagnose_options.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/photo_model.h"
+#include "solver/solve_options.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
@@ -27,12 +28,12 @@ namespace igi {
 class ResidualFitter;
 class RecordSubset;
 
-// The solver's albedo maps for a fit: "none", or "auto" (where the albedo varies), optionally
-// only for the regions in `only`.
+// The solver's albedo maps for a fit (SolveOptions::albedo_maps): AlbedoMaps::kNone (default),
+// or kAuto (where the albedo varies), optionally only for the regions in `only`.
 struct MapMode {
-  std::string maps = "none";
+  AlbedoMaps maps = AlbedoMaps::kNone;
   std::vector<std::string> only;  // empty: every region
-  bool Full() const { return maps == "auto" && only.empty(); }
+  bool Full() const { return maps == AlbedoMaps::kAuto && only.empty(); }
 };
 
 // The diagnosis's current model as the effects see it: the kept model, its complete renders and

@@ -211,13 +211,13 @@ Eigen::Vector3d ImageMean(const Image& image) {
 
 SynthRoom BuildRoom(const SynthOptions& options) {
   SynthRoom room;
-  const std::string& g = options.glossy_brdf;
+  const std::string g(BrdfModelName(options.glossy_brdf));
   AddRoomShell(room.size, &room.mesh);
   room.mesh.AddBox({2.8, 2.6}, 0.0, {0.9, 0.7, 0.6}, 25.0, "glossy_box");
   room.mesh.AddSphere({1.3, 1.4, 0.35}, 0.35, 16, 32, "glossy_sphere");
   room.mesh.AddBox({0.9, 3.1}, 0.0, {0.6, 0.6, 1.4}, -15.0, "matte_box");
 
-  room.floor_albedo = options.floor_texture == "smooth"
+  room.floor_albedo = options.floor_texture == FloorTexture::kSmooth
                           ? GaussianBlur(MakeFloorTexture(options.seed, false), 2.0)
                           : MakeFloorTexture(options.seed);
   const bool rho_d_known = !Contains(options.unknowns, "rho_d");
@@ -240,7 +240,7 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   if (options.textured_walls) TextureEveryRegion(options, rho_d_known, &room);
   room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
 
-  const double radius = options.lamp == "point" ? 0.0 : 0.04;
+  const double radius = options.lamp == LampShape::kPoint ? 0.0 : 0.04;
   room.lamps.push_back(
       {"lamp", options.lamp_position.value_or(Eigen::Vector3d(2.3, 1.7, 2.4)), 30.0, radius});
   room.lamps.push_back({"lamp2", {0.8, 0.9, 2.2}, 25.0, radius});

@@ -23,7 +23,178 @@ bool Contains(const std::vector<std::string>& list, const std::string& name) {
   return std::find(list.begin(), list.end(), name) != list.end();
 }
 
+// The text a choice's problem names: the flag's text when `typed`, else the value's name, or its
+// number where that name is "?" (a value outside the enum).
+template <typename E>
+std::string ChoiceText(E value, std::string_view (*name)(E), const std::string* typed) {
+  if (typed) return *typed;
+  const std::string_view n = name(value);
+  return n == "?" ? std::to_string(int(value)) : std::string(n);
+}
+
+ProblemList BracketProblems(const BracketOptions& b, const std::string* typed_format) {
+  ProblemList p;
+  if (b.count < 0 || b.count > 16)
+    p.Add("--brackets", "", std::to_string(b.count), "must be 0..16");
+  if (!(b.stops > 0) || b.stops > 8) p.Add("--stops", "", Str(b.stops), "must be in (0, 8]");
+  if (!(b.gamma > 0.1) || b.gamma > 10) p.Add("--gamma", "", Str(b.gamma), "must be in (0.1, 10]");
+  if (!(b.sigmoid_contrast > 0.2) || b.sigmoid_contrast > 10) {
+    p.Add("--sigmoid-contrast", "", Str(b.sigmoid_contrast), "must be in (0.2, 10]");
+  }
+  if (!(b.sigmoid_mid > 0) || b.sigmoid_mid >= 1) {
+    p.Add("--sigmoid-mid", "", Str(b.sigmoid_mid), "must be in (0, 1)");
+  }
+  if (b.response == ResponseKind::kFile && b.response_file.empty()) {
+    p.Add("--response-file", "", "", "required with --response file");
+  }
+  if (b.bits != 8 && b.bits != 16) {
+    p.Add("--bracket-bits", "", std::to_string(b.bits), "must be 8 or 16");
+  }
+  if (typed_format ? !BracketFormatFromName(*typed_format)
+                   : !BracketFormatFromName(BracketFormatName(b.format))) {
+    p.Add("--bracket-format", "", ChoiceText(b.format, BracketFormatName, typed_format),
+          "must be png or tif");
+  }
+  return p;
+}
+
+// Every problem of `o`; with `typed`, each choice is judged by its flag's text.
+ProblemList SynthProblems(const SynthOptions& o, const SynthChoiceFlags* typed) {
+  ProblemList p;
+  if (o.out.empty()) p.Add("--out", "", "", "required");
+  if (o.cameras < 1 || o.cameras > 64) {
+    p.Add("--cameras", "", std::to_string(o.cameras), "must be 1..64");
+  }
+  if (o.ceiling_cameras < 0 || o.ceiling_cameras > o.cameras) {
+    p.Add("--ceiling-cameras", "", std::to_string(o.ceiling_cameras), "must be 0..--cameras");
+  }
+  if (o.width < 8 || o.width > 8192) {
+    p.Add("--width", "", std::to_string(o.width), "must be 8..8192");
+  }
+  if (o.height < 8 || o.height > 8192) {
+    p.Add("--height", "", std::to_string(o.height), "must be 8..8192");
+  }
+  if (!(o.fov_deg >= 10) || o.fov_deg > 140) {
+    p.Add("--fov", "", Str(o.fov_deg), "must be in [10, 140]");
+  }
+  if (o.spp < 1 || o.spp > 1 << 20) p.Add("--spp", "", std::to_string(o.spp), "must be >= 1");
+  // Any BrdfModel has a name; only the two Ward models are the glossy regions' choices.
+  const std::optional<BrdfModel> glossy =
+      typed ? BrdfModelFromName(typed->glossy_brdf) : std::optional<BrdfModel>(o.glossy_brdf);
+  if (glossy != BrdfModel::kWard && glossy != BrdfModel::kWardGmd) {
+    p.Add("--glossy-brdf", "",
+          ChoiceText(o.glossy_brdf, BrdfModelName, typed ? &typed->glossy_brdf : nullptr),
+          "must be ward or ward_gmd");
+  }
+  if (typed ? !LampShapeFromName(typed->lamp) : !LampShapeFromName(LampShapeName(o.lamp))) {
+    p.Add("--lamp", "", ChoiceText(o.lamp, LampShapeName, typed ? &typed->lamp : nullptr),
+          "must be sphere or point");
+  }
+  if (o.lamp_position) {
+    const Eigen::Vector3d& q = *o.lamp_position;
+    // The room spans [0, 4] × [0, 4] × [0, 3] m (room_builder.h).
+    if (!(q.x() >= 0.1 && q.x() <= 3.9 && q.y() >= 0.1 && q.y() <= 3.9 && q.z() >= 0.1 &&
+          q.z() <= 2.9)) {
+      p.Add("--lamp-position", "", fmt::format("{},{},{}", q.x(), q.y(), q.z()),
+            "must lie inside the room, 0.1 m from its walls (x, y in [0.1, 3.9], z in [0.1, 2.9])");
+    }
+  }
+  if (o.grazing_cameras < 0 || o.grazing_cameras > 8) {
+    p.Add("--grazing-cameras", "", std::to_string(o.grazing_cameras), "must be 0..8");
+  }
+  if (typed ? !FloorTextureFromName(typed->floor_texture)
+            : !FloorTextureFromName(FloorTextureName(o.floor_texture))) {
+    p.Add("--floor-texture", "",
+          ChoiceText(o.floor_texture, FloorTextureName, typed ? &typed->floor_texture : nullptr),
+          "must be tiles or smooth");
+  }
+  for (const std::string& u : o.unknowns) {
+    if (u != "rho_d" && u != "rho_s" && u != "alpha") {
+      p.Add("--unknowns", "", u, "must be a list of rho_d, rho_s, alpha (or none)");
+    }
+  }
+  auto check_lightings = [&](const char* flag, const std::vector<std::string>& list) {
+    for (const std::string& l : list) {
+      if (l != "L0" && l != "L1") p.Add(flag, "", l, "must be a list of L0, L1");
+    }
+  };
+  check_lightings("--photo-lightings", o.photo_lightings);
+  check_lightings("--validation-lightings", o.validation_lightings);
+  if (o.photo_lightings.empty()) p.Add("--photo-lightings", "", "", "must name a lighting");
+  std::vector<std::string> seen;
+  for (const EffectSpec& e : o.effects) {
+    if (Contains(seen, e.name)) p.Add("--effect", "", e.name, "effect given twice");
+    seen.push_back(e.name);
+  }
+  if (!o.from.empty() && (o.brackets.count > 0 || o.unposed || o.noise != NoiseModel::kNone)) {
+    p.Add("--from", "", o.from.string(),
+          "takes the capture's photos as they are: no --brackets, "
+          "--unposed or --noise");
+  }
+  if (o.num_threads < 0) p.Add("--threads", "", std::to_string(o.num_threads), "must be >= 0");
+  try {
+    o.sensor.Validate();
+  } catch (const Error& e) {
+    p.Append(e);
+  }
+  const ProblemList bracket_problems =
+      BracketProblems(o.brackets, typed ? &typed->bracket_format : nullptr);
+  for (const std::string& line : bracket_problems.problems()) p.Add(line);
+  return p;
+}
+
 }  // namespace
+
+std::string_view BracketFormatName(BracketFormat format) {
+  switch (format) {
+    case BracketFormat::kPng:
+      return "png";
+    case BracketFormat::kTif:
+      return "tif";
+  }
+  return "?";
+}
+
+std::optional<BracketFormat> BracketFormatFromName(std::string_view name) {
+  for (BracketFormat f : {BracketFormat::kPng, BracketFormat::kTif}) {
+    if (BracketFormatName(f) == name) return f;
+  }
+  return std::nullopt;
+}
+
+std::string_view LampShapeName(LampShape shape) {
+  switch (shape) {
+    case LampShape::kSphere:
+      return "sphere";
+    case LampShape::kPoint:
+      return "point";
+  }
+  return "?";
+}
+
+std::optional<LampShape> LampShapeFromName(std::string_view name) {
+  for (LampShape s : {LampShape::kSphere, LampShape::kPoint}) {
+    if (LampShapeName(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
+std::string_view FloorTextureName(FloorTexture texture) {
+  switch (texture) {
+    case FloorTexture::kTiles:
+      return "tiles";
+    case FloorTexture::kSmooth:
+      return "smooth";
+  }
+  return "?";
+}
+
+std::optional<FloorTexture> FloorTextureFromName(std::string_view name) {
+  for (FloorTexture t : {FloorTexture::kTiles, FloorTexture::kSmooth}) {
+    if (FloorTextureName(t) == name) return t;
+  }
+  return std::nullopt;
+}
 
 const std::vector<std::string>& SupportedEffects() {
   static const std::vector<std::string> kEffects = {
@@ -83,93 +254,16 @@ void SensorOptions::Validate() const {
   p.ThrowIfAny();
 }
 
-void BracketOptions::Validate() const {
-  ProblemList p;
-  if (count < 0 || count > 16) p.Add("--brackets", "", std::to_string(count), "must be 0..16");
-  if (!(stops > 0) || stops > 8) p.Add("--stops", "", Str(stops), "must be in (0, 8]");
-  if (!(gamma > 0.1) || gamma > 10) p.Add("--gamma", "", Str(gamma), "must be in (0.1, 10]");
-  if (!(sigmoid_contrast > 0.2) || sigmoid_contrast > 10) {
-    p.Add("--sigmoid-contrast", "", Str(sigmoid_contrast), "must be in (0.2, 10]");
-  }
-  if (!(sigmoid_mid > 0) || sigmoid_mid >= 1) {
-    p.Add("--sigmoid-mid", "", Str(sigmoid_mid), "must be in (0, 1)");
-  }
-  if (response == ResponseKind::kFile && response_file.empty()) {
-    p.Add("--response-file", "", "", "required with --response file");
-  }
-  if (bits != 8 && bits != 16) p.Add("--bracket-bits", "", std::to_string(bits), "must be 8 or 16");
-  if (format != "png" && format != "tif")
-    p.Add("--bracket-format", "", format, "must be png or tif");
-  p.ThrowIfAny();
-}
+void BracketOptions::Validate() const { BracketProblems(*this, nullptr).ThrowIfAny(); }
 
-void SynthOptions::Validate() const {
-  ProblemList p;
-  if (out.empty()) p.Add("--out", "", "", "required");
-  if (cameras < 1 || cameras > 64) p.Add("--cameras", "", std::to_string(cameras), "must be 1..64");
-  if (ceiling_cameras < 0 || ceiling_cameras > cameras) {
-    p.Add("--ceiling-cameras", "", std::to_string(ceiling_cameras), "must be 0..--cameras");
-  }
-  if (width < 8 || width > 8192) p.Add("--width", "", std::to_string(width), "must be 8..8192");
-  if (height < 8 || height > 8192) {
-    p.Add("--height", "", std::to_string(height), "must be 8..8192");
-  }
-  if (!(fov_deg >= 10) || fov_deg > 140) p.Add("--fov", "", Str(fov_deg), "must be in [10, 140]");
-  if (spp < 1 || spp > 1 << 20) p.Add("--spp", "", std::to_string(spp), "must be >= 1");
-  if (glossy_brdf != "ward" && glossy_brdf != "ward_gmd") {
-    p.Add("--glossy-brdf", "", glossy_brdf, "must be ward or ward_gmd");
-  }
-  if (lamp != "sphere" && lamp != "point") p.Add("--lamp", "", lamp, "must be sphere or point");
-  if (lamp_position) {
-    const Eigen::Vector3d& q = *lamp_position;
-    // The room spans [0, 4] × [0, 4] × [0, 3] m (room_builder.h).
-    if (!(q.x() >= 0.1 && q.x() <= 3.9 && q.y() >= 0.1 && q.y() <= 3.9 && q.z() >= 0.1 &&
-          q.z() <= 2.9)) {
-      p.Add("--lamp-position", "", fmt::format("{},{},{}", q.x(), q.y(), q.z()),
-            "must lie inside the room, 0.1 m from its walls (x, y in [0.1, 3.9], z in [0.1, 2.9])");
-    }
-  }
-  if (grazing_cameras < 0 || grazing_cameras > 8) {
-    p.Add("--grazing-cameras", "", std::to_string(grazing_cameras), "must be 0..8");
-  }
-  if (floor_texture != "tiles" && floor_texture != "smooth") {
-    p.Add("--floor-texture", "", floor_texture, "must be tiles or smooth");
-  }
-  for (const std::string& u : unknowns) {
-    if (u != "rho_d" && u != "rho_s" && u != "alpha") {
-      p.Add("--unknowns", "", u, "must be a list of rho_d, rho_s, alpha (or none)");
-    }
-  }
-  auto check_lightings = [&](const char* flag, const std::vector<std::string>& list) {
-    for (const std::string& l : list) {
-      if (l != "L0" && l != "L1") p.Add(flag, "", l, "must be a list of L0, L1");
-    }
-  };
-  check_lightings("--photo-lightings", photo_lightings);
-  check_lightings("--validation-lightings", validation_lightings);
-  if (photo_lightings.empty()) p.Add("--photo-lightings", "", "", "must name a lighting");
-  std::vector<std::string> seen;
-  for (const EffectSpec& e : effects) {
-    if (Contains(seen, e.name)) p.Add("--effect", "", e.name, "effect given twice");
-    seen.push_back(e.name);
-  }
-  if (!from.empty() && (brackets.count > 0 || unposed || noise != NoiseModel::kNone)) {
-    p.Add("--from", "", from.string(),
-          "takes the capture's photos as they are: no --brackets, "
-          "--unposed or --noise");
-  }
-  if (num_threads < 0) p.Add("--threads", "", std::to_string(num_threads), "must be >= 0");
-  try {
-    sensor.Validate();
-  } catch (const Error& e) {
-    p.Append(e);
-  }
-  try {
-    brackets.Validate();
-  } catch (const Error& e) {
-    p.Append(e);
-  }
-  p.ThrowIfAny();
+void SynthOptions::Validate() const { SynthProblems(*this, nullptr).ThrowIfAny(); }
+
+void SynthOptions::SetChoices(const SynthChoiceFlags& flags) {
+  if (const auto g = BrdfModelFromName(flags.glossy_brdf)) glossy_brdf = *g;
+  if (const auto l = LampShapeFromName(flags.lamp)) lamp = *l;
+  if (const auto t = FloorTextureFromName(flags.floor_texture)) floor_texture = *t;
+  if (const auto f = BracketFormatFromName(flags.bracket_format)) brackets.format = *f;
+  SynthProblems(*this, &flags).ThrowIfAny();
 }
 
 }  // namespace igi

@@ -13,7 +13,10 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "recon/brdf_model.h"
 
 namespace igi {
 
@@ -32,6 +35,33 @@ const std::vector<std::string>& SupportedEffects();
 
 enum class NoiseModel { kNone, kRealistic };
 enum class ResponseKind { kGamma, kSigmoid, kFile };
+
+// The image file format of the LDR brackets: PNG or TIFF.
+enum class BracketFormat { kPng, kTif };
+// "png", "tif" (the --bracket-format flag's spelling and the files' extension).
+std::string_view BracketFormatName(BracketFormat format);
+std::optional<BracketFormat> BracketFormatFromName(std::string_view name);
+
+// The photographed lamps: a sphere of radius 4 cm or a point light.
+enum class LampShape { kSphere, kPoint };
+// "sphere", "point" (the --lamp flag's spelling).
+std::string_view LampShapeName(LampShape shape);
+std::optional<LampShape> LampShapeFromName(std::string_view name);
+
+// The floor's albedo texture (SynthOptions::floor_texture): kTiles or kSmooth.
+enum class FloorTexture { kTiles, kSmooth };
+// "tiles", "smooth" (the --floor-texture flag's spelling and truth.json's "floor_texture").
+std::string_view FloorTextureName(FloorTexture texture);
+std::optional<FloorTexture> FloorTextureFromName(std::string_view name);
+
+// The choice options as igi-synth's flags spell them, before they are parsed (SynthOptions::
+// SetChoices); each default is the name of the option's default.
+struct SynthChoiceFlags {
+  std::string glossy_brdf = "ward";
+  std::string lamp = "sphere";
+  std::string floor_texture = "tiles";
+  std::string bracket_format = "png";
+};
 
 // The camera sensor of --noise realistic and of the LDR brackets. Signal in electrons:
 //   e = radiance · electrons_per_radiance_s · exposure_s, shot noise Poisson(e), read noise
@@ -57,9 +87,9 @@ struct BracketOptions {
   double sigmoid_contrast = 1.6;  // kSigmoid: x^c/(x^c + m^c), normalised to 1 at x = 1
   // kSigmoid: m, the x at which the curve before normalisation is ½, in (0, 1).
   double sigmoid_mid = 0.18;
-  std::filesystem::path response_file;  // kFile: an igi-response JSON (docs/file-formats.md)
-  int bits = 8;                         // 8 or 16
-  std::string format = "png";           // png or tif
+  std::filesystem::path response_file;         // kFile: an igi-response JSON (docs/file-formats.md)
+  int bits = 8;                                // 8 or 16
+  BracketFormat format = BracketFormat::kPng;  // kPng (default) or kTif
   void Validate() const;
 };
 
@@ -72,11 +102,12 @@ struct SynthOptions {
   int ceiling_cameras = 0;
   int width = 160;  // photo size, pixels
   int height = 120;
-  double fov_deg = 60;               // horizontal field of view
-  int spp = 64;                      // render samples per pixel
-  uint64_t seed = 1;                 // same seed, same options -> same files
-  std::string glossy_brdf = "ward";  // ward or ward_gmd: the glossy regions' true model
-  std::string lamp = "sphere";       // sphere (r = 4 cm) or point
+  double fov_deg = 60;  // horizontal field of view
+  int spp = 64;         // render samples per pixel
+  uint64_t seed = 1;    // same seed, same options -> same files
+  // The glossy regions' true model: BrdfModel::kWard (default) or kWardGmd.
+  BrdfModel glossy_brdf = BrdfModel::kWard;
+  LampShape lamp = LampShape::kSphere;  // kSphere (default; r = 4 cm) or kPoint
   // The photographed lamp's centre (default (2.3, 1.7, 2.4), below the ceiling; inside the room).
   std::optional<Eigen::Vector3d> lamp_position;
   // Extra cameras, after the others, that see the floor's highlight at grazing incidence
@@ -104,11 +135,11 @@ struct SynthOptions {
   // structure-from-motion finds features everywhere (registration tests). Off: only the floor
   // is textured.
   bool textured_walls = false;
-  // The floor's albedo texture: "tiles" (4 × 4 tiles, one-texel grout lines and a per-texel
-  // grain: detail finer than the photos' pixel footprint), or "smooth": the same tiles and grout
-  // without the grain, low-pass filtered (Gaussian, σ = 2 texels = 6.25 cm) so that the photos
-  // resolve it (albedo-map accuracy tests: the truth is then recoverable from the pixels).
-  std::string floor_texture = "tiles";
+  // The floor's albedo texture: kTiles (default; 4 × 4 tiles, one-texel grout lines and a
+  // per-texel grain: detail finer than the photos' pixel footprint), or kSmooth: the same tiles
+  // and grout without the grain, low-pass filtered (Gaussian, σ = 2 texels = 6.25 cm) so that the
+  // photos resolve it (albedo-map accuracy tests: the truth is then recoverable from the pixels).
+  FloorTexture floor_texture = FloorTexture::kTiles;
   // scene.json declares no "cameras" and no "photos" (an unposed capture: the poses must be
   // recovered, e.g. by igi-register); truth/scene.json keeps the true cameras.
   bool unposed = false;
@@ -116,8 +147,13 @@ struct SynthOptions {
   // (vignetting, exposure_scale, camera_response, pose_error: the effects that need no render).
   std::filesystem::path from;
 
-  // Every problem as one InputError (flag name, value, rule).
+  // Every problem as one InputError (flag name, value, rule; a choice outside its enum: by its
+  // name or number).
   void Validate() const;
+  // Sets the choice options from their flags' text, then validates as Validate does: one
+  // InputError with every problem, a text that names no choice as "--FLAG: TEXT: must be ..." in
+  // its place among them.
+  void SetChoices(const SynthChoiceFlags& flags);
 };
 
 }  // namespace igi

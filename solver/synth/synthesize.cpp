@@ -171,7 +171,8 @@ class Pipeline {
     Json exposures = Json::array();
     for (size_t i = 0; i < brackets.size(); ++i) {
       char name[32];
-      std::snprintf(name, sizeof(name), "%02zu.%s", i, o_.brackets.format.c_str());
+      std::snprintf(name, sizeof(name), "%02zu.%s", i,
+                    std::string(BracketFormatName(o_.brackets.format)).c_str());
       fs::create_directories(o_.out / dir);
       WriteImage(o_.out / dir / name, brackets[i].encoded,
                  Type(o_.brackets.bits == 8 ? PixelType::kUInt8 : PixelType::kUInt16));
@@ -275,7 +276,7 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
                 {"validation", r.validation},
                 {"scene", "truth/scene.json"},
                 {"unknowns", options.unknowns},
-                {"floor_texture", options.floor_texture},
+                {"floor_texture", std::string(FloorTextureName(options.floor_texture))},
                 {"cameras", CameraTruth(cameras)},
                 {"photos", r.photo_truth},
                 {"sensor", SensorTruth(options)},

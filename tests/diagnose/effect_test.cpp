@@ -160,7 +160,7 @@ TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
   const std::vector<PixelRecord> records;
   const PixelHoldout holdout;
   const DiagnoseOptions options;
-  const MapMode maps{"auto", {"floor"}};
+  const MapMode maps{AlbedoMaps::kAuto, {"floor"}};
   const DiagnosisModel m{model,   model,   declared, photos, sims, records,
                          holdout, options, maps,     false,  0.05, {}};
   CandidateResult c;
@@ -171,7 +171,7 @@ TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
   Json expected = declared;
   expected["lights"]["lamp"]["intensity"] = {4.0, 4.0, 4.0};
   EXPECT_EQ(plan.document, expected) << plan.document.dump();
-  EXPECT_EQ(plan.maps.maps, "auto");
+  EXPECT_EQ(plan.maps.maps, AlbedoMaps::kAuto);
   EXPECT_EQ(plan.maps.only, std::vector<std::string>{"floor"});
   EXPECT_FALSE(plan.photos.has_value());
 }

@@ -81,8 +81,23 @@ TEST(DemoCalibrationTest, ComparisonLeavesOutTheGivenReference) {
   DemoOptions o;
   o.out = dir;
   EXPECT_NO_THROW(o.Validate());
-  o.calibration = "guess";
-  EXPECT_THROW(o.Validate(), InputError);
+  DemoChoiceFlags choices;
+  choices.calibration = "guess";
+  try {
+    o.SetChoices(choices);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems(), std::vector<std::string>{
+                                "--demo-calibration: guess: must be reference, measured or none"});
+  }
+  choices.calibration = "measured";
+  o.SetChoices(choices);
+  EXPECT_EQ(o.calibration, DemoCalibration::kMeasured);
+  for (DemoCalibration c :
+       {DemoCalibration::kReference, DemoCalibration::kMeasured, DemoCalibration::kNone}) {
+    EXPECT_EQ(DemoCalibrationFromName(DemoCalibrationName(c)), c);
+  }
+  EXPECT_FALSE(DemoCalibrationFromName("Reference"));
 }
 
 // A scene with the given cameras (name -> {qvec, tvec}) and nothing to load.

@@ -67,9 +67,9 @@ TEST(ColmapRunnerTest, MissingOrWrongColmapIsReported) {
   fs::remove_all(dir);
 }
 
-// The self-calibrated camera model, guided matching and the feature cap reach COLMAP's command line (a fake
-// COLMAP that logs its arguments and reconstructs nothing); a model igi cannot read is refused
-// before anything runs.
+// The self-calibrated camera model, guided matching and the feature cap reach COLMAP's command line
+// (a fake COLMAP that logs its arguments and reconstructs nothing); a model igi cannot read is
+// refused before anything runs.
 TEST(ColmapRunnerTest, CameraModelGuidedMatchingAndFeatureCapArePassed) {
   const fs::path dir = test::UniqueTempDir("igi_colmap_runner_args");
   const fs::path fake = dir / "fake-colmap";
@@ -78,16 +78,17 @@ TEST(ColmapRunnerTest, CameraModelGuidedMatchingAndFeatureCapArePassed) {
   fs::create_directories(dir / "images");
   ColmapRunOptions options;
   options.executable = fake.string();
-  EXPECT_EQ(options.camera_model, "SIMPLE_RADIAL");
+  EXPECT_EQ(options.camera_model, calib::ColmapCameraModel::kSimpleRadial);
   EXPECT_FALSE(options.guided_matching);
   options.guided_matching = true;
-  options.camera_model = "RADIAL";
+  options.camera_model = calib::ColmapCameraModel::kRadial;
   EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);  // nothing mapped
   const std::string log = ReadFileToString(dir / "work" / "colmap.log");
   EXPECT_NE(log.find("--ImageReader.camera_model RADIAL"), std::string::npos) << log;
   EXPECT_NE(log.find("--SiftMatching.guided_matching 1"), std::string::npos) << log;
   options.guided_matching = false;
-  options.intrinsics = KnownIntrinsics{"PINHOLE", 640, 480, {500, 500, 320, 240}};
+  options.intrinsics =
+      KnownIntrinsics{calib::ColmapCameraModel::kPinhole, 640, 480, {500, 500, 320, 240}};
   EXPECT_THROW(RunColmap(dir / "images", dir / "work", options), Error);
   const std::string known = ReadFileToString(dir / "work" / "colmap.log");
   EXPECT_NE(known.find("--ImageReader.camera_model PINHOLE"), std::string::npos) << known;
@@ -105,8 +106,15 @@ TEST(ColmapRunnerTest, CameraModelGuidedMatchingAndFeatureCapArePassed) {
   options.max_features = 50;
   EXPECT_THROW(options.Validate(), InputError);
   options.max_features = 1024;
-  options.camera_model = "FULL_OPENCV";
-  EXPECT_THROW(options.Validate(), InputError);
+  options.camera_model = calib::ColmapCameraModel::kFullOpenCv;
+  try {
+    options.Validate();
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems(),
+              std::vector<std::string>{"--camera-model: FULL_OPENCV: must be one of "
+                                       "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV"});
+  }
   fs::remove_all(dir);
 }
 

@@ -96,9 +96,9 @@ TEST(AlbedoMapStage, ATextureFinerThanThePatchesGetsAMapAndNoiseDoesNot) {
 TEST(AlbedoMapStage, TheOptionsDecideWhichRegionsMayHaveAMap) {
   StageFixture f([](double, double) { return 0.5; }, 1, 9);
   EXPECT_TRUE(MapCandidate(f.Data(), 0));
-  f.options.albedo_maps = "none";
+  f.options.albedo_maps = AlbedoMaps::kNone;
   EXPECT_FALSE(MapCandidate(f.Data(), 0));
-  f.options.albedo_maps = "all";
+  f.options.albedo_maps = AlbedoMaps::kAll;
   EXPECT_TRUE(WritesMap(f.Data(), 0, MapAtlas(f.Data(), 0), MapLightOf(f.Data()), nullptr));
   f.options.albedo_map_regions = {"wall"};
   EXPECT_FALSE(MapCandidate(f.Data(), 0));

@@ -91,7 +91,7 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   options.saturation = 1.0;   // 16-bit PNG / 65535: clipped pixels are exactly 1.0
   options.indirect_rays = 4;  // nothing to inter-reflect on a convex ball
   options.refine_iterations = 0;
-  options.albedo_maps = "none";  // compare region-constant models
+  options.albedo_maps = AlbedoMaps::kNone;  // compare region-constant models
   // Every observation fitted (23 423): the fit's choice between one albedo and one per patch
   // (which, under Lambert, soaks up the highlights) flips with which 6000 are drawn (the draw
   // keyed by photo and pixel instead of the observation's index: Lambert per patch, region rms
@@ -123,7 +123,8 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
       "fit render residual %.4f, region rms %.4f (albedo %s), held-out residual %.4f\n",
       brdf_name, fit.seconds, fit.region.observations, m.rho_d->x(), m.rho_d->y(), m.rho_d->z(),
       fit.region.final_params.rho_s.x(), fit.region.final_params.alpha, fit.fit_residual,
-      fit.region_rms, fit.region.stage2.albedo_model.c_str(), fit.held_out);
+      fit.region_rms, std::string(AlbedoModelName(fit.region.stage2.albedo_model)).c_str(),
+      fit.held_out);
   return fit;
 }
 
@@ -141,8 +142,8 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   const BallFit lambert = FitBall(BrdfModel::kLambert, "lambert", out);
   fs::remove_all(out);
 
-  EXPECT_EQ(ward.region.status, "solved");
-  EXPECT_EQ(lambert.region.status, "solved");
+  EXPECT_EQ(ward.region.status, RegionStatus::kSolved);
+  EXPECT_EQ(lambert.region.status, RegionStatus::kSolved);
   // The glossy lobe is real: a clearly positive ρs and a roughness in the range of real glossy
   // paints and plastics.
   EXPECT_GT(ward.region.final_params.rho_s.minCoeff(), 0.0);

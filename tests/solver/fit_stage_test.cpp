@@ -61,7 +61,7 @@ TEST(FitStage, TheFitFollowsTheIrradianceItIsGiven) {
 // Δ = (−(1 + g) + √((1 + g)² + 0.8g)) / 2g. Without feedback it is the refit itself.
 TEST(FitStage, TheJointUpdateIsTheFixedPointOfTheLinearisedLight) {
   FitFixture f(0.4, 400, 3);
-  f.options.refine_update = "joint_albedo";
+  f.options.refine_update = RefineUpdate::kJointAlbedo;
   f.materials[0].params.rho_d = Eigen::Vector3d::Constant(0.5);
   RegionFitResult fit;
   fit.fitted = true;

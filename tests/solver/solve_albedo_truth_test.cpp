@@ -50,8 +50,8 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   SynthOptions so;
   so.out = tmp / "capture";
   so.spp = spp;
-  so.lamp = "point";
-  so.floor_texture = "smooth";
+  so.lamp = LampShape::kPoint;
+  so.floor_texture = FloorTexture::kSmooth;
   so.validation_lightings = {};
   Synthesize(so);
   const Scene scene = LoadScene(so.out / "scene.json");
@@ -158,7 +158,7 @@ struct SolvedRoom {
 SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
   SolvedRoom room;
   so.out = room.capture = tmp / "capture";
-  so.lamp = "point";
+  so.lamp = LampShape::kPoint;
   so.validation_lightings = {};
   Synthesize(so);
   room.scene = LoadScene(so.out / "scene.json");
@@ -193,8 +193,8 @@ TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
   SynthOptions so;
   so.out = tmp / "capture";
   so.spp = 64;
-  so.lamp = "point";
-  so.floor_texture = "smooth";
+  so.lamp = LampShape::kPoint;
+  so.floor_texture = FloorTexture::kSmooth;
   so.validation_lightings = {};
   Synthesize(so);
   const Scene scene = LoadScene(so.out / "scene.json");
@@ -209,7 +209,7 @@ TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
     o.refine_iterations = 0;
     o.show_progress = false;
     o.max_observations = max_observations;
-    o.albedo_map_pass = pass;
+    o.albedo_map_pass = AlbedoMapPassFromName(pass).value();
     SolveSummary s = Solve(scene, o, tmp / name);
     const RegionSolution& r = s.regions[f];
     EXPECT_TRUE(r.albedo_map && r.albedo_map_seen) << name;
@@ -334,7 +334,7 @@ TEST(SolveAlbedoTruth, AWrongLobeShapeIsNoTexture) {
   so.out = tmp / "capture";
   so.cameras = 4;
   so.seed = 11;
-  so.lamp = "point";
+  so.lamp = LampShape::kPoint;
   so.lamp_position = Eigen::Vector3d(2, 2, 0.6);
   so.grazing_cameras = 1;
   so.validation_lightings = {};
@@ -367,7 +367,7 @@ TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
   const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_unseen_ceiling"), so);
   const Json truth = ReadJsonFile(room.capture / "truth.json")["materials"];
   const RegionSolution& ceiling = room.summary.regions[room.scene.FindMaterial("ceiling")];
-  ASSERT_EQ(ceiling.status, "unobserved");
+  ASSERT_EQ(ceiling.status, RegionStatus::kUnobserved);
   ASSERT_TRUE(ceiling.RhoDFromBouncedLight());
   const Eigen::Vector3d want(truth["ceiling"]["rho_d"][0].get<double>(),
                              truth["ceiling"]["rho_d"][1].get<double>(),
@@ -380,7 +380,7 @@ TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
   }
   for (const char* name : {"wall_x0", "wall_x4", "wall_y0", "wall_y4", "matte_box"}) {
     const RegionSolution& r = room.summary.regions[room.scene.FindMaterial(name)];
-    if (r.status != "solved") continue;
+    if (r.status != RegionStatus::kSolved) continue;
     const Json& t = truth[name]["rho_d"];
     std::printf("%s: rho_d %+.2f %+.2f %+.2f %%\n", name,
                 100 * (r.final_params.rho_d[0] / t[0].get<double>() - 1),

@@ -61,7 +61,7 @@ class SolveGather : public ::testing::Test {
     o.show_progress = false;
     const SolveSummary s = Solve(scene, o, dir_ / "out");
     const RegionSolution& ceiling = s.regions[scene.FindMaterial("ceiling")];
-    EXPECT_EQ(ceiling.status, "solved");
+    EXPECT_EQ(ceiling.status, RegionStatus::kSolved);
     return ceiling.stage1.rho_d.mean() / 0.7 - 1;
   }
 

@@ -84,7 +84,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
     SolveOptions o;
     o.pixel_stride = 1;
     o.refine_rays = 64;
-    o.refine_update = update;
+    o.refine_update = RefineUpdateFromName(update).value();
     o.num_threads = threads;
     o.show_progress = false;
     SolverState s(scene, o);
@@ -124,7 +124,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
       }
       std::printf("\n");
     }
-    EXPECT_EQ(s.summary.history.back().albedo_update, update);
+    EXPECT_EQ(s.summary.history.back().albedo_update, RefineUpdateFromName(update));
     return {before, after};
   }
 

@@ -61,13 +61,13 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
   const fs::path tmp = test::UniqueTempDir("solve_radiance");
   const Scene scene = LoadScene(StrippedScene(kRoom / "scene.json", tmp));
   SolveOptions o;
-  o.albedo_maps = "none";
+  o.albedo_maps = AlbedoMaps::kNone;
   o.refine_iterations = 1;
   const SolveSummary s = Solve(scene, o, tmp / "out");
   const Json truth = ReadJsonFile(kRoom / "truth.json")["materials"];
   for (const RegionSolution& r : s.regions) {
     const Json& t = truth[r.name];
-    ASSERT_EQ(r.status, "solved") << r.name;
+    ASSERT_EQ(r.status, RegionStatus::kSolved) << r.name;
     for (int c = 0; c < 3; ++c) {
       const double want = t["rho_d"][c].get<double>();
       // Target: within 2 %. Measured (paper stage): at most 0.45 %.
@@ -108,7 +108,7 @@ TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
 //   (1.034); with the one albedo instead, 0.1844 reported (1.080).
 struct WrittenCase {
   std::string name;
-  std::string albedo_maps;
+  AlbedoMaps albedo_maps;
   bool textured_walls;
 };
 
@@ -134,11 +134,11 @@ TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
   int mapped = 0;
   for (size_t r = 0; r < written.materials.size(); ++r) {
     const Material& m = written.materials[r];
-    if (o.albedo_maps == "none") EXPECT_FALSE(m.rho_d_map) << m.name;
-    if (m.rho_d_map && s.regions[r].stage1.albedo_model == "constant") ++mapped;
+    if (o.albedo_maps == AlbedoMaps::kNone) EXPECT_FALSE(m.rho_d_map) << m.name;
+    if (m.rho_d_map && s.regions[r].stage1.albedo_model == AlbedoModel::kConstant) ++mapped;
   }
   // The case's point: regions fitted with one albedo and written with a map.
-  if (o.albedo_maps != "none") EXPECT_GE(mapped, 2);
+  if (o.albedo_maps != AlbedoMaps::kNone) EXPECT_GE(mapped, 2);
   double num = 0, den = 0;
   for (size_t k = 0; k < written.photos.size(); ++k) {
     const Photo& ph = written.photos[k];
@@ -175,8 +175,8 @@ TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, SolveWritten,
-                         ::testing::Values(WrittenCase{"no_maps", "none", false},
-                                           WrittenCase{"texel_maps", "auto", true}),
+                         ::testing::Values(WrittenCase{"no_maps", AlbedoMaps::kNone, false},
+                                           WrittenCase{"texel_maps", AlbedoMaps::kAuto, true}),
                          [](const auto& info) { return info.param.name; });
 
 struct SynthCase {
@@ -233,7 +233,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05);
-      EXPECT_EQ(f.albedo_model, "per_patch");  // the texture is detected
+      EXPECT_EQ(f.albedo_model, AlbedoModel::kPerPatch);  // the texture is detected
       // The region's final rho_d (scene.json's) is its albedo map's mean over the texels the
       // photos show, compared with the true texture's mean over the same texels. The 1 % target:
       // measured +0.01..+0.16 % (clean), +0.22..+0.34 % (noisy) from 256-spp photos

@@ -13,8 +13,10 @@
 #include "solver/region_fit.h"
 #include "solver/render_internal.h"
 #include "solver/sampling.h"
+#include "solver/solve.h"
 #include "solver/solve_options.h"
 #include "tests/solver/test_scenes.h"
+#include "tools/common/error.h"
 #include "tools/common/image.h"
 
 namespace igi {
@@ -114,6 +116,92 @@ TEST(SolveOptions, TheLastRoundGivesRegionsWithFewObservationsMoreRays) {
   EXPECT_EQ(FinalRoundRays(128, 10), 1024);  // at most 8×
   EXPECT_EQ(FinalRoundRays(128, 0), 1024);
   EXPECT_EQ(FinalRoundRays(1024, 10), 4096);  // and 4096
+}
+
+// Each choice's name parses back to it (the names are the flags' spellings and report.json's
+// text); other text, another case and the empty text name nothing.
+TEST(SolveOptions, ChoiceNamesRoundTrip) {
+  for (SpecularColour v : {SpecularColour::kGrey, SpecularColour::kRgb}) {
+    EXPECT_EQ(SpecularColourFromName(SpecularColourName(v)), v);
+  }
+  for (AlbedoMaps v : {AlbedoMaps::kAuto, AlbedoMaps::kAll, AlbedoMaps::kNone}) {
+    EXPECT_EQ(AlbedoMapsFromName(AlbedoMapsName(v)), v);
+  }
+  for (AlbedoMapPass v : {AlbedoMapPass::kAuto, AlbedoMapPass::kAlways, AlbedoMapPass::kNever}) {
+    EXPECT_EQ(AlbedoMapPassFromName(AlbedoMapPassName(v)), v);
+  }
+  for (RefineUpdate v :
+       {RefineUpdate::kIndependent, RefineUpdate::kJoint, RefineUpdate::kJointAlbedo}) {
+    EXPECT_EQ(RefineUpdateFromName(RefineUpdateName(v)), v);
+  }
+  for (PhotoScaleMode v : {PhotoScaleMode::kGiven, PhotoScaleMode::kSolve}) {
+    EXPECT_EQ(PhotoScaleModeFromName(PhotoScaleModeName(v)), v);
+  }
+  for (AlbedoModel v : {AlbedoModel::kConstant, AlbedoModel::kPerPatch}) {
+    EXPECT_EQ(AlbedoModelFromName(AlbedoModelName(v)), v);
+  }
+  for (RegionStatus v : {RegionStatus::kKnown, RegionStatus::kSolved, RegionStatus::kUnobserved,
+                         RegionStatus::kNoHighlight}) {
+    EXPECT_EQ(RegionStatusFromName(RegionStatusName(v)), v);
+  }
+  EXPECT_EQ(SpecularColourName(SpecularColour::kGrey), "grey");
+  EXPECT_EQ(AlbedoMapsName(AlbedoMaps::kNone), "none");
+  EXPECT_EQ(AlbedoMapPassName(AlbedoMapPass::kAlways), "always");
+  EXPECT_EQ(RefineUpdateName(RefineUpdate::kJointAlbedo), "joint_albedo");
+  EXPECT_EQ(PhotoScaleModeName(PhotoScaleMode::kSolve), "solve");
+  EXPECT_EQ(AlbedoModelName(AlbedoModel::kPerPatch), "per_patch");
+  EXPECT_EQ(RegionStatusName(RegionStatus::kNoHighlight), "no_highlight");
+  EXPECT_FALSE(SpecularColourFromName("Grey"));
+  EXPECT_FALSE(AlbedoMapsFromName(""));
+  EXPECT_FALSE(AlbedoMapPassFromName("sometimes"));
+  EXPECT_FALSE(RefineUpdateFromName("joint-albedo"));
+  EXPECT_FALSE(PhotoScaleModeFromName("maybe"));
+  EXPECT_FALSE(AlbedoModelFromName("per-patch"));
+  EXPECT_FALSE(RegionStatusFromName("failed"));
+  EXPECT_TRUE(IsJointUpdate(RefineUpdate::kJoint));
+  EXPECT_TRUE(IsJointUpdate(RefineUpdate::kJointAlbedo));
+  EXPECT_FALSE(IsJointUpdate(RefineUpdate::kIndependent));
+}
+
+// igi-solve's choice flags: SetChoices parses them, and a text that names no choice is one
+// "--FLAG: TEXT: RULE" line in its place among the other options' problems; Validate rejects a
+// value outside an enum.
+TEST(SolveOptions, SetChoicesParsesTheFlagsAndNamesABadTextInItsPlace) {
+  SolveOptions o;
+  SolveChoiceFlags flags;
+  flags.specular_colour = "rgb";
+  flags.albedo_maps = "none";
+  flags.albedo_map_pass = "never";
+  flags.refine_update = "independent";
+  flags.photo_scale = "solve";
+  o.SetChoices(flags);
+  EXPECT_EQ(o.specular_colour, SpecularColour::kRgb);
+  EXPECT_EQ(o.albedo_maps, AlbedoMaps::kNone);
+  EXPECT_EQ(o.albedo_map_pass, AlbedoMapPass::kNever);
+  EXPECT_EQ(o.refine_update, RefineUpdate::kIndependent);
+  EXPECT_EQ(o.photo_scale, PhotoScaleMode::kSolve);
+
+  SolveOptions bad;
+  bad.pixel_stride = 0;
+  bad.holdout_block_px = 0;
+  SolveChoiceFlags typed;
+  typed.specular_colour = "blue";
+  typed.refine_update = "joint-albedo";
+  typed.photo_scale = "maybe";
+  try {
+    bad.SetChoices(typed);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    const std::vector<std::string> want = {
+        "--pixel-stride: 0: must be in [1, 64]", "--specular-colour: blue: must be grey or rgb",
+        "--refine-update: joint-albedo: must be joint, joint_albedo or independent",
+        "--photo-scale: maybe: must be given or solve", "--holdout-block-px: 0: must be >= 1"};
+    EXPECT_EQ(e.problems(), want);
+  }
+  SolveOptions outside;
+  outside.albedo_maps = static_cast<AlbedoMaps>(7);
+  EXPECT_THROW(outside.Validate(), InputError);
+  EXPECT_NO_THROW(SolveOptions().Validate());
 }
 
 TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
@@ -240,7 +328,7 @@ TEST(RegionFit, RecoversWardParametersExactlyFromNoiseFreeSamples) {
     const RegionFitInput in = MakeSamples(model, {rho_d}, 0.06, 0.08, 0.0, 1);
     const RegionFitResult r = FitRegion(in, {});
     ASSERT_TRUE(r.fitted);
-    EXPECT_EQ(r.albedo_model, "constant");
+    EXPECT_EQ(r.albedo_model, AlbedoModel::kConstant);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.rho_d[c], rho_d[c], 1e-4 * rho_d[c]);
     EXPECT_NEAR(r.rho_s.mean(), 0.06, 1e-4 * 0.06);
     EXPECT_NEAR(r.alpha, 0.08, 1e-4 * 0.08);
@@ -316,7 +404,7 @@ TEST(RegionFit, VaryingAlbedoIsFittedPerPatchAndKeepsTheLobe) {
   for (int k = 0; k < 12; ++k) slots.push_back(Eigen::Vector3d(0.3, 0.4, 0.2) * (0.6 + 0.07 * k));
   const RegionFitInput in = MakeSamples(BrdfModel::kWard, slots, 0.05, 0.12, 0.0, 3);
   const RegionFitResult r = FitRegion(in, {});
-  EXPECT_EQ(r.albedo_model, "per_patch");
+  EXPECT_EQ(r.albedo_model, AlbedoModel::kPerPatch);
   EXPECT_TRUE(r.albedo_varies);
   EXPECT_NEAR(r.rho_s.mean(), 0.05, 0.01 * 0.05);
   EXPECT_NEAR(r.alpha, 0.12, 0.01 * 0.12);

@@ -47,13 +47,67 @@ TEST(SynthOptions, ValidateRejectsBadValues) {
   o.cameras = 0;
   o.spp = 0;
   o.unknowns = {"colour"};
-  o.floor_texture = "marble";
+  SynthChoiceFlags choices;
+  choices.floor_texture = "marble";
   try {
-    o.Validate();
+    o.SetChoices(choices);
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.problems().size(), 4u);
   }
+}
+
+// Each choice's name parses back to it; igi-synth's choice flags are parsed by SetChoices, and a
+// text that names no choice (or a BRDF other than the two Ward models) is one "--FLAG: TEXT:
+// RULE" line in its place among the other options' problems.
+TEST(SynthOptions, ChoicesRoundTripAndBadTextsAreNamed) {
+  for (BracketFormat v : {BracketFormat::kPng, BracketFormat::kTif}) {
+    EXPECT_EQ(BracketFormatFromName(BracketFormatName(v)), v);
+  }
+  for (LampShape v : {LampShape::kSphere, LampShape::kPoint}) {
+    EXPECT_EQ(LampShapeFromName(LampShapeName(v)), v);
+  }
+  for (FloorTexture v : {FloorTexture::kTiles, FloorTexture::kSmooth}) {
+    EXPECT_EQ(FloorTextureFromName(FloorTextureName(v)), v);
+  }
+  EXPECT_EQ(BracketFormatName(BracketFormat::kTif), "tif");
+  EXPECT_FALSE(BracketFormatFromName("jpg"));
+  EXPECT_FALSE(LampShapeFromName("spot"));
+  EXPECT_FALSE(FloorTextureFromName("Tiles"));
+
+  SynthOptions o;
+  o.out = "x";
+  SynthChoiceFlags flags;
+  flags.glossy_brdf = "ward_gmd";
+  flags.lamp = "point";
+  flags.floor_texture = "smooth";
+  flags.bracket_format = "tif";
+  o.SetChoices(flags);
+  EXPECT_EQ(o.glossy_brdf, BrdfModel::kWardGmd);
+  EXPECT_EQ(o.lamp, LampShape::kPoint);
+  EXPECT_EQ(o.floor_texture, FloorTexture::kSmooth);
+  EXPECT_EQ(o.brackets.format, BracketFormat::kTif);
+
+  SynthOptions bad;
+  bad.out = "x";
+  bad.cameras = 0;
+  SynthChoiceFlags typed;
+  typed.glossy_brdf = "lambert";
+  typed.lamp = "spot";
+  typed.bracket_format = "jpg";
+  try {
+    bad.SetChoices(typed);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    const std::vector<std::string> want = {
+        "--cameras: 0: must be 1..64", "--glossy-brdf: lambert: must be ward or ward_gmd",
+        "--lamp: spot: must be sphere or point", "--bracket-format: jpg: must be png or tif"};
+    EXPECT_EQ(e.problems(), want);
+  }
+  SynthOptions lambert;
+  lambert.out = "x";
+  lambert.glossy_brdf = BrdfModel::kLambert;
+  EXPECT_THROW(lambert.Validate(), InputError);
 }
 
 // The room's OBJ reads back through Assimp with every region, UVs and normals.
@@ -108,7 +162,7 @@ TEST(SynthRoom, HasGlossyAndLambertianRegionsATexturedFloorAndTwoLamps) {
 TEST(SynthRoom, SmoothFloorTextureIsTheTilesLowPassFiltered) {
   SynthOptions o;
   const Image tiles = BuildRoom(o).floor_albedo;
-  o.floor_texture = "smooth";
+  o.floor_texture = FloorTexture::kSmooth;
   const SynthRoom room = BuildRoom(o);
   const Image& smooth = room.floor_albedo;
   ASSERT_EQ(smooth.width, tiles.width);

@@ -100,7 +100,7 @@ class AlbedoTextureEffect final : public Effect {
 
   // The refit's maps: the named regions', or every region's where the albedo varies.
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
-    MapMode maps{"auto", {}};
+    MapMode maps{AlbedoMaps::kAuto, {}};
     if (c->params.contains("regions")) {
       maps.only = c->params["regions"].get<std::vector<std::string>>();
     }

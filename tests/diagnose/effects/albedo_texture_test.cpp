@@ -51,17 +51,17 @@ struct Model {
 // (num_params −1) that names no regions, so that its trial maps every region. With maps for
 // every region already ("auto" for all), it offers nothing.
 TEST(AlbedoTextureTest, TryLastOnlyWhileTheMapsAreNotEveryRegions) {
-  for (const MapMode& maps : {MapMode{}, MapMode{"auto", {"floor"}}}) {
+  for (const MapMode& maps : {MapMode{}, MapMode{AlbedoMaps::kAuto, {"floor"}}}) {
     const Model m(maps);
     const std::unique_ptr<Effect> e = MakeAlbedoTexture();
     const std::optional<CandidateResult> c = e->TryLast(m.View());
-    ASSERT_TRUE(c.has_value()) << maps.maps << " " << maps.only.size();
+    ASSERT_TRUE(c.has_value()) << AlbedoMapsName(maps.maps) << " " << maps.only.size();
     EXPECT_EQ(c->effect, "albedo_texture");
     EXPECT_TRUE(c->valid);
     EXPECT_EQ(c->num_params, -1);
     EXPECT_FALSE(c->params.contains("regions"));
   }
-  const Model full(MapMode{"auto", {}});
+  const Model full(MapMode{AlbedoMaps::kAuto, {}});
   EXPECT_FALSE(MakeAlbedoTexture()->TryLast(full.View()).has_value());
 }
 
@@ -75,7 +75,7 @@ TEST(AlbedoTextureTest, PlanTrialMapsTheNamedRegionsOrEvery) {
   named.effect = "albedo_texture";
   named.params = {{"regions", {"floor", "box"}}};
   const TrialPlan some = e->PlanTrial(&named, m.View());
-  EXPECT_EQ(some.maps.maps, "auto");
+  EXPECT_EQ(some.maps.maps, AlbedoMaps::kAuto);
   EXPECT_EQ(some.maps.only, (std::vector<std::string>{"floor", "box"}));
   EXPECT_FALSE(some.maps.Full());
   EXPECT_EQ(some.document, m.declared);
@@ -83,7 +83,7 @@ TEST(AlbedoTextureTest, PlanTrialMapsTheNamedRegionsOrEvery) {
   CandidateResult last;
   last.effect = "albedo_texture";
   const TrialPlan every = e->PlanTrial(&last, m.View());
-  EXPECT_EQ(every.maps.maps, "auto");
+  EXPECT_EQ(every.maps.maps, AlbedoMaps::kAuto);
   EXPECT_TRUE(every.maps.only.empty());
   EXPECT_TRUE(every.maps.Full());
   EXPECT_EQ(every.document, m.declared);
