@@ -1,6 +1,6 @@
 #pragma once
 // The reflectance models of docs/scene-format.md ("brdf" values of scene.json), shared by the
-// scene model (recon) and the renderer (solver/brdf.h), which evaluates the reflective ones.
+// scene model (recon) and the renderer (solver/render/brdf.h), which evaluates the reflective ones.
 
 #include <optional>
 #include <string_view>
@@ -16,7 +16,7 @@ enum class BrdfModel {
   kEmitter,
   kBlack,
   // The four Ward models with their specular term weighted by Schlick's Fresnel factor
-  // (solver/brdf.h; igi's additions, docs/scene-format.md).
+  // (solver/render/brdf.h; igi's additions, docs/scene-format.md).
   kWardFresnel,
   kWardGmdFresnel,
   kWardAnisoFresnel,

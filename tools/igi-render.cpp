@@ -3,7 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "recon/scene.h"
-#include "solver/render.h"
+#include "solver/render/render.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"

@@ -3,11 +3,11 @@
 //   igi-run --hdr-photos --scene scene.json --out DIR     (photos and cameras in the scene)
 //   igi-run --demo --out DIR                              (a synthetic capture, then the chain)
 // Stages: response -> HDR -> registration -> solve -> diagnose -> report, each in DIR/NN-name/
-// with a marker; a rerun resumes from the first unfinished stage (pipeline/pipeline.h).
+// with a marker; a rerun resumes from the first unfinished stage (tools/pipeline/pipeline.h).
 #include <cstdio>
 
-#include "pipeline/demo.h"
-#include "pipeline/pipeline.h"
+#include "tools/pipeline/demo.h"
+#include "tools/pipeline/pipeline.h"
 #include "tools/common/cli.h"
 
 namespace {

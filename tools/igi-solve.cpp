@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "recon/scene.h"
-#include "solver/solve.h"
+#include "solver/inverse/solve.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 

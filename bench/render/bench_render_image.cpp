@@ -7,7 +7,7 @@
 #include <string>
 
 #include "recon/scene.h"
-#include "solver/render.h"
+#include "solver/render/render.h"
 #include "tools/common/image.h"
 
 int main(int argc, char** argv) {

@@ -11,7 +11,7 @@
 
 #include "bench/render/raw_embree_tracer.h"
 #include "recon/scene.h"
-#include "solver/render.h"
+#include "solver/render/render.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"

@@ -9,7 +9,7 @@
 #include <limits>
 #include <vector>
 
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 

@@ -12,9 +12,9 @@
 #include <string>
 
 #include "recon/scene.h"
-#include "solver/albedo_map.h"
-#include "solver/render_internal.h"
-#include "solver/solve.h"
+#include "solver/inverse/albedo_map.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/solve.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 #include "tools/common/strings.h"

@@ -36,11 +36,11 @@
 #include <string>
 
 #include "recon/scene.h"
-#include "solver/refine_stage.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/solve_internal.h"
-#include "solver/surface_hit.h"
+#include "solver/inverse/refine_stage.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/solve_internal.h"
+#include "solver/inverse/surface_hit.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 
@@ -314,7 +314,7 @@ int main(int argc, char** argv) {
   }
   if (kv["stage2"] != "0") {
     // (e) stage 2's gathering (the path tracer over a scene, RenderIncident in
-    // solver/refine_stage.h) at the same points, over the true scene and over the stage-1 model the
+    // solver/inverse/refine_stage.h) at the same points, over the true scene and over the stage-1 model the
     // refinement renders.
     const fs::path tmp =
         fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));

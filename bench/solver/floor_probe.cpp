@@ -15,12 +15,12 @@
 #include <map>
 
 #include "recon/scene.h"
-#include "solver/held_out_albedo.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/solve_internal.h"
+#include "solver/inverse/held_out_albedo.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/solve_internal.h"
 #include "solver/synth/synthesize.h"
-#include "solver/texel_splat.h"
+#include "solver/inverse/texel_splat.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 

@@ -12,10 +12,10 @@
 #include <map>
 
 #include "recon/scene.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/solve.h"
-#include "solver/surface_hit.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/solve.h"
+#include "solver/inverse/surface_hit.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 

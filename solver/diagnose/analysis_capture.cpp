@@ -8,7 +8,7 @@
 
 #include "recon/scene_document.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/observations.h"
+#include "solver/inverse/observations.h"
 #include "tools/common/image.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"

@@ -6,7 +6,7 @@
 
 #include "solver/diagnose/analysis_capture.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/solve_memory.h"
+#include "solver/inverse/solve_memory.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/memory.h"

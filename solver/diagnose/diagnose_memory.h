@@ -7,7 +7,7 @@
 // DiagnoseOptions::max_tries, held until the round is settled, plus one being rendered), the
 // residual records at the pixel stride, and a step's masked copy of the photos. Its solves run
 // beside all that: they get the memory budget less what the diagnosis holds, and draw their
-// observations to it (solver/solve_memory.h) or refuse with one line.
+// observations to it (solver/inverse/solve_memory.h) or refuse with one line.
 
 #include <cstdint>
 

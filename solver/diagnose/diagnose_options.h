@@ -3,7 +3,7 @@
 
 #include <cstdint>
 
-#include "solver/solve_options.h"
+#include "solver/inverse/solve_options.h"
 
 namespace igi {
 

@@ -18,8 +18,8 @@
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/diagnose_options.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/photo_model.h"
-#include "solver/solve_options.h"
+#include "solver/inverse/photo_model.h"
+#include "solver/inverse/solve_options.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 

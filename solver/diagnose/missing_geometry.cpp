@@ -12,8 +12,8 @@
 #include <optional>
 #include <tuple>
 
-#include "solver/render_internal.h"
-#include "solver/surface_hit.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/surface_hit.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 

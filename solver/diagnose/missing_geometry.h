@@ -45,7 +45,7 @@
 #include "recon/scene.h"
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/photo_model.h"
+#include "solver/inverse/photo_model.h"
 #include "tools/common/image.h"
 
 namespace igi {

@@ -5,12 +5,12 @@
 #include <limits>
 #include <memory>
 
-#include "solver/gather.h"
-#include "solver/observations.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/sampling.h"
-#include "solver/surface_hit.h"
+#include "solver/inverse/gather.h"
+#include "solver/inverse/observations.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/render/sampling.h"
+#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {

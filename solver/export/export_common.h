@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 #include "solver/export/export.h"
 #include "solver/export/ward_fit.h"
 

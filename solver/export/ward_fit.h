@@ -1,5 +1,5 @@
 #pragma once
-// Fits of a Ward specular lobe (solver/brdf.h) by the lobes other renderers implement, for the
+// Fits of a Ward specular lobe (solver/render/brdf.h) by the lobes other renderers implement, for the
 // exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
 // values (ρd left out: the diffuse terms map exactly) over a grid of direction pairs covering the
 // lobe: view directions θo in [0°, max_theta_o_deg] (and several azimuths for an anisotropic
@@ -14,7 +14,7 @@
 
 #include <string_view>
 
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 
 namespace igi {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 
 namespace igi {

@@ -6,7 +6,7 @@
 #include <set>
 
 #include "recon/scene.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 

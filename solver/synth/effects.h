@@ -28,7 +28,7 @@
 //   specular_reflection     a glossy region (region=wall_y4) is declared lambert
 //   fresnel                 the glossy regions (regions=a/b/c) are truly Fresnel-weighted
 //                           (ward -> ward_fresnel, … : specular × F(c)/F0, Schlick, ior=1.5);
-//                           declared without Fresnel (solver/brdf.h defines the models)
+//                           declared without Fresnel (solver/render/brdf.h defines the models)
 
 #include <map>
 #include <optional>

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 

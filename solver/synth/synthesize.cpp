@@ -8,8 +8,8 @@
 #include <map>
 
 #include "recon/scene.h"
-#include "solver/render.h"
-#include "solver/sampling.h"
+#include "solver/render/render.h"
+#include "solver/render/sampling.h"
 #include "solver/synth/camera_placement.h"
 #include "solver/synth/effects.h"
 #include "solver/synth/room_builder.h"

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 
 namespace igi {
 namespace {

@@ -9,7 +9,7 @@
 #include "recon/scene_document.h"
 #include "solver/diagnose/effect.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/photo_model.h"
+#include "solver/inverse/photo_model.h"
 #include "tools/common/json.h"
 
 namespace igi::test {

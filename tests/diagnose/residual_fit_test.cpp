@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-#include "solver/photo_model.h"
+#include "solver/inverse/photo_model.h"
 
 namespace igi {
 namespace {

@@ -15,7 +15,7 @@
 
 #include "recon/scene.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 
 namespace igi::test::room {

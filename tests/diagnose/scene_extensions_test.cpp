@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "solver/brdf.h"
-#include "solver/render.h"
+#include "solver/render/brdf.h"
+#include "solver/render/render.h"
 #include "tests/solver/test_scenes.h"
 #include "tools/common/error.h"
 

@@ -14,10 +14,10 @@
 
 #include "recon/scene.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/photo_model.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/sampling.h"
+#include "solver/inverse/photo_model.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/render/sampling.h"
 
 namespace igi::test::shadow {
 

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 #include "solver/diagnose/pixel_records.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 #include "tools/common/json.h"
 

@@ -3,7 +3,7 @@
 // the HDR maps, registers the photos (COLMAP, with control points and the known intrinsics),
 // solves and writes the report. Checked:
 // - the recovered parameters against truth.json, after the photometric scale k (the HDR maps'
-//   free constant, see pipeline/demo.h), within stated tolerances;
+//   free constant, see tools/pipeline/demo.h), within stated tolerances;
 // - the ceiling seen (4 cameras look up, posed from the surveyed targets) and solved; every photo
 //   registered, its pose near the true camera;
 // - resuming: with 05-diagnose (skipped here) deleted, a rerun keeps 00-04 (markers
@@ -46,7 +46,7 @@ using test::RunTool;
 // −0.9 %), ρs −6.3..+1.6 %, α −1.5..+1.6 %; "measured" (k = 1.009): ρd −8.4..+5.6 %, ρs
 // −2.0..+4.9 %, α −1.7..+1.1 % except the floor's broad faint lobe (ρs 0.04, α 0.15 on a
 // textured floor): +16.4 % (+1.6 % with "reference": weakly determined). A textured region's true
-// ρd is its texture's mean over the surface the photos see (pipeline/demo.h SeenTrueAlbedo), not
+// ρd is its texture's mean over the surface the photos see (tools/pipeline/demo.h SeenTrueAlbedo), not
 // over the whole texture: on the same solve that takes wall_x4 from −7.7 % to −5.1 % and the glossy
 // objects from +3.2 / +4.9 % to +1.8 / +0.0 %; every other region within 2.7 % (solve from every
 // third pixel, as the demo now does: the same within 1.5 points). Regions no photo sees

@@ -194,7 +194,7 @@ TEST_F(SolveE2E, MaskOfAnotherSizeIsBadInput) {
 }
 
 // A memory budget too small for even one photo and the scene: refused before any work, naming
-// the photo and the flag (solver/solve_memory.h).
+// the photo and the flag (solver/inverse/solve_memory.h).
 TEST_F(SolveE2E, MemoryBudgetBelowOnePhotoIsBadInput) {
   WriteGeometry(false);
   Json doc = ConstantPhotoScene(SceneDir(), PhotoEntry("photos/cam0_L0.exr", "cam0", "L0"));

@@ -11,7 +11,7 @@
 #include <map>
 
 #include "solver/export/export.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/export/export_test_scene.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"

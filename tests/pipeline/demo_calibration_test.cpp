@@ -1,4 +1,4 @@
-// igi-run --demo's absolute calibration (pipeline/demo.h MeasureRadianceScale): the median ratio
+// igi-run --demo's absolute calibration (tools/pipeline/demo.h MeasureRadianceScale): the median ratio
 // of the HDR maps to igi-synth's noise-free radiance, whatever a few outliers do; the comparison
 // with the truth (CompareWithTruth) and of the registered cameras with the true ones
 // (ComparePoses).
@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <numbers>
 
-#include "pipeline/demo.h"
+#include "tools/pipeline/demo.h"
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"

@@ -1,6 +1,6 @@
-// PHOTOS_DIR layouts (pipeline/photo_layout.h): each kind is recognised with its lighting from
+// PHOTOS_DIR layouts (tools/pipeline/photo_layout.h): each kind is recognised with its lighting from
 // the folder-name suffix; every broken layout is an InputError with one line per problem.
-#include "pipeline/photo_layout.h"
+#include "tools/pipeline/photo_layout.h"
 
 #include <gtest/gtest.h>
 

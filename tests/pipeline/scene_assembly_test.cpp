@@ -1,7 +1,7 @@
-// The solvable scene igi-run writes after registration (pipeline/scene_assembly.h): relative
+// The solvable scene igi-run writes after registration (tools/pipeline/scene_assembly.h): relative
 // paths rebased to the new folder, one photo per registered camera with its HDR map, mask and
 // the layout's lighting; unregistered photos listed. The registration PNG keeps the image size.
-#include "pipeline/scene_assembly.h"
+#include "tools/pipeline/scene_assembly.h"
 
 #include <gtest/gtest.h>
 

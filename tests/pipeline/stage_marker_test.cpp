@@ -1,6 +1,6 @@
-// Stage markers and fingerprints (pipeline/stage_marker.h): a fingerprint changes when a file's
+// Stage markers and fingerprints (tools/pipeline/stage_marker.h): a fingerprint changes when a file's
 // contents change and not otherwise; a marker round-trips; a damaged marker = unfinished.
-#include "pipeline/stage_marker.h"
+#include "tools/pipeline/stage_marker.h"
 
 #include <gtest/gtest.h>
 

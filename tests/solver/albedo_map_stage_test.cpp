@@ -1,7 +1,7 @@
-// The albedo-map stage alone (solver/albedo_map_stage.h), on data built by hand: observations of
+// The albedo-map stage alone (solver/inverse/albedo_map_stage.h), on data built by hand: observations of
 // a 1 m square under a known irradiance, photographed by two photos, whose radiance is a true
 // albedo × E/π with a few paths' noise. No photo is read and nothing is gathered or fitted.
-#include "solver/albedo_map_stage.h"
+#include "solver/inverse/albedo_map_stage.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <functional>
 #include <random>
 
-#include "solver/solve_internal.h"
+#include "solver/inverse/solve_internal.h"
 #include "tests/solver/stage_fixture.h"
 
 namespace igi {

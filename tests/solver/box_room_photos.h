@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render.h"
+#include "solver/render/render.h"
 #include "tools/common/image.h"
 
 namespace igi::test::box_room {

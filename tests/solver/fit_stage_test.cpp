@@ -1,14 +1,14 @@
-// The fit stage and the paper stage's smoothing alone (solver/fit_stage.h, solver/paper_stage.h),
+// The fit stage and the paper stage's smoothing alone (solver/inverse/fit_stage.h, solver/inverse/paper_stage.h),
 // on data built by hand: observations of a 1 m Lambertian square under a known irradiance. No
 // photo is read and nothing is gathered or rendered.
-#include "solver/fit_stage.h"
+#include "solver/inverse/fit_stage.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "solver/paper_stage.h"
+#include "solver/inverse/paper_stage.h"
 #include "tests/solver/stage_fixture.h"
 
 namespace igi {

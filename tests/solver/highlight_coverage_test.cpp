@@ -1,7 +1,7 @@
 // Highlight coverage against scenes whose highlights are known by construction: a glossy square
 // at z = 0 lit by a light at (-1, 0, 2) mirrors it at the origin toward (1, 0, 2). Observations
 // are made by this test's own ray caster (one per pixel centre of a pinhole camera).
-#include "solver/highlight_coverage.h"
+#include "solver/inverse/highlight_coverage.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "solver/render_internal.h"
+#include "solver/render/render_internal.h"
 #include "solver/synth/camera_placement.h"
 #include "tests/solver/test_scenes.h"
 

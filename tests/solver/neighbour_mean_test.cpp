@@ -1,7 +1,7 @@
-// The solver's neighbour mean (solver/neighbour_mean.h) against a brute-force O(n²) reference on
+// The solver's neighbour mean (solver/inverse/neighbour_mean.h) against a brute-force O(n²) reference on
 // random points: two regions, a plane and a curved surface (normals that fail the 25° test),
 // several photos, points on cell boundaries, and a subset (one lighting's observations).
-#include "solver/neighbour_mean.h"
+#include "solver/inverse/neighbour_mean.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// solver/numeric.h: the vectorisable exponential against std::exp, and Brent's minimiser on
+// solver/inverse/numeric.h: the vectorisable exponential against std::exp, and Brent's minimiser on
 // functions with known minima (smooth, kinked, at an end of the interval), with its evaluation
 // count against golden sections' to the same tolerance.
-#include "solver/numeric.h"
+#include "solver/inverse/numeric.h"
 
 #include <gtest/gtest.h>
 

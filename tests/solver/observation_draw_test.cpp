@@ -1,5 +1,5 @@
-// Drawing the observations to a budget as they are collected (solver/observation_draw.h) and the
-// memory plan behind it (solver/solve_memory.h): the probabilities keep each region's highlight
+// Drawing the observations to a budget as they are collected (solver/inverse/observation_draw.h) and the
+// memory plan behind it (solver/inverse/solve_memory.h): the probabilities keep each region's highlight
 // candidates and fit samples and share the rest of the budget; a thinned collection keeps a
 // subset of the very pixels a full one keeps, every highlight candidate among them; drawn blocks
 // are the means of their pixels on one surface; a budget that cannot hold one photo is refused
@@ -8,7 +8,7 @@
 // Scene: tests/e2e/box_room.h's 2 m room with a Ward floor of unknown lobe, cam0 looking down at
 // the lamp's highlight on the floor, cam1 up; photos path-traced at 16 paths, every pixel
 // (stride 1: 6144 pixels).
-#include "solver/observation_draw.h"
+#include "solver/inverse/observation_draw.h"
 
 #include <gtest/gtest.h>
 
@@ -22,8 +22,8 @@
 #include <tuple>
 
 #include "recon/scene.h"
-#include "solver/solve.h"
-#include "solver/solve_internal.h"
+#include "solver/inverse/solve.h"
+#include "solver/inverse/solve_internal.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"

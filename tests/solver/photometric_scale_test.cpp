@@ -1,15 +1,15 @@
-// The photos' scale from a reference of known reflectance (solver/photometric_scale.h,
+// The photos' scale from a reference of known reflectance (solver/inverse/photometric_scale.h,
 // RobustPhotoScale): the ratio of sums over the reference's samples, with whole patches the
 // model gets wrong left out, but not the skewed residuals that a textured reference's albedo,
 // looked up at one point under a pixel that averages it, gives single samples.
-#include "solver/photometric_scale.h"
+#include "solver/inverse/photometric_scale.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 
 namespace igi {
 namespace {

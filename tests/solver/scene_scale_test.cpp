@@ -1,7 +1,7 @@
-// The scene's length scale (solver/scene_scale.h): the mean free path from the surfaces the
+// The scene's length scale (solver/inverse/scene_scale.h): the mean free path from the surfaces the
 // photos see against Cauchy's mean chord 4V/S of a convex room seen all round, and the scale
 // that follows it.
-#include "solver/scene_scale.h"
+#include "solver/inverse/scene_scale.h"
 
 #include <gtest/gtest.h>
 

@@ -12,8 +12,8 @@
 #include <filesystem>
 
 #include "recon/scene.h"
-#include "solver/albedo_map.h"
-#include "solver/solve.h"
+#include "solver/inverse/albedo_map.h"
+#include "solver/inverse/solve.h"
 #include "solver/synth/synthesize.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
@@ -120,7 +120,7 @@ void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar
   // The regions of one albedo (all but the textured floor), paper stage: measured -0.56..+0.83 %
   // (glossy_box's red, rho_d 0.1, +0.83 %; the ceiling +0.27..+0.60 %; +0.59..+0.87 % with the
   // adaptive smoothing of the indirect irradiance, where the wider mean over the open ceiling
-  // moved it). Without the specular bounces (SolveOptions::specular_bounces, solver/gather.h) the
+  // moved it). Without the specular bounces (SolveOptions::specular_bounces, solver/inverse/gather.h) the
   // ceiling is +2.0..+2.3 % and this fails.
   for (const RegionSolution& r : s.regions) {
     if (r.name == "floor" || !truth.contains(r.name)) continue;
@@ -174,9 +174,9 @@ SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
 // --textured-walls, a noise texture of 42 % standard deviation) came out +3.1 % off its area
 // mean that way. With --albedo-maps auto such a region gets a map when two maps from disjoint
 // halves of the photos agree, significantly, on a texel-to-texel variation above 10 %
-// (solver/albedo_map.h SharedTexelDetail), and its ρd is the map's mean over the texels the
+// (solver/inverse/albedo_map.h SharedTexelDetail), and its ρd is the map's mean over the texels the
 // photos show.
-// Observations drawn to a budget (SolveOptions::max_observations, solver/observation_draw.h)
+// Observations drawn to a budget (SolveOptions::max_observations, solver/inverse/observation_draw.h)
 // are spaced more coarsely than the photos' pixels; the maps then come from their own pass over
 // the photos (SolveOptions::albedo_map_pass, SolverState::StreamAlbedoMaps) at the photos'
 // footprint. The same capture as above (smooth floor texture, point lamp, 64-spp photos, every
@@ -358,7 +358,7 @@ TEST(SolveAlbedoTruth, AWrongLobeShapeIsNoTexture) {
 
 // With the lamp 0.6 m above the floor no camera sees the ceiling (the cameras look down at the
 // lit floor), yet half the light on the walls is the ceiling's: its ρd is fitted to the light it
-// bounces onto the regions the photos show (solver/paper_stage.h FitUnobservedAlbedos). Before,
+// bounces onto the regions the photos show (solver/inverse/paper_stage.h FitUnobservedAlbedos). Before,
 // it kept a placeholder (the seen regions' mean albedo, 0.495 against the true 0.8), and the walls'
 // albedos absorbed the missing light.
 TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {

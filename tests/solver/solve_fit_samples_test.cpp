@@ -18,8 +18,8 @@
 #include <utility>
 
 #include "recon/scene.h"
-#include "solver/solve.h"
-#include "solver/solve_internal.h"
+#include "solver/inverse/solve.h"
+#include "solver/inverse/solve_internal.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"

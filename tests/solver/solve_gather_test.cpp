@@ -1,6 +1,6 @@
 // The paper stage's gathering against the path tracer: a glossy surface sends the points it
 // lights not only its diffuse radiance and the lamp's highlight but also its specular reflection
-// of the rest of the room (solver/gather.h, "specular bounce"). Without that term every point lit
+// of the rest of the room (solver/inverse/gather.h, "specular bounce"). Without that term every point lit
 // by a glossy surface gathers too little light and its albedo comes out too high (igi-synth's
 // ceiling +1.5..+2.3 % on converged photos, bench/RESULTS.md).
 //
@@ -15,11 +15,11 @@
 #include <numbers>
 
 #include "recon/scene.h"
-#include "solver/gather.h"
-#include "solver/patches.h"
-#include "solver/render.h"
-#include "solver/render_internal.h"
-#include "solver/solve.h"
+#include "solver/inverse/gather.h"
+#include "solver/inverse/patches.h"
+#include "solver/render/render.h"
+#include "solver/render/render_internal.h"
+#include "solver/inverse/solve.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"
@@ -91,7 +91,7 @@ TEST_F(SolveGather, GlossySurfacesPassOnTheirSpecularReflectionOfTheRoom) {
 
 // The ambient light of docs/scene-format.md (uniform radiance, never occluded) in the solver's
 // gathering: its irradiance is exactly πL wherever the point is, in the open or in a corner (the
-// renderer adds ρd·L exactly too, solver/render.cpp), and its samples keep the directions it
+// renderer adds ρd·L exactly too, solver/render/render.cpp), and its samples keep the directions it
 // arrives from. It was estimated from uniform-sphere light samples (noise of several percent per
 // point).
 TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {

@@ -1,4 +1,4 @@
-// Stage 2 of igi-solve (solver/refine_stage.h, SolverState::RefineRound): the light arriving
+// Stage 2 of igi-solve (solver/inverse/refine_stage.h, SolverState::RefineRound): the light arriving
 // at every observation is rendered by the path tracer from the current model, so the albedos
 // light their own next fit. Refitting each region alone (πL/E at that E: "independent") then
 // overshoots in a bright closed room: albedos 5 % too high make the rendered room too bright,
@@ -19,9 +19,9 @@
 #include <string>
 
 #include "recon/scene.h"
-#include "solver/render.h"
-#include "solver/solve.h"
-#include "solver/solve_internal.h"
+#include "solver/render/render.h"
+#include "solver/inverse/solve.h"
+#include "solver/inverse/solve_internal.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"

@@ -1,5 +1,5 @@
-// The solve's data, each a plain structure (solver/observation_set.h, solver/material_estimate.h,
-// solver/light_model.h), and the stages that are functions of them alone, run on hand-made
+// The solve's data, each a plain structure (solver/inverse/observation_set.h, solver/inverse/material_estimate.h,
+// solver/inverse/light_model.h), and the stages that are functions of them alone, run on hand-made
 // observations: no photo, no ray.
 #include <gtest/gtest.h>
 
@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/fit_inputs.h"
-#include "solver/light_model.h"
-#include "solver/material_estimate.h"
-#include "solver/observation_set.h"
-#include "solver/patches.h"
-#include "solver/region_fit.h"
+#include "solver/inverse/fit_inputs.h"
+#include "solver/inverse/light_model.h"
+#include "solver/inverse/material_estimate.h"
+#include "solver/inverse/observation_set.h"
+#include "solver/inverse/patches.h"
+#include "solver/inverse/region_fit.h"
 
 namespace igi {
 namespace {

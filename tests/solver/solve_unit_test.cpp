@@ -1,5 +1,5 @@
-// Unit tests of the solver's building blocks: patches (solver/patches.h) and the region fit
-// (solver/region_fit.h) on samples generated from the model with known parameters.
+// Unit tests of the solver's building blocks: patches (solver/inverse/patches.h) and the region fit
+// (solver/inverse/region_fit.h) on samples generated from the model with known parameters.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "solver/brdf.h"
-#include "solver/observations.h"
-#include "solver/patches.h"
-#include "solver/region_fit.h"
-#include "solver/render_internal.h"
-#include "solver/sampling.h"
-#include "solver/solve.h"
-#include "solver/solve_options.h"
+#include "solver/render/brdf.h"
+#include "solver/inverse/observations.h"
+#include "solver/inverse/patches.h"
+#include "solver/inverse/region_fit.h"
+#include "solver/render/render_internal.h"
+#include "solver/render/sampling.h"
+#include "solver/inverse/solve.h"
+#include "solver/inverse/solve_options.h"
 #include "tests/solver/test_scenes.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"

@@ -7,11 +7,11 @@
 #include <random>
 #include <string>
 
-#include "solver/light_model.h"
-#include "solver/material_estimate.h"
-#include "solver/observation_set.h"
-#include "solver/patches.h"
-#include "solver/solve_options.h"
+#include "solver/inverse/light_model.h"
+#include "solver/inverse/material_estimate.h"
+#include "solver/inverse/observation_set.h"
+#include "solver/inverse/patches.h"
+#include "solver/inverse/solve_options.h"
 #include "tests/solver/test_scenes.h"
 
 namespace igi::test {

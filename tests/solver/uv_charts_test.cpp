@@ -1,6 +1,6 @@
-// Region atlases (solver/uv_charts.h): the mesh's UVs where usable, generated charts otherwise,
+// Region atlases (solver/inverse/uv_charts.h): the mesh's UVs where usable, generated charts otherwise,
 // and the OBJ written with them.
-#include "solver/uv_charts.h"
+#include "solver/inverse/uv_charts.h"
 
 #include <gtest/gtest.h>
 

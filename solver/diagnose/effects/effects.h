@@ -74,7 +74,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
                            bool fresnel);
 
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
-// (solver/brdf.h), for a record's world-frame normal, view and light directions.
+// (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
 double IsotropicLobe(BrdfModel model, double alpha, const Eigen::Vector3f& n,
                      const Eigen::Vector3f& wo, const Eigen::Vector3f& wi);
 

@@ -14,12 +14,12 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/render_internal.h"
-#include "solver/sampling.h"
-#include "solver/surface_hit.h"
+#include "solver/render/render_internal.h"
+#include "solver/render/sampling.h"
+#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {

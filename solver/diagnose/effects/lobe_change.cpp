@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/observations.h"
-#include "solver/sampling.h"
+#include "solver/inverse/observations.h"
+#include "solver/render/sampling.h"
 
 namespace igi {
 

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "solver/diagnose/effects/effects.h"
-#include "solver/render.h"
-#include "solver/sampling.h"
+#include "solver/render/render.h"
+#include "solver/render/sampling.h"
 
 namespace igi {
 

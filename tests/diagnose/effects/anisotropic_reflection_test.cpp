@@ -12,7 +12,7 @@
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/ward_plate.h"
 

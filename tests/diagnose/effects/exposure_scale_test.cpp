@@ -10,7 +10,7 @@
 
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/effects/effects.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 

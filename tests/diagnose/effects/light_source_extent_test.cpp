@@ -15,7 +15,7 @@
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/shadow_records.h"
 

@@ -10,7 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "solver/diagnose/candidates.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 
 namespace igi {

@@ -8,10 +8,10 @@
 #include <random>
 #include <vector>
 
-#include "solver/brdf.h"
+#include "solver/render/brdf.h"
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/effects/effects.h"
-#include "solver/sampling.h"
+#include "solver/render/sampling.h"
 #include "tests/diagnose/lobe_plate.h"
 #include "tests/diagnose/one_light_record.h"
 

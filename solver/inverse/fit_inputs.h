@@ -1,0 +1,30 @@
+#pragma once
+// Internal to igi_solver: what the region fits (solver/inverse/region_fit.h) are given, from the solve's
+// data: each fitted region's knowns and hints from the material estimate, and one sample per fit
+// observation with its irradiance and incident light from the light model.
+
+#include <vector>
+
+#include "recon/scene.h"
+#include "solver/inverse/light_model.h"
+#include "solver/inverse/material_estimate.h"
+#include "solver/inverse/observation_set.h"
+#include "solver/inverse/patches.h"
+#include "solver/inverse/region_fit.h"
+
+namespace igi {
+
+// The inputs of the regions with an unknown that some photo sees (their indices in *regions,
+// ascending), one per region. A sample per fit observation (obs.in_fit) of such a region: its
+// radiance, its irradiance (light.e), the given albedo where ρd is known, its patch's slot, its
+// held-out albedo and lobe (materials.held_*, where HeldOutAlbedos filled them), its view in the
+// local frame and its incident samples, read in place (`light` must outlive the inputs). Stage 2
+// (`stage`) keeps stage 1's decision whether the albedo varies; a region fitted before starts its α
+// search there.
+std::vector<RegionFitInput> FitInputs(const Scene& scene, const PatchSet& patches,
+                                      const ObservationSet& obs, const LightModel& light,
+                                      const MaterialEstimate& materials, int stage,
+                                      bool grey_specular, bool held_out_albedo,
+                                      std::vector<int>* regions);
+
+}  // namespace igi

@@ -1,0 +1,760 @@
+#include "solver/inverse/region_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solver/render/brdf.h"
+#include "solver/inverse/numeric.h"
+
+namespace igi {
+
+double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
+                      const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  double s = SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
+  if (HasFresnel(model) && s > 0) s *= FresnelWeight<double>(ior, wo, wi);
+  return s;
+}
+
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+struct Prepared {
+  std::vector<Eigen::Vector3d> w;  // residual weights per sample and channel
+  std::vector<Eigen::Vector3d> a;  // E/π
+};
+
+Prepared Prepare(const RegionFitInput& in) {
+  // Shot-noise weights (variance ∝ level) from a proxy of each sample's level (the region's mean
+  // reflectance ratio times its irradiance), not from the observed value: weights that follow
+  // the photos' noise would bias the fit low. With variance ∝ E the albedo estimate is a ratio
+  // of sums, Σ L / Σ E/π, which noise in the gathered E does not bias the way a mean of ratios
+  // would.
+  Prepared p;
+  Eigen::Vector3d sum_l = Eigen::Vector3d::Zero(), sum_e = sum_l;
+  for (const FitSample& s : in.samples) {
+    sum_l += s.observed.cwiseMax(0.0);
+    sum_e += s.irradiance / kPi;
+  }
+  const size_t n = std::max<size_t>(1, in.samples.size());
+  const Eigen::Vector3d mean = sum_l / n;
+  for (const FitSample& s : in.samples) {
+    Eigen::Vector3d w;
+    for (int c = 0; c < 3; ++c) {
+      const double ratio = sum_e[c] > 0 ? sum_l[c] / sum_e[c] : 0.0;
+      w[c] = 1.0 / std::sqrt((ratio * s.irradiance[c] / kPi + 0.1 * mean[c]) * mean[c] + 1e-24);
+    }
+    p.w.push_back(w);
+    p.a.push_back(s.irradiance / kPi);
+  }
+  return p;
+}
+
+// The scalar value of a double or a Ceres Jet (LobeTable::Term's cut-off test).
+inline double ScalarPart(double x) { return x; }
+template <typename J, int N>
+double ScalarPart(const ceres::Jet<J, N>& x) {
+  return x.a;
+}
+
+// The specular term T_c(α) = Σ S·W·v of every sample from a per-incident-sample table of the
+// α-independent factors, computed once per region fit (the α search evaluates T at dozens of α):
+// S·W·v = exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy) (SpecularFactorParts, solver/render/brdf.h; Fresnel
+// folded into g).
+// Each sample's entries (a row) are sorted by qx + qy, so a sum stops at the first entry whose
+// exponent is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double, vectorised)
+// and by Ceres' polish (Jets), so both see the same lobe.
+class LobeTable {
+ public:
+  // Built once per region fit from all its samples; any subset of them (the held-albedo
+  // variant's) finds its rows by incident range (Rows).
+  explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
+    if (!HasSpecularLobe(in.model)) return;
+    std::vector<std::pair<const IncidentLocal*, int>> order;  // (incident, sample)
+    order.reserve(in.samples.size());
+    int64_t entries = 0;
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      order.emplace_back(in.samples[i].incident, int(i));
+      entries += in.samples[i].incident_count;
+    }
+    std::sort(order.begin(), order.end());
+    starts_.reserve(order.size());
+    begin_.reserve(order.size() + 1);
+    // At most one entry per incident sample: reserved once (grown by doubling, the six arrays
+    // held up to twice the region's incident light).
+    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_})
+      v->reserve(in.incident.size());
+    struct Entry {
+      float qx, qy;
+      Eigen::Vector3f gv;
+    };
+    std::vector<Entry> row;
+    for (const auto& [start, i] : order) {
+      const FitSample& s = in.samples[i];
+      starts_.push_back(start);
+      begin_.push_back(static_cast<int>(qx_.size()));
+      blur2_.push_back(std::max(0.0, s.lobe_blur2));
+      const Eigen::Vector3d wo = s.wo.cast<double>();
+      row.clear();
+      for (int64_t k = 0; k < s.incident_count; ++k) {
+        const IncidentLocal& inc = s.incident[k];
+        const Eigen::Vector3d wi = inc.Wi().cast<double>();
+        double qx = 0, qy = 0, g = 0;
+        if (!SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
+        if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
+        const Eigen::Vector3d gv = g * inc.Value().cast<double>();
+        if (!(g > 0.0) || !gv.allFinite()) continue;
+        row.push_back({float(qx), float(qy), gv.cast<float>()});
+      }
+      std::sort(row.begin(), row.end(),
+                [](const Entry& a, const Entry& b) { return a.qx + a.qy < b.qx + b.qy; });
+      for (const Entry& e : row) {
+        qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
+        gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
+      }
+    }
+    begin_.push_back(static_cast<int>(qx_.size()));
+  }
+
+  // The row of each sample of `in` (the table's input or a subset of its samples); −1: none.
+  std::vector<int> Rows(const RegionFitInput& in) const {
+    std::vector<int> rows(in.samples.size(), -1);
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const auto it = std::lower_bound(starts_.begin(), starts_.end(), in.samples[i].incident);
+      if (it != starts_.end() && *it == in.samples[i].incident) {
+        rows[i] = int(it - starts_.begin());
+      }
+    }
+    return rows;
+  }
+
+  // One row's term at (αx, αy) (Ceres' polish: T a double or a Jet), without the held-out
+  // albedo's share (Terms adds it).
+  template <typename T>
+  Eigen::Matrix<T, 3, 1> Term(int row, const T& ax, const T& ay) const {
+    using std::exp;
+    Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
+    if (row < 0) return sum;
+    using std::sqrt;
+    const T ax2 = ax * ax + T(blur2_[row]), ay2 = ay * ay + T(blur2_[row]);
+    const T ix = T(1.0) / ax2, iy = T(1.0) / ay2;
+    const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
+    for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
+      if (imin * double(qs_[k]) >= kMaxExponent) break;
+      if (double(qx_[k]) * ix0 + double(qy_[k]) * iy0 >= kMaxExponent) continue;
+      const T f = exp(-(T(double(qx_[k])) * ix + T(double(qy_[k])) * iy));
+      sum[0] += f * double(gr_[k]), sum[1] += f * double(gg_[k]), sum[2] += f * double(gb_[k]);
+    }
+    return sum / sqrt(ax2 * ay2);
+  }
+
+  // T_c(α) for every sample of `in` (its rows from Rows(in)), less the held-out albedo's own lobe
+  // where `in` fits with it (RegionFitInput::use_held_albedo). The α search's inner loop: the
+  // exponentials of a row up to its cut-off in one vectorised pass, then their weighted sums.
+  std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, const std::vector<int>& rows,
+                                     double ax, double ay) const {
+    std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
+    if (!HasSpecularLobe(model_)) return t;
+    std::vector<float> f;
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const FitSample& s = in.samples[i];
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      if (rows[i] >= 0) {
+        // The row's lobe: α² widened by its pixel's spread of normals.
+        const double ax2 = ax * ax + blur2_[rows[i]], ay2 = ay * ay + blur2_[rows[i]];
+        const float ix = float(1.0 / ax2), iy = float(1.0 / ay2);
+        const float cut = float(kMaxExponent * std::max(ax2, ay2));
+        const double scale = 1.0 / std::sqrt(ax2 * ay2);
+        const int b = begin_[rows[i]];
+        const int e =
+            int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[rows[i] + 1], cut) -
+                qs_.begin());
+        f.resize(size_t(e - b));
+        Exponentials(qx_.data() + b, qy_.data() + b, e - b, ix, iy, f.data());
+        sum = WeightedSum(f.data(), b, e - b) * scale;
+      }
+      if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
+        sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
+      }
+      t[i] = sum;
+    }
+    return t;
+  }
+
+ private:
+  static constexpr double kMaxExponent = 60.0;
+  static void Exponentials(const float* __restrict qx, const float* __restrict qy, int n, float ix,
+                           float iy, float* __restrict f) {
+    for (int k = 0; k < n; ++k) f[k] = ExpNonPositive(-(qx[k] * ix + qy[k] * iy));
+  }
+  // Σ f_k·(r, g, b)_k over entries [b, b + n), in two-lane double partial sums (SSE2 packets).
+  Eigen::Vector3d WeightedSum(const float* f, int b, int n) const {
+    using A2 = Eigen::Array2d;
+    A2 sr = A2::Zero(), sg = sr, sb = sr;
+    int k = 0;
+    for (; k + 2 <= n; k += 2) {
+      const A2 fk(f[k], f[k + 1]);
+      sr += fk * A2(gr_[b + k], gr_[b + k + 1]);
+      sg += fk * A2(gg_[b + k], gg_[b + k + 1]);
+      sb += fk * A2(gb_[b + k], gb_[b + k + 1]);
+    }
+    Eigen::Vector3d sum(sr.sum(), sg.sum(), sb.sum());
+    for (; k < n; ++k) sum += double(f[k]) * Eigen::Vector3d(gr_[b + k], gg_[b + k], gb_[b + k]);
+    return sum;
+  }
+  BrdfModel model_;
+  std::vector<const IncidentLocal*> starts_;  // each row's incident list, ascending
+  std::vector<int> begin_;                    // each row's first entry (+1: the end)
+  std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
+  // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v.
+  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
+};
+
+// The linear part for given specular terms: ρs and per-slot ρd by least squares.
+struct LinearSolution {
+  double cost = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> slot_rho_d;
+  double sum_v2 = 0;  // Σ v² of the projected specular column (grey), for ρs's variance
+};
+
+LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
+                           const std::vector<Eigen::Vector3d>& t, bool per_patch) {
+  const int slots = per_patch ? in.num_slots : 1;
+  std::vector<Eigen::Vector3d> A(slots, Eigen::Vector3d::Zero()), B = A, C = A;
+  const size_t n = in.samples.size();
+  auto slot_of = [&](size_t i) { return per_patch ? in.samples[i].slot : 0; };
+  if (in.fit_rho_d) {
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+      const int s = slot_of(i);
+      A[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+      B[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed);
+      C[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(t[i]);
+    }
+  }
+  std::vector<Eigen::Vector3d> u(n), v(n);
+  for (size_t i = 0; i < n; ++i) {
+    const FitSample& smp = in.samples[i];
+    for (int c = 0; c < 3; ++c) {
+      const double w = pr.w[i][c], a = pr.a[i][c];
+      if (in.fit_rho_d) {
+        const int s = slot_of(i);
+        const double ratio_b = A[s][c] > 0 ? B[s][c] / A[s][c] : 0.0;
+        const double ratio_c = A[s][c] > 0 ? C[s][c] / A[s][c] : 0.0;
+        u[i][c] = w * (smp.observed[c] - a * ratio_b);
+        v[i][c] = w * (t[i][c] - a * ratio_c);
+      } else {
+        u[i][c] = w * (smp.observed[c] - smp.rho_d_known[c] * a);
+        v[i][c] = w * t[i][c];
+      }
+    }
+  }
+  LinearSolution sol;
+  const bool spec = HasSpecularLobe(in.model);
+  if (spec && (in.rho_s_grey || in.rho_s_rgb)) {
+    sol.rho_s = in.rho_s_rgb ? *in.rho_s_rgb : Eigen::Vector3d::Constant(*in.rho_s_grey);
+  } else if (spec && in.grey_specular) {
+    double uv = 0, vv = 0;
+    for (size_t i = 0; i < n; ++i) {
+      uv += u[i].dot(v[i]);
+      vv += v[i].squaredNorm();
+    }
+    sol.rho_s.setConstant(vv > 0 ? std::max(0.0, uv / vv) : 0.0);
+    sol.sum_v2 = vv;
+  } else if (spec) {
+    for (int c = 0; c < 3; ++c) {
+      double uv = 0, vv = 0;
+      for (size_t i = 0; i < n; ++i) {
+        uv += u[i][c] * v[i][c];
+        vv += v[i][c] * v[i][c];
+      }
+      sol.rho_s[c] = vv > 0 ? std::max(0.0, uv / vv) : 0.0;
+      sol.sum_v2 += vv / 3;
+    }
+  }
+  sol.cost = 0;
+  for (size_t i = 0; i < n; ++i) sol.cost += (u[i] - v[i].cwiseProduct(sol.rho_s)).squaredNorm();
+  sol.slot_rho_d.assign(slots, Eigen::Vector3d::Constant(kNan));
+  if (in.fit_rho_d) {
+    for (int s = 0; s < slots; ++s) {
+      for (int c = 0; c < 3; ++c) {
+        if (A[s][c] > 0)
+          sol.slot_rho_d[s][c] = std::max(0.0, (B[s][c] - sol.rho_s[c] * C[s][c]) / A[s][c]);
+      }
+    }
+  }
+  return sol;
+}
+
+struct AlphaSearch {
+  double ax = 0.1, ay = 0.1;
+  LinearSolution linear;
+  double curvature_log_alpha = kNan;  // d²cost/d(log α)² at the minimum (isotropic)
+};
+
+// Minimises the projected cost over α (or αx, αy).
+AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch,
+                        const LobeTable& table) {
+  AlphaSearch best;
+  const bool aniso = IsAnisotropic(in.model);
+  const std::vector<int> rows = table.Rows(in);
+  auto eval = [&](double ax, double ay) {
+    return SolveLinear(in, pr, table.Terms(in, rows, ax, ay), per_patch);
+  };
+  if (!HasSpecularLobe(in.model)) {
+    best.linear = eval(0.1, 0.1);
+    return best;
+  }
+  const std::optional<double> known_x = aniso ? in.alpha_x : in.alpha;
+  const std::optional<double> known_y = aniso ? in.alpha_y : in.alpha;
+  const double lo = std::log(0.005), hi = std::log(1.0);
+  auto minimise = [](double a, double b, auto&& f) { return BrentMinimum(a, b, 1e-4, 40, f); };
+  if (!aniso) {
+    if (known_x) {
+      best.ax = best.ay = *known_x;
+      best.linear = eval(best.ax, best.ay);
+      return best;
+    }
+    // The solution at log α = la, with the cost's curvature there (for σ_α).
+    auto finish = [&](double la) {
+      best.ax = best.ay = std::exp(la);
+      best.linear = eval(best.ax, best.ay);
+      const double h = 0.02;
+      const double cp = eval(std::exp(la + h), std::exp(la + h)).cost;
+      const double cm = eval(std::exp(la - h), std::exp(la - h)).cost;
+      best.curvature_log_alpha = (cp + cm - 2 * best.linear.cost) / (h * h);
+      return best;
+    };
+    if (in.alpha_hint && *in.alpha_hint > 0) {
+      // A window of ±0.4 in log α around the hint; accepted unless the minimum sits at its edge.
+      const double c = std::log(*in.alpha_hint), a = std::max(lo, c - 0.4),
+                   b = std::min(hi, c + 0.4);
+      const double la =
+          minimise(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; });
+      if (la > a + 0.02 && la < b - 0.02) return finish(la);
+    }
+    constexpr int kGrid = 28;
+    double best_cost = std::numeric_limits<double>::infinity();
+    int best_i = 0;
+    for (int i = 0; i < kGrid; ++i) {
+      const double la = lo + (hi - lo) * i / (kGrid - 1);
+      const double c = eval(std::exp(la), std::exp(la)).cost;
+      if (c < best_cost) best_cost = c, best_i = i;
+    }
+    const double step = (hi - lo) / (kGrid - 1);
+    const double a = lo + step * std::max(0, best_i - 1),
+                 b = lo + step * std::min(kGrid - 1, best_i + 1);
+    return finish(minimise(a, b, [&](double x) { return eval(std::exp(x), std::exp(x)).cost; }));
+  }
+  // Anisotropic: a coarse grid, then alternating Brent minimisations.
+  double bx = known_x.value_or(0.1), by = known_y.value_or(0.1);
+  if (!known_x || !known_y) {
+    constexpr int kGrid = 12;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < kGrid; ++i) {
+      for (int j = 0; j < kGrid; ++j) {
+        const double x = known_x ? *known_x : std::exp(lo + (hi - lo) * i / (kGrid - 1));
+        const double y = known_y ? *known_y : std::exp(lo + (hi - lo) * j / (kGrid - 1));
+        const double c = eval(x, y).cost;
+        if (c < best_cost) best_cost = c, bx = x, by = y;
+      }
+    }
+    for (int round = 0; round < 3; ++round) {
+      const double w = (hi - lo) / 11.0 / (round + 1);
+      if (!known_x) {
+        bx = std::exp(minimise(std::log(bx) - w, std::log(bx) + w,
+                               [&](double x) { return eval(std::exp(x), by).cost; }));
+      }
+      if (!known_y) {
+        by = std::exp(minimise(std::log(by) - w, std::log(by) + w,
+                               [&](double y) { return eval(bx, std::exp(y)).cost; }));
+      }
+    }
+  }
+  best.ax = bx;
+  best.ay = by;
+  best.linear = eval(bx, by);
+  return best;
+}
+
+// Ceres residual of one sample for the constant-albedo model; parameter blocks in the order
+// ρd (3, if fitted), ρs (1 or 3, if fitted), α (1 or 2, if fitted).
+struct SampleResidual {
+  const RegionFitInput* in = nullptr;
+  const FitSample* s = nullptr;
+  const LobeTable* table = nullptr;
+  int row = -1;  // s's row in the table
+  Eigen::Vector3d w, a;
+  int block_d = -1, block_s = -1, block_a = -1;
+  Eigen::Vector3d rho_d_fixed, rho_s_fixed;
+  double ax_fixed = 0.1, ay_fixed = 0.1;
+
+  template <typename T>
+  bool operator()(T const* const* p, T* residual) const {
+    using V3 = Eigen::Matrix<T, 3, 1>;
+    V3 rho_d = rho_d_fixed.cast<T>(), rho_s = rho_s_fixed.cast<T>();
+    if (block_d >= 0) rho_d = V3(p[block_d][0], p[block_d][1], p[block_d][2]);
+    if (block_s >= 0) {
+      rho_s = in->grey_specular ? V3(p[block_s][0], p[block_s][0], p[block_s][0])
+                                : V3(p[block_s][0], p[block_s][1], p[block_s][2]);
+    }
+    T ax = T(ax_fixed), ay = T(ay_fixed);
+    if (block_a >= 0) {
+      ax = p[block_a][0];
+      ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
+    }
+    const V3 t = table->Term<T>(row, ax, ay);
+    for (int c = 0; c < 3; ++c) {
+      residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
+    }
+    return true;
+  }
+};
+
+struct Polish {
+  bool ok = false;
+  std::string message;
+  Eigen::Vector3d rho_d, sigma_rho_d = Eigen::Vector3d::Constant(kNan);
+  Eigen::Vector3d rho_s;
+  double ax = 0, ay = 0, sigma_rho_s = kNan, sigma_ax = kNan, sigma_ay = kNan;
+};
+
+Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaSearch& start,
+                      const RegionFitOptions& options, const LobeTable& table) {
+  Polish out;
+  const bool spec = HasSpecularLobe(in.model);
+  const bool aniso = IsAnisotropic(in.model);
+  const bool fit_s = spec && !in.rho_s_grey && !in.rho_s_rgb;
+  const bool fit_a = spec && !(aniso ? (in.alpha_x && in.alpha_y) : bool(in.alpha));
+  out.rho_d =
+      start.linear.slot_rho_d.empty() ? Eigen::Vector3d::Zero() : start.linear.slot_rho_d[0];
+  out.rho_s = start.linear.rho_s;
+  out.ax = start.ax;
+  out.ay = start.ay;
+  if (!in.fit_rho_d && !fit_s && !fit_a) return out;
+  double d[3] = {out.rho_d[0], out.rho_d[1], out.rho_d[2]};
+  double rs[3] = {out.rho_s[0], out.rho_s[1], out.rho_s[2]};
+  double al[2] = {out.ax, out.ay};
+  std::vector<double*> blocks;
+  int block_d = -1, block_s = -1, block_a = -1;
+  const int ns = in.grey_specular ? 1 : 3, na = aniso ? 2 : 1;
+  ceres::Problem problem;
+  const std::vector<int> rows = table.Rows(in);
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    auto* r = new SampleResidual;
+    r->row = rows[i];
+    r->in = &in;
+    r->s = &in.samples[i];
+    r->table = &table;
+    r->w = pr.w[i];
+    r->a = pr.a[i];
+    r->rho_d_fixed = in.samples[i].rho_d_known;
+    r->rho_s_fixed = out.rho_s;
+    r->ax_fixed = out.ax;
+    r->ay_fixed = out.ay;
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<SampleResidual, 8>(r);
+    blocks.clear();
+    int b = 0;
+    if (in.fit_rho_d) cost->AddParameterBlock(3), blocks.push_back(d), r->block_d = b++;
+    if (fit_s) cost->AddParameterBlock(ns), blocks.push_back(rs), r->block_s = b++;
+    if (fit_a) cost->AddParameterBlock(na), blocks.push_back(al), r->block_a = b++;
+    block_d = r->block_d, block_s = r->block_s, block_a = r->block_a;
+    cost->SetNumResiduals(3);
+    problem.AddResidualBlock(cost, nullptr, blocks);
+  }
+  if (in.fit_rho_d) {
+    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(d, c, 0.0);
+  }
+  if (fit_s) {
+    for (int c = 0; c < ns; ++c) problem.SetParameterLowerBound(rs, c, 0.0);
+  }
+  if (fit_a) {
+    for (int c = 0; c < na; ++c) {
+      // scene.json's range for α is (0, 1] (igi-render and the loader refuse more): a fit that
+      // wants a broader lobe is held at 1, as the search's grid is.
+      problem.SetParameterLowerBound(al, c, 0.002);
+      problem.SetParameterUpperBound(al, c, 1.0);
+    }
+  }
+  ceres::Solver::Options so;
+  so.max_num_iterations = options.max_polish_iterations;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.num_threads = std::max(1, options.num_threads);
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  out.ok = summary.IsSolutionUsable();
+  out.message = summary.message;
+  if (!out.ok) return out;
+  if (in.fit_rho_d) out.rho_d = Eigen::Vector3d(d[0], d[1], d[2]);
+  if (fit_s)
+    out.rho_s =
+        in.grey_specular ? Eigen::Vector3d::Constant(rs[0]) : Eigen::Vector3d(rs[0], rs[1], rs[2]);
+  if (fit_a) out.ax = al[0], out.ay = aniso ? al[1] : al[0];
+  // Covariance scaled by the residual variance (the weights are relative, not true sigmas).
+  const int k = (in.fit_rho_d ? 3 : 0) + (fit_s ? ns : 0) + (fit_a ? na : 0);
+  const double dof = std::max(1.0, 3.0 * in.samples.size() - k);
+  const double s2 = 2.0 * summary.final_cost / dof;
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  ceres::Covariance cov(co);
+  std::vector<const double*> params;
+  if (in.fit_rho_d) params.push_back(d);
+  if (fit_s) params.push_back(rs);
+  if (fit_a) params.push_back(al);
+  if (cov.Compute(params, &problem)) {
+    std::vector<double> m(size_t(k) * k);
+    if (cov.GetCovarianceMatrixInTangentSpace(params, m.data())) {
+      int o = 0;
+      auto sd = [&](int i) { return std::sqrt(std::max(0.0, m[size_t(i) * k + i] * s2)); };
+      if (in.fit_rho_d) out.sigma_rho_d = Eigen::Vector3d(sd(0), sd(1), sd(2)), o = 3;
+      if (fit_s) out.sigma_rho_s = sd(o), o += ns;
+      if (fit_a) out.sigma_ax = sd(o), out.sigma_ay = aniso ? sd(o + 1) : sd(o);
+    }
+  }
+  (void)block_d, (void)block_s, (void)block_a;
+  return out;
+}
+
+double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>& t,
+                   const std::vector<Eigen::Vector3d>& slot_rho_d, const Eigen::Vector3d& rho_s,
+                   bool per_patch) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    Eigen::Vector3d rd = in.fit_rho_d ? slot_rho_d[per_patch ? s.slot : 0] : s.rho_d_known;
+    if (!rd.allFinite()) continue;
+    const Eigen::Vector3d pred = rd.cwiseProduct(s.irradiance) / kPi + rho_s.cwiseProduct(t[i]);
+    num += (pred - s.observed).squaredNorm();
+    den += s.observed.squaredNorm();
+  }
+  return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+// Each slot's albedo from its samples whose specular part is under 10 % of the radiance (least
+// squares per channel); NaN for a slot without such a sample.
+std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const Prepared& pr,
+                                                const std::vector<Eigen::Vector3d>& t,
+                                                const Eigen::Vector3d& rho_s,
+                                                const Eigen::Vector3d& rho_d_mean) {
+  std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    const Eigen::Vector3d spec = rho_s.cwiseProduct(t[i]);
+    (void)rho_d_mean;
+    if ((spec.array() > 0.1 * s.observed.array().max(0.0)).any()) continue;
+    const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+    num[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(s.observed - spec);
+    den[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+  }
+  std::vector<Eigen::Vector3d> out(in.num_slots, Eigen::Vector3d::Constant(kNan));
+  for (int k = 0; k < in.num_slots; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      if (den[k][c] > 0) out[k][c] = std::max(0.0, num[k][c] / den[k][c]);
+    }
+  }
+  return out;
+}
+
+// Whether the per-patch albedos vary beyond their noise: the area-weighted spread of the
+// slots' mean albedo must exceed 3 % of the mean and three times the spread noise alone gives.
+bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolution& b,
+                  const std::vector<Eigen::Vector3d>& t, std::vector<int>* counts) {
+  const int slots = in.num_slots;
+  counts->assign(slots, 0);
+  std::vector<double> info(slots, 0.0);
+  double rss = 0;
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    ++(*counts)[s.slot];
+    for (int c = 0; c < 3; ++c) info[s.slot] += std::pow(pr.w[i][c] * pr.a[i][c], 2) / 3;
+    if (!b.slot_rho_d[s.slot].allFinite()) continue;
+    const Eigen::Vector3d pred =
+        b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
+    if (pred.allFinite()) rss += (pr.w[i].cwiseProduct(pred - s.observed)).squaredNorm();
+  }
+  int used = 0;
+  for (int s = 0; s < slots; ++s) used += (*counts)[s] > 0;
+  const double s2 = rss / std::max(1.0, 3.0 * in.samples.size() - 3.0 * used - 2);
+  double wsum = 0, mean = 0;
+  for (int s = 0; s < slots; ++s) {
+    if ((*counts)[s] < 3 || !b.slot_rho_d[s].allFinite()) continue;
+    wsum += in.slot_area[s];
+    mean += in.slot_area[s] * b.slot_rho_d[s].mean();
+  }
+  if (!(wsum > 0)) return false;
+  mean /= wsum;
+  double var = 0, noise = 0;
+  for (int s = 0; s < slots; ++s) {
+    if ((*counts)[s] < 3 || !b.slot_rho_d[s].allFinite()) continue;
+    var += in.slot_area[s] * std::pow(b.slot_rho_d[s].mean() - mean, 2);
+    noise += in.slot_area[s] * (info[s] > 0 ? s2 / info[s] / 3 : 0.0);
+  }
+  var /= wsum;
+  noise /= wsum;
+  return var > std::pow(0.03 * mean, 2) && var > 3 * noise;
+}
+
+// The samples whose held-out albedo is known, each with that albedo as its known ρd (in `held`,
+// a copy of `in` with fit_rho_d off); false (and `held` unchanged) when fewer than a fifth of
+// the samples, or fewer than 50, have one.
+bool FitWithHeldAlbedo(const RegionFitInput& in, RegionFitInput* held) {
+  std::vector<FitSample> kept;
+  for (const FitSample& s : in.samples) {
+    if (!s.rho_d_held.allFinite()) continue;
+    kept.push_back(s);
+    kept.back().rho_d_known = s.rho_d_held;
+  }
+  if (kept.size() < 50 || kept.size() * 5 < in.samples.size()) {
+    held->use_held_albedo = false;
+    return false;
+  }
+  held->samples = std::move(kept);
+  held->use_held_albedo = true;
+  return true;
+}
+
+}  // namespace
+
+std::string_view AlbedoModelName(AlbedoModel model) {
+  switch (model) {
+    case AlbedoModel::kConstant:
+      return "constant";
+    case AlbedoModel::kPerPatch:
+      return "per_patch";
+  }
+  return "?";
+}
+
+std::optional<AlbedoModel> AlbedoModelFromName(std::string_view name) {
+  for (AlbedoModel m : {AlbedoModel::kConstant, AlbedoModel::kPerPatch}) {
+    if (AlbedoModelName(m) == name) return m;
+  }
+  return std::nullopt;
+}
+
+RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
+  RegionFitResult r;
+  r.samples = static_cast<int>(in.samples.size());
+  if (in.samples.empty()) {
+    r.message = "no observation";
+    return r;
+  }
+  r.fitted = true;
+  const Prepared pr = Prepare(in);
+  const LobeTable table(in);  // every search, the polish and the terms below
+  const AlphaSearch a = SearchAlpha(in, pr, false, table);
+  const Polish pa = PolishConstant(in, pr, a, options, table);
+  r.rho_d = pa.rho_d;
+  r.rho_s = pa.rho_s;
+  r.alpha = r.alpha_x = pa.ax;
+  r.alpha_y = pa.ay;
+  r.sigma_rho_d = pa.sigma_rho_d;
+  r.sigma_rho_s = pa.sigma_rho_s;
+  r.sigma_alpha = r.sigma_alpha_x = pa.sigma_ax;
+  r.sigma_alpha_y = pa.sigma_ay;
+  if (!pa.ok && !pa.message.empty()) r.message = "Ceres: " + pa.message;
+  r.slot_rho_d.assign(in.num_slots, in.fit_rho_d ? r.rho_d : Eigen::Vector3d::Constant(kNan));
+  r.slot_count.assign(in.num_slots, 0);
+  for (const FitSample& s : in.samples) ++r.slot_count[s.slot];
+  const std::vector<int> rows = table.Rows(in);
+  std::vector<Eigen::Vector3d> t = table.Terms(in, rows, r.alpha_x, r.alpha_y);
+  r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
+  if (!in.fit_rho_d || in.num_slots <= 1) return r;
+  // Per-patch albedo from the observations off the highlights (specular part < 10 % of the
+  // radiance): fitted freely per patch, a highlight that only one photo shows would be absorbed
+  // into that patch's albedo instead of constraining ρs and α.
+  LinearSolution patch;
+  patch.rho_s = r.rho_s;
+  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s, r.rho_d);
+  std::vector<int> counts;
+  r.albedo_varies = in.albedo_varies ? *in.albedo_varies : AlbedoVaries(in, pr, patch, t, &counts);
+  if (r.albedo_varies && !in.albedo_varies) {
+    // More parameters must earn their place: the per-patch albedo has to cut the residual of
+    // the constant albedo by 10 % or more.
+    std::vector<Eigen::Vector3d> filled = patch.slot_rho_d;
+    for (Eigen::Vector3d& v : filled) {
+      if (!v.allFinite()) v = r.rho_d;
+    }
+    r.albedo_varies = RelativeRms(in, t, filled, r.rho_s, true) < 0.9 * r.relative_rms;
+  }
+  if (!r.albedo_varies) return r;
+  // The albedo varies: ρs and α again with each patch's albedo held (NaN: the region's), twice.
+  // The held variant copies the samples but not their incident samples: the lobe table has what
+  // the searches need of them (a region with every highlight sample has ~100 MB of them).
+  RegionFitInput held;
+  static_cast<RegionFitSettings&>(held) = in;
+  held.samples = in.samples;
+  held.fit_rho_d = false;
+  AlphaSearch b;
+  if (in.use_held_albedo && FitWithHeldAlbedo(in, &held)) {
+    const Prepared ph = Prepare(held);
+    b = SearchAlpha(held, ph, false, table);
+    t = table.Terms(in, rows, b.ax, b.ay);
+    patch.rho_s = b.linear.rho_s;
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+  }
+  for (int round = 0; round < 2 && !held.use_held_albedo; ++round) {
+    for (FitSample& smp : held.samples) {
+      const Eigen::Vector3d& v = patch.slot_rho_d[smp.slot];
+      smp.rho_d_known = v.allFinite() ? v : r.rho_d;
+    }
+    b = SearchAlpha(held, pr, false, table);
+    t = table.Terms(in, rows, b.ax, b.ay);
+    patch.rho_s = b.linear.rho_s;
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+  }
+  r.albedo_model = AlbedoModel::kPerPatch;
+  r.rho_s = b.linear.rho_s;
+  r.alpha = r.alpha_x = b.ax;
+  r.alpha_y = b.ay;
+  r.slot_rho_d = patch.slot_rho_d;
+  // The region's mean albedo with the lobe fitted: per patch Σ(L − specular)/Σ E/π over all its
+  // samples (a ratio of sums, highlights included), then the area-weighted mean over the patches
+  // that have samples. A ratio of sums over the whole region would weight each patch by its
+  // sample count (the fit samples crowd around the highlights, near cameras give more pixels),
+  // which biases the mean of a textured region toward the tiles that happen to lie there; the
+  // patches' off-highlight albedos favour bright texels near the highlights.
+  {
+    std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const FitSample& smp = in.samples[i];
+      const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
+      const Eigen::Vector3d diffuse = smp.observed - r.rho_s.cwiseProduct(t[i]);
+      num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(diffuse);
+      den[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero(), area = sum;
+    for (int k = 0; k < in.num_slots; ++k) {
+      const double area_k = k < int(in.slot_area.size()) ? in.slot_area[k] : 1.0;
+      for (int c = 0; c < 3; ++c) {
+        if (!(den[k][c] > 0)) continue;
+        sum[c] += area_k * num[k][c] / den[k][c];
+        area[c] += area_k;
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (area[c] > 0) r.rho_d[c] = std::max(0.0, sum[c] / area[c]);
+    }
+  }
+  for (Eigen::Vector3d& v : r.slot_rho_d) {
+    if (!v.allFinite()) v = r.rho_d;
+  }
+  // Uncertainties from the projected problem: ρs from its normal equation, α from the
+  // curvature of the profile cost in log α (the patches' albedos held).
+  const double dof = std::max(1.0, 3.0 * held.samples.size() - 2);
+  const double s2 = b.linear.cost / dof;
+  r.sigma_rho_s = b.linear.sum_v2 > 0 ? std::sqrt(s2 / b.linear.sum_v2) : kNan;
+  r.sigma_alpha = r.sigma_alpha_x = r.sigma_alpha_y =
+      b.curvature_log_alpha > 0 ? r.alpha * std::sqrt(2 * s2 / b.curvature_log_alpha) : kNan;
+  r.sigma_rho_d = Eigen::Vector3d::Constant(kNan);
+  r.relative_rms = RelativeRms(in, t, r.slot_rho_d, r.rho_s, true);
+  return r;
+}
+
+}  // namespace igi

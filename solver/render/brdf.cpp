@@ -1,0 +1,123 @@
+#include "solver/render/brdf.h"
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace igi {
+namespace {
+
+void CheckRgb(const Eigen::Vector3d& rho, const std::string& key,
+              std::vector<BrdfParamProblem>* problems) {
+  for (int c = 0; c < 3; ++c) {
+    if (!(std::isfinite(rho[c]) && rho[c] >= 0.0)) {
+      problems->push_back({key + "[" + std::to_string(c) + "]", rho[c], "must be finite and >= 0"});
+    }
+  }
+}
+
+void CheckAlpha(double alpha, const char* key, std::vector<BrdfParamProblem>* problems) {
+  if (!(std::isfinite(alpha) && alpha > 0.0)) {
+    problems->push_back({key, alpha, "must be finite and > 0"});
+  }
+}
+
+double Mean(const Eigen::Vector3d& v) { return (v[0] + v[1] + v[2]) / 3.0; }
+
+}  // namespace
+
+std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
+  std::vector<BrdfParamProblem> problems;
+  CheckRgb(params.rho_d, "rho_d", &problems);
+  if (HasSpecularLobe(params.model)) {
+    CheckRgb(params.rho_s, "rho_s", &problems);
+    if (IsAnisotropic(params.model)) {
+      CheckAlpha(params.alpha_x, "alpha_x", &problems);
+      CheckAlpha(params.alpha_y, "alpha_y", &problems);
+    } else {
+      CheckAlpha(params.alpha, "alpha", &problems);
+    }
+    if (HasFresnel(params.model) && !(std::isfinite(params.ior) && params.ior > 1.0)) {
+      problems.push_back({"ior", params.ior, "must be finite and > 1"});
+    }
+  }
+  return problems;
+}
+
+double SpecularLobeProbability(const BrdfParams& params) {
+  if (!HasSpecularLobe(params.model)) return 0.0;
+  const double diffuse = Mean(params.rho_d);
+  const double specular = Mean(params.rho_s);
+  const double total = diffuse + specular;
+  return total > 0.0 ? specular / total : 0.0;
+}
+
+namespace brdf_internal {
+
+BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
+                              const Eigen::Vector3d& wi) {
+  BrdfEval out;
+  if (!(wo.z() > 0.0)) return out;
+  const bool above = wi.z() > 0.0;
+  const double p_specular = SpecularLobeProbability(params);
+  if (above) out.f = params.rho_d * kInvPi;
+  out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
+
+  // Shared by f and pdf: the unnormalised half vector and the Gaussian of its slopes.
+  const double ax = params.AlphaX();
+  const double ay = params.AlphaY();
+  const Eigen::Vector3d h = wo + wi;
+  if (!(h.z() > 0.0)) return out;  // no half vector of the upper hemisphere maps here
+  const double hz2 = h.z() * h.z();
+  const double slope_x = h.x() / ax;
+  const double slope_y = h.y() / ay;
+  const double lobe = std::exp(-(slope_x * slope_x + slope_y * slope_y) / hz2);
+  const double h2 = h.squaredNorm();
+  // Half-vector density lobe/(π αx αy cos³θh) times the Jacobian 1/(4 wo·ĥ), with
+  // cosθh = h.z/|h| and wo·ĥ = |h|/2 (since |wo + wi|² = 2 + 2 wo·wi).
+  out.pdf += p_specular * lobe * h2 / (2.0 * kPi * ax * ay * hz2 * h.z());
+  if (above) {
+    double s = IsGmd(params.model) ? h2 * lobe / (kPi * ax * ay * hz2 * hz2)
+                                   : lobe / (4.0 * kPi * ax * ay * std::sqrt(wo.z() * wi.z()));
+    if (HasFresnel(params.model)) s *= FresnelWeight<double>(params.ior, wo, wi);
+    out.f += params.rho_s * s;
+  }
+  return out;
+}
+
+BrdfSample SampleGlossyBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
+                            const Eigen::Vector2d& u) {
+  BrdfSample sample;
+  if (!(wo.z() > 0.0)) return sample;
+  if (u_lobe < SpecularLobeProbability(params)) {
+    sample.lobe = BrdfLobe::kSpecular;
+    // Slopes (h.x/h.z, h.y/h.z) ~ Gaussian with deviations αx/√2, αy/√2 (Box-Muller radius);
+    // 1 - u.x() is in (0, 1], so the log is finite.
+    const double radius = std::sqrt(-std::log(1.0 - u.x()));
+    double sin_phi, cos_phi;
+    SinCos2Pi(u.y(), &sin_phi, &cos_phi);
+    const Eigen::Vector3d h =
+        Eigen::Vector3d(params.AlphaX() * radius * cos_phi, params.AlphaY() * radius * sin_phi, 1.0)
+            .normalized();
+    const double wo_dot_h = wo.dot(h);
+    if (!(wo_dot_h > 0.0)) return sample;  // wo would mirror to the back of h: a failed draw
+    sample.wi = (2.0 * wo_dot_h * h - wo).normalized();
+  } else {
+    sample.lobe = BrdfLobe::kDiffuse;
+    sample.wi = SampleCosineHemisphere(u);
+  }
+  const BrdfEval eval = EvalGlossyBrdfAndPdf(params, wo, sample.wi);
+  sample.f = eval.f;
+  sample.pdf = eval.pdf;
+  if (sample.Valid()) sample.weight = sample.f * (sample.wi.z() / sample.pdf);
+  return sample;
+}
+
+}  // namespace brdf_internal
+
+double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  return EvalBrdfAndPdf(params, wo, wi).pdf;
+}
+
+}  // namespace igi
