@@ -6,9 +6,9 @@
 // with a marker; a rerun resumes from the first unfinished stage (tools/pipeline/pipeline.h).
 #include <cstdio>
 
+#include "tools/common/cli.h"
 #include "tools/pipeline/demo.h"
 #include "tools/pipeline/pipeline.h"
-#include "tools/common/cli.h"
 
 namespace {
 

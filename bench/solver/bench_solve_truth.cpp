@@ -13,8 +13,8 @@
 
 #include "recon/scene.h"
 #include "solver/inverse/albedo_map.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 #include "tools/common/strings.h"

@@ -37,10 +37,9 @@
 
 #include "recon/scene.h"
 #include "solver/inverse/refine_stage.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve_internal.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 
@@ -171,7 +170,7 @@ int main(int argc, char** argv) {
         row.e_ind_raw = s.light.e_indirect[i];
         row.e_ind_smooth = s.light.e[i] - s.light.e_direct[i];
         row.l_photo = o.radiance.cast<double>();
-        const double eps = s.lighting_scenes[lighting]->ray_epsilon;
+        const double eps = s.lighting_scenes[lighting]->ray_epsilon();
         GatherQuery q;
         q.position = o.position.cast<double>();
         const Eigen::Vector3d fn = scene.mesh.FaceNormal(o.triangle).cast<double>();
@@ -203,7 +202,7 @@ int main(int argc, char** argv) {
             const int hr = s.patches.patch_region[is.patch];
             const MaterialState& hm = s.materials[hr];
             const std::optional<SurfaceHit> h =
-                TraceSurface(*s.lighting_scenes[lighting], q.position + q.n_geo * eps, wi);
+                s.lighting_scenes[lighting]->TraceSurface(q.position + q.n_geo * eps, wi);
             if (h && HasSpecularLobe(hm.params.model) && spec_rays > 0) {
               GatherQuery hq;
               hq.position = h->position;
@@ -314,8 +313,8 @@ int main(int argc, char** argv) {
   }
   if (kv["stage2"] != "0") {
     // (e) stage 2's gathering (the path tracer over a scene, RenderIncident in
-    // solver/inverse/refine_stage.h) at the same points, over the true scene and over the stage-1 model the
-    // refinement renders.
+    // solver/inverse/refine_stage.h) at the same points, over the true scene and over the stage-1
+    // model the refinement renders.
     const fs::path tmp =
         fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));
     fs::create_directories(tmp);
@@ -374,7 +373,7 @@ int main(int argc, char** argv) {
   std::vector<int> unseen;
   for (const auto& [q, n] : hits) unseen.push_back(q);
   std::vector<std::array<double, 5>> pe(unseen.size());
-  const Renderer::Impl& ls = *s.lighting_scenes[lighting];
+  const RayScene& ls = *s.lighting_scenes[lighting];
   ParallelFor(
       0, int64_t(unseen.size()),
       [&](int64_t k) {
@@ -387,7 +386,7 @@ int main(int argc, char** argv) {
         Eigen::Vector3d e = Eigen::Vector3d::Zero();
         int ray = 0;
         for (const WeightedDirection& d : HemisphereDirections(gq, ref_rays, 0.2, rng)) {
-          e += d.weight * ref.ReflectedRadiance(gq.position + gq.n_geo * ls.ray_epsilon, d.wi, 1,
+          e += d.weight * ref.ReflectedRadiance(gq.position + gq.n_geo * ls.ray_epsilon(), d.wi, 1,
                                                 uint64_t(q) * 65536 + ray++);
         }
         const GatherPoint& gp = st.gather.points[st.first_patch_point + q];

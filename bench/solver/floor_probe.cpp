@@ -16,11 +16,11 @@
 
 #include "recon/scene.h"
 #include "solver/inverse/held_out_albedo.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve_internal.h"
-#include "solver/synth/synthesize.h"
 #include "solver/inverse/texel_splat.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
+#include "solver/synth/synthesize.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
     // Reference radiance (pixel centre, many paths) and irradiance for a subset of floor samples.
     const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
     const Renderer ref(truth_scene, truth_scene.FindLighting("L0"));
-    const Renderer::Impl& ls = *s.lighting_scenes[0];
+    const RayScene& ls = *s.lighting_scenes[0];
     std::vector<size_t> subset;
     for (size_t i = 0; i < s.obs.size(); i += 13) {
       if (s.obs[i].region == floor) subset.push_back(i);
@@ -144,8 +144,8 @@ int main(int argc, char** argv) {
           Eigen::Vector3d eind = Eigen::Vector3d::Zero();
           Pcg32 rng(5 + i, 3);
           for (const WeightedDirection& d : HemisphereDirections(q, 2048, 0.2, rng)) {
-            eind += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * ls.ray_epsilon, d.wi, 1,
-                                                     1000 * i + 17);
+            eind += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * ls.ray_epsilon(), d.wi,
+                                                     1, 1000 * i + 17);
           }
           const Eigen::Vector3d eref = g.points[0].e_direct.cast<double>() + eind;
           const Eigen::Vector3d r = SampleTexture(tex, uv_of(o));

@@ -12,10 +12,9 @@
 #include <map>
 
 #include "recon/scene.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
 #include "tools/common/json.h"
 #include "tools/common/parallel.h"
 
@@ -67,13 +66,13 @@ int main(int argc, char** argv) {
   const Image mine = model.Render(cam, ro);
   const Image again = reference.Render(true_scene.cameras[true_scene.FindCamera("cam0")], ro);
   // Region of each block's centre pixel.
-  const std::unique_ptr<Renderer::Impl> geo = BuildRenderScene(true_scene, 0);
+  const RayScene geo(true_scene, 0);
   std::map<std::string, std::array<double, 5>> per;  // err², floor², signed err, want, count
   double num = 0, num_f = 0, den = 0;
   for (int by = 0; by + 8 <= validation.height; by += 8) {
     for (int bx = 0; bx + 8 <= validation.width; bx += 8) {
-      const std::optional<SurfaceHit> hit = TraceSurface(
-          *geo, cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(bx + 4, by + 4)));
+      const std::optional<SurfaceHit> hit = geo.TraceSurface(
+          cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(bx + 4, by + 4)));
       const std::string name = hit ? true_scene.materials[hit->region].name : "none";
       for (int c = 0; c < 3; ++c) {
         double w = 0, g = 0, a = 0;

@@ -12,8 +12,7 @@
 #include <optional>
 #include <tuple>
 
-#include "solver/render/render_internal.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 
@@ -485,13 +484,13 @@ PhotoSet MaskedPhotoSet(const PhotoSet& photos, const std::vector<Image>& exclud
 namespace {
 
 // The modelled surface's distance along each pixel's ray (infinity where it escapes).
-Image DepthOf(const Renderer::Impl& impl, const Camera& cam) {
+Image DepthOf(const RayScene& impl, const Camera& cam) {
   Image depth(cam.width, cam.height, 1, std::numeric_limits<float>::infinity());
   const Eigen::Vector3d center = cam.CenterInWorld();
   ParallelFor(0, cam.height, [&](int64_t y) {
     for (int x = 0; x < cam.width; ++x) {
       const std::optional<SurfaceHit> hit =
-          TraceSurface(impl, center, cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5)));
+          impl.TraceSurface(center, cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5)));
       if (hit) depth.at(x, int(y)) = float(hit->t);
     }
   });
@@ -826,11 +825,11 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
   box.extend(box.min() - Eigen::Vector3d::Constant(voxel));
   box.extend(box.max() + Eigen::Vector3d::Constant(voxel));
   const VoxelGrid grid = VoxelGrid::Over(box, voxel);
-  std::vector<std::unique_ptr<Renderer::Impl>> scenes(model.lightings.size());
+  std::vector<std::unique_ptr<RayScene>> scenes(model.lightings.size());
   std::vector<CarveView> views(model.photos.size());
   for (size_t i = 0; i < model.photos.size(); ++i) {
     const Photo& p = model.photos[i];
-    if (!scenes[p.lighting]) scenes[p.lighting] = BuildRenderScene(model, p.lighting);
+    if (!scenes[p.lighting]) scenes[p.lighting] = std::make_unique<RayScene>(model, p.lighting);
     CarveView& v = views[i];
     v.camera = model.cameras[p.camera];
     v.camera_id = p.camera;

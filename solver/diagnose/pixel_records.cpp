@@ -7,30 +7,29 @@
 
 #include "solver/inverse/gather.h"
 #include "solver/inverse/observations.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
 namespace {
 
-std::vector<std::unique_ptr<Renderer::Impl>> LightingScenes(const Scene& scene) {
-  std::vector<std::unique_ptr<Renderer::Impl>> out(scene.lightings.size());
+std::vector<std::unique_ptr<RayScene>> LightingScenes(const Scene& scene) {
+  std::vector<std::unique_ptr<RayScene>> out(scene.lightings.size());
   for (const Photo& p : scene.photos) {
-    if (!out[p.lighting]) out[p.lighting] = BuildRenderScene(scene, p.lighting);
+    if (!out[p.lighting]) out[p.lighting] = std::make_unique<RayScene>(scene, p.lighting);
   }
   return out;
 }
 
 // The region the ray through continuous pixel (x, y) hits first, or -1 (nothing, a light, or a
 // surface that does not reflect).
-int RegionAt(const Renderer::Impl& impl, const Camera& cam, double x, double y) {
+int RegionAt(const RayScene& impl, const Camera& cam, double x, double y) {
   const std::optional<SurfaceHit> hit =
-      TraceSurface(impl, cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(x, y)));
+      impl.TraceSurface(cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(x, y)));
   if (!hit) return -1;
-  const BrdfModel m = impl.materials[hit->region].model;
+  const BrdfModel m = impl.material(hit->region).model;
   return IsReflective(m) ? hit->region : -1;
 }
 
@@ -49,7 +48,7 @@ PhotoSet LoadPhotoSet(const Scene& scene) {
     if (p.mask) mask = ReadImage(*p.mask, 1);
     const double clip = AutoSaturation(img);
     Image& valid = set.valid[i] = Image(img.width, img.height, 1);
-    const Renderer::Impl& impl = *scenes[p.lighting];
+    const RayScene& impl = *scenes[p.lighting];
     ParallelFor(0, img.height, [&](int64_t yy) {
       const int y = int(yy);
       for (int x = 0; x < img.width; ++x) {
@@ -212,8 +211,8 @@ PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int
 
 namespace {
 
-Eigen::Vector3f AlbedoAt(const Scene& model, const Renderer::Impl& impl, const SurfaceHit& hit) {
-  const ShadingMaterial& m = impl.materials[hit.region];
+Eigen::Vector3f AlbedoAt(const Scene& model, const RayScene& impl, const SurfaceHit& hit) {
+  const ShadingMaterial& m = impl.material(hit.region);
   Eigen::Vector3d rho = m.params.rho_d;
   if (m.rho_d_map && model.mesh.has_uvs()) {
     const Eigen::Vector3i& t = model.mesh.triangles[hit.triangle];
@@ -247,17 +246,16 @@ void GatherAmbient(const Light& light, const SurfaceHit& hit, int k, Pcg32& rng,
   }
 }
 
-void GatherLights(const Scene& model, const Renderer::Impl& impl, const SurfaceHit& hit,
-                  int samples, Pcg32& rng, PixelRecord* r) {
-  const double eps = impl.ray_epsilon;
+void GatherLights(const Scene& model, const RayScene& impl, const SurfaceHit& hit, int samples,
+                  Pcg32& rng, PixelRecord* r) {
+  const double eps = impl.ray_epsilon();
   const std::vector<int>& ids = model.lightings[model.photos[r->photo].lighting].lights;
-  for (int l = 0; l < int(impl.lights.size()); ++l) {
-    const LightType type = impl.lights[l].type;
+  for (int l = 0; l < impl.num_lights(); ++l) {
+    const LightType type = impl.light_type(l);
     const bool delta =
         type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
     if (type == LightType::kAmbient) {
-      GatherAmbient(*impl.lights[l].light, hit, 4 * samples, rng, l < int(ids.size()) ? ids[l] : -1,
-                    r);
+      GatherAmbient(*impl.light(l), hit, 4 * samples, rng, l < int(ids.size()) ? ids[l] : -1, r);
       continue;
     }
     const int k = delta ? 1 : samples;
@@ -291,7 +289,7 @@ void GatherRoom(const Renderer& renderer, const ShadingMaterial& m, const Surfac
   q.view = r->view.cast<double>();
   q.lobe = true;
   const double alpha = std::clamp(std::max(m.params.AlphaX(), m.params.AlphaY()), 0.02, 0.5);
-  const double eps = renderer.impl().ray_epsilon;
+  const double eps = renderer.rays().ray_epsilon();
   int k = 0;
   for (const WeightedDirection& d :
        HemisphereDirections(q, PixelRecord::kRoomSamples, 2 * alpha, rng)) {
@@ -340,7 +338,7 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
         const auto [i, y] = row_of[k];
         const Photo& p = model.photos[i];
         const Camera& cam = model.cameras[p.camera];
-        const Renderer::Impl& impl = *scenes[p.lighting];
+        const RayScene& impl = *scenes[p.lighting];
         const Image& rec = photos.recorded[i];
         const double half_diag2 =
             0.25 * (double(cam.width) * cam.width + double(cam.height) * cam.height);
@@ -349,7 +347,7 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
           if (photos.valid[i].at(x, y, 0) < 0.5f) continue;
           const Eigen::Vector3d center = cam.CenterInWorld();
           const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-          const std::optional<SurfaceHit> hit = TraceSurface(impl, center, dir);
+          const std::optional<SurfaceHit> hit = impl.TraceSurface(center, dir);
           if (!hit) continue;
           PixelRecord r;
           r.photo = i;
@@ -390,7 +388,7 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
             r.sim_gradient(c, 1) = gy / 6;
           }
           GatherLights(model, impl, *hit, options.light_samples, rng, &r);
-          const ShadingMaterial& sm = impl.materials[hit->region];
+          const ShadingMaterial& sm = impl.material(hit->region);
           if (renderers[p.lighting] && HasSpecularLobe(sm.model)) {
             // Its own random stream: the lights' samples stay those of a scene without lobes.
             const uint64_t stream = uint64_t(k) * 65537 + uint64_t(x);

@@ -38,7 +38,8 @@ struct PixelRecord {
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // shading normal, toward the camera
   Eigen::Vector3f view = Eigen::Vector3f::Zero();    // unit, toward the camera
   // On a region with a specular lobe: the spread of the shading normals over the pixel, added
-  // to α² wherever the record's lobe is evaluated (Observation::lobe_blur2, solver/inverse/observations.h).
+  // to α² wherever the record's lobe is evaluated (Observation::lobe_blur2,
+  // solver/inverse/observations.h).
   float lobe_blur2 = 0;
   float r2 = 0;  // (distance to the principal point / half the image diagonal)²
   Eigen::Vector3f albedo = Eigen::Vector3f::Zero();     // the model's ρd at the point

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render/brdf.h"
 #include "solver/export/export.h"
 #include "solver/export/ward_fit.h"
+#include "solver/render/brdf.h"
 
 namespace igi::export_internal {
 

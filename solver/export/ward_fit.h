@@ -1,6 +1,6 @@
 #pragma once
-// Fits of a Ward specular lobe (solver/render/brdf.h) by the lobes other renderers implement, for the
-// exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
+// Fits of a Ward specular lobe (solver/render/brdf.h) by the lobes other renderers implement, for
+// the exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
 // values (ρd left out: the diffuse terms map exactly) over a grid of direction pairs covering the
 // lobe: view directions θo in [0°, max_theta_o_deg] (and several azimuths for an anisotropic
 // source), light directions parameterised by the half vector around the source's lobe (tanθh up to

@@ -6,7 +6,7 @@
 #include <functional>
 #include <string>
 
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "solver/inverse/texel_splat.h"
 #include "tools/common/error.h"
 

@@ -1,9 +1,10 @@
 #pragma once
 // Per-texel diffuse albedo maps: the solver's per-point albedo estimates, accumulated
-// into the texels of a region's atlas (solver/inverse/uv_charts.h) and turned into a linear RGB image.
+// into the texels of a region's atlas (solver/inverse/uv_charts.h) and turned into a linear RGB
+// image.
 //
-// Texel convention = the renderer's lookup (solver/render/render.cpp SampleTexture): a UV (u right, v
-// up) sits at x = u·W − 0.5, y = (1 − v)·H − 0.5 in texel units (row 0 = top), and reads the four
+// Texel convention = the renderer's lookup (solver/render/render.cpp SampleTexture): a UV (u right,
+// v up) sits at x = u·W − 0.5, y = (1 − v)·H − 0.5 in texel units (row 0 = top), and reads the four
 // nearest texels bilinearly, indices clamped to the image. Add() splats with exactly those
 // weights (the adjoint of the lookup), so a texel's value is the weighted ratio of the samples
 // whose lookups would read it.

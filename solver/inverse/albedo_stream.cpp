@@ -1,6 +1,6 @@
 // The albedo maps' own pass over the photos (SolverState::StreamAlbedoMaps): when the
-// observations were drawn to a budget (solver/inverse/observation_draw.h), a map built from them alone
-// would have texels as coarse as the drawn observations' spacing. Instead every photo is read
+// observations were drawn to a budget (solver/inverse/observation_draw.h), a map built from them
+// alone would have texels as coarse as the drawn observations' spacing. Instead every photo is read
 // again, one at a time, and every pixel at the stride that sees a mapped region cleanly adds its
 // albedo estimate π(L − ρs·T)/E to the region's map at the photos' own resolution.
 //
@@ -19,12 +19,12 @@
 #include <cmath>
 
 #include "solver/inverse/albedo_map.h"
-#include "solver/render/brdf.h"
 #include "solver/inverse/gather.h"
 #include "solver/inverse/observation_grid.h"
-#include "solver/render/sampling.h"
 #include "solver/inverse/solve_internal.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/sampling.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
@@ -68,7 +68,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
     const Photo& photo = scene.photos[i];
     const Camera& cam = scene.cameras[photo.camera];
     const int l = photo.lighting;
-    const Renderer::Impl& geometry = *lighting_scenes[l];
+    const RayScene& geometry = *lighting_scenes[l];
     const LoadedPhoto loaded = LoadPhoto(int(i));
     const std::vector<uint8_t>* mask = loaded.mask.empty() ? nullptr : &loaded.mask;
     const double saturation =
@@ -86,7 +86,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
               continue;
             }
             const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-            const std::optional<SurfaceHit> hit = TraceSurface(geometry, eye, dir);
+            const std::optional<SurfaceHit> hit = geometry.TraceSurface(eye, dir);
             if (!hit || !mapped[hit->region]) continue;
             const auto quarter = QuarterPixelNormals(geometry, cam, x, y, *hit, cos_edge, 0.01);
             if (!quarter) continue;

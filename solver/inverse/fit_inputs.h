@@ -1,7 +1,7 @@
 #pragma once
-// Internal to igi_solver: what the region fits (solver/inverse/region_fit.h) are given, from the solve's
-// data: each fitted region's knowns and hints from the material estimate, and one sample per fit
-// observation with its irradiance and incident light from the light model.
+// Internal to igi_solver: what the region fits (solver/inverse/region_fit.h) are given, from the
+// solve's data: each fitted region's knowns and hints from the material estimate, and one sample
+// per fit observation with its irradiance and incident light from the light model.
 
 #include <vector>
 

@@ -7,8 +7,8 @@
 #include <numeric>
 
 #include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
@@ -57,9 +57,9 @@ bool SampleBounce(const Eigen::Vector3d& wo, double lobe_alpha, Pcg32& rng, Eige
 }
 
 // The specular bounce at `hit` of an indirect ray along `dir`; false where none can be drawn.
-bool TraceBounce(const Renderer::Impl& scene, const PatchSet& patches, const SurfaceHit& hit,
+bool TraceBounce(const RayScene& scene, const PatchSet& patches, const SurfaceHit& hit,
                  const Eigen::Vector3d& dir, double lobe_alpha, Pcg32& rng, PointSamples* out) {
-  const Frame frame = ShadingFrame(scene.scene->materials[hit.region], hit.n_s);
+  const Frame frame = ShadingFrame(scene.scene().materials[hit.region], hit.n_s);
   const Eigen::Vector3d wo = frame.ToLocal(-dir);
   if (!(wo.z() > 0)) return false;
   Eigen::Vector3d wi;
@@ -73,8 +73,8 @@ bool TraceBounce(const Renderer::Impl& scene, const PatchSet& patches, const Sur
   b.weight = static_cast<float>(weight);
   ++out->rays;
   const std::optional<SurfaceHit> next =
-      TraceSurface(scene, hit.position + hit.n_geo * scene.ray_epsilon, wi_world);
-  if (next && IsReflective(scene.scene->materials[next->region].brdf)) {
+      scene.TraceSurface(hit.position + hit.n_geo * scene.ray_epsilon(), wi_world);
+  if (next && IsReflective(scene.scene().materials[next->region].brdf)) {
     b.patch = patches.PatchOf(next->triangle, next->b1, next->b2);
   }
   out->bounces.push_back(b);
@@ -122,14 +122,14 @@ Eigen::Vector2d PixelStratum(int s, int k, Pcg32& rng) {
   return u;
 }
 
-void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_samples,
+void GatherDirect(const RayScene& scene, const GatherQuery& q, int light_samples,
                   int footprint_samples, Pcg32& rng, PointSamples* out) {
-  const double eps = scene.ray_epsilon;
+  const double eps = scene.ray_epsilon();
   const bool footprint = q.footprint.has_value();
-  for (int l = 0; l < static_cast<int>(scene.lights.size()); ++l) {
-    const LightType type = scene.lights[l].type;
+  for (int l = 0; l < scene.num_lights(); ++l) {
+    const LightType type = scene.light_type(l);
     if (type == LightType::kAmbient) {
-      GatherAmbient(scene.lights[l].light->radiance, q, 4 * light_samples, rng, out);
+      GatherAmbient(scene.light(l)->radiance, q, 4 * light_samples, rng, out);
       continue;
     }
     const bool delta =
@@ -168,8 +168,8 @@ void GatherDirect(const Renderer::Impl& scene, const GatherQuery& q, int light_s
 
 }  // namespace
 
-Eigen::Vector3f GatherDirectAt(const Renderer::Impl& scene, const GatherQuery& query,
-                               int light_samples, int footprint_samples, Pcg32& rng,
+Eigen::Vector3f GatherDirectAt(const RayScene& scene, const GatherQuery& query, int light_samples,
+                               int footprint_samples, Pcg32& rng,
                                std::vector<DirectSample>* samples) {
   PointSamples ps;
   GatherDirect(scene, query, light_samples, footprint_samples, rng, &ps);
@@ -179,19 +179,19 @@ Eigen::Vector3f GatherDirectAt(const Renderer::Impl& scene, const GatherQuery& q
 
 namespace {
 
-void GatherIndirect(const Renderer::Impl& scene, const PatchSet& patches, const GatherQuery& q,
+void GatherIndirect(const RayScene& scene, const PatchSet& patches, const GatherQuery& q,
                     const GatherOptions& options, Pcg32& rng, PointSamples* out) {
-  const double eps = scene.ray_epsilon;
+  const double eps = scene.ray_epsilon();
   for (const WeightedDirection& d :
        HemisphereDirections(q, options.indirect_rays, options.lobe_alpha, rng)) {
     IndirectSample is;
     is.wi = d.wi.cast<float>();
     is.weight = static_cast<float>(d.weight);
     ++out->rays;
-    const std::optional<SurfaceHit> hit = TraceSurface(scene, q.position + q.n_geo * eps, d.wi);
-    if (hit && IsReflective(scene.scene->materials[hit->region].brdf)) {
+    const std::optional<SurfaceHit> hit = scene.TraceSurface(q.position + q.n_geo * eps, d.wi);
+    if (hit && IsReflective(scene.scene().materials[hit->region].brdf)) {
       is.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
-      if (options.specular_bounces && HasSpecularLobe(scene.scene->materials[hit->region].brdf) &&
+      if (options.specular_bounces && HasSpecularLobe(scene.scene().materials[hit->region].brdf) &&
           TraceBounce(scene, patches, *hit, d.wi, options.lobe_alpha, rng, out)) {
         is.bounce = static_cast<int>(out->bounces.size()) - 1;  // local; rebased in Gather()
       }
@@ -259,7 +259,7 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
   return out;
 }
 
-GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
+GatherSet Gather(const RayScene& scene, const PatchSet& patches,
                  const std::vector<GatherQuery>& queries, const GatherOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const int64_t n = static_cast<int64_t>(queries.size());

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "solver/inverse/patches.h"
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
 
 namespace igi {
@@ -122,13 +122,13 @@ struct WeightedDirection {
 std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
                                                     Pcg32& rng);
 
-GatherSet Gather(const Renderer::Impl& scene, const PatchSet& patches,
+GatherSet Gather(const RayScene& scene, const PatchSet& patches,
                  const std::vector<GatherQuery>& queries, const GatherOptions& options);
 
 // The direct light at one query point alone (Gather's direct samples for it): appends its
 // samples to *samples and returns their sum, the direct irradiance.
-Eigen::Vector3f GatherDirectAt(const Renderer::Impl& scene, const GatherQuery& query,
-                               int light_samples, int footprint_samples, Pcg32& rng,
+Eigen::Vector3f GatherDirectAt(const RayScene& scene, const GatherQuery& query, int light_samples,
+                               int footprint_samples, Pcg32& rng,
                                std::vector<DirectSample>* samples);
 
 }  // namespace igi

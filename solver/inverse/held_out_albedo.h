@@ -5,8 +5,8 @@
 // around a point with that photo's own sums taken out, so a highlight sample's albedo never comes
 // from the highlight's own pixels (which would absorb part of the lobe into the albedo).
 //
-// Texel convention and splat weights are AlbedoMapBuilder's (solver/inverse/albedo_map.h): a sample adds
-// to the 4 texels its bilinear lookup would read.
+// Texel convention and splat weights are AlbedoMapBuilder's (solver/inverse/albedo_map.h): a sample
+// adds to the 4 texels its bilinear lookup would read.
 
 #include <Eigen/Core>
 #include <array>

@@ -1,5 +1,5 @@
-// Highlight coverage (solver/inverse/highlight_coverage.h): which observations see a specular highlight,
-// and where a camera would need to stand for a region that none shows.
+// Highlight coverage (solver/inverse/highlight_coverage.h): which observations see a specular
+// highlight, and where a camera would need to stand for a region that none shows.
 #include "solver/inverse/highlight_coverage.h"
 
 #include <fmt/format.h>
@@ -11,7 +11,7 @@
 #include <optional>
 #include <set>
 
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
@@ -50,9 +50,9 @@ struct LightDir {
 };
 
 // Samples of `light` above the surface (n_geo) at p: one for delta lights, `samples` otherwise.
-void SampleLightDirs(const Renderer::Impl& impl, int light, const Vector3d& p,
-                     const Vector3d& n_geo, int samples, Pcg32* rng, std::vector<LightDir>* out) {
-  const LightType type = impl.lights[light].type;
+void SampleLightDirs(const RayScene& impl, int light, const Vector3d& p, const Vector3d& n_geo,
+                     int samples, Pcg32* rng, std::vector<LightDir>* out) {
+  const LightType type = impl.light_type(light);
   if (type == LightType::kAmbient) return;  // light from everywhere: no highlight to place
   const bool delta =
       type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
@@ -65,11 +65,10 @@ void SampleLightDirs(const Renderer::Impl& impl, int light, const Vector3d& p,
   }
 }
 
-// The shadow test of the renderer (solver/render/render.cpp): offset origin, segment stopped short of
-// the light.
-bool Shadowed(const Renderer::Impl& impl, const Vector3d& p, const Vector3d& n_geo,
-              const LightDir& d) {
-  const double eps = impl.ray_epsilon;
+// The shadow test of the renderer (solver/render/render.cpp): offset origin, segment stopped short
+// of the light.
+bool Shadowed(const RayScene& impl, const Vector3d& p, const Vector3d& n_geo, const LightDir& d) {
+  const double eps = impl.ray_epsilon();
   const double distance =
       std::isfinite(d.distance) ? d.distance - std::max(4 * eps, 1e-6 * d.distance) : d.distance;
   return impl.Occluded(p + n_geo * eps, d.wi, distance, d.light);
@@ -87,16 +86,16 @@ double TanRatio(const Vector3d& n, const Vector3d& wi, const Vector3d& view, dou
 
 // The smallest tanθh / α over the unshadowed light samples seen by one observation. Samples are
 // tested for shadow in order of increasing ratio, so usually one shadow ray suffices.
-double ObservationMinRatio(const Renderer::Impl& impl, const Observation& o, double alpha,
+double ObservationMinRatio(const RayScene& impl, const Observation& o, double alpha,
                            const HighlightCoverageOptions& options, uint64_t index) {
   const Vector3d p = o.position.cast<double>();
   const Vector3d n = o.normal.cast<double>().normalized();
   const Vector3d v = o.view.cast<double>().normalized();
-  Vector3d n_geo = impl.triangles[o.triangle].normal;
+  Vector3d n_geo = impl.face_normal(o.triangle);
   if (n_geo.dot(v) < 0) n_geo = -n_geo;
   Pcg32 rng(options.seed, index);
   std::vector<LightDir> dirs;
-  for (int l = 0; l < static_cast<int>(impl.lights.size()); ++l) {
+  for (int l = 0; l < impl.num_lights(); ++l) {
     SampleLightDirs(impl, l, p, n_geo, options.light_samples, &rng, &dirs);
   }
   std::vector<std::pair<double, size_t>> order;
@@ -111,9 +110,8 @@ double ObservationMinRatio(const Renderer::Impl& impl, const Observation& o, dou
   return kInf;
 }
 
-const Renderer::Impl* LightingScene(const Scene& scene,
-                                    const std::vector<std::unique_ptr<Renderer::Impl>>& scenes,
-                                    int photo) {
+const RayScene* LightingScene(const Scene& scene,
+                              const std::vector<std::unique_ptr<RayScene>>& scenes, int photo) {
   if (photo < 0 || photo >= static_cast<int>(scene.photos.size())) return nullptr;
   const int lighting = scene.photos[photo].lighting;
   if (lighting < 0 || lighting >= static_cast<int>(scenes.size())) return nullptr;
@@ -122,7 +120,7 @@ const Renderer::Impl* LightingScene(const Scene& scene,
 
 // Fills observed, highlight_pixels, observations, photos and min_tan_theta_h_over_alpha.
 void AnalyseObservations(const Scene& scene, const std::vector<Observation>& observations,
-                         const std::vector<std::unique_ptr<Renderer::Impl>>& scenes,
+                         const std::vector<std::unique_ptr<RayScene>>& scenes,
                          const HighlightCoverageOptions& options, const std::vector<int>& slot,
                          std::vector<RegionHighlightCoverage>* coverage) {
   const int64_t count = static_cast<int64_t>(observations.size());
@@ -133,9 +131,9 @@ void AnalyseObservations(const Scene& scene, const std::vector<Observation>& obs
       [&](int64_t i) {
         const Observation& o = observations[i];
         if (o.region < 0 || o.region >= static_cast<int>(slot.size()) || slot[o.region] < 0) return;
-        const Renderer::Impl* impl = LightingScene(scene, scenes, o.photo);
+        const RayScene* impl = LightingScene(scene, scenes, o.photo);
         if (impl == nullptr) return;
-        if (o.triangle < 0 || o.triangle >= static_cast<int>(impl->triangles.size())) {
+        if (o.triangle < 0 || o.triangle >= static_cast<int>(impl->scene().mesh.num_triangles())) {
           throw Error(fmt::format("observation {}: triangle {} out of range", i, o.triangle));
         }
         analysed[i] = 1;
@@ -214,7 +212,7 @@ struct LitPoint {
   std::vector<LightDir> dirs;
 };
 
-std::vector<LitPoint> LightRegion(const Renderer::Impl& impl, int light,
+std::vector<LitPoint> LightRegion(const RayScene& impl, int light,
                                   const std::vector<SurfacePoint>& points,
                                   const HighlightCoverageOptions& options) {
   std::vector<LitPoint> lit;
@@ -274,22 +272,22 @@ double BoxExit(const Bounds& b, const Vector3d& o, const Vector3d& d) {
 
 // A camera centre along the mirror direction of the light at lp, `distance` away or shortened
 // to stay in front of the first surface hit and inside the scene's bounds.
-std::optional<Vector3d> MirrorCamera(const Renderer::Impl& impl, const LitPoint& lp,
-                                     double distance, const Bounds& bounds) {
+std::optional<Vector3d> MirrorCamera(const RayScene& impl, const LitPoint& lp, double distance,
+                                     const Bounds& bounds) {
   Vector3d l = Vector3d::Zero();
   for (const LightDir& d : lp.dirs) l += d.wi;
   l.normalize();
   const Vector3d r = (2 * lp.s.n.dot(l) * lp.s.n - l).normalized();
   if (!(r.dot(lp.s.n_geo) > 0.05)) return std::nullopt;  // grazing or below the surface
-  const Vector3d o = lp.s.p + lp.s.n_geo * impl.ray_epsilon;
+  const Vector3d o = lp.s.p + lp.s.n_geo * impl.ray_epsilon();
   double d = std::min(distance, BoxExit(bounds, o, r));
-  if (const std::optional<Hit> hit = impl.Intersect(o, r, d)) d = std::min(d, 0.9 * hit->t);
+  if (const std::optional<RayHit> hit = impl.Intersect(o, r, d)) d = std::min(d, 0.9 * hit->t);
   if (!(d >= kMinDistanceFraction * distance)) return std::nullopt;
   return lp.s.p + r * d;
 }
 
 // Whether a camera at c sees lp's highlight: in front, unoccluded, inside the lobe.
-bool SeesHighlight(const Renderer::Impl& impl, const LitPoint& lp, const Vector3d& c, double alpha,
+bool SeesHighlight(const RayScene& impl, const LitPoint& lp, const Vector3d& c, double alpha,
                    double factor) {
   const Vector3d to = c - lp.s.p;
   const double dist = to.norm();
@@ -299,13 +297,13 @@ bool SeesHighlight(const Renderer::Impl& impl, const LitPoint& lp, const Vector3
   bool inside = false;
   for (const LightDir& d : lp.dirs) inside = inside || TanRatio(lp.s.n, d.wi, v, alpha) < factor;
   if (!inside) return false;
-  const double eps = impl.ray_epsilon;
+  const double eps = impl.ray_epsilon();
   return !impl.Occluded(lp.s.p + lp.s.n_geo * eps, v, dist - std::max(4 * eps, 1e-6 * dist));
 }
 
 // Number of lit points whose highlight a camera at c looking at `target` sees in its field;
 // zero when it does not see target's own highlight.
-int ScoreCamera(const Renderer::Impl& impl, const std::vector<LitPoint>& lit, size_t target,
+int ScoreCamera(const RayScene& impl, const std::vector<LitPoint>& lit, size_t target,
                 const Vector3d& c, double alpha, double factor) {
   if (!SeesHighlight(impl, lit[target], c, alpha, factor)) return 0;
   const Vector3d axis = (lit[target].s.p - c).normalized();
@@ -318,8 +316,8 @@ int ScoreCamera(const Renderer::Impl& impl, const std::vector<LitPoint>& lit, si
   return count;
 }
 
-std::string LightName(const RenderLight& rl) {
-  return rl.light != nullptr ? rl.light->name : std::string("the emitting surfaces");
+std::string LightName(const Light* light) {
+  return light != nullptr ? light->name : std::string("the emitting surfaces");
 }
 
 std::string SuggestionText(const HighlightSuggestion& s, const std::string& region) {
@@ -340,9 +338,8 @@ struct SuggestContext {
 };
 
 // The best camera for one light of one lighting, or nullopt when no point offers one.
-std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx,
-                                                   const Renderer::Impl& impl, int light,
-                                                   const RegionHighlightCoverage& c) {
+std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx, const RayScene& impl,
+                                                   int light, const RegionHighlightCoverage& c) {
   const std::vector<LitPoint> lit = LightRegion(impl, light, *ctx.points, *ctx.options);
   std::vector<int> score(lit.size(), 0);
   std::vector<Vector3d> camera(lit.size(), Vector3d::Zero());
@@ -356,8 +353,8 @@ std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx,
   if (best == score.end() || *best == 0) return std::nullopt;
   const size_t i = best - score.begin();
   HighlightSuggestion s;
-  s.lighting = ctx.scene->lightings[impl.lighting].name;
-  s.light = LightName(impl.lights[light]);
+  s.lighting = ctx.scene->lightings[impl.lighting()].name;
+  s.light = LightName(impl.light(light));
   s.position = camera[i];
   s.look_at = lit[i].s.p;
   s.distance_m = (s.position - s.look_at).norm();
@@ -393,7 +390,7 @@ double WantedDistance(const Scene& scene, const std::vector<Observation>& observ
 }
 
 void Suggest(const Scene& scene, const std::vector<Observation>& observations,
-             const std::vector<std::unique_ptr<Renderer::Impl>>& scenes,
+             const std::vector<std::unique_ptr<RayScene>>& scenes,
              const HighlightCoverageOptions& options, RegionHighlightCoverage* c) {
   double area = 0;
   const std::vector<SurfacePoint> points =
@@ -401,9 +398,9 @@ void Suggest(const Scene& scene, const std::vector<Observation>& observations,
   if (points.empty()) return;
   SuggestContext ctx{&scene, &points, area, 0, SceneBounds(scene), &options};
   ctx.distance = WantedDistance(scene, observations, c->region, points, ctx.bounds);
-  for (const std::unique_ptr<Renderer::Impl>& impl : scenes) {
+  for (const std::unique_ptr<RayScene>& impl : scenes) {
     if (impl == nullptr) continue;
-    for (int l = 0; l < static_cast<int>(impl->lights.size()); ++l) {
+    for (int l = 0; l < impl->num_lights(); ++l) {
       if (auto s = SuggestForLight(ctx, *impl, l, *c)) c->suggestions.push_back(std::move(*s));
     }
   }
@@ -446,7 +443,7 @@ void HighlightCoverageOptions::Validate() const {
 
 std::vector<RegionHighlightCoverage> AnalyseHighlightCoverage(
     const Scene& scene, const std::vector<Observation>& observations,
-    const std::vector<std::unique_ptr<Renderer::Impl>>& lighting_scenes,
+    const std::vector<std::unique_ptr<RayScene>>& lighting_scenes,
     const HighlightCoverageOptions& options) {
   options.Validate();
   std::vector<RegionHighlightCoverage> coverage;

@@ -57,12 +57,12 @@ struct RegionHighlightCoverage {
 };
 
 // For every region whose material has a specular lobe (HasSpecularLobe) and an unknown ρs or
-// roughness, in material order. `lighting_scenes[l]` is BuildRenderScene(scene, l), or null for
-// a lighting not photographed (observations under a null lighting are not analysed;
+// roughness, in material order. `lighting_scenes[l]` is std::make_unique<RayScene>(scene, l), or
+// null for a lighting not photographed (observations under a null lighting are not analysed;
 // suggestions use the non-null lightings only).
 std::vector<RegionHighlightCoverage> AnalyseHighlightCoverage(
     const Scene& scene, const std::vector<Observation>& observations,
-    const std::vector<std::unique_ptr<Renderer::Impl>>& lighting_scenes,
+    const std::vector<std::unique_ptr<RayScene>>& lighting_scenes,
     const HighlightCoverageOptions& options);
 
 // A JSON array for report.json: one object per region (infinity written as null).

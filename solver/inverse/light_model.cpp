@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-#include "solver/render/brdf.h"
 #include "solver/inverse/neighbour_mean.h"
 #include "solver/inverse/observations.h"
+#include "solver/render/brdf.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
@@ -173,8 +173,8 @@ Eigen::Vector3d PatchRadiance(const PatchSet& patches, const MaterialEstimate& m
 }
 
 // The specular radiance an indirect sample's glossy hit reflects back along the sample from its
-// bounce (solver/inverse/gather.h): ρs·S·W(wo, wi)·weight times the diffuse radiance of the patch the
-// bounce meets (the specular part of that radiance is left out: second order in ρs).
+// bounce (solver/inverse/gather.h): ρs·S·W(wo, wi)·weight times the diffuse radiance of the patch
+// the bounce meets (the specular part of that radiance is left out: second order in ρs).
 Eigen::Vector3d BounceRadiance(const PatchSet& patches, const MaterialEstimate& materials,
                                const LightingState& st, const IndirectSample& s) {
   if (s.bounce < 0 || s.patch < 0) return Eigen::Vector3d::Zero();

@@ -1,10 +1,10 @@
 #pragma once
 // Internal to igi_solver: the light a solve models at its observations. Per lighting, the gather
-// (solver/inverse/gather.h: its observations' points first, then one per patch) and the radiance leaving
-// each patch; per observation, in the observation set's order (solver/inverse/observation_set.h), its
-// direct and indirect irradiance (the indirect smoothed over neighbours into `e`), its incident
-// samples in the local frame (regions with a specular lobe) and its specular term T = Σ S·W·v at
-// the current α.
+// (solver/inverse/gather.h: its observations' points first, then one per patch) and the radiance
+// leaving each patch; per observation, in the observation set's order
+// (solver/inverse/observation_set.h), its direct and indirect irradiance (the indirect smoothed
+// over neighbours into `e`), its incident samples in the local frame (regions with a specular lobe)
+// and its specular term T = Σ S·W·v at the current α.
 
 #include <Eigen/Core>
 #include <vector>
@@ -81,7 +81,8 @@ struct LightModel {
 
 // The mean of `values` (per observation) over each observation's neighbours: same region,
 // normals within ~25°, within `radius` (or point_radius[i], each at most `radius`), and
-// (same_photo) in the same photo, else any photo of the same lighting (solver/inverse/neighbour_mean.h).
+// (same_photo) in the same photo, else any photo of the same lighting
+// (solver/inverse/neighbour_mean.h).
 std::vector<Eigen::Vector3d> NeighbourMean(const ObservationSet& obs,
                                            const std::vector<LightingState>& lightings,
                                            const std::vector<Eigen::Vector3d>& values,

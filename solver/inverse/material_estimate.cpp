@@ -1,7 +1,7 @@
 #include "solver/inverse/material_estimate.h"
 
 #include "solver/inverse/held_out_albedo.h"
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 
 namespace igi {
 

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render/brdf.h"
 #include "solver/inverse/observation_set.h"
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
-#include "solver/render/sampling.h"
 #include "solver/inverse/uv_charts.h"
+#include "solver/render/brdf.h"
+#include "solver/render/sampling.h"
 #include "tools/common/image.h"
 
 namespace igi {
@@ -36,8 +36,8 @@ struct MaterialState {
   Eigen::Vector3d map_scale = Eigen::Vector3d::Ones();
   int observations = 0;
   // A region no photo sees whose ρd was fitted to the light it bounces onto the seen regions
-  // (FitUnobservedAlbedos in solver/inverse/paper_stage.h): its relative uncertainty per channel (NaN: not
-  // fitted).
+  // (FitUnobservedAlbedos in solver/inverse/paper_stage.h): its relative uncertainty per channel
+  // (NaN: not fitted).
   Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
   bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
 };
@@ -47,8 +47,8 @@ struct MaterialEstimate {
   std::vector<std::vector<int>> region_patches;  // per region: its patches (slot order)
   std::vector<int> patch_slot;                   // per patch: index within its region
   // Per observation of a textured glossy region: the other photos' observations off the
-  // highlights at the albedo map's texel (solver/inverse/held_out_albedo.h): their πL/E and their lobe
-  // per unit ρs, πT/E (the albedo is the first less ρs times the second); NaN elsewhere.
+  // highlights at the albedo map's texel (solver/inverse/held_out_albedo.h): their πL/E and their
+  // lobe per unit ρs, πT/E (the albedo is the first less ρs times the second); NaN elsewhere.
   std::vector<Eigen::Vector3d> held_rho_d, held_lobe;
   std::vector<std::unique_ptr<RegionAtlas>> held_atlases;  // per region, built when needed
 
@@ -76,8 +76,8 @@ struct MaterialEstimate {
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every fit sample's
 // albedo as the other photos see it off their highlights (modelled specular part ρs·t under 10 %
 // of the modelled radiance in every channel), per texel of `texel_size_m`, into
-// estimate->held_rho_d and held_lobe (solver/inverse/held_out_albedo.h). `e` and `t`: per observation,
-// its irradiance and its specular term per unit ρs.
+// estimate->held_rho_d and held_lobe (solver/inverse/held_out_albedo.h). `e` and `t`: per
+// observation, its irradiance and its specular term per unit ρs.
 void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d>& e,
                     const std::vector<Eigen::Vector3d>& t, const TriangleMesh& mesh,
                     double texel_size_m, MaterialEstimate* estimate);

@@ -1,6 +1,6 @@
 #pragma once
-// Small numerical helpers of the region fits (solver/inverse/region_fit.cpp), written here because no
-// dependency of igi offers them: Ceres has no public one-dimensional minimiser (Boost.Math's
+// Small numerical helpers of the region fits (solver/inverse/region_fit.cpp), written here because
+// no dependency of igi offers them: Ceres has no public one-dimensional minimiser (Boost.Math's
 // brent_find_minima is not among the Debian packages igi uses), and libm's expf is a call per
 // value, which keeps a loop of them from being vectorised.
 

@@ -5,16 +5,16 @@
 #include <limits>
 
 #include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
 
-bool NearHighlight(const Renderer::Impl& lighting, const Eigen::Vector3d& position,
+bool NearHighlight(const RayScene& lighting, const Eigen::Vector3d& position,
                    const Eigen::Vector3d& view, const Eigen::Vector3d& normal) {
-  for (int l = 0; l < int(lighting.lights.size()); ++l) {
-    if (lighting.lights[l].type == LightType::kAmbient) continue;
+  for (int l = 0; l < lighting.num_lights(); ++l) {
+    if (lighting.light_type(l) == LightType::kAmbient) continue;
     const LightSample s = lighting.SampleLight(l, position, Eigen::Vector3d(0.5, 0.5, 0.5));
     const Eigen::Vector3d h = (s.wi + view).normalized();
     const double c = h.dot(normal);
@@ -46,16 +46,17 @@ double PixelsAtStride(const Scene& scene, int pixel_stride) {
   return n;
 }
 
-std::vector<RegionPixelCensus> CensusPixels(
-    const Scene& scene, const std::vector<const Renderer::Impl*>& lighting_scenes,
-    const std::vector<char>& lobe_class, const ObservationDrawOptions& options) {
+std::vector<RegionPixelCensus> CensusPixels(const Scene& scene,
+                                            const std::vector<const RayScene*>& lighting_scenes,
+                                            const std::vector<char>& lobe_class,
+                                            const ObservationDrawOptions& options) {
   const size_t regions = scene.materials.size();
   std::vector<RegionPixelCensus> census(regions);
   const int stride = options.pixel_stride;
   for (size_t i = 0; i < scene.photos.size(); ++i) {
     const Photo& photo = scene.photos[i];
     const Camera& cam = scene.cameras[photo.camera];
-    const Renderer::Impl* geometry = lighting_scenes[photo.lighting];
+    const RayScene* geometry = lighting_scenes[photo.lighting];
     if (geometry == nullptr) continue;
     const int cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
     // Every step-th pixel of the stride's grid in x and y, each standing for step² of them.
@@ -75,7 +76,7 @@ std::vector<RegionPixelCensus> CensusPixels(
             const int x = gx * step * stride + stride / 2;
             if (x >= cam.width) break;
             const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-            const std::optional<SurfaceHit> hit = TraceSurface(*geometry, center, dir);
+            const std::optional<SurfaceHit> hit = geometry->TraceSurface(center, dir);
             if (!hit || !IsReflective(scene.materials[hit->region].brdf)) continue;
             const bool near =
                 lobe_class[hit->region] && NearHighlight(*geometry, hit->position, -dir, hit->n_s);

@@ -10,11 +10,11 @@ namespace {
 // Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
 // drawn with the same probability by a hash of its photo and pixel; returns how many it marked.
 // The indices were themselves collected with probability `collected` by the same hash
-// (solver/inverse/observation_draw.h), so this draw is nested in that one: a pixel is marked when its
-// hash falls under `collected` × count / indices.size().
-// Not by the observation's index: a change to one photo's observations (its pose, its mask, a
-// pixel that passes an edge test or not) shifts every later photo's indices and redraws them
-// all, and a faint lobe's ρs moved by up to 11 points with the draw alone (bench/RESULTS.md).
+// (solver/inverse/observation_draw.h), so this draw is nested in that one: a pixel is marked when
+// its hash falls under `collected` × count / indices.size(). Not by the observation's index: a
+// change to one photo's observations (its pose, its mask, a pixel that passes an edge test or not)
+// shifts every later photo's indices and redraws them all, and a faint lobe's ρs moved by up to 11
+// points with the draw alone (bench/RESULTS.md).
 size_t DrawSubset(const std::vector<Observation>& obs, const std::vector<int>& indices,
                   size_t count, double collected, std::vector<char>* chosen) {
   size_t marked = 0;

@@ -1,12 +1,12 @@
 #pragma once
-// Internal to igi_solver: the observations one solve fits (solver/inverse/observations.h), as a set: the
-// observations themselves, the draw they were collected under (solver/inverse/observation_draw.h) and
-// which of them the region fits use (the fit samples).
+// Internal to igi_solver: the observations one solve fits (solver/inverse/observations.h), as a
+// set: the observations themselves, the draw they were collected under
+// (solver/inverse/observation_draw.h) and which of them the region fits use (the fit samples).
 //
 // The set is the solve's first product (read from the photos, then fixed except for their
-// radiance's units: solver/inverse/photometric_scale.h); the light model (solver/inverse/light_model.h) and the
-// material estimate (solver/inverse/material_estimate.h) hold their per-observation values in the set's
-// order.
+// radiance's units: solver/inverse/photometric_scale.h); the light model
+// (solver/inverse/light_model.h) and the material estimate (solver/inverse/material_estimate.h)
+// hold their per-observation values in the set's order.
 
 #include <cstddef>
 #include <vector>

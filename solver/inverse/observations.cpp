@@ -7,41 +7,10 @@
 
 #include "solver/inverse/observation_draw.h"
 #include "solver/inverse/patches.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
-
-std::optional<SurfaceHit> TraceSurface(const Renderer::Impl& scene, const Eigen::Vector3d& origin,
-                                       const Eigen::Vector3d& dir) {
-  const std::optional<Hit> hit = scene.Intersect(origin, dir);
-  if (!hit || hit->geometry != 0 || hit->sphere_light >= 0) return std::nullopt;
-  const TriangleMesh& mesh = scene.scene->mesh;
-  SurfaceHit s;
-  s.triangle = hit->primitive;
-  s.b1 = hit->u;
-  s.b2 = hit->v;
-  s.t = hit->t;
-  s.position = origin + hit->t * dir;
-  const TriangleShading& ts = scene.triangles[s.triangle];
-  s.region = ts.material;
-  s.n_geo = ts.normal;
-  s.n_s = s.n_geo;
-  if (!ts.flat) {
-    const Eigen::Vector3i& tri = mesh.triangles[s.triangle];
-    const double b0 = 1.0 - s.b1 - s.b2;
-    s.n_s = (b0 * mesh.normals[tri[0]] + s.b1 * mesh.normals[tri[1]] + s.b2 * mesh.normals[tri[2]])
-                .cast<double>()
-                .normalized();
-  }
-  s.front = s.n_geo.dot(dir) < 0;
-  if (!s.front) {
-    s.n_geo = -s.n_geo;
-    s.n_s = -s.n_s;
-  }
-  if (!(s.n_s.dot(-dir) > 0)) s.n_s = s.n_geo;
-  return s;
-}
 
 double AutoSaturation(const Image& image) {
   float max_value = 0;
@@ -83,7 +52,7 @@ bool OnPieceOf(const std::optional<SurfaceHit>& h, const SurfaceHit& centre, dou
 
 }  // namespace
 
-std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer::Impl& geometry,
+std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const RayScene& geometry,
                                                                   const Camera& camera, int x,
                                                                   int y, const SurfaceHit& centre,
                                                                   double cos_min, double max_offset,
@@ -93,7 +62,7 @@ std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const Renderer
   for (int k = 0; k < 4; ++k) {
     const double ox = ((k & 1) ? 0.75 : 0.25) * size, oy = ((k & 2) ? 0.75 : 0.25) * size;
     const std::optional<SurfaceHit> h =
-        TraceSurface(geometry, eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
+        geometry.TraceSurface(eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
     if (!OnPieceOf(h, centre, cos_min, max_offset)) return std::nullopt;
     normals[k] = h->n_s;
   }
@@ -114,10 +83,12 @@ PixelUse CheckPixel(const Image& radiance, const std::vector<uint8_t>* mask, int
   return clipped ? PixelUse::kClipped : PixelUse::kUsable;
 }
 
-std::vector<Observation> CollectObservations(
-    const Scene& scene, int photo_index, const Image& radiance, const std::vector<uint8_t>* mask,
-    const Renderer::Impl& geometry, const PatchSet& patches, const ObservationOptions& options,
-    PhotoObservationStats* stats) {
+std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
+                                             const Image& radiance,
+                                             const std::vector<uint8_t>* mask,
+                                             const RayScene& geometry, const PatchSet& patches,
+                                             const ObservationOptions& options,
+                                             PhotoObservationStats* stats) {
   const Photo& photo = scene.photos[photo_index];
   const Camera& camera = scene.cameras[photo.camera];
   const double saturation = options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
@@ -162,12 +133,12 @@ std::vector<Observation> CollectObservations(
     }
     const Eigen::Vector3d dir =
         camera.WorldRayFromImg(Eigen::Vector2d(x0 + 0.5 * size, y0 + 0.5 * size));
-    const std::optional<SurfaceHit> hit = TraceSurface(geometry, center, dir);
+    const std::optional<SurfaceHit> hit = geometry.TraceSurface(center, dir);
     if (!hit || !IsReflective(scene.materials[hit->region].brdf)) return std::nullopt;
     for (int y = y0 + stride / 2; y < y0 + size; y += stride) {
       for (int x = x0 + stride / 2; x < x0 + size; x += stride) {
         const Eigen::Vector2d px(x + 0.5, y + 0.5);
-        if (!OnPieceOf(TraceSurface(geometry, center, camera.WorldRayFromImg(px)), *hit, cos_edge,
+        if (!OnPieceOf(geometry.TraceSurface(center, camera.WorldRayFromImg(px)), *hit, cos_edge,
                        0.01)) {
           return std::nullopt;
         }
@@ -194,7 +165,7 @@ std::vector<Observation> CollectObservations(
             continue;
           }
           const Eigen::Vector3d dir = camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, yy + 0.5));
-          const std::optional<SurfaceHit> hit = TraceSurface(geometry, center, dir);
+          const std::optional<SurfaceHit> hit = geometry.TraceSurface(center, dir);
           if (!hit || !IsReflective(scene.materials[hit->region].brdf)) {
             ++st.background;
             continue;

@@ -4,9 +4,9 @@
 // (±¼, ±¼) of a pixel hit the same region with normals within a few degrees (so the pixel's mean
 // radiance, docs/scene-format.md, and its centre's agree), the mask allows it, every channel is
 // finite and non-negative, and no channel is clipped. Where the observations are drawn to a budget,
-// one may stand for a square block of pixels instead (solver/inverse/observation_draw.h): their mean, kept
-// when every pixel of it is usable and the rays through the centres of its stride cells and its
-// quarter points meet one smooth piece of one region.
+// one may stand for a square block of pixels instead (solver/inverse/observation_draw.h): their
+// mean, kept when every pixel of it is usable and the rays through the centres of its stride cells
+// and its quarter points meet one smooth piece of one region.
 //
 // Frames and units: world frame, metres; radiance linear in the scene's units.
 
@@ -75,15 +75,13 @@ struct PhotoObservationStats {
 // (0.25|0.75, 0.25|0.75), index bit 0: x, bit 1: y) and its centre's normal n.
 double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Eigen::Vector3d& n);
 
-struct SurfaceHit;
-
 // The shading normals at the four quarter points of the square of `size` pixels whose top-left
 // pixel is (x, y) (pixel (x, y) itself for size 1) of `camera` (the order of PixelNormalSpread),
 // traced through `geometry`; none when a ray misses `centre`'s region, turns its normal to a
 // cosine of `cos_min` or less from the centre's, or meets a point off the centre's face plane by
 // `max_offset`·centre.t or more.
 std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(
-    const Renderer::Impl& geometry, const Camera& camera, int x, int y, const SurfaceHit& centre,
+    const RayScene& geometry, const Camera& camera, int x, int y, const SurfaceHit& centre,
     double cos_min, double max_offset = std::numeric_limits<double>::infinity(), int size = 1);
 
 // The roughness a pixel sees: α widened by its spread of normals (√(α² + spread)).
@@ -103,12 +101,11 @@ PixelUse CheckPixel(const Image& radiance, const std::vector<uint8_t>* mask, int
 double AutoSaturation(const Image& image);
 
 // The observations of photo `photo` (its linear radiance image and optional 8-bit mask of the
-// photo's size, row by row, 0 = ignore), traced through `geometry`, the Embree scene of the
-// photo's lighting (solver/render/render_internal.h).
+// photo's size, row by row, 0 = ignore), traced through `geometry`, the ray queries on the
+// photo's lighting.
 std::vector<Observation> CollectObservations(const Scene& scene, int photo, const Image& radiance,
                                              const std::vector<uint8_t>* mask,
-                                             const Renderer::Impl& geometry,
-                                             const PatchSet& patches,
+                                             const RayScene& geometry, const PatchSet& patches,
                                              const ObservationOptions& options,
                                              PhotoObservationStats* stats);
 

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <tuple>
 
-#include "solver/render/sampling.h"
 #include "solver/inverse/solve_internal.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 
 namespace igi {

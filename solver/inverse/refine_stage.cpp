@@ -7,9 +7,9 @@
 #include <atomic>
 #include <chrono>
 
+#include "solver/inverse/solve_options.h"
 #include "solver/render/render.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/solve_options.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "solver/render/brdf.h"
 #include "solver/inverse/numeric.h"
+#include "solver/render/brdf.h"
 
 namespace igi {
 

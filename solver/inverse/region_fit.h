@@ -7,13 +7,13 @@
 // The model of one observation o (radiance L toward its camera, channel c):
 //   L_c = ρd_c·E_c/π + ρs_c·T_c(α),   T_c(α) = Σ_k S(wo, wi_k; α)·W(wo, wi_k)·v_k,c
 // with E the gathered irradiance and (wi_k, v_k) the incident samples (v = L_in·cosθ/pdf, so
-// Σ v = E), S the model's colourless specular factor and W its Fresnel weight (solver/render/brdf.h).
-// For a given α the model is linear in ρd and ρs: they are projected out (variable projection)
-// and α is found by a log-grid search refined by Brent's method; Ceres then polishes all
-// parameters jointly (autodiff through EvalBrdf's specular factor) and gives their covariance.
-// Residuals are weighted as for shot noise, 1/√((ρ̄E/π + 0.1·mean L)·mean L) per channel, ρ̄
-// the region's mean ratio of L to E/π: weights that follow neither the photos' noise nor that of
-// the gathered irradiance (either would bias the fit).
+// Σ v = E), S the model's colourless specular factor and W its Fresnel weight
+// (solver/render/brdf.h). For a given α the model is linear in ρd and ρs: they are projected out
+// (variable projection) and α is found by a log-grid search refined by Brent's method; Ceres then
+// polishes all parameters jointly (autodiff through EvalBrdf's specular factor) and gives their
+// covariance. Residuals are weighted as for shot noise, 1/√((ρ̄E/π + 0.1·mean L)·mean L) per
+// channel, ρ̄ the region's mean ratio of L to E/π: weights that follow neither the photos' noise nor
+// that of the gathered irradiance (either would bias the fit).
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -7,8 +7,7 @@
 
 namespace igi {
 
-SceneScale MeasureSceneScale(const Scene& scene, const Renderer::Impl* geometry,
-                             int pixels_per_camera) {
+SceneScale MeasureSceneScale(const Scene& scene, const RayScene* geometry, int pixels_per_camera) {
   SceneScale out;
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
   for (const Eigen::Vector3f& p : scene.mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -27,9 +26,9 @@ SceneScale MeasureSceneScale(const Scene& scene, const Renderer::Impl* geometry,
       for (int i = 0; i < nx; ++i) {
         const Eigen::Vector2d pixel((i + 0.5) * cam.width / nx, (j + 0.5) * cam.height / ny);
         const Eigen::Vector3d dir = cam.WorldRayFromImg(pixel);
-        const std::optional<Hit> hit = geometry->Intersect(centre, dir);
-        if (!hit || hit->geometry != 0) continue;
-        Eigen::Vector3d n = geometry->triangles[hit->primitive].normal;
+        const std::optional<RayHit> hit = geometry->Intersect(centre, dir);
+        if (!hit || hit->triangle < 0) continue;
+        Eigen::Vector3d n = geometry->face_normal(hit->triangle);
         if (n.dot(dir) > 0) n = -n;  // the side the camera sees
         const double cos_surface = std::max(0.05, -n.dot(dir));
         // The pixel's solid angle relative to the axis' (pinhole: cos³ of the off-axis angle).
@@ -39,9 +38,9 @@ SceneScale MeasureSceneScale(const Scene& scene, const Renderer::Impl* geometry,
         const Eigen::Vector2d u(double(MixBits(key) >> 11) * 0x1.0p-53,
                                 double(MixBits(key ^ 0x5851f42d4c957f2dULL) >> 11) * 0x1.0p-53);
         const Eigen::Vector3d wi = Frame::FromNormal(n).ToWorld(SampleCosineHemisphere(u));
-        const Eigen::Vector3d origin = centre + dir * hit->t + n * geometry->ray_epsilon;
+        const Eigen::Vector3d origin = centre + dir * hit->t + n * geometry->ray_epsilon();
         ++rays;
-        const std::optional<Hit> next = geometry->Intersect(origin, wi);
+        const std::optional<RayHit> next = geometry->Intersect(origin, wi);
         if (!next) continue;
         ++hits;
         weighted += w * next->t;
@@ -59,7 +58,7 @@ SceneScale MeasureSceneScale(const Scene& scene, const Renderer::Impl* geometry,
 
 SceneScale MeasureSceneScale(const Scene& scene) {
   if (scene.lightings.empty()) return MeasureSceneScale(scene, nullptr);
-  const std::unique_ptr<Renderer::Impl> geometry = BuildRenderScene(scene, 0);
+  const std::unique_ptr<RayScene> geometry = std::make_unique<RayScene>(scene, 0);
   return MeasureSceneScale(scene, geometry.get());
 }
 

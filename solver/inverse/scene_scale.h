@@ -14,7 +14,7 @@
 // meet a surface (an open scene) there is no free path, and the diagonal stands.
 
 #include "recon/scene.h"
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 
 namespace igi {
 
@@ -29,7 +29,7 @@ struct SceneScale {
 
 // `geometry`: a render scene of `scene` (any lighting; light geometry is passed through), null
 // for the diagonal alone. `pixels_per_camera` origins per camera on a regular grid.
-SceneScale MeasureSceneScale(const Scene& scene, const Renderer::Impl* geometry,
+SceneScale MeasureSceneScale(const Scene& scene, const RayScene* geometry,
                              int pixels_per_camera = 2048);
 
 // MeasureSceneScale on a render scene of the scene's first lighting (the diagonal alone when it

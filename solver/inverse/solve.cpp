@@ -9,16 +9,15 @@
 #include <unordered_map>
 
 #include "solver/inverse/albedo_map.h"
-#include "solver/render/brdf.h"
 #include "solver/inverse/gather.h"
 #include "solver/inverse/patches.h"
 #include "solver/inverse/photo_model.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
-#include "solver/render/sampling.h"
 #include "solver/inverse/scene_scale.h"
 #include "solver/inverse/solve_internal.h"
-#include "solver/inverse/surface_hit.h"
+#include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
+#include "solver/render/sampling.h"
 #include "tools/common/error.h"
 #include "tools/common/memory.h"
 #include "tools/common/parallel.h"
@@ -63,7 +62,7 @@ std::optional<RegionStatus> RegionStatusFromName(std::string_view name) {
 // and highlight coverage.
 void SolverState::Prepare() {
   BuildLightingScenes();
-  const Renderer::Impl* geometry = nullptr;
+  const RayScene* geometry = nullptr;
   for (const auto& s : lighting_scenes) geometry = geometry ? geometry : s.get();
   const SceneScale scale = MeasureSceneScale(scene, geometry);
   summary.scene_diagonal_m = scale.diagonal_m;
@@ -191,7 +190,7 @@ void SolverState::PlanObservations() {
   d.max_fit_samples = options.max_fit_samples;
   d.max_block = options.max_observation_block;
   d.num_threads = options.num_threads;
-  std::vector<const Renderer::Impl*> geometry(lighting_scenes.size(), nullptr);
+  std::vector<const RayScene*> geometry(lighting_scenes.size(), nullptr);
   for (size_t l = 0; l < lighting_scenes.size(); ++l) geometry[l] = lighting_scenes[l].get();
   const std::vector<RegionPixelCensus> census = CensusPixels(scene, geometry, lobe_class, d);
   // The census's share of pixels on regions with a lobe, and their fit samples.
@@ -253,7 +252,7 @@ void SolverState::BuildLightingScenes() {
         continue;
       }
     }
-    lighting_scenes[l] = BuildRenderScene(scene, l);
+    lighting_scenes[l] = std::make_unique<RayScene>(scene, l);
   }
   problems.ThrowIfAny();
 }
@@ -325,9 +324,9 @@ void SolverState::SelectFitSamples() {
                         size_t(options.max_fit_samples), &obs);
 }
 
-// The footprint of observation o's pixel or block (solver/inverse/gather.h): ray directions at unit depth,
-// so that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion is
-// linearised over the pixel).
+// The footprint of observation o's pixel or block (solver/inverse/gather.h): ray directions at unit
+// depth, so that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion
+// is linearised over the pixel).
 GatherQuery::Footprint SolverState::PixelFootprint(const Observation& o) const {
   const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
   const Eigen::Quaterniond world_from_cam = cam.cam_from_world.rotation.conjugate();

@@ -32,12 +32,12 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render/brdf.h"
 #include "solver/inverse/highlight_coverage.h"
 #include "solver/inverse/observations.h"
 #include "solver/inverse/photometric_scale.h"
 #include "solver/inverse/region_fit.h"
 #include "solver/inverse/solve_options.h"
+#include "solver/render/brdf.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
@@ -176,10 +176,11 @@ struct SolveSummary {
 SolveSummary Solve(const Scene& scene, const SolveOptions& options,
                    const std::filesystem::path& out_dir);
 
-// The input scene.json document with every material value filled in (solver/inverse/solve_output.cpp):
-// rho_d (region mean) always, rho_s/alpha where the model has them, rho_d_map where a map was
-// estimated ("albedo/<region>.exr"), geometry replaced by "geometry/solved.obj" when texture
-// charts were generated; every other relative path rewritten relative to `out_dir`.
+// The input scene.json document with every material value filled in
+// (solver/inverse/solve_output.cpp): rho_d (region mean) always, rho_s/alpha where the model has
+// them, rho_d_map where a map was estimated ("albedo/<region>.exr"), geometry replaced by
+// "geometry/solved.obj" when texture charts were generated; every other relative path rewritten
+// relative to `out_dir`.
 Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary,
                          const std::filesystem::path& out_dir);
 

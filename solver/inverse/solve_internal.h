@@ -15,7 +15,6 @@
 
 #include "solver/inverse/albedo_map.h"
 #include "solver/inverse/albedo_map_stage.h"
-#include "solver/render/brdf.h"
 #include "solver/inverse/gather.h"
 #include "solver/inverse/light_model.h"
 #include "solver/inverse/material_estimate.h"
@@ -23,11 +22,12 @@
 #include "solver/inverse/paper_stage.h"
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
-#include "solver/render/render_internal.h"
-#include "solver/render/sampling.h"
 #include "solver/inverse/solve.h"
 #include "solver/inverse/solve_memory.h"
 #include "solver/inverse/uv_charts.h"
+#include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/sampling.h"
 
 namespace igi {
 
@@ -53,7 +53,7 @@ struct SolverState {
   PatchSet patches;
   // The memory estimate (solver/inverse/solve_memory.h), planned before any photo is read.
   SolveMemoryEstimate memory;
-  std::vector<std::unique_ptr<Renderer::Impl>> lighting_scenes;  // per lighting (null: unused)
+  std::vector<std::unique_ptr<RayScene>> lighting_scenes;  // per lighting (null: unused)
   // The solve's three products, each a plain structure that the stages read and write: the
   // observations (and the draw they were collected under), the material estimate, and the
   // light modelled at the observations.
@@ -79,8 +79,8 @@ struct SolverState {
   // largest photo and the fits' fewest observations fit.
   void PlanObservations();
   void CollectAllObservations();
-  // The fit samples (obs.in_fit: SelectFitSamples in solver/inverse/observation_set.h) of the regions
-  // with an unknown.
+  // The fit samples (obs.in_fit: SelectFitSamples in solver/inverse/observation_set.h) of the
+  // regions with an unknown.
   void SelectFitSamples();
   void GatherAll();
   GatherQuery::Footprint PixelFootprint(const Observation& o) const;
@@ -99,7 +99,7 @@ struct SolverState {
   std::vector<double> RayEpsilons() const {
     std::vector<double> eps(lighting_scenes.size(), 0.0);
     for (size_t l = 0; l < eps.size(); ++l) {
-      if (lighting_scenes[l]) eps[l] = lighting_scenes[l]->ray_epsilon;
+      if (lighting_scenes[l]) eps[l] = lighting_scenes[l]->ray_epsilon();
     }
     return eps;
   }

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 
-#include "solver/render/brdf.h"
 #include "solver/inverse/gather.h"
 #include "solver/inverse/observations.h"
 #include "solver/inverse/region_fit.h"
 #include "solver/inverse/solve_internal.h"
+#include "solver/render/brdf.h"
 #include "tools/common/memory.h"
 
 namespace igi {

@@ -1,7 +1,8 @@
 #pragma once
 // Internal to igi_solver: igi-solve's memory, estimated before anything large is allocated
 // (STYLE.md §8), so that the observations can be drawn to fit a budget
-// (SolveOptions::memory_budget, solver/inverse/observation_draw.h) or the solve refused with one line.
+// (SolveOptions::memory_budget, solver/inverse/observation_draw.h) or the solve refused with one
+// line.
 //
 // What grows with the observations is, per observation: the observation itself and the solver's
 // per-observation arrays, its gathered light (a record per direct sample and per hemisphere ray,

@@ -81,7 +81,8 @@ struct SolveOptions {
   // photo whose maximum value is shared by 3 or more pixels is taken as clipped at that value.
   double saturation = 0;
   // Patch size, metres: 0 = auto (the scene's length scale / 96: its bounding-box diagonal, or
-  // 3.5 mean free paths from the seen surfaces where that is shorter; solver/inverse/scene_scale.h).
+  // 3.5 mean free paths from the seen surfaces where that is shorter;
+  // solver/inverse/scene_scale.h).
   double patch_size_m = 0;
   // Gathering at each observation and patch: samples per extended light (sphere, area; 1..1024)
   // and stratified hemisphere rays for the light arriving from other surfaces (0..4096). More:
@@ -90,16 +91,16 @@ struct SolveOptions {
   int indirect_rays = 64;
   // Where an indirect ray meets a glossy surface, trace one more ray about its mirror direction
   // so that the surface's specular reflection of the rest of the room joins the light it sends
-  // (solver/inverse/gather.h). Off (--specular-bounces false): glossy patches send only their diffuse
-  // radiance and the direct light's highlight, and the surfaces they light gather too little
-  // (measured: docs/solve.md).
+  // (solver/inverse/gather.h). Off (--specular-bounces false): glossy patches send only their
+  // diffuse radiance and the direct light's highlight, and the surfaces they light gather too
+  // little (measured: docs/solve.md).
   bool specular_bounces = true;
   // Sample each observation's direct light over its pixel's footprint on the surface (a pixel
-  // records the mean over it; solver/inverse/gather.h GatherQuery::Footprint), with footprint_samples
-  // points per delta light, and widen each observation's lobe by the spread of the normals over
-  // that footprint (Observation::lobe_blur2: α² + the spread), so that a curved glossy surface's
-  // highlight is not fitted as a rougher lobe. Off (--pixel-footprint false): at the centre
-  // ray's point only, with the centre's normal.
+  // records the mean over it; solver/inverse/gather.h GatherQuery::Footprint), with
+  // footprint_samples points per delta light, and widen each observation's lobe by the spread of
+  // the normals over that footprint (Observation::lobe_blur2: α² + the spread), so that a curved
+  // glossy surface's highlight is not fitted as a rougher lobe. Off (--pixel-footprint false): at
+  // the centre ray's point only, with the centre's normal.
   bool pixel_footprint = true;
   // With pixel_footprint: stratified points of the footprint per delta light (point, spot,
   // directional), >= 1; extended lights spread their light_samples over it.

@@ -221,8 +221,8 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
   j["texel_size_m"] = s.texel_size_m;
   j["map_texel_size_m"] = s.map_texel_size_m;
   j["observations"] = s.observations;
-  // The observation budget and the draw (solver/inverse/observation_draw.h), and the memory: the budget,
-  // the estimate it was planned with (solver/inverse/solve_memory.h) and the measured peak.
+  // The observation budget and the draw (solver/inverse/observation_draw.h), and the memory: the
+  // budget, the estimate it was planned with (solver/inverse/solve_memory.h) and the measured peak.
   j["observation_draw"] = {{"budget", Num(s.observation_budget)},
                            {"available", Num(s.observations_available)},
                            {"drawn", s.observations},

@@ -2,10 +2,10 @@
 // The reflectance models of docs/scene-format.md and their importance sampling.
 //
 // Frame and directions: every direction is a unit vector in the LOCAL shading frame of a Frame
-// (solver/render/sampling.h): x along the tangent t, y along b = n × t, z along the normal n. Build the
-// frame with Frame::FromNormalTangent(n, tangent) for the anisotropic models (the tangent is the
-// material's "tangent", the x direction of alpha_x) and Frame::FromNormal(n) otherwise.
-// wo points from the surface toward the viewer (v in the contract), wi toward the light (l); both
+// (solver/render/sampling.h): x along the tangent t, y along b = n × t, z along the normal n. Build
+// the frame with Frame::FromNormalTangent(n, tangent) for the anisotropic models (the tangent is
+// the material's "tangent", the x direction of alpha_x) and Frame::FromNormal(n) otherwise. wo
+// points from the surface toward the viewer (v in the contract), wi toward the light (l); both
 // leave the surface. The BRDFs are one-sided: f = 0 unless wo.z > 0 and wi.z > 0 (a renderer
 // shading a two-sided surface flips the frame to wo's side first). All models are reciprocal,
 // f(wo, wi) = f(wi, wo). Values are per steradian, RGB.

@@ -143,7 +143,7 @@ Eigen::Vector3d LightNumbers(LightType type, Pcg32& rng) {
 
 class PathTracer {
  public:
-  PathTracer(const Renderer::Impl& impl, const RenderOptions& options)
+  PathTracer(const RenderScene& impl, const RenderOptions& options)
       : impl_(impl), options_(options) {
     for (int l = 0; l < static_cast<int>(impl.lights.size()); ++l) {
       if (impl.lights[l].type == LightType::kAmbient) {
@@ -198,7 +198,7 @@ class PathTracer {
                              const Eigen::Vector3d& wo_local, Pcg32& rng,
                              Eigen::Vector3d* albedo) const;
 
-  const Renderer::Impl& impl_;
+  const RenderScene& impl_;
   const RenderOptions& options_;
   std::vector<int> sampled_lights_;  // lights drawn by next-event estimation: all but ambient
   double light_select_pdf_ = 0;      // 1 / sampled_lights_.size()
@@ -400,7 +400,7 @@ void RenderOptions::Validate() const {
   check((width == 0) == (height == 0), "--width/--height", width, "give both or neither");
 }
 
-Renderer::Renderer(const Scene& scene, int lighting) : impl_(BuildRenderScene(scene, lighting)) {}
+Renderer::Renderer(const Scene& scene, int lighting) : rays_(scene, lighting) {}
 Renderer::~Renderer() = default;
 
 Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
@@ -417,7 +417,7 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   }
   Image image(camera.width, camera.height, 3,
               mask ? std::numeric_limits<float>::quiet_NaN() : 0.0f);
-  const PathTracer tracer(*impl_, options);
+  const PathTracer tracer(rays_.internal(), options);
   const Eigen::Vector3d center = camera.CenterInWorld();
   // PINHOLE rays straight from the intrinsics and a rotation matrix (what WorldRayFromImg
   // computes, without its per-call quaternion rotation); OPENCV goes through WorldRayFromImg.
@@ -474,7 +474,7 @@ namespace {
 // The mean of `spp` paths along one ray (non-finite paths dropped).
 // With `d_ln_params`: also the mean's derivatives with respect to each region's parameter
 // scales (Renderer::kDerivativeKinds entries per scene material, overwritten).
-Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& origin,
+Eigen::Vector3d MeanRadiance(const RenderScene& impl, const Eigen::Vector3d& origin,
                              const Eigen::Vector3d& direction, int spp, uint64_t seed,
                              bool reflected_only,
                              std::vector<Eigen::Vector3d>* d_ln_params = nullptr) {
@@ -512,20 +512,20 @@ Eigen::Vector3d MeanRadiance(const Renderer::Impl& impl, const Eigen::Vector3d& 
 
 Eigen::Vector3d Renderer::Radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                    int spp, uint64_t seed) const {
-  return MeanRadiance(*impl_, origin, direction, spp, seed, false);
+  return MeanRadiance(rays_.internal(), origin, direction, spp, seed, false);
 }
 
 Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction, int spp,
                                             uint64_t seed) const {
-  return MeanRadiance(*impl_, origin, direction, spp, seed, true);
+  return MeanRadiance(rays_.internal(), origin, direction, spp, seed, true);
 }
 
 Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction, int spp,
                                             uint64_t seed,
                                             std::vector<Eigen::Vector3d>* d_ln_params) const {
-  return MeanRadiance(*impl_, origin, direction, spp, seed, true, d_ln_params);
+  return MeanRadiance(rays_.internal(), origin, direction, spp, seed, true, d_ln_params);
 }
 
 }  // namespace igi

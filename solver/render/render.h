@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "recon/scene.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/image.h"
 
 namespace igi {
@@ -81,11 +82,11 @@ class Renderer {
                                     int spp, uint64_t seed,
                                     std::vector<Eigen::Vector3d>* d_ln_params) const;
 
-  struct Impl;
-  const Impl& impl() const { return *impl_; }  // for the solver (solver/render/render_internal.h)
+  // Ray queries on the scene this renderer traces.
+  const RayScene& rays() const { return rays_; }
 
  private:
-  std::unique_ptr<Impl> impl_;
+  RayScene rays_;
 };
 
 }  // namespace igi

@@ -1,6 +1,6 @@
 #pragma once
-// Internal to the renderer (solver/render*.cpp): the prepared scene of one lighting. Not public
-// API; Embree types stay out of it (the Embree scene is held behind an opaque handle).
+// Internal to the renderer (solver/render/): the prepared scene of one lighting. Not public API
+// (ray_scene.h is); Embree types stay out of it (the Embree scene is held behind an opaque handle).
 
 #include <Eigen/Core>
 #include <memory>
@@ -9,23 +9,12 @@
 
 #include "recon/scene.h"
 #include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/render.h"
 #include "solver/render/sampling.h"
 #include "tools/common/image.h"
 
 namespace igi {
-
-// A surface's reflectance, ready to shade.
-struct ShadingMaterial {
-  BrdfModel model = BrdfModel::kLambert;
-  BrdfParams params;                                   // rho_d replaced per hit when textured
-  std::optional<Eigen::Vector3d> tangent;              // anisotropic models (world)
-  std::shared_ptr<const Image> rho_d_map;              // linear albedo texture
-  Eigen::Vector3d emission = Eigen::Vector3d::Zero();  // "emitter": radiance of the front side
-};
-
-// `m` ready to shade (its albedo map read, if any; unknown values as placeholders).
-ShadingMaterial MakeShadingMaterial(const Material& m);
 
 // A set of emitting triangles sampled by area (an area light, or the scene's emitter
 // materials). Triangles emit `radiance` from their front (counter-clockwise) side.
@@ -42,15 +31,6 @@ struct RenderLight {
   const Light* light = nullptr;        // nullptr for the emitter-material set
   Eigen::Matrix3d spot_frame = Eigen::Matrix3d::Identity();
   TriangleEmitter triangles;  // kArea
-};
-
-// A sampled direction toward a light, from a shading point.
-struct LightSample {
-  Eigen::Vector3d wi = Eigen::Vector3d::Zero();     // world, unit
-  double distance = 0;                              // to the light (infinity: directional)
-  Eigen::Vector3d value = Eigen::Vector3d::Zero();  // radiance, or I/d² or E for delta lights
-  double pdf = 0;                                   // solid angle; 1 for delta lights
-  bool delta = false;
 };
 
 struct Hit {
@@ -73,7 +53,8 @@ struct TriangleShading {
   Eigen::Vector3d bitangent = Eigen::Vector3d::UnitY();
 };
 
-struct Renderer::Impl {
+// The prepared scene of one lighting (RayScene's and the Renderer's).
+struct RenderScene {
   const Scene* scene = nullptr;
   int lighting = -1;
   std::vector<ShadingMaterial> materials;   // per scene material
@@ -104,14 +85,10 @@ struct Renderer::Impl {
   double LightPdf(int light, const Eigen::Vector3d& point, const Eigen::Vector3d& dir,
                   const Eigen::Vector3d& hit_point, const Eigen::Vector3d& hit_normal) const;
 
-  ~Impl();
+  ~RenderScene();
 };
 
-// Texture lookup: bilinear, u right and v up (v = 0 is the bottom row); coordinates outside
-// [0, 1] repeat, texels at the borders clamp. RGB of a 3-channel linear texture.
-Eigen::Vector3d SampleTexture(const Image& texture, Eigen::Vector2d uv);
-
 // Builds the Embree scene, materials and lights (render_scene.cpp).
-std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lighting);
+std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting);
 
 }  // namespace igi

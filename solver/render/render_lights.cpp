@@ -23,7 +23,7 @@ int SampleTriangle(const TriangleEmitter& e, const Eigen::Vector3d& u, Eigen::Ve
 
 }  // namespace
 
-LightSample Renderer::Impl::SampleLight(int index, const Eigen::Vector3d& point,
+LightSample RenderScene::SampleLight(int index, const Eigen::Vector3d& point,
                                         const Eigen::Vector3d& u) const {
   const RenderLight& rl = lights[index];
   const Light* light = rl.light;
@@ -93,7 +93,7 @@ LightSample Renderer::Impl::SampleLight(int index, const Eigen::Vector3d& point,
   return s;
 }
 
-double Renderer::Impl::LightPdf(int index, const Eigen::Vector3d& point,
+double RenderScene::LightPdf(int index, const Eigen::Vector3d& point,
                                 const Eigen::Vector3d& dir, const Eigen::Vector3d& hit_point,
                                 const Eigen::Vector3d& hit_normal) const {
   const RenderLight& rl = lights[index];

@@ -10,7 +10,7 @@
 
 namespace igi {
 
-struct Renderer::Impl::Embree {
+struct RenderScene::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   ~Embree() {
@@ -19,7 +19,7 @@ struct Renderer::Impl::Embree {
   }
 };
 
-Renderer::Impl::~Impl() = default;
+RenderScene::~RenderScene() = default;
 
 namespace {
 
@@ -101,7 +101,7 @@ std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
 }
 
 // The per-triangle shading records of the scene mesh (after emitter_triangle_index is set).
-std::vector<TriangleShading> TriangleRecords(const Renderer::Impl& impl) {
+std::vector<TriangleShading> TriangleRecords(const RenderScene& impl) {
   const TriangleMesh& mesh = impl.scene->mesh;
   const std::vector<Eigen::Vector3d> normals = FaceNormals(mesh);
   std::vector<TriangleShading> records(mesh.num_triangles());
@@ -125,13 +125,13 @@ std::vector<TriangleShading> TriangleRecords(const Renderer::Impl& impl) {
 
 }  // namespace
 
-std::unique_ptr<Renderer::Impl> BuildRenderScene(const Scene& scene, int lighting) {
-  auto impl = std::make_unique<Renderer::Impl>();
+std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting) {
+  auto impl = std::make_unique<RenderScene>();
   impl->scene = &scene;
   impl->lighting = lighting;
   for (const Material& m : scene.materials) impl->materials.push_back(MakeShadingMaterial(m));
 
-  impl->embree = std::make_unique<Renderer::Impl::Embree>();
+  impl->embree = std::make_unique<RenderScene::Embree>();
   impl->embree->device = rtcNewDevice(nullptr);
   if (impl->embree->device == nullptr) throw Error("cannot create the Embree device");
   impl->embree->scene = rtcNewScene(impl->embree->device);
@@ -235,8 +235,8 @@ RTCRay MakeRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max)
 
 }  // namespace
 
-std::optional<Hit> Renderer::Impl::Intersect(const Eigen::Vector3d& origin,
-                                             const Eigen::Vector3d& dir, double t_max) const {
+std::optional<Hit> RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                                          double t_max) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rayhit;
@@ -267,8 +267,8 @@ std::optional<Hit> Renderer::Impl::Intersect(const Eigen::Vector3d& origin,
   return hit;
 }
 
-bool Renderer::Impl::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                              double distance, int target) const {
+bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                           double distance, int target) const {
   if (!(distance > 0)) return false;  // ambient light: nothing occludes it
   for (int i : sphere_lights) {
     const Light& l = *lights[i].light;

@@ -123,9 +123,9 @@ std::string SynthMesh::ToObj(const std::string& header) const {
   return os.str();
 }
 
-std::optional<RayHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d& origin,
-                                   const Eigen::Vector3d& direction, double t_min, double t_max) {
-  std::optional<RayHit> best;
+std::optional<MeshHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d& origin,
+                                    const Eigen::Vector3d& direction, double t_min, double t_max) {
+  std::optional<MeshHit> best;
   double nearest = t_max;
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
     // Möller–Trumbore.
@@ -146,7 +146,7 @@ std::optional<RayHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d&
     const double dist = e2.dot(qv) * inv;
     if (dist > t_min && dist < nearest) {
       nearest = dist;
-      best = RayHit{dist, int(i)};
+      best = MeshHit{dist, int(i)};
     }
   }
   return best;

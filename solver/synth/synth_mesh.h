@@ -45,15 +45,15 @@ struct SynthMesh {
   std::string ToObj(const std::string& header) const;
 };
 
-struct RayHit {
+struct MeshHit {
   double distance = 0;
   int triangle = -1;
 };
 // The nearest hit of the ray origin + t·direction (direction unit) with t in (t_min, t_max);
 // both faces count.
-std::optional<RayHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d& origin,
-                                   const Eigen::Vector3d& direction, double t_min = 1e-6,
-                                   double t_max = 1e30);
+std::optional<MeshHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d& origin,
+                                    const Eigen::Vector3d& direction, double t_min = 1e-6,
+                                    double t_max = 1e30);
 // Whether nothing blocks the open segment between a and b (ends excluded by `epsilon` metres).
 bool SegmentVisible(const SynthMesh& mesh, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                     double epsilon = 1e-4);

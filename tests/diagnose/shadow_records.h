@@ -15,8 +15,8 @@
 #include "recon/scene.h"
 #include "solver/diagnose/pixel_records.h"
 #include "solver/inverse/photo_model.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/render/sampling.h"
 
 namespace igi::test::shadow {
@@ -89,7 +89,7 @@ inline std::vector<PixelRecord> FloorGridRecords(const Scene& model, const Scene
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d p(-1.5 + 3.0 * (i + 0.5) / n, -1.5 + 3.0 * (j + 0.5) / n, 0);
       const Eigen::Vector3d dir = (p - eye).normalized();
-      const std::optional<Hit> hit = sim.impl().Intersect(eye, dir);
+      const std::optional<RayHit> hit = sim.rays().Intersect(eye, dir);
       if (!hit || std::abs(hit->t - (p - eye).norm()) > 1e-3) continue;  // hidden from the eye
       PixelRecord r;
       r.x = 2 * i;

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render/brdf.h"
 #include "solver/diagnose/pixel_records.h"
+#include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 #include "tools/common/json.h"

@@ -1,6 +1,6 @@
-// igi-run --demo's absolute calibration (tools/pipeline/demo.h MeasureRadianceScale): the median ratio
-// of the HDR maps to igi-synth's noise-free radiance, whatever a few outliers do; the comparison
-// with the truth (CompareWithTruth) and of the registered cameras with the true ones
+// igi-run --demo's absolute calibration (tools/pipeline/demo.h MeasureRadianceScale): the median
+// ratio of the HDR maps to igi-synth's noise-free radiance, whatever a few outliers do; the
+// comparison with the truth (CompareWithTruth) and of the registered cameras with the true ones
 // (ComparePoses).
 #include <gtest/gtest.h>
 
@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <numbers>
 
-#include "tools/pipeline/demo.h"
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/demo.h"
 
 namespace igi {
 namespace {

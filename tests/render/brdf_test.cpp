@@ -288,7 +288,8 @@ TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicroface
 }
 
 // The solver's α search builds SpecularFactor from these parts once per direction pair
-// (solver/inverse/region_fit.cpp): they must give it back at any roughness, and nothing below the surface.
+// (solver/inverse/region_fit.cpp): they must give it back at any roughness, and nothing below the
+// surface.
 TEST(BrdfEvalTest, SpecularFactorPartsGiveTheFactorAtAnyRoughness) {
   Pcg32 rng(5, 6);
   for (BrdfModel model : kAllModels) {

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "tests/solver/test_scenes.h"
 
 namespace igi {
@@ -115,12 +115,13 @@ TEST(RenderTest, SphereLightRimHasNoFireflies) {
   const auto dir = TempSceneDir("sphere_rim");
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
   Json light{{"type", "sphere"}, {"center", {0, 0, 1}}, {"radius", 1}, {"radiance", 100}};
-  const double eps = BuildRenderScene(LoadTestScene(dir, FloorScene(light)), 0)->ray_epsilon;
+  const double eps =
+      std::make_unique<RayScene>(LoadTestScene(dir, FloorScene(light)), 0)->ray_epsilon();
   const double r = 10 * eps, d = 40 * r, s = std::sqrt(0.5);
   light["center"] = {d * s, 0.0, d * s};
   light["radius"] = r;
   const Scene scene = LoadTestScene(dir, FloorScene(light));
-  ASSERT_NEAR(BuildRenderScene(scene, 0)->ray_epsilon, eps, 1e-12);
+  ASSERT_NEAR(std::make_unique<RayScene>(scene, 0)->ray_epsilon(), eps, 1e-12);
   const Renderer renderer(scene, 0);
   const Eigen::Vector3d origin = scene.cameras[0].CenterInWorld();
   const int n = 100000;

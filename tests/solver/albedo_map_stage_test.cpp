@@ -1,6 +1,7 @@
-// The albedo-map stage alone (solver/inverse/albedo_map_stage.h), on data built by hand: observations of
-// a 1 m square under a known irradiance, photographed by two photos, whose radiance is a true
-// albedo × E/π with a few paths' noise. No photo is read and nothing is gathered or fitted.
+// The albedo-map stage alone (solver/inverse/albedo_map_stage.h), on data built by hand:
+// observations of a 1 m square under a known irradiance, photographed by two photos, whose radiance
+// is a true albedo × E/π with a few paths' noise. No photo is read and nothing is gathered or
+// fitted.
 #include "solver/inverse/albedo_map_stage.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Albedo maps (solver/inverse/albedo_map.h): splatting ratio samples into an atlas, push-pull filling,
-// and PSNR.
+// Albedo maps (solver/inverse/albedo_map.h): splatting ratio samples into an atlas, push-pull
+// filling, and PSNR.
 #include "solver/inverse/albedo_map.h"
 
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/error.h"
 
 namespace igi {
@@ -49,7 +49,8 @@ TriangleMesh Box() {
   return mesh;
 }
 
-// The renderer's own lookup (solver/render/render_internal.h): the map must match what it reads.
+// The renderer's own lookup (solver/render/ray_scene.h SampleTexture): the map must match what it
+// reads.
 Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) {
   return SampleTexture(tex, uv);
 }

@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "recon/scene.h"
-#include "solver/render/render.h"
 #include "solver/inverse/solve.h"
+#include "solver/render/render.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 

@@ -1,6 +1,6 @@
-// The fit stage and the paper stage's smoothing alone (solver/inverse/fit_stage.h, solver/inverse/paper_stage.h),
-// on data built by hand: observations of a 1 m Lambertian square under a known irradiance. No
-// photo is read and nothing is gathered or rendered.
+// The fit stage and the paper stage's smoothing alone (solver/inverse/fit_stage.h,
+// solver/inverse/paper_stage.h), on data built by hand: observations of a 1 m Lambertian square
+// under a known irradiance. No photo is read and nothing is gathered or rendered.
 #include "solver/inverse/fit_stage.h"
 
 #include <gtest/gtest.h>

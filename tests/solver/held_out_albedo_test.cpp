@@ -1,5 +1,5 @@
-// The held-out per-texel albedo (solver/inverse/held_out_albedo.h): a point's albedo comes from the other
-// photos only, so a photo whose samples carry a highlight never lends it to its own samples.
+// The held-out per-texel albedo (solver/inverse/held_out_albedo.h): a point's albedo comes from the
+// other photos only, so a photo whose samples carry a highlight never lends it to its own samples.
 #include "solver/inverse/held_out_albedo.h"
 
 #include <gtest/gtest.h>

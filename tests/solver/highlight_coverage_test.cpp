@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "solver/render/render_internal.h"
+#include "solver/render/ray_scene.h"
 #include "solver/synth/camera_placement.h"
 #include "tests/solver/test_scenes.h"
 
@@ -72,23 +72,23 @@ int AddPhoto(Scene* scene, const Vector3d& eye, const Vector3d& target) {
 }
 
 // One observation per pixel centre that hits the scene mesh (flat faces: normal = face normal).
-std::vector<Observation> Observe(const Scene& scene, const Renderer::Impl& impl, int photo) {
+std::vector<Observation> Observe(const Scene& scene, const RayScene& impl, int photo) {
   const Camera& cam = scene.cameras[scene.photos[photo].camera];
   const Vector3d c = cam.CenterInWorld();
   std::vector<Observation> out;
   for (int y = 0; y < cam.height; ++y) {
     for (int x = 0; x < cam.width; ++x) {
       const Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-      const std::optional<Hit> hit = impl.Intersect(c, dir);
-      if (!hit || hit->geometry != 0) continue;
+      const std::optional<RayHit> hit = impl.Intersect(c, dir);
+      if (!hit || hit->triangle < 0) continue;
       Observation o;
       o.photo = photo;
       o.x = x;
       o.y = y;
-      o.triangle = hit->primitive;
-      o.region = scene.mesh.triangle_region[hit->primitive];
+      o.triangle = hit->triangle;
+      o.region = scene.mesh.triangle_region[hit->triangle];
       o.position = (c + dir * hit->t).cast<float>();
-      Eigen::Vector3f n = scene.mesh.FaceNormal(hit->primitive);
+      Eigen::Vector3f n = scene.mesh.FaceNormal(hit->triangle);
       if (n.cast<double>().dot(dir) > 0) n = -n;
       o.normal = n;
       o.view = (-dir).cast<float>();
@@ -117,14 +117,14 @@ int LobeCount(const std::vector<Observation>& obs, int region, double limit, dou
 
 struct Fixture {
   Scene scene;
-  std::vector<std::unique_ptr<Renderer::Impl>> scenes;
+  std::vector<std::unique_ptr<RayScene>> scenes;
   std::vector<Observation> observations;
 };
 
 Fixture Make(const std::string& name, const Json& light, bool blocker = false) {
   Fixture f;
   f.scene = MakeScene(test::UniqueTempDir("igi_cover_" + name), light, blocker);
-  f.scenes.push_back(BuildRenderScene(f.scene, 0));
+  f.scenes.push_back(std::make_unique<RayScene>(f.scene, 0));
   return f;
 }
 

@@ -1,6 +1,6 @@
-// The solver's neighbour mean (solver/inverse/neighbour_mean.h) against a brute-force O(n²) reference on
-// random points: two regions, a plane and a curved surface (normals that fail the 25° test),
-// several photos, points on cell boundaries, and a subset (one lighting's observations).
+// The solver's neighbour mean (solver/inverse/neighbour_mean.h) against a brute-force O(n²)
+// reference on random points: two regions, a plane and a curved surface (normals that fail the 25°
+// test), several photos, points on cell boundaries, and a subset (one lighting's observations).
 #include "solver/inverse/neighbour_mean.h"
 
 #include <gtest/gtest.h>

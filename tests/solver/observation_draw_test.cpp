@@ -1,9 +1,9 @@
-// Drawing the observations to a budget as they are collected (solver/inverse/observation_draw.h) and the
-// memory plan behind it (solver/inverse/solve_memory.h): the probabilities keep each region's highlight
-// candidates and fit samples and share the rest of the budget; a thinned collection keeps a
-// subset of the very pixels a full one keeps, every highlight candidate among them; drawn blocks
-// are the means of their pixels on one surface; a budget that cannot hold one photo is refused
-// before any work.
+// Drawing the observations to a budget as they are collected (solver/inverse/observation_draw.h)
+// and the memory plan behind it (solver/inverse/solve_memory.h): the probabilities keep each
+// region's highlight candidates and fit samples and share the rest of the budget; a thinned
+// collection keeps a subset of the very pixels a full one keeps, every highlight candidate among
+// them; drawn blocks are the means of their pixels on one surface; a budget that cannot hold one
+// photo is refused before any work.
 //
 // Scene: tests/e2e/box_room.h's 2 m room with a Ward floor of unknown lobe, cam0 looking down at
 // the lamp's highlight on the floor, cam1 up; photos path-traced at 16 paths, every pixel
@@ -190,7 +190,7 @@ TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSame
 
   const int floor = scene.FindMaterial("floor");
   auto near = [&](const SolverState& s, const Observation& ob) {
-    const Renderer::Impl& g = *s.lighting_scenes[scene.photos[ob.photo].lighting];
+    const RayScene& g = *s.lighting_scenes[scene.photos[ob.photo].lighting];
     return NearHighlight(g, ob.position.cast<double>(), ob.view.cast<double>(),
                          ob.normal.cast<double>());
   };

@@ -1,6 +1,6 @@
-// The observation grid's nearest-neighbour query (solver/inverse/observation_grid.h) against a brute-force
-// search on random points: two regions, four photos under two lightings, normals that fail the
-// 25° test, grouped by lighting and by photo.
+// The observation grid's nearest-neighbour query (solver/inverse/observation_grid.h) against a
+// brute-force search on random points: two regions, four photos under two lightings, normals that
+// fail the 25° test, grouped by lighting and by photo.
 #include "solver/inverse/observation_grid.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // The paper stage's gathering against the path tracer: a glossy surface sends the points it
 // lights not only its diffuse radiance and the lamp's highlight but also its specular reflection
-// of the rest of the room (solver/inverse/gather.h, "specular bounce"). Without that term every point lit
-// by a glossy surface gathers too little light and its albedo comes out too high (igi-synth's
-// ceiling +1.5..+2.3 % on converged photos, bench/RESULTS.md).
+// of the rest of the room (solver/inverse/gather.h, "specular bounce"). Without that term every
+// point lit by a glossy surface gathers too little light and its albedo comes out too high
+// (igi-synth's ceiling +1.5..+2.3 % on converged photos, bench/RESULTS.md).
 //
 // Scene: tests/e2e/box_room.h's 2 m room with a glossy floor (Ward ρd 0.15, ρs 0.4, α 0.1, all
 // known), known walls and a ceiling whose albedo (0.7) is solved from one photo of the camera
@@ -17,9 +17,9 @@
 #include "recon/scene.h"
 #include "solver/inverse/gather.h"
 #include "solver/inverse/patches.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"
@@ -99,7 +99,7 @@ TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {
   doc["lights"]["amb"] = {{"type", "ambient"}, {"radiance", {0.3, 0.2, 0.1}}};
   doc["lightings"]["L0"] = Json::array({"amb"});
   const Scene scene = WriteAndLoad(doc, "ambient.json");
-  const auto rs = BuildRenderScene(scene, scene.FindLighting("L0"));
+  const auto rs = std::make_unique<RayScene>(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   std::vector<GatherQuery> queries(3);
   queries[0].position = {1, 1, 0};        // mid-floor, facing up
@@ -136,7 +136,7 @@ TEST_F(SolveGather, DirectLightIsTheMeanOverThePixelsFootprint) {
                            {"position", {1.0, 1.0, h}},
                            {"intensity", {intensity, intensity, intensity}}};
   const Scene scene = WriteAndLoad(doc, "near_lamp.json");
-  const auto rs = BuildRenderScene(scene, scene.FindLighting("L0"));
+  const auto rs = std::make_unique<RayScene>(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   // A camera at (1, 1, 1.9) looking straight down; its pixel's corner rays at unit depth.
   const Eigen::Vector3d eye(1, 1, 1.9), corner(1 - side / 2, 1 - side / 2, 0);

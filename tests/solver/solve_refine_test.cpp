@@ -1,7 +1,7 @@
-// Stage 2 of igi-solve (solver/inverse/refine_stage.h, SolverState::RefineRound): the light arriving
-// at every observation is rendered by the path tracer from the current model, so the albedos
-// light their own next fit. Refitting each region alone (πL/E at that E: "independent") then
-// overshoots in a bright closed room: albedos 5 % too high make the rendered room too bright,
+// Stage 2 of igi-solve (solver/inverse/refine_stage.h, SolverState::RefineRound): the light
+// arriving at every observation is rendered by the path tracer from the current model, so the
+// albedos light their own next fit. Refitting each region alone (πL/E at that E: "independent")
+// then overshoots in a bright closed room: albedos 5 % too high make the rendered room too bright,
 // and the next fit comes out several per cent too low. The joint update also renders the
 // irradiance's derivatives with respect to every region's albedo scale and solves for all
 // albedos at once, so one round from the same start lands on the answer.
@@ -19,9 +19,9 @@
 #include <string>
 
 #include "recon/scene.h"
-#include "solver/render/render.h"
 #include "solver/inverse/solve.h"
 #include "solver/inverse/solve_internal.h"
+#include "solver/render/render.h"
 #include "tests/e2e/box_room.h"
 #include "tests/solver/box_room_photos.h"
 #include "tests/temp_dir.h"

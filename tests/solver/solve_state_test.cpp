@@ -1,6 +1,6 @@
-// The solve's data, each a plain structure (solver/inverse/observation_set.h, solver/inverse/material_estimate.h,
-// solver/inverse/light_model.h), and the stages that are functions of them alone, run on hand-made
-// observations: no photo, no ray.
+// The solve's data, each a plain structure (solver/inverse/observation_set.h,
+// solver/inverse/material_estimate.h, solver/inverse/light_model.h), and the stages that are
+// functions of them alone, run on hand-made observations: no photo, no ray.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -12,9 +12,9 @@
 
 #include "recon/scene.h"
 #include "solver/inverse/albedo_map.h"
-#include "solver/render/render.h"
-#include "solver/render/render_internal.h"
 #include "solver/inverse/solve.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/render.h"
 #include "solver/synth/synthesize.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
@@ -157,7 +157,8 @@ TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
         if (pr.photo.at(x, y, 0) == 0 && pr.photo.at(x, y, 1) == 0) continue;  // not observed
         for (int c = 0; c < 3; ++c) {
           const double p = pr.photo.at(x, y, c);
-          // The observation's pixel (solver/inverse/observations.cpp: the middle of each stride cell).
+          // The observation's pixel (solver/inverse/observations.cpp: the middle of each stride
+          // cell).
           const int px = x * stride + stride / 2;
           const int py = std::min(y * stride + stride / 2, r1.height - 1);
           num += (r1.at(px, py, c) - p) * (r2.at(px, py, c) - p);
@@ -223,13 +224,12 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
       // texture by where its samples crowd); guarded at 2 %: the region's final rho_d is the
       // map's (below), which meets the 1 % target. The lobe is fitted with each highlight
       // sample's albedo as the other photos see its texel off their highlights
-      // (solver/inverse/held_out_albedo.h), rho_s through that albedo's own lobe: rho_s -4.14 % (clean),
-      // -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos:
-      // -2.19 %, -1.69 %, -1.54 %, -1.37 %); rho_s and alpha also join stage 2's joint update.
-      // The 5 % target guards them. Without that, rho_s came out -10.3 % / -8.1 % (the photos'
-      // Monte Carlo noise in the held-out albedos: the lobe is 14 % of the
-      // highlight samples' radiance, so 0.07 % of albedo error is 1 % of rho_s;
-      // bench/solver/floor_probe, bench/RESULTS.md).
+      // (solver/inverse/held_out_albedo.h), rho_s through that albedo's own lobe: rho_s -4.14 %
+      // (clean), -2.32 % (noisy), alpha -3.45 %, -2.08 % at the paper's stage (64-spp photos: -2.19
+      // %, -1.69 %, -1.54 %, -1.37 %); rho_s and alpha also join stage 2's joint update. The 5 %
+      // target guards them. Without that, rho_s came out -10.3 % / -8.1 % (the photos' Monte Carlo
+      // noise in the held-out albedos: the lobe is 14 % of the highlight samples' radiance, so 0.07
+      // % of albedo error is 1 % of rho_s; bench/solver/floor_probe, bench/RESULTS.md).
       for (int c = 0; c < 3; ++c) EXPECT_LT(RelErr(f.rho_d[c], seen_mean[c]), 0.02);
       EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05);
       EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05);

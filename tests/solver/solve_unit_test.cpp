@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/inverse/observations.h"
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
-#include "solver/render/render_internal.h"
-#include "solver/render/sampling.h"
 #include "solver/inverse/solve.h"
 #include "solver/inverse/solve_options.h"
+#include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
+#include "solver/render/sampling.h"
 #include "tests/solver/test_scenes.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
@@ -81,7 +81,7 @@ TEST(Observations, APixelsSpreadOfNormalsFollowsTheSurfacesCurvature) {
   const Image radiance(81, 81, 3, 0.5f);
   WriteImage(dir / "top.exr", radiance);
   const Scene scene = test::LoadTestScene(dir, doc);
-  const auto impl = BuildRenderScene(scene, 0);
+  const auto impl = std::make_unique<RayScene>(scene, 0);
   const PatchSet patches = BuildPatches(scene.mesh, 0.1);
   ObservationOptions oo;
   oo.pixel_stride = 1;

@@ -1,5 +1,5 @@
-// Region atlases (solver/inverse/uv_charts.h): the mesh's UVs where usable, generated charts otherwise,
-// and the OBJ written with them.
+// Region atlases (solver/inverse/uv_charts.h): the mesh's UVs where usable, generated charts
+// otherwise, and the OBJ written with them.
 #include "solver/inverse/uv_charts.h"
 
 #include <gtest/gtest.h>

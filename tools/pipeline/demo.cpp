@@ -9,13 +9,13 @@
 #include <numbers>
 #include <random>
 
-#include "tools/pipeline/stage_marker.h"
-#include "tools/pipeline/subprocess.h"
 #include "recon/mesh_closest_point.h"
 #include "recon/scene.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/stage_marker.h"
+#include "tools/pipeline/subprocess.h"
 
 namespace igi {
 namespace fs = std::filesystem;

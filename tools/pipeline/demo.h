@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "tools/pipeline/pipeline.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/pipeline.h"
 
 namespace igi {
 

@@ -7,9 +7,9 @@
 #include <chrono>
 #include <functional>
 
+#include "tools/common/error.h"
 #include "tools/pipeline/pipeline_internal.h"
 #include "tools/pipeline/subprocess.h"
-#include "tools/common/error.h"
 
 namespace igi {
 namespace fs = std::filesystem;

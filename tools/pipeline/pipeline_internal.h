@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "recon/scene.h"
+#include "tools/common/json.h"
 #include "tools/pipeline/photo_layout.h"
 #include "tools/pipeline/pipeline.h"
 #include "tools/pipeline/stage_marker.h"
-#include "recon/scene.h"
-#include "tools/common/json.h"
 
 namespace igi::pipeline_internal {
 

@@ -4,12 +4,12 @@
 
 #include <optional>
 
-#include "tools/pipeline/pipeline_internal.h"
-#include "tools/pipeline/scene_assembly.h"
 #include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/pipeline_internal.h"
+#include "tools/pipeline/scene_assembly.h"
 
 namespace igi::pipeline_internal {
 namespace fs = std::filesystem;

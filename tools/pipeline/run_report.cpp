@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tools/pipeline/pipeline_internal.h"
 #include "recon/scene.h"
 #include "tools/common/html_report.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/pipeline_internal.h"
 
 namespace igi {
 namespace fs = std::filesystem;

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "tools/pipeline/photo_layout.h"
 #include "tools/common/json.h"
+#include "tools/pipeline/photo_layout.h"
 
 namespace igi {
 

@@ -9,12 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/render/render_internal.h"
+#include "solver/render/brdf.h"
+#include "solver/render/render.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {

@@ -14,12 +14,11 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
-#include "solver/render/render_internal.h"
+#include "solver/render/brdf.h"
+#include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
-#include "solver/inverse/surface_hit.h"
 #include "tools/common/parallel.h"
 
 namespace igi {
@@ -56,10 +55,10 @@ struct FootprintPoint {
 // The direct radiance a sphere source of radius `radius` (0: a point) sends toward the camera
 // from footprint point `q` (BRDF of its region with the record's albedo, shadow rays through the
 // model's geometry), from the cone samples `u`; adds the unoccluded share to `lit`/`above`.
-Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
-                  const FootprintPoint& q, const Eigen::Vector3f& albedo, double radius,
-                  const Eigen::Vector2d* u, int* lit, int* above) {
-  const ShadingMaterial& sm = impl.materials[q.region];
+Vector3d DirectAt(const RayScene& impl, int target, const SphereSource& s, const FootprintPoint& q,
+                  const Eigen::Vector3f& albedo, double radius, const Eigen::Vector2d* u, int* lit,
+                  int* above) {
+  const ShadingMaterial& sm = impl.material(q.region);
   BrdfParams params = sm.params;
   params.rho_d = albedo.cast<double>();
   const Vector3d p = q.position.cast<double>(), n = q.normal.cast<double>();
@@ -67,7 +66,7 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
                           ? Frame::FromNormalTangent(n, *sm.tangent)
                           : Frame::FromNormal(n);
   const Vector3d lo = frame.ToLocal(q.view.cast<double>());
-  const Vector3d origin = p + n * (4 * impl.ray_epsilon);
+  const Vector3d origin = p + n * (4 * impl.ray_epsilon());
   const Vector3d to = s.center - p;
   const double d = to.norm();
   if (!(d > 0)) return Vector3d::Zero();
@@ -76,7 +75,7 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
   if (radius <= 0 || radius >= 0.95 * d) {  // a point (or a point inside the sphere)
     if (!(cos_center > 0)) return Vector3d::Zero();
     ++*above;
-    if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon, target)) return Vector3d::Zero();
+    if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon(), target)) return Vector3d::Zero();
     ++*lit;
     return EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) *
            (cos_center / (d * d));
@@ -96,7 +95,7 @@ Vector3d DirectAt(const Renderer::Impl& impl, int target, const SphereSource& s,
     ++*above;
     diffuse += rho_pi.cwiseProduct(radiance) * cs;
     const double t = d * ct - std::sqrt(std::max(0.0, radius * radius - d * d * st * st));
-    if (impl.Occluded(origin, dir, t - 4 * impl.ray_epsilon, target)) continue;
+    if (impl.Occluded(origin, dir, t - 4 * impl.ray_epsilon(), target)) continue;
     ++*lit;
     sum += EvalBrdf(params, lo, frame.ToLocal(dir)).cwiseProduct(radiance) * cs;
   }
@@ -167,7 +166,7 @@ class ExtentModel {
     }
     for (const Photo& p : cx.model.photos) {
       if (target_[p.lighting] >= 0 && !impls_[p.lighting]) {
-        impls_[p.lighting] = BuildRenderScene(cx.model, p.lighting);
+        impls_[p.lighting] = std::make_unique<RayScene>(cx.model, p.lighting);
       }
     }
     ParallelFor(0, int64_t(records.size()), [&](int64_t i) { Prepare(size_t(i), hidden); });
@@ -185,7 +184,7 @@ class ExtentModel {
       const PixelRecord& r = records_[i];
       const Photo& photo = cx_.model.photos[r.photo];
       if (target_[photo.lighting] < 0 || points_[i].empty()) return;
-      const Renderer::Impl& impl = *impls_[photo.lighting];
+      const RayScene& impl = *impls_[photo.lighting];
       Vector3d sum = Vector3d::Zero();
       int lit = 0, above = 0;
       for (size_t k = 0; k < points_[i].size(); ++k) {
@@ -242,7 +241,7 @@ class ExtentModel {
   void PrepareHidden(size_t i) {
     const PixelRecord& r = records_[i];
     const Photo& photo = cx_.model.photos[r.photo];
-    const Renderer::Impl& impl = *impls_[photo.lighting];
+    const RayScene& impl = *impls_[photo.lighting];
     const Vector3d p = r.position.cast<double>(), n = r.normal.cast<double>();
     const Vector3d to = source_.center - p;
     const double d = to.norm();
@@ -250,11 +249,11 @@ class ExtentModel {
     const Vector3d w = to / d;
     const double cos_p = w.dot(n);
     if (!(cos_p > 0)) return;
-    const Vector3d origin = p + n * (4 * impl.ray_epsilon);
-    if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon, target_[photo.lighting])) return;
+    const Vector3d origin = p + n * (4 * impl.ray_epsilon());
+    if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon(), target_[photo.lighting])) return;
     // The surface behind the light, seen from the point through its centre.
     const std::optional<SurfaceHit> hit =
-        TraceSurface(impl, source_.center + w * (declared_radius_ + 4 * impl.ray_epsilon), w);
+        impl.TraceSurface(source_.center + w * (declared_radius_ + 4 * impl.ray_epsilon()), w);
     if (!hit || hit->region < 0 || hit->region >= int(cx_.model.materials.size())) return;
     const Material& m = cx_.model.materials[hit->region];
     const double t = (hit->position - source_.center).norm();
@@ -281,7 +280,7 @@ class ExtentModel {
         const double sx = (k % 4 + rng.UniformDouble()) / 4, sy = (k / 4 + rng.UniformDouble()) / 4;
         const Vector3d eye = cam.CenterInWorld();
         const Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(r.x + sx, r.y + sy));
-        const std::optional<SurfaceHit> hit = TraceSurface(*impls_[photo.lighting], eye, dir);
+        const std::optional<SurfaceHit> hit = impls_[photo.lighting]->TraceSurface(eye, dir);
         if (!hit || hit->region != r.region) continue;  // off the record's surface
         q = {hit->position.cast<float>(), hit->n_s.cast<float>(), (-dir).cast<float>(),
              hit->region};
@@ -300,7 +299,7 @@ class ExtentModel {
 
   const CandidateContext& cx_;
   const std::vector<PixelRecord>& records_;
-  std::vector<std::unique_ptr<Renderer::Impl>> impls_;
+  std::vector<std::unique_ptr<RayScene>> impls_;
   std::vector<int> target_;  // per lighting: the light's index among its emitters, or -1
   std::vector<std::vector<Eigen::Vector2d>> u_;
   std::vector<std::vector<FootprintPoint>> points_;

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
 #include "solver/inverse/observations.h"
+#include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
 namespace igi {

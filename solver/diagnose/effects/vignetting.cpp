@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/residual_fit.h"
+#include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
 namespace igi {

@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "solver/render/brdf.h"
 #include "solver/diagnose/candidates.h"
 #include "solver/diagnose/effects/effects.h"
+#include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 #include "tests/diagnose/lobe_plate.h"
 #include "tests/diagnose/one_light_record.h"
