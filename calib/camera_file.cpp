@@ -3,17 +3,12 @@
 #include <optional>
 #include <string_view>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
 namespace igi::calib {
 namespace {
-
-// Every model of the enum.
-constexpr ColmapCameraModel kModels[] = {
-    ColmapCameraModel::kSimplePinhole, ColmapCameraModel::kPinhole,
-    ColmapCameraModel::kSimpleRadial,  ColmapCameraModel::kRadial,
-    ColmapCameraModel::kOpenCv,        ColmapCameraModel::kFullOpenCv};
 
 // 0 for a value outside the enum.
 size_t NumParams(ColmapCameraModel model) {
@@ -58,29 +53,19 @@ void Validate(const CameraFile& camera, const std::string& file,
 
 }  // namespace
 
-std::string_view ColmapCameraModelName(ColmapCameraModel model) {
-  switch (model) {
-    case ColmapCameraModel::kSimplePinhole:
-      return "SIMPLE_PINHOLE";
-    case ColmapCameraModel::kPinhole:
-      return "PINHOLE";
-    case ColmapCameraModel::kSimpleRadial:
-      return "SIMPLE_RADIAL";
-    case ColmapCameraModel::kRadial:
-      return "RADIAL";
-    case ColmapCameraModel::kOpenCv:
-      return "OPENCV";
-    case ColmapCameraModel::kFullOpenCv:
-      return "FULL_OPENCV";
-  }
-  return "?";
-}
+constexpr EnumNames<ColmapCameraModel, 6> kColmapCameraModelNames{
+    {{ColmapCameraModel::kSimplePinhole, "SIMPLE_PINHOLE"},
+     {ColmapCameraModel::kPinhole, "PINHOLE"},
+     {ColmapCameraModel::kSimpleRadial, "SIMPLE_RADIAL"},
+     {ColmapCameraModel::kRadial, "RADIAL"},
+     {ColmapCameraModel::kOpenCv, "OPENCV"},
+     {ColmapCameraModel::kFullOpenCv, "FULL_OPENCV"}}};
 
+std::string_view ColmapCameraModelName(ColmapCameraModel model) {
+  return kColmapCameraModelNames.Name(model);
+}
 std::optional<ColmapCameraModel> ColmapCameraModelFromName(std::string_view name) {
-  for (ColmapCameraModel m : kModels) {
-    if (ColmapCameraModelName(m) == name) return m;
-  }
-  return std::nullopt;
+  return kColmapCameraModelNames.FromName(name);
 }
 
 void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera) {

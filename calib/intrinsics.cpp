@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <optional>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/parallel.h"
@@ -163,21 +164,12 @@ std::vector<std::string> FlagNames(const IntrinsicsOptions& options) {
 
 }  // namespace
 
-std::string_view BoardTypeName(BoardType type) {
-  switch (type) {
-    case BoardType::kChessboard:
-      return "chessboard";
-    case BoardType::kCharuco:
-      return "charuco";
-  }
-  return "?";
-}
+constexpr EnumNames<BoardType, 2> kBoardTypeNames{
+    {{BoardType::kChessboard, "chessboard"}, {BoardType::kCharuco, "charuco"}}};
 
+std::string_view BoardTypeName(BoardType type) { return kBoardTypeNames.Name(type); }
 std::optional<BoardType> BoardTypeFromName(std::string_view name) {
-  for (BoardType t : {BoardType::kChessboard, BoardType::kCharuco}) {
-    if (BoardTypeName(t) == name) return t;
-  }
-  return std::nullopt;
+  return kBoardTypeNames.FromName(name);
 }
 
 void IntrinsicsOptions::Validate() const {

@@ -10,6 +10,7 @@
 
 #include "calib/pixel_sampling.h"
 #include "calib/robertson.h"
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
@@ -265,22 +266,15 @@ double ParseLambda(const std::string& text) {
   return *value;
 }
 
-std::string_view ResponseRecoveryMethodName(ResponseRecoveryMethod method) {
-  switch (method) {
-    case ResponseRecoveryMethod::kDebevec:
-      return "debevec";
-    case ResponseRecoveryMethod::kRobertson:
-      return "robertson";
-  }
-  return "?";
-}
+constexpr EnumNames<ResponseRecoveryMethod, 2> kResponseRecoveryMethodNames{
+    {{ResponseRecoveryMethod::kDebevec, "debevec"},
+     {ResponseRecoveryMethod::kRobertson, "robertson"}}};
 
+std::string_view ResponseRecoveryMethodName(ResponseRecoveryMethod method) {
+  return kResponseRecoveryMethodNames.Name(method);
+}
 std::optional<ResponseRecoveryMethod> ResponseRecoveryMethodFromName(std::string_view name) {
-  for (ResponseRecoveryMethod m :
-       {ResponseRecoveryMethod::kDebevec, ResponseRecoveryMethod::kRobertson}) {
-    if (ResponseRecoveryMethodName(m) == name) return m;
-  }
-  return std::nullopt;
+  return kResponseRecoveryMethodNames.FromName(name);
 }
 
 void ResponseOptions::Validate() const {

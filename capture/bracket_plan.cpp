@@ -5,26 +5,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
 namespace igi::capture {
 
-std::string_view PlanFileFormatName(PlanFileFormat format) {
-  switch (format) {
-    case PlanFileFormat::kPng:
-      return "png";
-    case PlanFileFormat::kTiff:
-      return "tiff";
-  }
-  return "?";
-}
+constexpr EnumNames<PlanFileFormat, 2> kPlanFileFormatNames{
+    {{PlanFileFormat::kPng, "png"}, {PlanFileFormat::kTiff, "tiff"}}};
 
+std::string_view PlanFileFormatName(PlanFileFormat format) {
+  return kPlanFileFormatNames.Name(format);
+}
 std::optional<PlanFileFormat> PlanFileFormatFromName(std::string_view name) {
-  for (PlanFileFormat f : {PlanFileFormat::kPng, PlanFileFormat::kTiff}) {
-    if (PlanFileFormatName(f) == name) return f;
-  }
-  return std::nullopt;
+  return kPlanFileFormatNames.FromName(name);
 }
 
 void BracketPlan::Validate(const std::string& source) const {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
@@ -85,21 +86,14 @@ void CheckInputs(const std::vector<Image>& images, const std::vector<double>& ex
 
 }  // namespace
 
-std::string_view MergeWeightingName(MergeWeighting weighting) {
-  switch (weighting) {
-    case MergeWeighting::kNoise:
-      return "noise";
-    case MergeWeighting::kHat:
-      return "hat";
-  }
-  return "?";
-}
+constexpr EnumNames<MergeWeighting, 2> kMergeWeightingNames{
+    {{MergeWeighting::kNoise, "noise"}, {MergeWeighting::kHat, "hat"}}};
 
+std::string_view MergeWeightingName(MergeWeighting weighting) {
+  return kMergeWeightingNames.Name(weighting);
+}
 std::optional<MergeWeighting> MergeWeightingFromName(std::string_view name) {
-  for (MergeWeighting w : {MergeWeighting::kNoise, MergeWeighting::kHat}) {
-    if (MergeWeightingName(w) == name) return w;
-  }
-  return std::nullopt;
+  return kMergeWeightingNames.FromName(name);
 }
 
 void MergeOptions::Validate() const {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
@@ -41,38 +42,22 @@ void SetLinearParams(LibRaw* raw, const RawDecodeOptions& options) {
 
 }  // namespace
 
+constexpr EnumNames<RawWhiteBalance, 2> kRawWhiteBalanceNames{
+    {{RawWhiteBalance::kCamera, "camera"}, {RawWhiteBalance::kNone, "none"}}};
+
 std::string_view RawWhiteBalanceName(RawWhiteBalance white_balance) {
-  switch (white_balance) {
-    case RawWhiteBalance::kCamera:
-      return "camera";
-    case RawWhiteBalance::kNone:
-      return "none";
-  }
-  return "?";
+  return kRawWhiteBalanceNames.Name(white_balance);
 }
-
 std::optional<RawWhiteBalance> RawWhiteBalanceFromName(std::string_view name) {
-  for (RawWhiteBalance w : {RawWhiteBalance::kCamera, RawWhiteBalance::kNone}) {
-    if (RawWhiteBalanceName(w) == name) return w;
-  }
-  return std::nullopt;
+  return kRawWhiteBalanceNames.FromName(name);
 }
 
-std::string_view RawColorName(RawColor color) {
-  switch (color) {
-    case RawColor::kSrgb:
-      return "srgb";
-    case RawColor::kRaw:
-      return "raw";
-  }
-  return "?";
-}
+constexpr EnumNames<RawColor, 2> kRawColorNames{
+    {{RawColor::kSrgb, "srgb"}, {RawColor::kRaw, "raw"}}};
 
+std::string_view RawColorName(RawColor color) { return kRawColorNames.Name(color); }
 std::optional<RawColor> RawColorFromName(std::string_view name) {
-  for (RawColor c : {RawColor::kSrgb, RawColor::kRaw}) {
-    if (RawColorName(c) == name) return c;
-  }
-  return std::nullopt;
+  return kRawColorNames.FromName(name);
 }
 
 void RawDecodeOptions::Validate() const {

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string_view>
 
-namespace igi {
+namespace igi::recon {
 
 enum class BrdfModel {
   kLambert,
@@ -66,4 +66,4 @@ constexpr bool IsReflective(BrdfModel model) {
   return model == BrdfModel::kLambert || HasSpecularLobe(model);
 }
 
-}  // namespace igi
+}  // namespace igi::recon

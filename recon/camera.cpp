@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace igi {
+namespace igi::recon {
 
 std::string_view CameraModelName(CameraModel model) {
   return model == CameraModel::kPinhole ? "PINHOLE" : "OPENCV";
@@ -88,4 +88,4 @@ std::optional<std::pair<CameraModel, std::vector<double>>> ConvertColmapCameraMo
   return std::nullopt;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

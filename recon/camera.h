@@ -13,7 +13,7 @@
 
 #include "tools/common/geometry.h"
 
-namespace igi {
+namespace igi::recon {
 
 enum class CameraModel { kPinhole, kOpenCv };
 
@@ -60,4 +60,4 @@ size_t CameraModelNumParams(CameraModel model);
 std::optional<std::pair<CameraModel, std::vector<double>>> ConvertColmapCameraModel(
     std::string_view colmap_model, const std::vector<double>& params);
 
-}  // namespace igi
+}  // namespace igi::recon

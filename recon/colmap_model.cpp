@@ -14,7 +14,7 @@
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -759,4 +759,4 @@ void WriteColmapModelText(const ColmapModel& model, const fs::path& dir) {
   WriteFileAtomic(dir / "points3D.txt", points3d);
 }
 
-}  // namespace igi
+}  // namespace igi::recon

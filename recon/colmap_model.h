@@ -32,7 +32,7 @@
 #include <string_view>
 #include <vector>
 
-namespace igi {
+namespace igi::recon {
 
 // | |q| - 1 | up to which a quaternion is kept bit for bit: a unit quaternion printed with 17
 // significant digits and read back is within a few 1e-16 of unit length.
@@ -130,4 +130,4 @@ std::optional<std::string> ColmapModelNameFromId(int model_id);
 // All model names in id order.
 std::vector<std::string> ColmapModelNames();
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -14,7 +14,7 @@
 #include "tools/common/parallel.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 std::string ShellQuote(const std::string& s) {
@@ -275,4 +275,4 @@ ColmapRunSummary LoadColmapRun(const std::filesystem::path& images_dir,
   return summary;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

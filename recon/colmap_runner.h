@@ -17,7 +17,7 @@
 #include "calib/camera_file.h"
 #include "recon/colmap_model.h"
 
-namespace igi {
+namespace igi::recon {
 
 // Known intrinsics to give COLMAP (from camera.json): held fixed during mapping.
 struct KnownIntrinsics {
@@ -91,4 +91,4 @@ ColmapRunSummary RunColmap(const std::filesystem::path& images_dir,
 ColmapRunSummary LoadColmapRun(const std::filesystem::path& images_dir,
                                const std::filesystem::path& model_dir);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -13,7 +13,7 @@
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
@@ -554,4 +554,4 @@ IesProfile ReadIesProfile(const std::filesystem::path& path) {
   return ParseIesProfile(ReadFileToString(path), path);
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace igi {
+namespace igi::recon {
 
 // Photometric types of LM-63 (field 6 of the first numeric line).
 inline constexpr int kIesTypeC = 1;
@@ -90,4 +90,4 @@ IesProfile ReadIesProfile(const std::filesystem::path& path);
 // to file's folder).
 IesProfile ParseIesProfile(const std::string& text, const std::filesystem::path& file);
 
-}  // namespace igi
+}  // namespace igi::recon

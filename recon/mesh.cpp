@@ -8,7 +8,7 @@
 #include <cmath>
 #include <map>
 
-namespace igi {
+namespace igi::recon {
 
 Eigen::Vector3f TriangleMesh::FaceNormal(size_t t) const {
   const Eigen::Vector3i& tri = triangles[t];
@@ -23,7 +23,7 @@ double TriangleArea(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Ei
 
 double TriangleMesh::TriangleArea(size_t t) const {
   const Eigen::Vector3i& tri = triangles[t];
-  return igi::TriangleArea(positions[tri[0]], positions[tri[1]], positions[tri[2]]);
+  return igi::recon::TriangleArea(positions[tri[0]], positions[tri[1]], positions[tri[2]]);
 }
 
 void TriangleMesh::Append(const TriangleMesh& other) {
@@ -175,4 +175,4 @@ TriangleMesh LoadMesh(const std::filesystem::path& path, ProblemList* problems,
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

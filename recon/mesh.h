@@ -12,7 +12,7 @@
 
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct TriangleMesh {
   std::vector<Eigen::Vector3f> positions;
@@ -50,4 +50,4 @@ struct MeshLoadSummary {
 TriangleMesh LoadMesh(const std::filesystem::path& path, ProblemList* problems,
                       MeshLoadSummary* summary = nullptr);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -12,7 +12,7 @@
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 using Eigen::Matrix3d;
@@ -473,4 +473,4 @@ std::vector<Vector3d> ModelPoints(const ColmapModel& model) {
   return points;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -21,7 +21,7 @@
 #include "recon/mesh.h"
 #include "recon/registration.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct MeshAlignmentOptions {
   int max_iterations = 60;      // of the final ICP
@@ -82,4 +82,4 @@ PoseRefinementSummary RefinePosesAgainstMesh(const TriangleMesh& mesh, double in
 // The model's 3D points (any order).
 std::vector<Eigen::Vector3d> ModelPoints(const ColmapModel& model);
 
-}  // namespace igi
+}  // namespace igi::recon

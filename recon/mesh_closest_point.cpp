@@ -6,7 +6,7 @@
 
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                        const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -137,4 +137,4 @@ std::optional<MeshRayHit> MeshClosestPoint::Intersect(const Eigen::Vector3d& ori
   return MeshRayHit{static_cast<int>(rh.hit.primID), rh.ray.tfar, rh.hit.u, rh.hit.v};
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -9,7 +9,7 @@
 
 #include "recon/mesh.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct ClosestPoint {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    // on the mesh, metres
@@ -51,4 +51,4 @@ class MeshClosestPoint {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace igi
+}  // namespace igi::recon

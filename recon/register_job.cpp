@@ -20,7 +20,7 @@
 #include "tools/common/image.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::recon {
 
 namespace fs = std::filesystem;
 
@@ -363,4 +363,4 @@ RegisterSummary Register(const RegisterOptions& options, const RegisterInputs& i
   return summary;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

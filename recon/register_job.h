@@ -25,7 +25,7 @@
 #include "recon/scene.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct RegisterOptions {
   std::string images;   // folder of photos (JPEG, PNG, TIFF, BMP)
@@ -74,4 +74,4 @@ RegisterInputs ValidateRegisterInputs(const RegisterOptions& options);
 // from ValidateRegisterInputs(options).
 RegisterSummary Register(const RegisterOptions& options, const RegisterInputs& inputs);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -7,7 +7,7 @@
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 // Least-squares point nearest to rays (origin, unit direction).
@@ -174,4 +174,4 @@ MarkerAlignment AlignByMarkers(const ColmapModel& model, const Markers& markers)
   return alignment;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -21,7 +21,7 @@
 #include "recon/camera.h"
 #include "recon/colmap_model.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct ImageReprojection {
   std::string name;
@@ -70,4 +70,4 @@ struct MarkerAlignment {
 // markers can be triangulated.
 MarkerAlignment AlignByMarkers(const ColmapModel& model, const Markers& markers);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -18,7 +18,7 @@
 #include "recon/mesh_closest_point.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 using Eigen::Vector2d;
@@ -555,4 +555,4 @@ std::vector<MarkerPose> RePoseImagesFromMarkers(const Markers& markers, ColmapMo
   return reposed;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -25,7 +25,7 @@
 #include "recon/mesh.h"
 #include "recon/registration.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct BundleRefinementOptions {
   double track_sigma_px = 1.0;     // accuracy of a feature position: residuals / this
@@ -102,4 +102,4 @@ std::vector<MarkerPose> RePoseImagesFromMarkers(const Markers& markers, ColmapMo
                                                 double disagree_px = 10, int min_markers = 4,
                                                 double max_rms_px = 2.0);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 struct BrdfName {
@@ -176,4 +176,4 @@ Json RelativeScenePaths(Json doc, const std::filesystem::path& base) {
   return doc;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

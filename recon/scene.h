@@ -23,7 +23,7 @@
 #include "recon/mesh.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 
 // What is known of one region's reflectance. Absent values are unknowns for the solver; for
 // rendering every value the model needs must be present (Material::MissingForRendering).
@@ -147,4 +147,4 @@ Json CameraJson(const Camera& camera);
 // Loads and validates `path`. Throws InputError listing every problem ("FILE: KEY: VALUE: RULE").
 Scene LoadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
 
-}  // namespace igi
+}  // namespace igi::recon

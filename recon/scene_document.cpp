@@ -5,7 +5,7 @@
 
 #include "recon/scene_loader.h"
 
-namespace igi {
+namespace igi::recon {
 namespace fs = std::filesystem;
 namespace {
 
@@ -215,4 +215,4 @@ void SceneDocument::SetPhotoResponse(size_t index, double exponent, double refer
   doc_.at("photos").at(index)["response"] = {{"exponent", exponent}, {"reference", reference}};
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -22,7 +22,7 @@
 #include "tools/common/geometry.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 
 // A photo entry as written: paths relative to the document's folder, or absolute.
 struct ScenePhotoEntry {
@@ -127,4 +127,4 @@ class SceneDocument {
   Json doc_;
 };
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -7,7 +7,7 @@
 
 #include "recon/scene_loader.h"
 
-namespace igi {
+namespace igi::recon {
 
 namespace fs = std::filesystem;
 
@@ -223,4 +223,4 @@ Scene LoadSceneDocument(Json document, const fs::path& path, const SceneLoadOpti
   return scene;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

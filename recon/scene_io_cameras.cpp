@@ -5,7 +5,7 @@
 #include "recon/registration.h"
 #include "recon/scene_loader.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -185,4 +185,4 @@ Json CameraJson(const Camera& camera) {
   return j;
 }
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -4,7 +4,7 @@
 
 #include "recon/scene_loader.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -148,4 +148,4 @@ void ReadLightsAndLightings(const SceneLoader& ld, const JsonCursor& root, Scene
   }
 }
 
-}  // namespace igi
+}  // namespace igi::recon

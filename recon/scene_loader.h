@@ -9,7 +9,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 
 struct SceneLoader {
   const SceneLoadOptions& options;
@@ -35,4 +35,4 @@ void ReadPhotos(const SceneLoader& ld, const JsonCursor& root, Scene* scene);
 Scene LoadSceneDocument(Json document, const std::filesystem::path& path,
                         const SceneLoadOptions& options);
 
-}  // namespace igi
+}  // namespace igi::recon

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
-  igi::DiagnoseOptions o;
+  igi::diagnose::DiagnoseOptions o;
   app.add_option("scene", scene_path, "scene.json (unknown materials are solved first)")
       ->required();
   app.add_option("--out", out_dir,
@@ -70,17 +70,17 @@ int main(int argc, char** argv) {
     o.show_progress = !common.quiet;
     o.Validate();
     igi::RejectOutputInSceneFolder(out_dir, scene_path);
-    const igi::Scene scene = igi::LoadScene(scene_path);
+    const igi::recon::Scene scene = igi::recon::LoadScene(scene_path);
     if (scene.photos.empty()) {
       throw igi::InputError(igi::DescribeProblem(scene.file.string(), "photos", "[]",
                                                  "needs at least one photo to compare with"));
     }
-    const igi::DiagnosisSummary s = igi::Diagnose(scene, o, out_dir);
-    igi::WriteDiagnosisOutputs(s, o, out_dir);
+    const igi::diagnose::DiagnosisSummary s = igi::diagnose::Diagnose(scene, o, out_dir);
+    igi::diagnose::WriteDiagnosisOutputs(s, o, out_dir);
     if (!common.quiet) {
       std::cout << "baseline residual " << s.baseline_residual << " (held out "
                 << s.baseline_held_out << ")\n";
-      for (const igi::DiagnosisStep& d : s.steps) {
+      for (const igi::diagnose::DiagnosisStep& d : s.steps) {
         std::cout << (d.kept ? "  + " : "  - ") << d.candidate.effect << ": " << d.verdict << "\n";
       }
       std::cout << "final residual " << s.final_residual << " (held out " << s.final_held_out

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/false);
   std::string scene_path, format_name, out_path;
-  igi::ExportOptions options;
+  igi::exporter::ExportOptions options;
   app.add_option("scene", scene_path, "scene.json with every material value (igi-solve's)")
       ->required();
   app.add_option("--format", format_name, "radiance, mitsuba or gltf")->required();
@@ -27,22 +27,22 @@ int main(int argc, char** argv) {
   app.add_option("--mitsuba-spp", options.mitsuba_spp, "Mitsuba: samples per pixel")
       ->capture_default_str();
   return igi::RunMain(app, flags, argc, argv, [&] {
-    const auto format = igi::ExportFormatFromName(format_name);
+    const auto format = igi::exporter::ExportFormatFromName(format_name);
     if (!format) {
       throw igi::InputError(
           igi::DescribeProblem("", "--format", format_name, "must be radiance, mitsuba or gltf"));
     }
     options.format = *format;
     options.Validate();
-    igi::CheckExportDir(out_path);
-    igi::SceneLoadOptions load;
+    igi::exporter::CheckExportDir(out_path);
+    igi::recon::SceneLoadOptions load;
     load.require_complete_materials = true;
     load.check_images = false;  // photos are not exported; textures are read when written
-    const igi::Scene scene = igi::LoadScene(scene_path, load);
-    const igi::ExportReport report = igi::ExportScene(scene, out_path, options);
+    const igi::recon::Scene scene = igi::recon::LoadScene(scene_path, load);
+    const igi::exporter::ExportReport report = igi::exporter::ExportScene(scene, out_path, options);
     spdlog::info("{} export: {} files, {} approximations (see {}/export_report.json)",
-                 igi::ExportFormatName(*format), report.files.size(), report.approximations.size(),
-                 out_path);
+                 igi::exporter::ExportFormatName(*format), report.files.size(),
+                 report.approximations.size(), out_path);
     return 0;
   });
 }

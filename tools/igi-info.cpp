@@ -8,7 +8,7 @@
 
 namespace {
 
-void PrintSummary(const igi::Scene& scene) {
+void PrintSummary(const igi::recon::Scene& scene) {
   std::printf("scene %s\n", scene.file.c_str());
   std::printf("geometry: %zu file(s), %zu vertices, %zu triangles, uvs %s\n",
               scene.geometry_files.size(), scene.mesh.positions.size(),
@@ -16,29 +16,30 @@ void PrintSummary(const igi::Scene& scene) {
   std::vector<size_t> triangles(scene.materials.size(), 0);
   for (int r : scene.mesh.triangle_region) ++triangles[r];
   for (size_t i = 0; i < scene.materials.size(); ++i) {
-    const igi::Material& m = scene.materials[i];
+    const igi::recon::Material& m = scene.materials[i];
     const auto missing = m.MissingForRendering();
     std::string unknowns;
     for (const auto& k : missing) unknowns += (unknowns.empty() ? "" : ",") + k;
     std::printf("material %-16s %-15s %7zu triangles  unknown: %s\n", m.name.c_str(),
-                std::string(igi::BrdfModelName(m.brdf)).c_str(), triangles[i],
+                std::string(igi::recon::BrdfModelName(m.brdf)).c_str(), triangles[i],
                 unknowns.empty() ? "-" : unknowns.c_str());
   }
-  for (const igi::Light& l : scene.lights) {
-    std::printf("light %-16s %s\n", l.name.c_str(), std::string(igi::LightTypeName(l.type)).c_str());
+  for (const igi::recon::Light& l : scene.lights) {
+    std::printf("light %-16s %s\n", l.name.c_str(),
+                std::string(igi::recon::LightTypeName(l.type)).c_str());
   }
-  for (const igi::Lighting& l : scene.lightings) {
+  for (const igi::recon::Lighting& l : scene.lightings) {
     std::string names;
     for (int i : l.lights) names += (names.empty() ? "" : ", ") + scene.lights[i].name;
     std::printf("lighting %-13s [%s]\n", l.name.c_str(), names.c_str());
   }
-  for (const igi::Camera& c : scene.cameras) {
+  for (const igi::recon::Camera& c : scene.cameras) {
     const Eigen::Vector3d center = c.CenterInWorld();
     std::printf("camera %-15s %s %dx%d f=%.2f,%.2f centre=(%.3f, %.3f, %.3f)\n", c.name.c_str(),
-                std::string(igi::CameraModelName(c.model)).c_str(), c.width, c.height,
+                std::string(igi::recon::CameraModelName(c.model)).c_str(), c.width, c.height,
                 c.focal_x_px(), c.focal_y_px(), center.x(), center.y(), center.z());
   }
-  for (const igi::Photo& p : scene.photos) {
+  for (const igi::recon::Photo& p : scene.photos) {
     std::printf("photo %s camera=%s lighting=%s mask=%s\n", p.file.filename().c_str(),
                 scene.cameras[p.camera].name.c_str(), scene.lightings[p.lighting].name.c_str(),
                 p.mask ? p.mask->filename().c_str() : "-");
@@ -58,10 +59,10 @@ int main(int argc, char** argv) {
   app.add_flag("--render", for_render, "Also require every material value rendering needs");
   app.add_flag("--no-images", no_images, "Do not open photos, masks and textures");
   return igi::RunMain(app, flags, argc, argv, [&] {
-    igi::SceneLoadOptions options;
+    igi::recon::SceneLoadOptions options;
     options.require_complete_materials = for_render;
     options.check_images = !no_images;
-    const igi::Scene scene = igi::LoadScene(scene_path, options);
+    const igi::recon::Scene scene = igi::recon::LoadScene(scene_path, options);
     PrintSummary(scene);
     return 0;
   });

@@ -38,17 +38,17 @@ namespace fs = std::filesystem;
 // intrinsics), registers, prints one line and throws PartialError (exit 3) listing the photos
 // that did not register.
 int Run(const std::string& camera, bool multi_camera, const igi::CommonFlags& flags,
-        igi::RegisterOptions* options) {
+        igi::recon::RegisterOptions* options) {
   if (!camera.empty()) {
     const igi::calib::CameraFile file = igi::calib::ReadCameraFile(camera);
     options->colmap.intrinsics =
-        igi::KnownIntrinsics{file.model, file.width, file.height, file.params};
+        igi::recon::KnownIntrinsics{file.model, file.width, file.height, file.params};
     options->camera_file = camera;
   }
   options->colmap.threads = flags.threads;
   options->colmap.single_camera = !multi_camera;
-  const igi::RegisterInputs inputs = igi::ValidateRegisterInputs(*options);
-  const igi::RegisterSummary run = igi::Register(*options, inputs);
+  const igi::recon::RegisterInputs inputs = igi::recon::ValidateRegisterInputs(*options);
+  const igi::recon::RegisterSummary run = igi::recon::Register(*options, inputs);
   std::printf("%s: %zu of %zu photos registered, %zu points\n", options->out.c_str(),
               run.registered, run.images, run.points);
   if (run.unregistered.empty()) return 0;
@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
                "igi-register");
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
-  igi::RegisterOptions options;
+  igi::recon::RegisterOptions options;
   std::string camera;
   std::string camera_model = "SIMPLE_RADIAL";  // checked against kSelfCalibratedModels when parsed
   bool multi_camera = false;
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
   app.add_option("--camera-model", camera_model,
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
                  "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
-      ->check(CLI::IsMember(igi::kSelfCalibratedModels));
+      ->check(CLI::IsMember(igi::recon::kSelfCalibratedModels));
   app.add_flag("--guided-matching", options.colmap.guided_matching,
                "COLMAP matches each photo pair again along its epipolar geometry (more correct "
                "matches, 2-2.4x the matching time)");

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags);
   std::string scene_path, camera_name, lighting_name, out_path;
-  igi::RenderOptions options;
+  igi::render::RenderOptions options;
   bool half = false;
   app.add_option("scene", scene_path, "scene.json")->required();
   app.add_option("--camera", camera_name, "Camera name (a key of cameras)")->required();
@@ -31,10 +31,10 @@ int main(int argc, char** argv) {
       throw igi::InputError(igi::DescribeProblem(out_path, "--out", "", "must end in .exr"));
     }
     options.Validate();
-    igi::SceneLoadOptions load;
+    igi::recon::SceneLoadOptions load;
     load.require_complete_materials = true;
     load.check_images = false;  // photos are not needed to render
-    const igi::Scene scene = igi::LoadScene(scene_path, load);
+    const igi::recon::Scene scene = igi::recon::LoadScene(scene_path, load);
     const int camera = scene.FindCamera(camera_name);
     if (camera < 0) {
       throw igi::InputError(igi::DescribeProblem(scene_path, "--camera", camera_name,
@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
       throw igi::InputError(igi::DescribeProblem(scene_path, "--lighting", lighting_name,
                                                  "no lighting of that name in the scene"));
     }
-    const igi::Renderer renderer(scene, lighting);
-    igi::RenderSummary summary;
+    const igi::render::Renderer renderer(scene, lighting);
+    igi::render::RenderSummary summary;
     igi::Image image = renderer.Render(scene.cameras[camera], options, &summary);
     image.metadata["igi:scene"] = scene.file.string();
     image.metadata["igi:camera"] = camera_name;

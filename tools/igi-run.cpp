@@ -29,7 +29,7 @@ DIR/report.html.
 Exit codes: 0 ok, 1 a stage failed (named; finished stages kept), 2 bad input (nothing
 written), 3 partial (e.g. photos that did not register).)";
 
-void PrintSummary(const igi::RunSummary& s) {
+void PrintSummary(const igi::pipeline::RunSummary& s) {
   for (const auto& st : s.stages) {
     std::printf("  %-12s %-8s %6.1f s  %6.1f s CPU\n", st.stage.c_str(), st.status.c_str(),
                 st.seconds, st.cpu_seconds);
@@ -48,10 +48,10 @@ int main(int argc, char** argv) {
   app.footer(kLayout);
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
-  igi::RunOptions o;
-  igi::DemoOptions demo;
+  igi::pipeline::RunOptions o;
+  igi::pipeline::DemoOptions demo;
   // --demo's choice flags as typed; SetChoices parses them into `demo` and validates it.
-  igi::DemoChoiceFlags demo_choices;
+  igi::pipeline::DemoChoiceFlags demo_choices;
   bool run_demo = false;
   std::string photos, scene, out, bin;
   app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     o.out = out;
     o.bin_dir = bin;
     o.num_threads = flags.threads;
-    igi::RunSummary summary;
+    igi::pipeline::RunSummary summary;
     if (run_demo) {
       demo.out = out;
       demo.bin_dir = bin;
@@ -113,13 +113,13 @@ int main(int argc, char** argv) {
       if (!o.solve_args.empty()) demo.solve_args = o.solve_args;
       if (!o.diagnose_args.empty()) demo.diagnose_args = o.diagnose_args;
       demo.SetChoices(demo_choices);
-      const igi::DemoSummary d = igi::RunDemo(demo);
+      const igi::pipeline::DemoSummary d = igi::pipeline::RunDemo(demo);
       summary = d.run;
       PrintSummary(summary);
       std::printf("recovered parameters beside the truth (%s/demo_summary.json):\n", out.c_str());
       for (const std::string& line : d.table) std::printf("  %s\n", line.c_str());
     } else {
-      summary = igi::RunPipeline(o);
+      summary = igi::pipeline::RunPipeline(o);
       PrintSummary(summary);
     }
     if (summary.partial) throw igi::PartialError(summary.partial_lines);

@@ -19,9 +19,9 @@ int main(int argc, char** argv) {
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
-  igi::SolveOptions o;
+  igi::solver::SolveOptions o;
   // The choice flags as typed; SetChoices parses them into `o` and validates every option.
-  igi::SolveChoiceFlags choices;
+  igi::solver::SolveChoiceFlags choices;
   app.add_option("scene", scene_path, "scene.json (materials with missing values are solved)")
       ->required();
   app.add_option("--out", out_dir, "output folder (scene.json, albedo/, report.json, report.html)")
@@ -113,13 +113,13 @@ int main(int argc, char** argv) {
     o.show_progress = !common.quiet;
     o.SetChoices(choices);
     igi::RejectOutputInSceneFolder(out_dir, scene_path);
-    igi::SceneLoadOptions lo;
-    const igi::Scene scene = igi::LoadScene(scene_path, lo);
-    const igi::SolveSummary summary = igi::Solve(scene, o, out_dir);
-    igi::WriteSolveOutputs(summary, o, out_dir);
+    igi::recon::SceneLoadOptions lo;
+    const igi::recon::Scene scene = igi::recon::LoadScene(scene_path, lo);
+    const igi::solver::SolveSummary summary = igi::solver::Solve(scene, o, out_dir);
+    igi::solver::WriteSolveOutputs(summary, o, out_dir);
     std::vector<std::string> failed;
-    for (const igi::RegionSolution& r : summary.regions) {
-      if (r.status == igi::RegionStatus::kUnobserved) {
+    for (const igi::solver::RegionSolution& r : summary.regions) {
+      if (r.status == igi::solver::RegionStatus::kUnobserved) {
         failed.push_back(igi::DescribeProblem(
             scene.file.string(), "materials." + r.name, "unknown values",
             r.RhoDFromBouncedLight()

@@ -23,9 +23,9 @@ int main(int argc, char** argv) {
                "igi-synth"};
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
-  igi::SynthOptions o;
+  igi::synth::SynthOptions o;
   // The choice flags as typed; SetChoices parses them into `o` and validates every option.
-  igi::SynthChoiceFlags choices;
+  igi::synth::SynthChoiceFlags choices;
   std::string noise = "none", response = "gamma", unknowns = "rho_d,rho_s,alpha";
   std::string photo_lightings = "L0", validation_lightings = "L1", lamp_position;
   std::vector<std::string> effects;
@@ -88,17 +88,17 @@ int main(int argc, char** argv) {
   return igi::RunMain(app, flags, argc, argv, [&] {
     igi::ProblemList problems;
     if (noise == "none")
-      o.noise = igi::NoiseModel::kNone;
+      o.noise = igi::synth::NoiseModel::kNone;
     else if (noise == "realistic")
-      o.noise = igi::NoiseModel::kRealistic;
+      o.noise = igi::synth::NoiseModel::kRealistic;
     else
       problems.Add("--noise", "", noise, "must be none or realistic");
     if (response == "gamma")
-      o.brackets.response = igi::ResponseKind::kGamma;
+      o.brackets.response = igi::synth::ResponseKind::kGamma;
     else if (response == "sigmoid")
-      o.brackets.response = igi::ResponseKind::kSigmoid;
+      o.brackets.response = igi::synth::ResponseKind::kSigmoid;
     else if (response == "file")
-      o.brackets.response = igi::ResponseKind::kFile;
+      o.brackets.response = igi::synth::ResponseKind::kFile;
     else
       problems.Add("--response", "", response, "must be gamma, sigmoid or file");
     if (!lamp_position.empty()) {
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
     o.validation_lightings = List(validation_lightings);
     for (const std::string& e : effects) {
       try {
-        o.effects.push_back(igi::ParseEffectSpec(e));
+        o.effects.push_back(igi::synth::ParseEffectSpec(e));
       } catch (const igi::Error& err) {
         problems.Append(err);
       }
@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
     problems.ThrowIfAny();
     o.num_threads = flags.threads;
     o.SetChoices(choices);
-    const igi::SynthSummary s = igi::Synthesize(o);
+    const igi::synth::SynthSummary s = igi::synth::Synthesize(o);
     std::printf("wrote %s: %zu photos, %zu validation renders, %lld saturated pixels, %.1f s\n",
                 o.out.c_str(), s.photos.size(), s.validation.size(),
                 static_cast<long long>(s.saturated_pixels), s.seconds);

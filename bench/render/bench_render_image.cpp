@@ -17,21 +17,21 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    igi::SceneLoadOptions load;
+    igi::recon::SceneLoadOptions load;
     load.require_complete_materials = true;
     load.check_images = false;
-    const igi::Scene scene = igi::LoadScene(argv[1], load);
+    const igi::recon::Scene scene = igi::recon::LoadScene(argv[1], load);
     const int camera = scene.FindCamera(argv[2]);
     const int lighting = scene.FindLighting(argv[3]);
     if (camera < 0 || lighting < 0) throw igi::InputError("unknown camera or lighting");
-    igi::RenderOptions options;
+    igi::render::RenderOptions options;
     options.spp = std::stoi(argv[4]);
     options.seed = std::stoull(argv[5]);
     options.num_threads = std::stoi(argv[6]);
     options.show_progress = false;
     const auto start = std::chrono::steady_clock::now();
-    const igi::Renderer renderer(scene, lighting);
-    igi::RenderSummary summary;
+    const igi::render::Renderer renderer(scene, lighting);
+    igi::render::RenderSummary summary;
     const igi::Image image = renderer.Render(scene.cameras[camera], options, &summary);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -26,10 +26,10 @@ double Median(std::vector<double> v) {
 
 // Materials the scene leaves unknown (solver inputs) get a grey Lambertian value so that the
 // scene renders; the benchmark is about rays, not appearance.
-void CompleteMaterials(igi::Scene* scene) {
-  for (igi::Material& m : scene->materials) {
+void CompleteMaterials(igi::recon::Scene* scene) {
+  for (igi::recon::Material& m : scene->materials) {
     if (m.MissingForRendering().empty()) continue;
-    m.brdf = igi::BrdfModel::kLambert;
+    m.brdf = igi::recon::BrdfModel::kLambert;
     m.rho_d = Eigen::Vector3d::Constant(0.5);
   }
 }
@@ -56,18 +56,18 @@ int main(int argc, char** argv) {
                "Raw side: sphere lights as Embree point-spheres in its scene (default: "
                "intersected analytically after rtcIntersect1, as igi does)");
   return igi::RunMain(app, flags, argc, argv, [&] {
-    igi::SceneLoadOptions load;
+    igi::recon::SceneLoadOptions load;
     load.check_images = false;
-    igi::Scene scene = igi::LoadScene(scene_path, load);
+    igi::recon::Scene scene = igi::recon::LoadScene(scene_path, load);
     CompleteMaterials(&scene);
     const int camera = camera_name.empty() ? 0 : scene.FindCamera(camera_name);
     const int lighting = lighting_name.empty() ? 0 : scene.FindLighting(lighting_name);
     if (camera < 0 || lighting < 0) throw igi::InputError("unknown --camera or --lighting");
     const int threads = igi::ResolveThreads(flags.threads);
 
-    const igi::Renderer renderer(scene, lighting);
+    const igi::render::Renderer renderer(scene, lighting);
     const igi::bench::RawEmbreeTracer raw(scene, lighting, embree_spheres);
-    igi::RenderOptions options;
+    igi::render::RenderOptions options;
     options.spp = spp;
     options.num_threads = threads;
     options.show_progress = false;
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
     std::vector<double> igi_rate, raw_rate;
     uint64_t igi_rays = 0, raw_rays = 0, raw_shadow = 0;
     for (int r = 0; r < reps; ++r) {
-      igi::RenderSummary s;
+      igi::render::RenderSummary s;
       options.seed = uint64_t(r);
       renderer.Render(scene.cameras[camera], options, &s);
       igi_rate.push_back(s.RaysPerSecond());

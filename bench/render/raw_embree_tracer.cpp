@@ -22,14 +22,14 @@ constexpr unsigned kMaskSpheres = 2;   // sphere lights: hit by camera/bounce ra
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 struct RawLight {
-  LightType type = LightType::kPoint;
+  recon::LightType type = recon::LightType::kPoint;
   Vec3 position = Vec3::Zero();  // point/spot position, sphere centre
   Vec3 direction = Vec3::UnitZ();
   float radius = 0;
   std::vector<Vec3> tri_vertices;  // area: 3 per triangle
 };
 
-unsigned AttachMesh(RTCDevice device, RTCScene scene, const TriangleMesh& mesh) {
+unsigned AttachMesh(RTCDevice device, RTCScene scene, const recon::TriangleMesh& mesh) {
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
@@ -73,7 +73,7 @@ float HitSphere(const Vec3& o, const Vec3& d, const Vec3& c, float r) {
   return -b - s > 1e-6f ? -b - s : (-b + s > 1e-6f ? -b + s : kInf);
 }
 
-float Uniform(Pcg32& rng) { return float(rng.NextUInt32() >> 8) * 0x1p-24f; }
+float Uniform(render::Pcg32& rng) { return float(rng.NextUInt32() >> 8) * 0x1p-24f; }
 
 // Cosine-distributed direction around unit n (Duff et al.'s frame, Malley's method).
 Vec3 CosineAround(const Vec3& n, float u0, float u1) {
@@ -82,7 +82,7 @@ Vec3 CosineAround(const Vec3& n, float u0, float u1) {
   const float b = n.x() * n.y() * a;
   const Vec3 t(1.0f + sign * n.x() * n.x() * a, sign * b, -sign * n.x());
   const Vec3 bt(b, sign + n.y() * n.y() * a, -n.y());
-  const float r = std::sqrt(u0), phi = 2.0f * float(kPi) * u1;
+  const float r = std::sqrt(u0), phi = 2.0f * float(render::kPi) * u1;
   const float x = r * std::cos(phi), y = r * std::sin(phi);
   return t * x + bt * y + n * std::sqrt(std::max(0.0f, 1.0f - u0));
 }
@@ -119,26 +119,27 @@ struct RawEmbreeTracer::Impl {
   }
 
   // Direction and distance toward a point sampled on light `index`.
-  float SampleLight(int index, const Vec3& p, Pcg32& rng, Vec3* wi) const;
+  float SampleLight(int index, const Vec3& p, render::Pcg32& rng, Vec3* wi) const;
   // One path; returns its rays (and counts shadow rays into *shadow).
-  uint64_t TracePath(Vec3 origin, Vec3 dir, const RawTraceOptions& options, Pcg32& rng,
+  uint64_t TracePath(Vec3 origin, Vec3 dir, const RawTraceOptions& options, render::Pcg32& rng,
                      uint64_t* shadow) const;
 };
 
-float RawEmbreeTracer::Impl::SampleLight(int index, const Vec3& p, Pcg32& rng, Vec3* wi) const {
+float RawEmbreeTracer::Impl::SampleLight(int index, const Vec3& p, render::Pcg32& rng,
+                                         Vec3* wi) const {
   const RawLight& l = lights[index];
   Vec3 target;
   switch (l.type) {
-    case LightType::kDirectional:
+    case recon::LightType::kDirectional:
       *wi = -l.direction;
       return kInf;
-    case LightType::kSphere: {
-      const float z = 1.0f - 2.0f * Uniform(rng), phi = 2.0f * float(kPi) * Uniform(rng);
+    case recon::LightType::kSphere: {
+      const float z = 1.0f - 2.0f * Uniform(rng), phi = 2.0f * float(render::kPi) * Uniform(rng);
       const float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
       target = l.position + l.radius * Vec3(s * std::cos(phi), s * std::sin(phi), z);
       break;
     }
-    case LightType::kArea: {
+    case recon::LightType::kArea: {
       const size_t t = std::min<size_t>(size_t(Uniform(rng) * float(l.tri_vertices.size() / 3)),
                                         l.tri_vertices.size() / 3 - 1);
       float b1 = Uniform(rng), b2 = Uniform(rng);
@@ -157,7 +158,7 @@ float RawEmbreeTracer::Impl::SampleLight(int index, const Vec3& p, Pcg32& rng, V
 }
 
 uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceOptions& options,
-                                          Pcg32& rng, uint64_t* shadow) const {
+                                          render::Pcg32& rng, uint64_t* shadow) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   uint64_t rays = 0;
@@ -172,7 +173,7 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
     ++rays;
     if (!embree_spheres) {
       for (const RawLight& l : lights) {
-        if (l.type == LightType::kSphere &&
+        if (l.type == recon::LightType::kSphere &&
             HitSphere(origin, dir, l.position, l.radius) < rh.ray.tfar) {
           rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         }
@@ -207,35 +208,36 @@ uint64_t RawEmbreeTracer::Impl::TracePath(Vec3 origin, Vec3 dir, const RawTraceO
   return rays;
 }
 
-RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting, bool embree_spheres)
+RawEmbreeTracer::RawEmbreeTracer(const recon::Scene& scene, int lighting, bool embree_spheres)
     : impl_(std::make_unique<Impl>()) {
   impl_->embree_spheres = embree_spheres;
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw Error("cannot create the Embree device");
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-  const TriangleMesh& mesh = scene.mesh;
+  const recon::TriangleMesh& mesh = scene.mesh;
   AttachMesh(impl_->device, impl_->scene, mesh);  // geometry 0
   float extent = 1.0f;
   for (const Vec3& p : mesh.positions) extent = std::max(extent, p.cwiseAbs().maxCoeff());
   impl_->epsilon = 1e-5f * extent;
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
     impl_->normals.push_back(mesh.FaceNormal(t));
-    const Material& m = scene.materials[mesh.triangle_region[t]];
+    const recon::Material& m = scene.materials[mesh.triangle_region[t]];
     const Eigen::Vector3d a = m.rho_d.value_or(Eigen::Vector3d::Constant(0.5)) +
                               m.rho_s.value_or(Eigen::Vector3d::Zero());
     impl_->albedo.push_back(a.cast<float>());
   }
   for (int index : scene.lightings[lighting].lights) {
-    const Light& light = scene.lights[index];
+    const recon::Light& light = scene.lights[index];
     RawLight rl;
     rl.type = light.type;
-    rl.position = (light.type == LightType::kSphere ? light.center : light.position).cast<float>();
+    rl.position =
+        (light.type == recon::LightType::kSphere ? light.center : light.position).cast<float>();
     rl.direction = light.direction.cast<float>();
     rl.radius = float(light.radius);
-    if (light.type == LightType::kSphere && embree_spheres)
+    if (light.type == recon::LightType::kSphere && embree_spheres)
       AttachSphere(impl_->device, impl_->scene, light.center, light.radius);
-    if (light.type == LightType::kArea) {
+    if (light.type == recon::LightType::kArea) {
       for (const Eigen::Vector3i& t : light.mesh.triangles) {
         for (int k = 0; k < 3; ++k) rl.tri_vertices.push_back(light.mesh.positions[t[k]]);
       }
@@ -249,7 +251,8 @@ RawEmbreeTracer::RawEmbreeTracer(const Scene& scene, int lighting, bool embree_s
 
 RawEmbreeTracer::~RawEmbreeTracer() = default;
 
-RawTraceSummary RawEmbreeTracer::Trace(const Camera& camera, const RawTraceOptions& options) const {
+RawTraceSummary RawEmbreeTracer::Trace(const recon::Camera& camera,
+                                       const RawTraceOptions& options) const {
   const auto start = std::chrono::steady_clock::now();
   const Eigen::Matrix3f world_from_cam =
       camera.cam_from_world.rotation.conjugate().toRotationMatrix().cast<float>();
@@ -264,7 +267,7 @@ RawTraceSummary RawEmbreeTracer::Trace(const Camera& camera, const RawTraceOptio
         for (int x = 0; x < camera.width; ++x) {
           const uint64_t pixel = uint64_t(y) * camera.width + x;
           for (int k = 0; k < options.spp; ++k) {
-            Pcg32 rng(options.seed, pixel * uint64_t(options.spp) + uint64_t(k));
+            render::Pcg32 rng(options.seed, pixel * uint64_t(options.spp) + uint64_t(k));
             const float px = float(x) + Uniform(rng), py = float(y) + Uniform(rng);
             const Vec3 d_cam((px - cx) / fx, (py - cy) / fy, 1.0f);
             rays += impl_->TracePath(center, (world_from_cam * d_cam).normalized(), options, rng,

@@ -40,12 +40,12 @@ class RawEmbreeTracer {
   // `embree_spheres`, sphere lights as Embree point-spheres; otherwise they are intersected
   // analytically in float after rtcIntersect1, as igi does in double) with the same build
   // quality as the Renderer.
-  RawEmbreeTracer(const Scene& scene, int lighting, bool embree_spheres = false);
+  RawEmbreeTracer(const recon::Scene& scene, int lighting, bool embree_spheres = false);
   ~RawEmbreeTracer();
   RawEmbreeTracer(const RawEmbreeTracer&) = delete;
   RawEmbreeTracer& operator=(const RawEmbreeTracer&) = delete;
 
-  RawTraceSummary Trace(const Camera& camera, const RawTraceOptions& options) const;
+  RawTraceSummary Trace(const recon::Camera& camera, const RawTraceOptions& options) const;
 
   struct Impl;
 

@@ -30,8 +30,8 @@ void DumpComparison(const igi::Image& mine, const igi::Image& seen, const igi::I
   for (int y = 0; y < want.height; ++y) {
     for (int x = 0; x < want.width; ++x) {
       const Eigen::Vector2d uv((x + 0.5) / want.width, 1.0 - (y + 0.5) / want.height);
-      const Eigen::Vector3d v = igi::SampleTexture(mine, uv);
-      const double s = igi::SampleTexture(seen, uv)[0];
+      const Eigen::Vector3d v = igi::render::SampleTexture(mine, uv);
+      const double s = igi::render::SampleTexture(seen, uv)[0];
       for (int c = 0; c < 3; ++c) {
         est.at(x, y, c) = float(v[c]);
         const double d = v[c] - want.at(x, y, c);
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path capture = argv[1];
-  igi::SolveOptions o;
+  igi::solver::SolveOptions o;
   o.num_threads = 2;
   o.refine_iterations = 1;
   o.show_progress = false;
@@ -89,9 +89,9 @@ int main(int argc, char** argv) {
     else if (key == "step")
       o.refine_albedo_step = v;
     else if (key == "joint")  // 1: refine_update kJoint, 2: kJointAlbedo, 0: kIndependent
-      o.refine_update = v == 2   ? igi::RefineUpdate::kJointAlbedo
-                        : v != 0 ? igi::RefineUpdate::kJoint
-                                 : igi::RefineUpdate::kIndependent;
+      o.refine_update = v == 2   ? igi::solver::RefineUpdate::kJointAlbedo
+                        : v != 0 ? igi::solver::RefineUpdate::kJoint
+                                 : igi::solver::RefineUpdate::kIndependent;
     else if (key == "bounce")
       o.specular_bounces = v != 0;
     else if (key == "smooth")
@@ -104,10 +104,10 @@ int main(int argc, char** argv) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  const igi::Scene scene = igi::LoadScene(capture / "scene.json");
+  const igi::recon::Scene scene = igi::recon::LoadScene(capture / "scene.json");
   const fs::path out =
       fs::temp_directory_path() / ("bench_solve_truth_" + std::to_string(::getpid()));
-  const igi::SolveSummary s = igi::Solve(scene, o, out);
+  const igi::solver::SolveSummary s = igi::solver::Solve(scene, o, out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const igi::Json truth = igi::ReadJsonFile(capture / "truth.json")["materials"];
@@ -115,11 +115,11 @@ int main(int argc, char** argv) {
   std::printf("solved in %.1f s, texel %.4f m\n", seconds, s.texel_size_m);
   std::printf("%-14s %-6s %7s %7s %7s %7s %7s  %s\n", "region", "stage", "rd_r%", "rd_g%", "rd_b%",
               "rs%", "a%", "albedo");
-  for (const igi::RegionSolution& r : s.regions) {
-    if (r.status != igi::RegionStatus::kSolved || !truth.contains(r.name)) continue;
+  for (const igi::solver::RegionSolution& r : s.regions) {
+    if (r.status != igi::solver::RegionStatus::kSolved || !truth.contains(r.name)) continue;
     const igi::Json& t = truth[r.name];
     for (int stage = 1; stage <= 2; ++stage) {
-      const igi::RegionFitResult& f = stage == 1 ? r.stage1 : r.stage2;
+      const igi::solver::RegionFitResult& f = stage == 1 ? r.stage1 : r.stage2;
       std::printf("%-14s %-6d", r.name.c_str(), stage);
       for (int c = 0; c < 3; ++c)
         std::printf(" %+7.2f", rel(f.rho_d[c], t["rho_d"][c].get<double>()));
@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
       } else {
         std::printf(" %7s %7s", "", "");
       }
-      std::printf("  %s", std::string(igi::AlbedoModelName(f.albedo_model)).c_str());
+      std::printf("  %s", std::string(igi::solver::AlbedoModelName(f.albedo_model)).c_str());
       if (stage == 2) std::printf("  %d obs", r.observations);
       std::printf("\n");
     }
@@ -137,9 +137,10 @@ int main(int argc, char** argv) {
       const igi::Image want = igi::ReadImage(capture / t["rho_d_map"].get<std::string>(), 3);
       double peak = 0;
       for (float v : want.pixels) peak = std::max(peak, double(v));
-      const igi::AlbedoComparison all = igi::CompareAlbedoMaps(*r.albedo_map, nullptr, want, peak);
-      const igi::AlbedoComparison seen =
-          igi::CompareAlbedoMaps(*r.albedo_map, &*r.albedo_map_seen, want, peak);
+      const igi::solver::AlbedoComparison all =
+          igi::solver::CompareAlbedoMaps(*r.albedo_map, nullptr, want, peak);
+      const igi::solver::AlbedoComparison seen =
+          igi::solver::CompareAlbedoMaps(*r.albedo_map, &*r.albedo_map_seen, want, peak);
       if (dump) DumpComparison(*r.albedo_map, *r.albedo_map_seen, want);
       {  // region means over the texels some photo sees (area means: the floor's UVs are affine)
         Eigen::Vector3d sum_t = Eigen::Vector3d::Zero(), sum_e = sum_t;
@@ -147,8 +148,8 @@ int main(int argc, char** argv) {
         for (int y = 0; y < want.height; ++y) {
           for (int x = 0; x < want.width; ++x) {
             const Eigen::Vector2d uv((x + 0.5) / want.width, 1.0 - (y + 0.5) / want.height);
-            if (igi::SampleTexture(*r.albedo_map_seen, uv)[0] < 1) continue;
-            sum_e += igi::SampleTexture(*r.albedo_map, uv);
+            if (igi::render::SampleTexture(*r.albedo_map_seen, uv)[0] < 1) continue;
+            sum_e += igi::render::SampleTexture(*r.albedo_map, uv);
             for (int c = 0; c < 3; ++c) sum_t[c] += want.at(x, y, c);
             ++n;
           }
@@ -162,7 +163,7 @@ int main(int argc, char** argv) {
             r.name.c_str(), 100 * (mt.mean() / full.mean() - 1), 100 * (me.mean() / mt.mean() - 1),
             100 * (r.stage1.rho_d.mean() / mt.mean() - 1));
         // The truth over the texels SeenTexelMean takes.
-        const Eigen::Vector3d mn = igi::TextureMeanOverSeenTexels(want, *r.albedo_map_seen);
+        const Eigen::Vector3d mn = igi::solver::TextureMeanOverSeenTexels(want, *r.albedo_map_seen);
         std::printf(
             "%s: scene.json's rho_d %+.2f %+.2f %+.2f %% of the truth over the map's seen texels\n",
             r.name.c_str(), rel(r.final_params.rho_d[0], mn[0]),
@@ -187,7 +188,8 @@ int main(int argc, char** argv) {
             eroded.at(x, y, 0) = ok ? 1.f : 0.f;
           }
         }
-        const igi::AlbedoComparison e = igi::CompareAlbedoMaps(*r.albedo_map, &eroded, want, peak);
+        const igi::solver::AlbedoComparison e =
+            igi::solver::CompareAlbedoMaps(*r.albedo_map, &eroded, want, peak);
         std::printf(
             "  %d texels away from unseen texels and the border: PSNR %.2f dB over %.0f %%\n",
             r_erode, e.psnr_db, 100 * e.compared);

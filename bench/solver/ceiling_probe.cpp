@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each line as it is printed
   SetDefaultThreads(2);
-  const Scene scene = LoadScene(dir / "scene.json");
-  SolveOptions options;
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json");
+  solver::SolveOptions options;
   options.refine_iterations = 0;
   options.num_threads = 2;
   options.show_progress = false;
@@ -98,16 +98,16 @@ int main(int argc, char** argv) {
   options.smoothing_radius_m = std::stod(kv["smooth"]);
   options.patch_size_m = std::stod(kv["patch"]);
   options.specular_bounces = kv["bounce"] != "0";
-  SolverState s(scene, options);
+  solver::SolverState s(scene, options);
   s.Prepare();
   s.GatherAll();
   s.RunStage1();
   if (!kv["model_maps"].empty()) {
     // The stage-1 model's albedo maps (the ones the refinement renders), into that folder.
-    std::vector<RegionAtlas> atlases;
+    std::vector<solver::RegionAtlas> atlases;
     std::vector<Image> maps;
     fs::create_directories(kv["model_maps"]);
-    const Scene model = s.CompleteScene(&atlases, &maps, kv["model_maps"]);
+    const recon::Scene model = s.CompleteScene(&atlases, &maps, kv["model_maps"]);
     for (size_t r = 0; r < model.materials.size(); ++r) {
       if (!model.materials[r].rho_d_map) continue;
       std::printf("model map %s\n", model.materials[r].rho_d_map->c_str());
@@ -115,12 +115,12 @@ int main(int argc, char** argv) {
       std::vector<std::pair<double, size_t>> top;
       for (size_t i = 0; i < s.obs.size(); ++i) {
         if (s.obs[i].region != int(r)) continue;
-        top.emplace_back(kPi * s.obs[i].radiance[0] / s.light.e[i][0], i);
+        top.emplace_back(render::kPi * s.obs[i].radiance[0] / s.light.e[i][0], i);
       }
       std::sort(top.rbegin(), top.rend());
       for (size_t k = 0; k < 8 && k < top.size(); ++k) {
         const size_t i = top[k].second;
-        const Observation& o = s.obs[i];
+        const solver::Observation& o = s.obs[i];
         std::printf(
             "  albedo %.2f photo %d px (%.0f, %.0f) size %d pos (%.3f %.3f %.3f) L (%.4g %.4g "
             "%.4g) "
@@ -139,15 +139,16 @@ int main(int argc, char** argv) {
                                  truth[kv["region"]]["rho_d"][1].get<double>(),
                                  truth[kv["region"]]["rho_d"][2].get<double>());
   const Eigen::Vector3d rho_fit = s.materials[region].params.rho_d;
-  std::printf("%s: stage-1 rho_d %+.2f %+.2f %+.2f %% (%s), patch %.4f m\n", kv["region"].c_str(),
-              100 * (rho_fit[0] / rho_true[0] - 1), 100 * (rho_fit[1] / rho_true[1] - 1),
-              100 * (rho_fit[2] / rho_true[2] - 1),
-              std::string(AlbedoModelName(s.materials[region].last_fit.albedo_model)).c_str(),
-              s.summary.patch_size_m);
-  const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
+  std::printf(
+      "%s: stage-1 rho_d %+.2f %+.2f %+.2f %% (%s), patch %.4f m\n", kv["region"].c_str(),
+      100 * (rho_fit[0] / rho_true[0] - 1), 100 * (rho_fit[1] / rho_true[1] - 1),
+      100 * (rho_fit[2] / rho_true[2] - 1),
+      std::string(solver::AlbedoModelName(s.materials[region].last_fit.albedo_model)).c_str(),
+      s.summary.patch_size_m);
+  const recon::Scene truth_scene = recon::LoadScene(dir / "truth" / "scene.json");
   const int lighting = 0;
-  const Renderer ref(truth_scene, lighting);
-  const LightingState& st = s.light.lightings[lighting];
+  const render::Renderer ref(truth_scene, lighting);
+  const solver::LightingState& st = s.light.lightings[lighting];
   std::vector<int> count(s.patches.size(), 0);
   for (int i : st.obs) ++count[s.obs[i].patch];
   std::vector<int> subset;
@@ -164,34 +165,35 @@ int main(int argc, char** argv) {
       0, int64_t(subset.size()),
       [&](int64_t k) {
         const int i = subset[k];
-        const Observation& o = s.obs[i];
+        const solver::Observation& o = s.obs[i];
         Row& row = rows[k];
         row.e_dir = s.light.e_direct[i];
         row.e_ind_raw = s.light.e_indirect[i];
         row.e_ind_smooth = s.light.e[i] - s.light.e_direct[i];
         row.l_photo = o.radiance.cast<double>();
         const double eps = s.lighting_scenes[lighting]->ray_epsilon();
-        GatherQuery q;
+        solver::GatherQuery q;
         q.position = o.position.cast<double>();
         const Eigen::Vector3d fn = scene.mesh.FaceNormal(o.triangle).cast<double>();
         q.n_geo = fn.dot(o.view.cast<double>()) >= 0 ? fn : -fn;
         q.n_s = o.normal.cast<double>();
-        Pcg32 rng(1000 + i, 7);
+        render::Pcg32 rng(1000 + i, 7);
         row.e_ind_ref.setZero();
         int ray = 0;
-        for (const WeightedDirection& d : HemisphereDirections(q, ref_rays, 0.2, rng)) {
+        for (const solver::WeightedDirection& d :
+             solver::HemisphereDirections(q, ref_rays, 0.2, rng)) {
           row.e_ind_ref += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * eps, d.wi, 1,
                                                             uint64_t(i) * 65536 + ray++);
         }
-        const GatherPoint& gp = st.gather.points[s.light.point[i]];
+        const solver::GatherPoint& gp = st.gather.points[s.light.point[i]];
         for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
-          const IndirectSample& is = st.gather.indirect[j];
+          const solver::IndirectSample& is = st.gather.indirect[j];
           const Eigen::Vector3d wi = is.wi.cast<double>();
           const Eigen::Vector3d l_true =
               ref.ReflectedRadiance(q.position + q.n_geo * eps, wi, paths, uint64_t(j) * 977 + 5);
-          const Eigen::Vector3d l_model = is.patch < 0
-                                              ? Eigen::Vector3d::Zero()
-                                              : IndirectRadiance(s.patches, s.materials, st, is);
+          const Eigen::Vector3d l_model =
+              is.patch < 0 ? Eigen::Vector3d::Zero()
+                           : solver::IndirectRadiance(s.patches, s.materials, st, is);
           const std::string hit =
               is.patch < 0 ? "none" : scene.materials[s.patches.patch_region[is.patch]].name;
           const std::string b = is.patch < 0 ? "none" : Bucket(count[is.patch]);
@@ -200,24 +202,25 @@ int main(int argc, char** argv) {
           Eigen::Vector3d l_spec_ind = Eigen::Vector3d::Zero();
           if (is.patch >= 0) {
             const int hr = s.patches.patch_region[is.patch];
-            const MaterialState& hm = s.materials[hr];
-            const std::optional<SurfaceHit> h =
+            const solver::MaterialState& hm = s.materials[hr];
+            const std::optional<render::SurfaceHit> h =
                 s.lighting_scenes[lighting]->TraceSurface(q.position + q.n_geo * eps, wi);
-            if (h && HasSpecularLobe(hm.params.model) && spec_rays > 0) {
-              GatherQuery hq;
+            if (h && recon::HasSpecularLobe(hm.params.model) && spec_rays > 0) {
+              solver::GatherQuery hq;
               hq.position = h->position;
               hq.n_geo = h->n_geo;
               hq.n_s = h->n_s;
               hq.view = -wi;
               hq.lobe = true;
-              const Frame frame = s.materials.LocalFrame(hr, h->n_s);
+              const render::Frame frame = s.materials.LocalFrame(hr, h->n_s);
               const Eigen::Vector3d wo = frame.ToLocal(-wi);
-              Pcg32 r2(j * 3 + 1, 11);
+              render::Pcg32 r2(j * 3 + 1, 11);
               int m = 0;
-              for (const WeightedDirection& d2 : HemisphereDirections(hq, spec_rays, 0.2, r2)) {
+              for (const solver::WeightedDirection& d2 :
+                   solver::HemisphereDirections(hq, spec_rays, 0.2, r2)) {
                 const double sw =
-                    SpecularWeight(hm.params.model, hm.params.AlphaX(), hm.params.AlphaY(),
-                                   hm.params.ior, wo, frame.ToLocal(d2.wi));
+                    solver::SpecularWeight(hm.params.model, hm.params.AlphaX(), hm.params.AlphaY(),
+                                           hm.params.ior, wo, frame.ToLocal(d2.wi));
                 if (!(sw > 0)) continue;
                 l_spec_ind += sw * d2.weight *
                               ref.ReflectedRadiance(h->position + h->n_geo * eps, d2.wi, 1,
@@ -236,7 +239,7 @@ int main(int argc, char** argv) {
           row.by["hit " + hit].Add(is.weight * l_model, is.weight * l_true);
           row.by["patch " + b].Add(is.weight * l_model, is.weight * l_true);
         }
-        const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+        const recon::Camera& cam = scene.cameras[scene.photos[o.photo].camera];
         row.l_pixel_ref = ref.Radiance(cam.CenterInWorld(),
                                        cam.WorldRayFromImg(Eigen::Vector2d(o.x + 0.5, o.y + 0.5)),
                                        pixel_paths, uint64_t(i) * 31 + 3);
@@ -281,9 +284,9 @@ int main(int argc, char** argv) {
               kv["every"].c_str(), seen, seconds);
   for (auto& [key, t] : tot) {
     const Eigen::Vector3d e_g = t[0] + t[2], e_ref = t[0] + t[3];
-    const Eigen::Vector3d rho_g = kPi * t[4].cwiseQuotient(e_g);
-    const Eigen::Vector3d rho_r = kPi * t[4].cwiseQuotient(e_ref);
-    const Eigen::Vector3d rho_pix = kPi * t[5].cwiseQuotient(e_ref);
+    const Eigen::Vector3d rho_g = render::kPi * t[4].cwiseQuotient(e_g);
+    const Eigen::Vector3d rho_r = render::kPi * t[4].cwiseQuotient(e_ref);
+    const Eigen::Vector3d rho_pix = render::kPi * t[5].cwiseQuotient(e_ref);
     std::printf(
         "%-8s E_dir/E %.3f | E_ind smoothed/ref %.4f raw/ref %.4f | E_gathered/E_ref %.4f | "
         "L_photo/L_pixel_ref %.4f | L_photo/(rho E_ref/pi) %.4f\n"
@@ -291,7 +294,7 @@ int main(int argc, char** argv) {
         "ref E %+.2f %%\n",
         key.c_str(), t[0].sum() / e_ref.sum(), t[2].sum() / t[3].sum(), t[1].sum() / t[3].sum(),
         e_g.sum() / e_ref.sum(), t[4].sum() / t[5].sum(),
-        t[4].sum() / (rho_true.cwiseProduct(e_ref) / kPi).sum(),
+        t[4].sum() / (rho_true.cwiseProduct(e_ref) / render::kPi).sum(),
         100 * (rho_g.mean() / rho_true.mean() - 1), 100 * (rho_r.mean() / rho_true.mean() - 1),
         100 * (rho_pix.mean() / rho_true.mean() - 1));
     // The standard error of L_photo/L_pixel_box (both noisy renders) from the rows' scatter.
@@ -318,22 +321,22 @@ int main(int argc, char** argv) {
     const fs::path tmp =
         fs::temp_directory_path() / ("ceiling_probe_" + std::to_string(::getpid()));
     fs::create_directories(tmp);
-    std::vector<RegionAtlas> atlases;
+    std::vector<solver::RegionAtlas> atlases;
     std::vector<Image> maps;
-    const Scene model = s.CompleteScene(&atlases, &maps, tmp);
+    const recon::Scene model = s.CompleteScene(&atlases, &maps, tmp);
     s.options.refine_rays = std::stoi(kv["stage2"]);
     s.options.seed = std::stoull(kv["seed2"]);
     // The scenes rendered: the true scene, the stage-1 model, and the model with one region at a
     // time as the truth has it (which region's model sends the difference), or without its map.
-    std::vector<std::pair<std::string, Scene>> variants = {{"true scene", truth_scene},
-                                                           {"stage-1 model", model}};
+    std::vector<std::pair<std::string, recon::Scene>> variants = {{"true scene", truth_scene},
+                                                                  {"stage-1 model", model}};
     for (size_t r = 0; r < model.materials.size(); ++r) {
       if (kv["variants"].find(model.materials[r].name) == std::string::npos) continue;
-      Scene one = model;
+      recon::Scene one = model;
       one.materials[r] = truth_scene.materials[r];
       variants.emplace_back("model, " + model.materials[r].name + " true", std::move(one));
       if (model.materials[r].rho_d_map) {
-        Scene flat = model;
+        recon::Scene flat = model;
         flat.materials[r].rho_d_map.reset();
         flat.materials[r].rho_d = s.materials[r].params.rho_d;
         variants.emplace_back("model, " + model.materials[r].name + " without its map",
@@ -341,8 +344,8 @@ int main(int argc, char** argv) {
       }
     }
     for (const auto& [name, scene_v] : variants) {
-      RenderIncident(s.Stage(), scene_v, s.RayEpsilons(), s.materials, std::stoull(kv["round"]),
-                     &s.light);
+      solver::RenderIncident(s.Stage(), scene_v, s.RayEpsilons(), s.materials,
+                             std::stoull(kv["round"]), &s.light);
       Eigen::Vector3d sum = Eigen::Vector3d::Zero(), ref_sum = sum;
       for (size_t k = 0; k < rows.size(); ++k) {
         sum += s.light.e_indirect[subset[k]];
@@ -364,7 +367,7 @@ int main(int argc, char** argv) {
   // centres (direct and indirect) against a reference of the true scene there.
   std::map<int, int> hits;
   for (int i : subset) {
-    const GatherPoint& gp = st.gather.points[s.light.point[i]];
+    const solver::GatherPoint& gp = st.gather.points[s.light.point[i]];
     for (int j = gp.indirect_begin; j < gp.indirect_end; ++j) {
       const int q = st.gather.indirect[j].patch;
       if (q >= 0 && count[q] == 0) ++hits[q];
@@ -373,23 +376,24 @@ int main(int argc, char** argv) {
   std::vector<int> unseen;
   for (const auto& [q, n] : hits) unseen.push_back(q);
   std::vector<std::array<double, 5>> pe(unseen.size());
-  const RayScene& ls = *s.lighting_scenes[lighting];
+  const render::RayScene& ls = *s.lighting_scenes[lighting];
   ParallelFor(
       0, int64_t(unseen.size()),
       [&](int64_t k) {
         const int q = unseen[k];
-        GatherQuery gq;
+        solver::GatherQuery gq;
         gq.position = s.patches.center[q].cast<double>();
         gq.n_geo = scene.mesh.FaceNormal(s.patches.patch_triangle[q]).cast<double>();
         gq.n_s = s.patches.normal[q].cast<double>();
-        Pcg32 rng(77 + q, 9);
+        render::Pcg32 rng(77 + q, 9);
         Eigen::Vector3d e = Eigen::Vector3d::Zero();
         int ray = 0;
-        for (const WeightedDirection& d : HemisphereDirections(gq, ref_rays, 0.2, rng)) {
+        for (const solver::WeightedDirection& d :
+             solver::HemisphereDirections(gq, ref_rays, 0.2, rng)) {
           e += d.weight * ref.ReflectedRadiance(gq.position + gq.n_geo * ls.ray_epsilon(), d.wi, 1,
                                                 uint64_t(q) * 65536 + ray++);
         }
-        const GatherPoint& gp = st.gather.points[st.first_patch_point + q];
+        const solver::GatherPoint& gp = st.gather.points[st.first_patch_point + q];
         const Eigen::Vector3d e_dir = gp.e_direct.cast<double>();
         pe[k] = {e_dir.sum(), (st.patch_e[q].cast<double>() - e_dir).sum(), e.sum(),
                  double(hits[q]), s.materials.PatchAlbedo(s.patches, q).sum()};

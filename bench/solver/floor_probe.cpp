@@ -31,20 +31,20 @@ int main(int argc, char** argv) {
   const fs::path dir = argc > 1 ? argv[1] : "/tmp/wts/clean";
   const bool noisy = argc > 2 && std::string(argv[2]) == "noisy";
   if (!fs::exists(dir / "scene.json")) {
-    SynthOptions so;
+    synth::SynthOptions so;
     so.out = dir;
     so.spp = std::getenv("PROBE_SPP") ? std::atoi(std::getenv("PROBE_SPP")) : 64;
-    if (noisy) so.noise = NoiseModel::kRealistic;
+    if (noisy) so.noise = synth::NoiseModel::kRealistic;
     if (std::getenv("PROBE_SEED")) so.seed = std::atoi(std::getenv("PROBE_SEED"));
-    Synthesize(so);
+    synth::Synthesize(so);
   }
   SetDefaultThreads(2);
-  const Scene scene = LoadScene(dir / "scene.json");
-  SolveOptions options;
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json");
+  solver::SolveOptions options;
   options.refine_iterations = 0;
   options.num_threads = 2;
   if (const char* e = std::getenv("PROBE_HELD")) options.held_out_albedo = std::string(e) == "1";
-  SolverState s(scene, options);
+  solver::SolverState s(scene, options);
   s.Prepare();
   s.GatherAll();
   s.RunStage1();
@@ -53,29 +53,29 @@ int main(int argc, char** argv) {
   const Image tex = ReadImage(dir / truth["floor"]["rho_d_map"].get<std::string>(), 3);
   const double rs_true = truth["floor"]["rho_s"].get<double>();
   const double a_true = truth["floor"]["alpha"].get<double>();
-  const MaterialState& m = s.materials[floor];
+  const solver::MaterialState& m = s.materials[floor];
   std::printf("sigma rho_s %.4f sigma alpha %.4f\n", m.last_fit.sigma_rho_s,
               m.last_fit.sigma_alpha);
   std::printf("texel %.4f m, floor fit rho_s %.4f (%+.1f %%) alpha %.4f (%+.1f %%) model %s\n",
               s.summary.texel_size_m, m.params.rho_s.mean(),
               100 * (m.params.rho_s.mean() / rs_true - 1), m.params.alpha,
               100 * (m.params.alpha / a_true - 1),
-              std::string(AlbedoModelName(m.last_fit.albedo_model)).c_str());
+              std::string(solver::AlbedoModelName(m.last_fit.albedo_model)).c_str());
   // Held-out albedo variants: A as the solver (current params), B with the true lobe
   // subtracted and the true model deciding off-highlight, C the true texture times E (blur only).
   std::vector<Eigen::Vector3d> t_true(s.obs.size(), Eigen::Vector3d::Zero());
   for (size_t i = 0; i < s.obs.size(); ++i) {
-    const Observation& o = s.obs[i];
+    const solver::Observation& o = s.obs[i];
     if (o.region != floor) continue;
     const Eigen::Vector3d wo =
         s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
-    for (const IncidentLocal& inc : s.light.incident[i]) {
-      const double w =
-          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
+    for (const solver::IncidentLocal& inc : s.light.incident[i]) {
+      const double w = solver::SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo,
+                                              inc.Wi().cast<double>());
       if (w > 0) t_true[i] += w * inc.Value().cast<double>();
     }
   }
-  auto uv_of = [&](const Observation& o) {
+  auto uv_of = [&](const solver::Observation& o) {
     const Eigen::Vector3i& t = scene.mesh.triangles[o.triangle];
     return Eigen::Vector2d(((1.0f - o.b1 - o.b2) * scene.mesh.uvs[t[0]] +
                             o.b1 * scene.mesh.uvs[t[1]] + o.b2 * scene.mesh.uvs[t[2]])
@@ -85,13 +85,14 @@ int main(int argc, char** argv) {
     // Per off-highlight sample: the albedo error pi(L - rs T)/E - R, by photo and by spec share.
     std::map<std::string, std::array<double, 3>> bins;
     for (size_t i = 0; i < s.obs.size(); ++i) {
-      const Observation& o = s.obs[i];
+      const solver::Observation& o = s.obs[i];
       if (o.region != floor) continue;
-      const Eigen::Vector3d r = SampleTexture(tex, uv_of(o));
+      const Eigen::Vector3d r = render::SampleTexture(tex, uv_of(o));
       const Eigen::Vector3d spec = rs_true * t_true[i];
-      const double share = spec.mean() / (r.cwiseProduct(s.light.e[i]).mean() / kPi + spec.mean());
+      const double share =
+          spec.mean() / (r.cwiseProduct(s.light.e[i]).mean() / render::kPi + spec.mean());
       const Eigen::Vector3d err =
-          (kPi * (o.radiance.cast<double>() - spec)).cwiseQuotient(s.light.e[i]) - r;
+          (render::kPi * (o.radiance.cast<double>() - spec)).cwiseQuotient(s.light.e[i]) - r;
       const int b = share < 0.01 ? 0 : share < 0.03 ? 1 : share < 0.1 ? 2 : share < 0.2 ? 3 : 4;
       for (std::string key :
            {fmt::format("photo {} share<{}", o.photo, b), fmt::format("all share<{}", b),
@@ -108,9 +109,9 @@ int main(int argc, char** argv) {
   }
   if (std::getenv("PROBE_REF")) {
     // Reference radiance (pixel centre, many paths) and irradiance for a subset of floor samples.
-    const Scene truth_scene = LoadScene(dir / "truth" / "scene.json");
-    const Renderer ref(truth_scene, truth_scene.FindLighting("L0"));
-    const RayScene& ls = *s.lighting_scenes[0];
+    const recon::Scene truth_scene = recon::LoadScene(dir / "truth" / "scene.json");
+    const render::Renderer ref(truth_scene, truth_scene.FindLighting("L0"));
+    const render::RayScene& ls = *s.lighting_scenes[0];
     std::vector<size_t> subset;
     for (size_t i = 0; i < s.obs.size(); i += 13) {
       if (s.obs[i].region == floor) subset.push_back(i);
@@ -120,37 +121,40 @@ int main(int argc, char** argv) {
         0, int64_t(subset.size()),
         [&](int64_t k) {
           const size_t i = subset[k];
-          const Observation& o = s.obs[i];
-          const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+          const solver::Observation& o = s.obs[i];
+          const recon::Camera& cam = scene.cameras[scene.photos[o.photo].camera];
           const Eigen::Vector3d c = cam.CenterInWorld();
           const Eigen::Vector3d dir = cam.WorldRayFromImg(
               Eigen::Vector2d(o.x + 0.5, std::min(o.y + 1, cam.height - 1) + 0.5));
           (void)dir;
           const Eigen::Vector3d dir2 = (o.position.cast<double>() - c).normalized();
           const Eigen::Vector3d lref = ref.Radiance(c, dir2, 4096, 77 + i);
-          GatherQuery q;
+          solver::GatherQuery q;
           q.position = o.position.cast<double>();
           const Eigen::Vector3d fn = scene.mesh.FaceNormal(o.triangle).cast<double>();
           q.n_geo = fn.dot(o.view.cast<double>()) >= 0 ? fn : -fn;
           q.n_s = o.normal.cast<double>();
-          PatchSet none;
-          GatherOptions go;
+          solver::PatchSet none;
+          solver::GatherOptions go;
           go.light_samples = 1024;
           go.indirect_rays = 0;
           go.num_threads = 1;
           go.seed = 99 + i;
           (void)ls;
-          const GatherSet g = Gather(ls, s.patches, {q}, go);
+          const solver::GatherSet g = solver::Gather(ls, s.patches, {q}, go);
           Eigen::Vector3d eind = Eigen::Vector3d::Zero();
-          Pcg32 rng(5 + i, 3);
-          for (const WeightedDirection& d : HemisphereDirections(q, 2048, 0.2, rng)) {
+          render::Pcg32 rng(5 + i, 3);
+          for (const solver::WeightedDirection& d :
+               solver::HemisphereDirections(q, 2048, 0.2, rng)) {
             eind += d.weight * ref.ReflectedRadiance(q.position + q.n_geo * ls.ray_epsilon(), d.wi,
                                                      1, 1000 * i + 17);
           }
           const Eigen::Vector3d eref = g.points[0].e_direct.cast<double>() + eind;
-          const Eigen::Vector3d r = SampleTexture(tex, uv_of(o));
-          const Eigen::Vector3d model = r.cwiseProduct(s.light.e[i]) / kPi + rs_true * t_true[i];
-          const Eigen::Vector3d model_ref = r.cwiseProduct(eref) / kPi + rs_true * t_true[i];
+          const Eigen::Vector3d r = render::SampleTexture(tex, uv_of(o));
+          const Eigen::Vector3d model =
+              r.cwiseProduct(s.light.e[i]) / render::kPi + rs_true * t_true[i];
+          const Eigen::Vector3d model_ref =
+              r.cwiseProduct(eref) / render::kPi + rs_true * t_true[i];
           res[k] = {lref.mean(),
                     model.mean(),
                     model_ref.mean(),
@@ -171,7 +175,7 @@ int main(int argc, char** argv) {
         res.size(), sl / sm, sl / smr, se / ser, sd / sdr, sp / sl);
     FILE* rf = std::fopen("/tmp/wts/ref.csv", "w");
     for (size_t k = 0; k < res.size(); ++k) {
-      const Observation& o = s.obs[subset[k]];
+      const solver::Observation& o = s.obs[subset[k]];
       std::fprintf(rf, "%d,%d,%d", o.photo, o.x, o.y);
       for (double x : res[k]) std::fprintf(rf, ",%g", x);
       std::fprintf(rf, ",%g\n", double(o.radiance.mean()));
@@ -184,17 +188,17 @@ int main(int argc, char** argv) {
   };
   const int sel_mode = std::getenv("PROBE_SEL") ? std::atoi(std::getenv("PROBE_SEL")) : 0;
   for (double texel : {s.summary.texel_size_m}) {
-    AtlasOptions ao;
+    solver::AtlasOptions ao;
     ao.texel_size_m = texel;
-    const RegionAtlas atlas = BuildRegionAtlas(scene.mesh, floor, ao);
+    const solver::RegionAtlas atlas = solver::BuildRegionAtlas(scene.mesh, floor, ao);
     const int64_t nt = int64_t(atlas.width) * atlas.height;
     for (double thr : {0.1, 0.2, 0.3}) {
       std::string line = fmt::format("texel {:.4f} thr {:.2f}:", texel, thr);
       for (int var = 0; var < 3; ++var) {
-        HeldOutAlbedo held(atlas);
+        solver::HeldOutAlbedo held(atlas);
         std::unordered_map<int64_t, Acc> tot, per;
         for (size_t i = 0; i < s.obs.size(); ++i) {
-          const Observation& o = s.obs[i];
+          const solver::Observation& o = s.obs[i];
           if (o.region != floor) continue;
           const Eigen::Vector3d l = o.radiance.cast<double>();
           const Eigen::Vector3d spec =
@@ -202,14 +206,15 @@ int main(int argc, char** argv) {
                        : Eigen::Vector3d(rs_true * t_true[i]);
           const Eigen::Vector3d alb = sel_mode == 0   ? s.materials.PatchAlbedo(s.patches, o.patch)
                                       : sel_mode == 1 ? Eigen::Vector3d(m.params.rho_d)
-                                                      : SampleTexture(tex, uv_of(o));
-          const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / kPi;
+                                                      : render::SampleTexture(tex, uv_of(o));
+          const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / render::kPi;
           const bool off = !(spec.array() > thr * (diffuse + spec).array()).any();
           const Eigen::Vector3d numer =
-              var == 2 ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]))
-                       : Eigen::Vector3d(kPi * (l - spec));
+              var == 2
+                  ? Eigen::Vector3d(render::SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]))
+                  : Eigen::Vector3d(render::kPi * (l - spec));
           if (off) held.Add(o.photo, o.triangle, o.b1, o.b2, numer, s.light.e[i]);
-          const TexelSplat sp = BilinearTexelSplat(atlas, o.triangle, o.b1, o.b2);
+          const solver::TexelSplat sp = solver::BilinearTexelSplat(atlas, o.triangle, o.b1, o.b2);
           for (int k = 0; k < 4; ++k) {
             const double w = sp.weight[k];
             if (!(w > 0)) continue;
@@ -220,7 +225,7 @@ int main(int argc, char** argv) {
                 // the fit side: the observed radiance (var 2: the true texture's diffuse + true
                 // lobe)
                 const Eigen::Vector3d lv =
-                    var == 2 ? Eigen::Vector3d(numer / kPi + rs_true * t_true[i]) : l;
+                    var == 2 ? Eigen::Vector3d(numer / render::kPi + rs_true * t_true[i]) : l;
                 a->l += w * lv, a->e += w * s.light.e[i], a->t += w * t_true[i], a->wf += w;
               }
             }
@@ -228,17 +233,18 @@ int main(int argc, char** argv) {
         }
         double num = 0, den = 0;
         for (size_t i = 0; i < s.obs.size(); ++i) {
-          const Observation& o = s.obs[i];
+          const solver::Observation& o = s.obs[i];
           if (o.region != floor || !s.obs.in_fit[i]) continue;
           const Eigen::Vector3d h = held.At(o.photo, o.triangle, o.b1, o.b2);
           if (!h.allFinite()) continue;
           const Eigen::Vector3d lv =
-              var == 2
-                  ? Eigen::Vector3d(SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]) / kPi +
-                                    rs_true * t_true[i])
-                  : Eigen::Vector3d(o.radiance.cast<double>());
+              var == 2 ? Eigen::Vector3d(
+                             render::SampleTexture(tex, uv_of(o)).cwiseProduct(s.light.e[i]) /
+                                 render::kPi +
+                             rs_true * t_true[i])
+                       : Eigen::Vector3d(o.radiance.cast<double>());
           for (int c = 0; c < 3; ++c) {
-            num += (lv[c] - h[c] * s.light.e[i][c] / kPi) * t_true[i][c];
+            num += (lv[c] - h[c] * s.light.e[i][c] / render::kPi) * t_true[i][c];
             den += t_true[i][c] * t_true[i][c];
           }
         }
@@ -255,36 +261,37 @@ int main(int argc, char** argv) {
           for (int c = 0; c < 3; ++c) {
             const double alb = hn[c] / hd[c];
             const double lbar = a.l[c] / a.wf, ebar = a.e[c] / a.wf, tbar = a.t[c] / a.wf;
-            num2 += a.wf * (lbar - alb * ebar / kPi) * tbar;
+            num2 += a.wf * (lbar - alb * ebar / render::kPi) * tbar;
             den2 += a.wf * tbar * tbar;
           }
         }
         if (var < 2) {
           // Joint: held albedo without the lobe (h0) and the held samples' lobe (tau per unit
           // rho_s).
-          HeldOutAlbedo h0(atlas), tau(atlas);
+          solver::HeldOutAlbedo h0(atlas), tau(atlas);
           for (size_t i = 0; i < s.obs.size(); ++i) {
-            const Observation& o = s.obs[i];
+            const solver::Observation& o = s.obs[i];
             if (o.region != floor) continue;
             const Eigen::Vector3d spec =
                 var == 0 ? Eigen::Vector3d(m.params.rho_s.cwiseProduct(s.light.t[i]))
                          : Eigen::Vector3d(rs_true * t_true[i]);
             const Eigen::Vector3d alb =
                 sel_mode == 0 ? s.materials.PatchAlbedo(s.patches, o.patch) : m.params.rho_d;
-            const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / kPi;
+            const Eigen::Vector3d diffuse = alb.cwiseProduct(s.light.e[i]) / render::kPi;
             if ((spec.array() > thr * (diffuse + spec).array()).any()) continue;
-            h0.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), s.light.e[i]);
-            tau.Add(o.photo, o.triangle, o.b1, o.b2, kPi * t_true[i], s.light.e[i]);
+            h0.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * o.radiance.cast<double>(),
+                   s.light.e[i]);
+            tau.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * t_true[i], s.light.e[i]);
           }
           double n3 = 0, d3 = 0;
           for (size_t i = 0; i < s.obs.size(); ++i) {
-            const Observation& o = s.obs[i];
+            const solver::Observation& o = s.obs[i];
             if (o.region != floor || !s.obs.in_fit[i]) continue;
             const Eigen::Vector3d h = h0.At(o.photo, o.triangle, o.b1, o.b2),
                                   tu = tau.At(o.photo, o.triangle, o.b1, o.b2);
             if (!h.allFinite() || !tu.allFinite()) continue;
             for (int c = 0; c < 3; ++c) {
-              const double a = s.light.e[i][c] / kPi;
+              const double a = s.light.e[i][c] / render::kPi;
               const double u = o.radiance[c] - h[c] * a, v = t_true[i][c] - tu[c] * a;
               n3 += u * v, d3 += v * v;
             }
@@ -305,7 +312,7 @@ int main(int argc, char** argv) {
                "photo,x,y,u,v,L0,L1,L2,E0,E1,E2,T_true,T_fit,held0,held1,held2,true0,true1,"
                "true2,patch0,patch1,patch2,Edir0\n");
   for (size_t i = 0; i < s.obs.size(); ++i) {
-    const Observation& o = s.obs[i];
+    const solver::Observation& o = s.obs[i];
     if (o.region != floor || !s.obs.in_fit[i]) continue;
     const Eigen::Vector3i& t = scene.mesh.triangles[o.triangle];
     const Eigen::Vector2d uv = ((1.0f - o.b1 - o.b2) * scene.mesh.uvs[t[0]] +
@@ -314,15 +321,15 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d wo =
         s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     double tt = 0, tf = 0;
-    for (const IncidentLocal& inc : s.light.incident[i]) {
-      const double w1 =
-          SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo, inc.Wi().cast<double>());
-      const double w2 = SpecularWeight(m.params.model, m.params.alpha, m.params.alpha, m.params.ior,
-                                       wo, inc.Wi().cast<double>());
+    for (const solver::IncidentLocal& inc : s.light.incident[i]) {
+      const double w1 = solver::SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo,
+                                               inc.Wi().cast<double>());
+      const double w2 = solver::SpecularWeight(m.params.model, m.params.alpha, m.params.alpha,
+                                               m.params.ior, wo, inc.Wi().cast<double>());
       if (w1 > 0) tt += w1 * inc.Value().cast<double>().mean();
       if (w2 > 0) tf += w2 * inc.Value().cast<double>().mean();
     }
-    const Eigen::Vector3d tr = SampleTexture(tex, uv);
+    const Eigen::Vector3d tr = render::SampleTexture(tex, uv);
     const Eigen::Vector3d pa = s.materials.PatchAlbedo(s.patches, o.patch);
     const Eigen::Vector3d& h = s.materials.held_rho_d[i];
     std::fprintf(f, "%d,%d,%d,%.6f,%.6f,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g\n",

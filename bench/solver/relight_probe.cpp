@@ -25,8 +25,8 @@ int main(int argc, char** argv) {
   const fs::path dir = argv[1];
   const fs::path out = argv[2];
   SetDefaultThreads(2);
-  const Scene scene = LoadScene(dir / "scene.json");
-  SolveOptions o;
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json");
+  solver::SolveOptions o;
   o.refine_iterations = 1;
   o.num_threads = 2;
   o.show_progress = false;
@@ -35,16 +35,16 @@ int main(int argc, char** argv) {
   if (const char* e = std::getenv("PROBE_BOUNCE")) o.specular_bounces = std::string(e) == "1";
   if (const char* e = std::getenv("PROBE_STEP")) o.refine_albedo_step = std::atof(e);
   if (const char* e = std::getenv("PROBE_UPDATE"))
-    o.refine_update = RefineUpdateFromName(e).value();
+    o.refine_update = solver::RefineUpdateFromName(e).value();
   if (const char* e = std::getenv("PROBE_RAYS")) o.refine_rays = std::atoi(e);
   if (const char* e = std::getenv("PROBE_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   if (const char* e = std::getenv("PROBE_TEXEL")) o.texel_size_m = std::atof(e);
   if (const char* e = std::getenv("PROBE_STRIDE")) o.pixel_stride = std::atoi(e);
   const bool reuse = std::getenv("PROBE_REUSE") != nullptr && fs::exists(out / "scene.json");
   if (!reuse) {
-    const SolveSummary s = Solve(scene, o, out);
-    WriteSolveOutputs(s, o, out);
-    for (const RegionSolution& r : s.regions) {
+    const solver::SolveSummary s = solver::Solve(scene, o, out);
+    solver::WriteSolveOutputs(s, o, out);
+    for (const solver::RegionSolution& r : s.regions) {
       std::printf(
           "%-14s stage1 rho_d %.4f %.4f %.4f rho_s %.4f alpha %.4f | stage2 rho_d %.4f %.4f %.4f "
           "rho_s %.4f alpha %.4f\n",
@@ -53,25 +53,25 @@ int main(int argc, char** argv) {
           r.stage2.rho_d[2], r.stage2.rho_s.mean(), r.stage2.alpha);
     }
   }
-  const Scene solved = LoadScene(out / "scene.json");
-  const Scene true_scene = LoadScene(dir / "truth" / "scene.json");
-  Renderer model(solved, solved.FindLighting("L1"));
-  Renderer reference(true_scene, true_scene.FindLighting("L1"));
-  RenderOptions ro;
+  const recon::Scene solved = recon::LoadScene(out / "scene.json");
+  const recon::Scene true_scene = recon::LoadScene(dir / "truth" / "scene.json");
+  render::Renderer model(solved, solved.FindLighting("L1"));
+  render::Renderer reference(true_scene, true_scene.FindLighting("L1"));
+  render::RenderOptions ro;
   ro.spp = 64;
   ro.show_progress = false;
   ro.seed = 101;
-  const Camera& cam = solved.cameras[solved.FindCamera("cam0")];
+  const recon::Camera& cam = solved.cameras[solved.FindCamera("cam0")];
   const Image validation = ReadImage(dir / "validation" / "cam0_L1.exr", 3);
   const Image mine = model.Render(cam, ro);
   const Image again = reference.Render(true_scene.cameras[true_scene.FindCamera("cam0")], ro);
   // Region of each block's centre pixel.
-  const RayScene geo(true_scene, 0);
+  const render::RayScene geo(true_scene, 0);
   std::map<std::string, std::array<double, 5>> per;  // err², floor², signed err, want, count
   double num = 0, num_f = 0, den = 0;
   for (int by = 0; by + 8 <= validation.height; by += 8) {
     for (int bx = 0; bx + 8 <= validation.width; bx += 8) {
-      const std::optional<SurfaceHit> hit = geo.TraceSurface(
+      const std::optional<render::SurfaceHit> hit = geo.TraceSurface(
           cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(bx + 4, by + 4)));
       const std::string name = hit ? true_scene.materials[hit->region].name : "none";
       for (int c = 0; c < 3; ++c) {

@@ -13,18 +13,18 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace fs = std::filesystem;
 
 namespace {
 
 // Writes the f × f block means of photo `p` to `file`, and its mask to `mask_file` when a block
 // is invalid or the photo has a mask. Returns whether the mask was written.
-bool ReducePhoto(const Photo& p, int f, const fs::path& file, const fs::path& mask_file) {
+bool ReducePhoto(const recon::Photo& p, int f, const fs::path& file, const fs::path& mask_file) {
   const Image img = ReadImage(p.file, 3);
   std::optional<Image> mask;
   if (p.mask) mask = ReadImage(*p.mask, 1);
-  const double clip = AutoSaturation(img);
+  const double clip = solver::AutoSaturation(img);
   const int w = img.width / f, h = img.height / f;
   Image out(w, h, 3), valid(w, h, 1);
   ParallelFor(0, h, [&](int64_t yy) {
@@ -57,12 +57,12 @@ bool ReducePhoto(const Photo& p, int f, const fs::path& file, const fs::path& ma
 
 }  // namespace
 
-AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double max_megapixels,
-                              const fs::path& dir, bool show_progress) {
+AnalysisCapture ReduceCapture(const recon::Scene& scene, const Json& declared,
+                              double max_megapixels, const fs::path& dir, bool show_progress) {
   AnalysisCapture capture;
   std::vector<int> factor(scene.cameras.size(), 1);
   for (size_t k = 0; k < scene.cameras.size(); ++k) {
-    const Camera& cam = scene.cameras[k];
+    const recon::Camera& cam = scene.cameras[k];
     factor[k] = ReductionFactor(cam.width, cam.height, max_megapixels);
     if (factor[k] > 1) {
       capture.cameras[cam.name] = {factor[k], cam.width / factor[k], cam.height / factor[k]};
@@ -70,10 +70,10 @@ AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double m
   }
   if (capture.cameras.empty()) return capture;
   capture.reduced = true;
-  SceneDocument doc(declared);
+  recon::SceneDocument doc(declared);
   doc.SetCameras(Json::object());
   for (size_t k = 0; k < scene.cameras.size(); ++k) {
-    Camera cam = scene.cameras[k];
+    recon::Camera cam = scene.cameras[k];
     const int f = factor[k];
     cam.width /= f;
     cam.height /= f;
@@ -84,7 +84,7 @@ AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double m
   Progress progress("igi-diagnose: reducing the photos", int64_t(scene.photos.size()), 2.0,
                     show_progress && ProgressAllowed());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Photo& p = scene.photos[i];
+    const recon::Photo& p = scene.photos[i];
     doc.SetPhotoCamera(i, scene.cameras[p.camera].name);
     const int f = factor[p.camera];
     if (f == 1) continue;
@@ -103,13 +103,13 @@ AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double m
   return capture;
 }
 
-Json AtDeclaredSize(Json document, const Scene& declared) {
-  SceneDocument doc(std::move(document));
-  for (const Camera& cam : declared.cameras) {
+Json AtDeclaredSize(Json document, const recon::Scene& declared) {
+  recon::SceneDocument doc(std::move(document));
+  for (const recon::Camera& cam : declared.cameras) {
     if (doc.HasCamera(cam.name)) doc.SetCameraIntrinsics(cam.name, cam);
   }
   for (size_t i = 0; i < declared.photos.size() && i < doc.NumPhotos(); ++i) {
-    const Photo& p = declared.photos[i];
+    const recon::Photo& p = declared.photos[i];
     doc.SetPhotoFile(i, fs::absolute(p.file).lexically_normal());
     doc.SetPhotoMask(i, p.mask ? std::optional<fs::path>(fs::absolute(*p.mask).lexically_normal())
                                : std::nullopt);
@@ -130,4 +130,4 @@ Json AnalysisCaptureJson(const AnalysisCapture& capture, double max_megapixels) 
            "photos and intrinsics as declared"}};
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -20,7 +20,7 @@
 #include "recon/scene.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct AnalysisCapture {
   bool reduced = false;              // some camera's photos were reduced
@@ -35,15 +35,16 @@ struct AnalysisCapture {
 
 // Writes the reduced capture of `scene` under `dir` (nothing when no camera needs reducing);
 // `declared` is its document with absolute paths.
-AnalysisCapture ReduceCapture(const Scene& scene, const Json& declared, double max_megapixels,
-                              const std::filesystem::path& dir, bool show_progress = false);
+AnalysisCapture ReduceCapture(const recon::Scene& scene, const Json& declared,
+                              double max_megapixels, const std::filesystem::path& dir,
+                              bool show_progress = false);
 
 // A scene document of the analysis capture (absolute paths) with the declared cameras'
 // intrinsics and the declared photos' files and masks put back; everything fitted (poses,
 // vignetting, materials, lights, per-photo scales) is kept.
-Json AtDeclaredSize(Json doc, const Scene& declared);
+Json AtDeclaredSize(Json doc, const recon::Scene& declared);
 
 // The analysis capture's description for diagnosis.json.
 Json AnalysisCaptureJson(const AnalysisCapture& capture, double max_megapixels);
 
-}  // namespace igi
+}  // namespace igi::diagnose

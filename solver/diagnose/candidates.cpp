@@ -8,11 +8,11 @@
 
 #include "solver/diagnose/residual_fit.h"
 
-namespace igi {
+namespace igi::diagnose {
 
-std::vector<std::string> PhotoFiles(const Scene& model) {
+std::vector<std::string> PhotoFiles(const recon::Scene& model) {
   std::vector<std::string> out;
-  for (const Photo& p : model.photos) out.push_back(p.file.filename().string());
+  for (const recon::Photo& p : model.photos) out.push_back(p.file.filename().string());
   return out;
 }
 
@@ -64,4 +64,4 @@ std::string CandidateResult::Key() const {
   return effect;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -13,14 +13,14 @@
 #include "solver/diagnose/pixel_records.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct CandidateContext {
-  const Scene& model;     // the current (complete) model
-  const Json& declared;   // the declared scene document (absolute paths)
-  bool materials_solved;  // unknown materials are re-solved after each step
-  double cell_m = 0.05;   // surface cell of regions with albedo maps (their free albedo)
-  int block_px = 16;      // held-out block: the unit of the gain's standard error
+  const recon::Scene& model;  // the current (complete) model
+  const Json& declared;       // the declared scene document (absolute paths)
+  bool materials_solved;      // unknown materials are re-solved after each step
+  double cell_m = 0.05;       // surface cell of regions with albedo maps (their free albedo)
+  int block_px = 16;          // held-out block: the unit of the gain's standard error
   // The searches over a candidate's nonlinear parameters (an emission profile's axis, a source's
   // radius, an anisotropic lobe) run on a subsample of about this many fitted records; the
   // parameters they find are then fitted and scored on every record.
@@ -65,10 +65,10 @@ std::vector<CandidateResult*> RankForTrials(std::vector<CandidateResult>& candid
                                             double min_gain, double min_z);
 
 // The photos' file names (a candidate's "where" for effects of every photo).
-std::vector<std::string> PhotoFiles(const Scene& model);
+std::vector<std::string> PhotoFiles(const recon::Scene& model);
 
 struct ResidualFit;
 // Copies a fit's predicted squared-error sums and significance into a candidate.
 void FillScores(const ResidualFit& fit, CandidateResult* out);
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -26,13 +26,13 @@
 #include "tools/common/error.h"
 #include "tools/common/memory.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace fs = std::filesystem;
 
 namespace {
 
-bool HasUnknowns(const Scene& scene) {
-  for (const Material& m : scene.materials) {
+bool HasUnknowns(const recon::Scene& scene) {
+  for (const recon::Material& m : scene.materials) {
     if (!m.MissingForRendering().empty()) return true;
   }
   return false;
@@ -40,7 +40,7 @@ bool HasUnknowns(const Scene& scene) {
 
 struct ModelState {
   fs::path dir;
-  Scene model;
+  recon::Scene model;
   // The photos re-rendered (complete, except a trial's, rendered only where its held-out test
   // reads until it is applied: CompleteModel).
   Simulation sim;
@@ -61,21 +61,21 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   WriteJsonFile(dir / "declared.json", declared, 1);
   fs::path model_path = dir / "declared.json";
   if (solve) {
-    const Scene declared_scene = LoadScene(dir / "declared.json");
-    SolveOptions so = o.solve;
+    const recon::Scene declared_scene = recon::LoadScene(dir / "declared.json");
+    solver::SolveOptions so = o.solve;
     so.holdout_fraction = o.holdout_fraction;
     so.holdout_block_px = o.holdout_block_px;
     so.num_threads = o.num_threads;
     so.show_progress = false;
     so.albedo_maps = maps.maps;
     so.albedo_map_regions = maps.only;
-    const SolveSummary summary = Solve(declared_scene, so, dir);
-    WriteSolveOutputs(summary, so, dir);
+    const solver::SolveSummary summary = solver::Solve(declared_scene, so, dir);
+    solver::WriteSolveOutputs(summary, so, dir);
     model_path = dir / "scene.json";
   }
-  SceneLoadOptions lo;
+  recon::SceneLoadOptions lo;
   lo.require_complete_materials = true;
-  st.model = LoadScene(model_path, lo);
+  st.model = recon::LoadScene(model_path, lo);
   const auto t1 = std::chrono::steady_clock::now();
   SimulatePhotos(st.model, o, o.seed, &st.sim, only);
   const auto t2 = std::chrono::steady_clock::now();
@@ -87,7 +87,7 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
       solve ? fmt::format("{:.1f} s solving, ", Seconds(t1 - t0).count()) : "",
       Seconds(t2 - t1).count(), st.sim.Complete() ? "" : " (the held-out test's pixels)",
       with_records ? fmt::format(", {:.1f} s building records", Seconds(t3 - t2).count()) : "");
-  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  const solver::PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st.train = ResidualOverPhotos(photos, st.sim.sims, holdout, false);
   st.held = ResidualOverPhotos(photos, st.sim.sims, holdout, true);
   return st;
@@ -101,7 +101,7 @@ void CompleteModel(ModelState* st, const DiagnoseOptions& o, const PhotoSet& pho
   spdlog::info("igi-diagnose: {}: {:.1f} s simulating the rest of the photos",
                st->dir.filename().string(),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  const solver::PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st->train = ResidualOverPhotos(photos, st->sim.sims, holdout, false);
   st->held = ResidualOverPhotos(photos, st->sim.sims, holdout, true);
 }
@@ -111,7 +111,7 @@ void RenderAgain(ModelState* st, const DiagnoseOptions& o, const PhotoSet& photo
   st->sim = Simulation{};
   SimulatePhotos(st->model, o, o.seed, &st->sim);
   st->records = BuildRecords(st->model, photos, st->sim.sims, o, &st->sim.variance);
-  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  const solver::PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   st->train = ResidualOverPhotos(photos, st->sim.sims, holdout, false);
   st->held = ResidualOverPhotos(photos, st->sim.sims, holdout, true);
 }
@@ -127,7 +127,7 @@ void RenderAgain(ModelState* st, const DiagnoseOptions& o, const PhotoSet& photo
 // BlockGainZ, Bonferroni-combined (EitherZ).
 // With `pixel_units` false, `only` just selects the blocks and the z is BlockGainZ over them.
 std::pair<double, double> HeldOutGain(const PhotoSet& photos, const ModelState& before_state,
-                                      const ModelState& after_state, const PixelHoldout& h,
+                                      const ModelState& after_state, const solver::PixelHoldout& h,
                                       const BlockFilter& only = nullptr, bool pixel_units = true) {
   const std::vector<Image>& before = before_state.sim.sims;
   const std::vector<Image>& after = after_state.sim.sims;
@@ -226,7 +226,7 @@ std::vector<Image> RenderedPart(const std::vector<Image>& sims, const std::vecto
 // The fitted pixels' residual of `sims` over the grid of kTrialGrid where `trial` is rendered
 // (ResidualOverPhotos' sums, on those pixels only).
 ResidualSums GridResidual(const PhotoSet& photos, const std::vector<Image>& sims,
-                          const std::vector<Image>& trial, const PixelHoldout& holdout) {
+                          const std::vector<Image>& trial, const solver::PixelHoldout& holdout) {
   ResidualSums s;
   for (size_t i = 0; i < sims.size() && i < trial.size(); ++i) {
     const Image& rec = photos.recorded[i];
@@ -291,8 +291,8 @@ Json Unexplained(const ModelState& st, double floor) {
 
 // Surface cell for the albedo nuisance of regions with maps: the scene's length scale / 96
 // (igi-solve's patch size).
-double CellSize(const Scene& model) {
-  const double scale = MeasureSceneScale(model).scale_m;
+double CellSize(const recon::Scene& model) {
+  const double scale = solver::MeasureSceneScale(model).scale_m;
   return scale > 0 ? std::max(1e-3, scale / 96) : 0.05;
 }
 
@@ -316,13 +316,14 @@ size_t MostImprovedPhoto(const PhotoSet& photos, const std::vector<Image>& befor
 }
 
 // Diagnoses `scene` as it is (the analysis capture, when the photos were reduced).
-DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs::path& out_dir) {
+DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
+                                 const fs::path& out_dir) {
   DiagnosisSummary sum;
   PhotoSet photos = LoadPhotoSet(scene);  // valid pixels; a step may mask more
   const bool solve = HasUnknowns(scene);
   sum.solved = solve;
-  Json declared = AbsoluteScenePaths(scene.document, scene.dir);
-  const PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
+  Json declared = recon::AbsoluteScenePaths(scene.document, scene.dir);
+  const solver::PixelHoldout holdout{o.holdout_fraction, o.holdout_block_px, o.solve.holdout_seed};
   // A trial's refit is rendered only where its held-out test reads (and on a sparse grid for its
   // fitted pixels' residual), and completed only when it is applied: most trials are rejected
   // (or lose to a better one), and their renders were most of a diagnosis's time.
@@ -331,7 +332,7 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
   // Albedo maps are themselves a model to earn: the baseline (when solving) has constant
   // albedos per region, so that a map cannot absorb an effect of the image or the lights before
   // it is found; an effect's step (albedo_texture) adds them.
-  MapMode maps{solve ? AlbedoMaps::kNone : AlbedoMaps::kAuto, {}};
+  MapMode maps{solve ? solver::AlbedoMaps::kNone : solver::AlbedoMaps::kAuto, {}};
   spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
   ModelState st =
       FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos, true);
@@ -543,8 +544,8 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
   sum.unexplained = Unexplained(st, sum.noise_floor);
   sum.final_model_dir = st.dir;
   const fs::path model_file = st.dir / (solve ? "scene.json" : "declared.json");
-  sum.final_scene =
-      RelativeScenePaths(AbsoluteScenePaths(ReadJsonFile(model_file), st.dir), out_dir);
+  sum.final_scene = recon::RelativeScenePaths(
+      recon::AbsoluteScenePaths(ReadJsonFile(model_file), st.dir), out_dir);
   if (!scene.photos.empty()) {
     Image render = st.sim.sims[0];
     sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},
@@ -556,7 +557,8 @@ DiagnosisSummary DiagnoseCapture(const Scene& scene, DiagnoseOptions o, const fs
 
 }  // namespace
 
-DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs::path& out_dir) {
+DiagnosisSummary Diagnose(const recon::Scene& scene, const DiagnoseOptions& o,
+                          const fs::path& out_dir) {
   o.Validate();
   const auto start = std::chrono::steady_clock::now();
   // The memory plan before anything is read or written: the solves get what the diagnosis
@@ -565,8 +567,8 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   DiagnoseOptions inner = o;
   inner.solve.memory_budget = memory.solve_budget_bytes / kGiB;
   const AnalysisCapture capture =
-      ReduceCapture(scene, AbsoluteScenePaths(scene.document, scene.dir), o.analysis_megapixels,
-                    out_dir / "analysis", o.show_progress);
+      ReduceCapture(scene, recon::AbsoluteScenePaths(scene.document, scene.dir),
+                    o.analysis_megapixels, out_dir / "analysis", o.show_progress);
   DiagnosisSummary sum;
   if (!capture.reduced) {
     sum = DiagnoseCapture(scene, inner, out_dir);
@@ -575,11 +577,11 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
       spdlog::info("igi-diagnose: camera {}'s photos analysed as {}x{} blocks' means ({}x{})", name,
                    r.factor, r.factor, r.width, r.height);
     }
-    sum = DiagnoseCapture(LoadScene(capture.scene_file), inner, out_dir);
+    sum = DiagnoseCapture(recon::LoadScene(capture.scene_file), inner, out_dir);
     // The improved scene names the declared photos and intrinsics: what was fitted on the
     // reduced capture holds at full size.
-    sum.final_scene = RelativeScenePaths(
-        AtDeclaredSize(AbsoluteScenePaths(sum.final_scene, out_dir), scene), out_dir);
+    sum.final_scene = recon::RelativeScenePaths(
+        AtDeclaredSize(recon::AbsoluteScenePaths(sum.final_scene, out_dir), scene), out_dir);
     sum.analysis = AnalysisCaptureJson(capture, o.analysis_megapixels);
   }
   sum.memory = DiagnoseMemoryJson(memory, PeakResidentBytes());
@@ -587,4 +589,4 @@ DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& o, const fs
   return sum;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

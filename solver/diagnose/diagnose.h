@@ -25,7 +25,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct DiagnosisStep {
   CandidateResult candidate;  // what was fitted and predicted
@@ -61,7 +61,7 @@ struct DiagnosisSummary {
 };
 
 // Diagnoses `scene` (loaded with geometry). Intermediate models go under out_dir/steps/.
-DiagnosisSummary Diagnose(const Scene& scene, const DiagnoseOptions& options,
+DiagnosisSummary Diagnose(const recon::Scene& scene, const DiagnoseOptions& options,
                           const std::filesystem::path& out_dir);
 
 // diagnosis.json (docs/file-formats.md), with igi's additions (noise floor, rejected steps).
@@ -71,4 +71,4 @@ Json DiagnosisJson(const DiagnosisSummary& summary, const DiagnoseOptions& optio
 void WriteDiagnosisOutputs(const DiagnosisSummary& summary, const DiagnoseOptions& options,
                            const std::filesystem::path& out_dir);
 
-}  // namespace igi
+}  // namespace igi::diagnose

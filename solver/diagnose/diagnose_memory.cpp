@@ -11,7 +11,7 @@
 #include "tools/common/image.h"
 #include "tools/common/memory.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // Bytes per analysed pixel: a photo (RGB float) and its usable pixels (float); a model's
@@ -20,11 +20,11 @@ constexpr double kPhotoBytes = 16, kStateBytes = 36;
 
 }  // namespace
 
-DiagnoseMemoryPlan PlanDiagnoseMemory(const Scene& scene, const DiagnoseOptions& options) {
+DiagnoseMemoryPlan PlanDiagnoseMemory(const recon::Scene& scene, const DiagnoseOptions& options) {
   DiagnoseMemoryPlan plan;
-  plan.budget_bytes = SolveMemoryBudgetBytes(options.solve);
-  for (const Photo& p : scene.photos) {
-    const Camera& cam = scene.cameras[p.camera];
+  plan.budget_bytes = solver::SolveMemoryBudgetBytes(options.solve);
+  for (const recon::Photo& p : scene.photos) {
+    const recon::Camera& cam = scene.cameras[p.camera];
     const int f = ReductionFactor(cam.width, cam.height, options.analysis_megapixels);
     plan.pixels += double(cam.width / f) * double(cam.height / f);
   }
@@ -54,4 +54,4 @@ Json DiagnoseMemoryJson(const DiagnoseMemoryPlan& plan, uint64_t peak_bytes) {
           {"peak_bytes", double(peak_bytes)}};
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -15,7 +15,7 @@
 #include "solver/diagnose/diagnose_options.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct DiagnoseMemoryPlan {
   double budget_bytes = 0;        // --memory-budget (or the machine's memory less a margin)
@@ -28,8 +28,8 @@ struct DiagnoseMemoryPlan {
 // options.analysis_megapixels). Throws InputError (exit 2) when what the diagnosis holds leaves
 // less than a quarter of the budget to its solves: the line names the bytes it holds, the
 // budget, and the flag that lowers the need.
-DiagnoseMemoryPlan PlanDiagnoseMemory(const Scene& scene, const DiagnoseOptions& options);
+DiagnoseMemoryPlan PlanDiagnoseMemory(const recon::Scene& scene, const DiagnoseOptions& options);
 
 Json DiagnoseMemoryJson(const DiagnoseMemoryPlan& plan, uint64_t peak_bytes);
 
-}  // namespace igi
+}  // namespace igi::diagnose

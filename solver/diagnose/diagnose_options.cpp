@@ -4,7 +4,7 @@
 
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 void DiagnoseOptions::Validate() const {
   ProblemList problems;
@@ -36,4 +36,4 @@ void DiagnoseOptions::Validate() const {
   solve.Validate();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -5,7 +5,7 @@
 
 #include "solver/inverse/solve_options.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct DiagnoseOptions {
   int spp = 32;  // paths per pixel of the re-renders
@@ -51,8 +51,8 @@ struct DiagnoseOptions {
   // Used when materials are unknown (refits re-solve them). Every pixel is an observation: an
   // albedo map's texel is the pixel footprint times the stride, and at igi-solve's default of 2
   // the maps cannot follow a texture the photos resolve.
-  SolveOptions solve = [] {
-    SolveOptions s;
+  solver::SolveOptions solve = [] {
+    solver::SolveOptions s;
     s.pixel_stride = 1;
     return s;
   }();
@@ -60,4 +60,4 @@ struct DiagnoseOptions {
   void Validate() const;
 };
 
-}  // namespace igi
+}  // namespace igi::diagnose

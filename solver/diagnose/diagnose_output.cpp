@@ -5,7 +5,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/html_report.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace fs = std::filesystem;
 
 namespace {
@@ -138,4 +138,4 @@ void WriteDiagnosisOutputs(const DiagnosisSummary& s, const DiagnoseOptions& o,
   WriteJsonFile(out_dir / "scene.json", s.final_scene, 1);
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

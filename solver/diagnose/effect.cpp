@@ -12,7 +12,7 @@
 #include "solver/diagnose/residual_fit.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 void Effect::AddFits(const CandidateContext&, const RecordFits&, const KeyFilter&,
                      std::vector<CandidateTask>*) const {}
@@ -26,12 +26,12 @@ std::optional<CandidateResult> Effect::TryFirst(const DiagnosisModel&, int) { re
 std::optional<CandidateResult> Effect::TryLast(const DiagnosisModel&) { return std::nullopt; }
 
 TrialPlan Effect::PlanTrial(CandidateResult* c, const DiagnosisModel& m) {
-  SceneDocument doc(m.declared);
+  recon::SceneDocument doc(m.declared);
   Write(*c, &doc);
   return {std::move(doc).json(), m.maps, std::nullopt};
 }
 
-std::optional<Refinement> Effect::Refine(const CandidateResult&, const Json&, const Scene&,
+std::optional<Refinement> Effect::Refine(const CandidateResult&, const Json&, const recon::Scene&,
                                          const Simulation&, const DiagnosisModel&) const {
   return std::nullopt;
 }
@@ -58,7 +58,7 @@ Judgement Effect::Judge(const CandidateResult& c, const HeldOutOutcome& outcome,
   return j;
 }
 
-void Effect::DescribeKept(CandidateResult*, const Scene&) const {}
+void Effect::DescribeKept(CandidateResult*, const recon::Scene&) const {}
 
 Effect* FindEffect(const std::vector<std::unique_ptr<Effect>>& effects, const std::string& name) {
   for (const auto& e : effects) {
@@ -145,4 +145,4 @@ HeldOutScope RegionScope(const CandidateResult& c, const DiagnosisModel& m) {
   return scope;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -23,7 +23,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 class ResidualFitter;
 class RecordSubset;
@@ -31,21 +31,21 @@ class RecordSubset;
 // The solver's albedo maps for a fit (SolveOptions::albedo_maps): AlbedoMaps::kNone (default),
 // or kAuto (where the albedo varies), optionally only for the regions in `only`.
 struct MapMode {
-  AlbedoMaps maps = AlbedoMaps::kNone;
+  solver::AlbedoMaps maps = solver::AlbedoMaps::kNone;
   std::vector<std::string> only;  // empty: every region
-  bool Full() const { return maps == AlbedoMaps::kAuto && only.empty(); }
+  bool Full() const { return maps == solver::AlbedoMaps::kAuto && only.empty(); }
 };
 
 // The diagnosis's current model as the effects see it: the kept model, its complete renders and
 // residual samples, and what the diagnosis was asked.
 struct DiagnosisModel {
-  const Scene& scene;                       // the capture as declared
-  const Scene& model;                       // complete materials
+  const recon::Scene& scene;                // the capture as declared
+  const recon::Scene& model;                // complete materials
   const Json& declared;                     // the declared document it was fitted from
   const PhotoSet& photos;                   // the photos and their valid pixels
   const std::vector<Image>& sims;           // the model's renders of them
   const std::vector<PixelRecord>& records;  // its residual samples
-  const PixelHoldout& holdout;
+  const solver::PixelHoldout& holdout;
   const DiagnoseOptions& options;
   const MapMode& maps;            // the albedo maps the model was fitted with
   bool materials_solved;          // unknown materials are re-solved at every refit
@@ -143,7 +143,7 @@ class Effect {
   // After the trial's refit (`refit`, rendered where the held-out test reads, from `document`):
   // a second fit on the refit's own residual, or none.
   virtual std::optional<Refinement> Refine(const CandidateResult& c, const Json& document,
-                                           const Scene& refit, const Simulation& refit_sim,
+                                           const recon::Scene& refit, const Simulation& refit_sim,
                                            const DiagnosisModel& m) const;
 
   // Where the trial's held-out gain is tested. By default the candidate's support blocks
@@ -156,10 +156,10 @@ class Effect {
                           const HeldOutScope& scope, const DiagnoseOptions& o) const;
 
   // Completes a kept candidate's description from its refitted model (nothing by default).
-  virtual void DescribeKept(CandidateResult* c, const Scene& refit) const;
+  virtual void DescribeKept(CandidateResult* c, const recon::Scene& refit) const;
 
   // Writes candidate `c` (its params) into the scene document `doc`.
-  virtual void Write(const CandidateResult& c, SceneDocument* doc) const = 0;
+  virtual void Write(const CandidateResult& c, recon::SceneDocument* doc) const = 0;
 };
 
 // Every effect igi-diagnose models, in the order the driver consults them (effects/effects.cpp).
@@ -187,4 +187,4 @@ HeldOutScope SupportScope(const CandidateResult& c);
 // blocks instead when the candidate has them.
 HeldOutScope RegionScope(const CandidateResult& c, const DiagnosisModel& m);
 
-}  // namespace igi
+}  // namespace igi::diagnose

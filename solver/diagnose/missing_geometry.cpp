@@ -16,7 +16,7 @@
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace fs = std::filesystem;
 
 void MissingGeometryOptions::Validate() const {
@@ -238,7 +238,7 @@ std::vector<uint8_t> CarveVoxels(const std::vector<CarveView>& views, const Voxe
   return carved;
 }
 
-std::vector<uint8_t> NearSurfaceVoxels(const TriangleMesh& mesh, const VoxelGrid& grid) {
+std::vector<uint8_t> NearSurfaceVoxels(const recon::TriangleMesh& mesh, const VoxelGrid& grid) {
   std::vector<uint8_t> on(size_t(grid.Count()), 0);
   auto mark = [&](const Eigen::Vector3d& p) {
     const Eigen::Vector3d q = (p - grid.origin) / grid.voxel_m;
@@ -484,12 +484,12 @@ PhotoSet MaskedPhotoSet(const PhotoSet& photos, const std::vector<Image>& exclud
 namespace {
 
 // The modelled surface's distance along each pixel's ray (infinity where it escapes).
-Image DepthOf(const RayScene& impl, const Camera& cam) {
+Image DepthOf(const render::RayScene& impl, const recon::Camera& cam) {
   Image depth(cam.width, cam.height, 1, std::numeric_limits<float>::infinity());
   const Eigen::Vector3d center = cam.CenterInWorld();
   ParallelFor(0, cam.height, [&](int64_t y) {
     for (int x = 0; x < cam.width; ++x) {
-      const std::optional<SurfaceHit> hit =
+      const std::optional<render::SurfaceHit> hit =
           impl.TraceSurface(center, cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5)));
       if (hit) depth.at(x, int(y)) = float(hit->t);
     }
@@ -556,8 +556,8 @@ struct Contrast {
 };
 
 Contrast InsideContrast(const PhotoSet& photos, const std::vector<Image>& sims,
-                        const std::vector<Image>& excluded, const PixelHoldout& holdout, int fold,
-                        int folds) {
+                        const std::vector<Image>& excluded, const solver::PixelHoldout& holdout,
+                        int fold, int folds) {
   struct Acc {
     double in = 0, out = 0;
     int n_in = 0, n_out = 0;
@@ -619,7 +619,7 @@ Contrast InsideContrast(const PhotoSet& photos, const std::vector<Image>& sims,
 // pixels around them (never from their own values), so that carving is not left free inside
 // every block the fold holds.
 void FindBlobsWithoutFold(const PhotoSet& photos, const std::vector<Image>& sims,
-                          const PixelHoldout& holdout, int fold, int folds,
+                          const solver::PixelHoldout& holdout, int fold, int folds,
                           const MissingGeometryOptions& o, std::vector<CarveView>* views) {
   for (size_t i = 0; i < views->size(); ++i) {
     Image usable = photos.valid[i];
@@ -675,19 +675,19 @@ struct LightAnchor {
   bool directional = false;
 };
 
-std::vector<LightAnchor> LightAnchors(const Scene& model, int lighting) {
+std::vector<LightAnchor> LightAnchors(const recon::Scene& model, int lighting) {
   std::vector<LightAnchor> out;
   for (int li : model.lightings[size_t(lighting)].lights) {
-    const Light& light = model.lights[size_t(li)];
-    if (light.type == LightType::kPoint || light.type == LightType::kSpot) {
+    const recon::Light& light = model.lights[size_t(li)];
+    if (light.type == recon::LightType::kPoint || light.type == recon::LightType::kSpot) {
       out.push_back({light.position, false});
-    } else if (light.type == LightType::kSphere) {
+    } else if (light.type == recon::LightType::kSphere) {
       out.push_back({light.center, false});
-    } else if (light.type == LightType::kArea && !light.mesh.positions.empty()) {
+    } else if (light.type == recon::LightType::kArea && !light.mesh.positions.empty()) {
       Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (const Eigen::Vector3f& p : light.mesh.positions) c += p.cast<double>();
       out.push_back({c / double(light.mesh.positions.size()), false});
-    } else if (light.type == LightType::kDirectional) {
+    } else if (light.type == recon::LightType::kDirectional) {
       out.push_back({-light.direction.normalized(), true});
     }
   }
@@ -756,7 +756,7 @@ struct SurfaceAgreement {
   double Slope() const { return aa > 0 ? ab / aa : 0; }
 };
 
-SurfaceAgreement AgreementBehind(const Scene& model, const PhotoSet& photos,
+SurfaceAgreement AgreementBehind(const recon::Scene& model, const PhotoSet& photos,
                                  const std::vector<Image>& sims,
                                  const std::vector<CarveView>& views, const VoxelGrid& grid,
                                  const Carving& c) {
@@ -806,10 +806,11 @@ Json Vec(const Eigen::Vector3d& v, double unit = 1e-3) {
 
 }  // namespace
 
-MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& photos,
+MissingGeometryResult LocateMissingGeometry(const recon::Scene& model, const PhotoSet& photos,
                                             const std::vector<Image>& sims,
                                             const std::vector<PixelRecord>& records,
-                                            const PixelHoldout& holdout, const fs::path& mask_dir,
+                                            const solver::PixelHoldout& holdout,
+                                            const fs::path& mask_dir,
                                             const MissingGeometryOptions& o) {
   o.Validate();
   MissingGeometryResult res;
@@ -825,11 +826,12 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
   box.extend(box.min() - Eigen::Vector3d::Constant(voxel));
   box.extend(box.max() + Eigen::Vector3d::Constant(voxel));
   const VoxelGrid grid = VoxelGrid::Over(box, voxel);
-  std::vector<std::unique_ptr<RayScene>> scenes(model.lightings.size());
+  std::vector<std::unique_ptr<render::RayScene>> scenes(model.lightings.size());
   std::vector<CarveView> views(model.photos.size());
   for (size_t i = 0; i < model.photos.size(); ++i) {
-    const Photo& p = model.photos[i];
-    if (!scenes[p.lighting]) scenes[p.lighting] = std::make_unique<RayScene>(model, p.lighting);
+    const recon::Photo& p = model.photos[i];
+    if (!scenes[p.lighting])
+      scenes[p.lighting] = std::make_unique<render::RayScene>(model, p.lighting);
     CarveView& v = views[i];
     v.camera = model.cameras[p.camera];
     v.camera_id = p.camera;
@@ -955,4 +957,4 @@ MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& 
   return res;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

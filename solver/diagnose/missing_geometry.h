@@ -48,7 +48,7 @@
 #include "solver/inverse/photo_model.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct MissingGeometryOptions {
   double voxels_per_extent = 80;      // voxel = the scene box's largest extent / this
@@ -83,7 +83,7 @@ struct MissingGeometryOptions {
 // A photo's view for carving: its camera, the modelled surface's distance along each pixel's ray
 // (infinity where the ray escapes), and the blob state per pixel: 1 blob, 0 clear, −1 unknown.
 struct CarveView {
-  Camera camera;
+  recon::Camera camera;
   int camera_id = 0;  // views of one camera (several lightings) count as one view
   Image depth_m;      // 1 channel
   Image state;        // 1 channel
@@ -125,7 +125,7 @@ std::vector<uint8_t> CarveVoxels(const std::vector<CarveView>& views, const Voxe
                                  int min_views);
 
 // Voxels within 1.5 voxels of the mesh's triangles: 1 per such voxel.
-std::vector<uint8_t> NearSurfaceVoxels(const TriangleMesh& mesh, const VoxelGrid& grid);
+std::vector<uint8_t> NearSurfaceVoxels(const recon::TriangleMesh& mesh, const VoxelGrid& grid);
 
 // The views with their "surface" blob pixels made unknown: those whose modelled surface point
 // more of the other cameras that see it (and know) show in a blob than clear — a change on the
@@ -154,14 +154,14 @@ struct MissingGeometryResult {
 
 // Locates missing geometry from the residual of `model` (sims: its simulated photos) and writes
 // the masks into mask_dir (PNG, one per photo; the candidate's params "mask_files" name them).
-MissingGeometryResult LocateMissingGeometry(const Scene& model, const PhotoSet& photos,
+MissingGeometryResult LocateMissingGeometry(const recon::Scene& model, const PhotoSet& photos,
                                             const std::vector<Image>& sims,
                                             const std::vector<PixelRecord>& records,
-                                            const PixelHoldout& holdout,
+                                            const solver::PixelHoldout& holdout,
                                             const std::filesystem::path& mask_dir,
                                             const MissingGeometryOptions& options = {});
 
 // `photos` with the excluded pixels made invalid.
 PhotoSet MaskedPhotoSet(const PhotoSet& photos, const std::vector<Image>& excluded);
 
-}  // namespace igi
+}  // namespace igi::diagnose

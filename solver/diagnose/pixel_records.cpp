@@ -12,43 +12,43 @@
 #include "solver/render/sampling.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
-std::vector<std::unique_ptr<RayScene>> LightingScenes(const Scene& scene) {
-  std::vector<std::unique_ptr<RayScene>> out(scene.lightings.size());
-  for (const Photo& p : scene.photos) {
-    if (!out[p.lighting]) out[p.lighting] = std::make_unique<RayScene>(scene, p.lighting);
+std::vector<std::unique_ptr<render::RayScene>> LightingScenes(const recon::Scene& scene) {
+  std::vector<std::unique_ptr<render::RayScene>> out(scene.lightings.size());
+  for (const recon::Photo& p : scene.photos) {
+    if (!out[p.lighting]) out[p.lighting] = std::make_unique<render::RayScene>(scene, p.lighting);
   }
   return out;
 }
 
 // The region the ray through continuous pixel (x, y) hits first, or -1 (nothing, a light, or a
 // surface that does not reflect).
-int RegionAt(const RayScene& impl, const Camera& cam, double x, double y) {
-  const std::optional<SurfaceHit> hit =
+int RegionAt(const render::RayScene& impl, const recon::Camera& cam, double x, double y) {
+  const std::optional<render::SurfaceHit> hit =
       impl.TraceSurface(cam.CenterInWorld(), cam.WorldRayFromImg(Eigen::Vector2d(x, y)));
   if (!hit) return -1;
-  const BrdfModel m = impl.material(hit->region).model;
-  return IsReflective(m) ? hit->region : -1;
+  const recon::BrdfModel m = impl.material(hit->region).model;
+  return recon::IsReflective(m) ? hit->region : -1;
 }
 
 }  // namespace
 
-PhotoSet LoadPhotoSet(const Scene& scene) {
+PhotoSet LoadPhotoSet(const recon::Scene& scene) {
   PhotoSet set;
   const auto scenes = LightingScenes(scene);
   set.recorded.resize(scene.photos.size());
   set.valid.resize(scene.photos.size());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Photo& p = scene.photos[i];
-    const Camera& cam = scene.cameras[p.camera];
+    const recon::Photo& p = scene.photos[i];
+    const recon::Camera& cam = scene.cameras[p.camera];
     const Image& img = set.recorded[i] = ReadImage(p.file, 3);
     std::optional<Image> mask;
     if (p.mask) mask = ReadImage(*p.mask, 1);
-    const double clip = AutoSaturation(img);
+    const double clip = solver::AutoSaturation(img);
     Image& valid = set.valid[i] = Image(img.width, img.height, 1);
-    const RayScene& impl = *scenes[p.lighting];
+    const render::RayScene& impl = *scenes[p.lighting];
     ParallelFor(0, img.height, [&](int64_t yy) {
       const int y = int(yy);
       for (int x = 0; x < img.width; ++x) {
@@ -92,7 +92,7 @@ Image BoxMean(const Image& in, int r) {
 
 }  // namespace
 
-void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+void SimulatePhotos(const recon::Scene& model, const DiagnoseOptions& options, uint64_t seed,
                     Simulation* sim, const PixelMasks* only) {
   const size_t n = model.photos.size();
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -103,12 +103,12 @@ void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t
     sim->raw_variance.assign(n, Image());
     sim->rendered.assign(n, {});
   }
-  std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
+  std::vector<std::unique_ptr<render::Renderer>> renderers(model.lightings.size());
   const bool split = options.spp >= 2;
   const int spp1 = split ? options.spp / 2 : options.spp, spp2 = options.spp - spp1;
   for (size_t i = 0; i < n; ++i) {
-    const Photo& p = model.photos[i];
-    const Camera& cam = model.cameras[p.camera];
+    const recon::Photo& p = model.photos[i];
+    const recon::Camera& cam = model.cameras[p.camera];
     const size_t pixels = size_t(cam.width) * cam.height;
     if (sim->sims[i].empty()) {
       sim->sims[i] = Image(cam.width, cam.height, 3, nan);
@@ -125,9 +125,9 @@ void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t
     }
     if (count == 0) continue;
     if (!renderers[p.lighting]) {
-      renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+      renderers[p.lighting] = std::make_unique<render::Renderer>(model, p.lighting);
     }
-    RenderOptions ro;
+    render::RenderOptions ro;
     ro.spp = spp1;
     ro.seed = seed + 7919 * i;
     ro.num_threads = options.num_threads;
@@ -146,10 +146,10 @@ void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t
         mean.pixels[k] =
             float((spp1 * double(h1.pixels[k]) + spp2 * double(h2.pixels[k])) / options.spp);
       }
-      ApplyExposureAndResponse(p, &h1);
-      ApplyExposureAndResponse(p, &h2);
+      solver::ApplyExposureAndResponse(p, &h1);
+      solver::ApplyExposureAndResponse(p, &h2);
     }
-    ApplyExposureAndResponse(p, &mean);
+    solver::ApplyExposureAndResponse(p, &mean);
     const double k_var = split ? 1.0 / (options.spp * (1.0 / spp1 + 1.0 / spp2)) : 0.0;
     Image& out = sim->sims[i];
     Image& raw = sim->raw_variance[i];
@@ -174,11 +174,12 @@ void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t
   if (complete) sim->rendered.clear();
 }
 
-PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int grid) {
+PixelMasks HeldOutTestMasks(const recon::Scene& model, const solver::PixelHoldout& holdout,
+                            int grid) {
   constexpr int kWindow = 2;  // SimulatePhotos' variance window
   PixelMasks masks(model.photos.size());
   for (size_t i = 0; i < masks.size(); ++i) {
-    const Camera& cam = model.cameras[model.photos[i].camera];
+    const recon::Camera& cam = model.cameras[model.photos[i].camera];
     const int w = cam.width, h = cam.height;
     std::vector<uint8_t> held(size_t(w) * h, 0), rows(size_t(w) * h, 0);
     for (int y = 0; y < h; ++y) {
@@ -211,8 +212,9 @@ PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int
 
 namespace {
 
-Eigen::Vector3f AlbedoAt(const Scene& model, const RayScene& impl, const SurfaceHit& hit) {
-  const ShadingMaterial& m = impl.material(hit.region);
+Eigen::Vector3f AlbedoAt(const recon::Scene& model, const render::RayScene& impl,
+                         const render::SurfaceHit& hit) {
+  const render::ShadingMaterial& m = impl.material(hit.region);
   Eigen::Vector3d rho = m.params.rho_d;
   if (m.rho_d_map && model.mesh.has_uvs()) {
     const Eigen::Vector3i& t = model.mesh.triangles[hit.triangle];
@@ -220,7 +222,7 @@ Eigen::Vector3f AlbedoAt(const Scene& model, const RayScene& impl, const Surface
     const Eigen::Vector2d uv =
         (b0 * model.mesh.uvs[t[0]] + hit.b1 * model.mesh.uvs[t[1]] + hit.b2 * model.mesh.uvs[t[2]])
             .cast<double>();
-    rho = SampleTexture(*m.rho_d_map, uv);
+    rho = render::SampleTexture(*m.rho_d_map, uv);
   }
   return rho.cast<float>();
 }
@@ -229,39 +231,39 @@ Eigen::Vector3f AlbedoAt(const Scene& model, const RayScene& impl, const Surface
 // directions about the shading normal, stratified on a grid, each bringing irradiance π·L/k: the
 // diffuse term Σ ρd/π·irradiance is ρd·L exactly, as the renderer computes it, and a lobe is
 // estimated without bias. No shadow rays.
-void GatherAmbient(const Light& light, const SurfaceHit& hit, int k, Pcg32& rng, int id,
-                   PixelRecord* r) {
-  const Frame frame = Frame::FromNormal(hit.n_s);
+void GatherAmbient(const recon::Light& light, const render::SurfaceHit& hit, int k,
+                   render::Pcg32& rng, int id, PixelRecord* r) {
+  const render::Frame frame = render::Frame::FromNormal(hit.n_s);
   const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
-  const Eigen::Vector3f irradiance = (light.radiance * (kPi / k)).cast<float>();
+  const Eigen::Vector3f irradiance = (light.radiance * (render::kPi / k)).cast<float>();
   for (int s = 0; s < k; ++s) {
     Eigen::Vector2d u = rng.Uniform2D();
     if (s < side * side) u = Eigen::Vector2d((s % side + u.x()) / side, (s / side + u.y()) / side);
     RecordLightSample rs;
     rs.light = id;
-    rs.wi = frame.ToWorld(SampleCosineHemisphere(u)).cast<float>();
+    rs.wi = frame.ToWorld(render::SampleCosineHemisphere(u)).cast<float>();
     rs.irradiance = irradiance;
     rs.distance = 1e30f;
     r->lights.push_back(rs);
   }
 }
 
-void GatherLights(const Scene& model, const RayScene& impl, const SurfaceHit& hit, int samples,
-                  Pcg32& rng, PixelRecord* r) {
+void GatherLights(const recon::Scene& model, const render::RayScene& impl,
+                  const render::SurfaceHit& hit, int samples, render::Pcg32& rng, PixelRecord* r) {
   const double eps = impl.ray_epsilon();
   const std::vector<int>& ids = model.lightings[model.photos[r->photo].lighting].lights;
   for (int l = 0; l < impl.num_lights(); ++l) {
-    const LightType type = impl.light_type(l);
-    const bool delta =
-        type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
-    if (type == LightType::kAmbient) {
+    const recon::LightType type = impl.light_type(l);
+    const bool delta = type == recon::LightType::kPoint || type == recon::LightType::kSpot ||
+                       type == recon::LightType::kDirectional;
+    if (type == recon::LightType::kAmbient) {
       GatherAmbient(*impl.light(l), hit, 4 * samples, rng, l < int(ids.size()) ? ids[l] : -1, r);
       continue;
     }
     const int k = delta ? 1 : samples;
     for (int s = 0; s < k; ++s) {
       const Eigen::Vector3d u(rng.UniformDouble(), rng.UniformDouble(), rng.UniformDouble());
-      const LightSample ls = impl.SampleLight(l, hit.position, u);
+      const render::LightSample ls = impl.SampleLight(l, hit.position, u);
       if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0)) continue;
       const double cos_geo = ls.wi.dot(hit.n_geo), cos_s = ls.wi.dot(hit.n_s);
       if (!(cos_geo > 0) || !(cos_s > 0)) continue;
@@ -280,9 +282,9 @@ void GatherLights(const Scene& model, const RayScene& impl, const SurfaceHit& hi
 }
 
 // The room's light reflected onto a glossy record (PixelRecord::room).
-void GatherRoom(const Renderer& renderer, const ShadingMaterial& m, const SurfaceHit& hit,
-                uint64_t seed, Pcg32& rng, PixelRecord* r) {
-  GatherQuery q;
+void GatherRoom(const render::Renderer& renderer, const render::ShadingMaterial& m,
+                const render::SurfaceHit& hit, uint64_t seed, render::Pcg32& rng, PixelRecord* r) {
+  solver::GatherQuery q;
   q.position = hit.position;
   q.n_geo = hit.n_geo;
   q.n_s = hit.n_s;
@@ -291,8 +293,8 @@ void GatherRoom(const Renderer& renderer, const ShadingMaterial& m, const Surfac
   const double alpha = std::clamp(std::max(m.params.AlphaX(), m.params.AlphaY()), 0.02, 0.5);
   const double eps = renderer.rays().ray_epsilon();
   int k = 0;
-  for (const WeightedDirection& d :
-       HemisphereDirections(q, PixelRecord::kRoomSamples, 2 * alpha, rng)) {
+  for (const solver::WeightedDirection& d :
+       solver::HemisphereDirections(q, PixelRecord::kRoomSamples, 2 * alpha, rng)) {
     const Eigen::Vector3d li =
         renderer.ReflectedRadiance(hit.position + hit.n_geo * eps, d.wi, 1, seed * 64 + k++);
     if (!li.allFinite() || !(li.maxCoeff() > 0)) continue;
@@ -306,7 +308,7 @@ void GatherRoom(const Renderer& renderer, const ShadingMaterial& m, const Surfac
 
 }  // namespace
 
-std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
+std::vector<PixelRecord> BuildRecords(const recon::Scene& model, const PhotoSet& photos,
                                       const std::vector<Image>& sims,
                                       const DiagnoseOptions& options,
                                       const std::vector<Image>* variance) {
@@ -314,16 +316,16 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
   // The room's reflection needs the model's radiance: one renderer per photographed lighting,
   // built only when some reflective region has a specular lobe.
   bool glossy = false;
-  for (const Material& m : model.materials) glossy |= HasSpecularLobe(m.brdf);
-  std::vector<std::unique_ptr<Renderer>> renderers(model.lightings.size());
+  for (const recon::Material& m : model.materials) glossy |= recon::HasSpecularLobe(m.brdf);
+  std::vector<std::unique_ptr<render::Renderer>> renderers(model.lightings.size());
   if (glossy) {
-    for (const Photo& p : model.photos) {
+    for (const recon::Photo& p : model.photos) {
       if (!renderers[p.lighting])
-        renderers[p.lighting] = std::make_unique<Renderer>(model, p.lighting);
+        renderers[p.lighting] = std::make_unique<render::Renderer>(model, p.lighting);
     }
   }
-  const PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
-                             options.solve.holdout_seed};
+  const solver::PixelHoldout holdout{options.holdout_fraction, options.holdout_block_px,
+                                     options.solve.holdout_seed};
   std::vector<std::vector<PixelRecord>> rows;
   std::vector<std::pair<int, int>> row_of;  // (photo, y)
   for (size_t i = 0; i < model.photos.size(); ++i) {
@@ -336,18 +338,18 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
       0, int64_t(row_of.size()),
       [&](int64_t k) {
         const auto [i, y] = row_of[k];
-        const Photo& p = model.photos[i];
-        const Camera& cam = model.cameras[p.camera];
-        const RayScene& impl = *scenes[p.lighting];
+        const recon::Photo& p = model.photos[i];
+        const recon::Camera& cam = model.cameras[p.camera];
+        const render::RayScene& impl = *scenes[p.lighting];
         const Image& rec = photos.recorded[i];
         const double half_diag2 =
             0.25 * (double(cam.width) * cam.width + double(cam.height) * cam.height);
-        Pcg32 rng = PixelSampleRng(options.seed + 17, uint64_t(k), 0);
+        render::Pcg32 rng = render::PixelSampleRng(options.seed + 17, uint64_t(k), 0);
         for (int x = 0; x < rec.width; x += options.pixel_stride) {
           if (photos.valid[i].at(x, y, 0) < 0.5f) continue;
           const Eigen::Vector3d center = cam.CenterInWorld();
           const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-          const std::optional<SurfaceHit> hit = impl.TraceSurface(center, dir);
+          const std::optional<render::SurfaceHit> hit = impl.TraceSurface(center, dir);
           if (!hit) continue;
           PixelRecord r;
           r.photo = i;
@@ -366,9 +368,9 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
           r.position = hit->position.cast<float>();
           r.normal = hit->n_s.cast<float>();
           r.view = (-dir).cast<float>();
-          if (HasSpecularLobe(model.materials[hit->region].brdf)) {
-            const auto quarter = QuarterPixelNormals(impl, cam, x, y, *hit, 0.98);
-            if (quarter) r.lobe_blur2 = float(PixelNormalSpread(*quarter, hit->n_s));
+          if (recon::HasSpecularLobe(model.materials[hit->region].brdf)) {
+            const auto quarter = solver::QuarterPixelNormals(impl, cam, x, y, *hit, 0.98);
+            if (quarter) r.lobe_blur2 = float(solver::PixelNormalSpread(*quarter, hit->n_s));
           }
           const double dx = x + 0.5 - cam.principal_x_px(), dy = y + 0.5 - cam.principal_y_px();
           r.r2 = float((dx * dx + dy * dy) / half_diag2);
@@ -388,11 +390,11 @@ std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos
             r.sim_gradient(c, 1) = gy / 6;
           }
           GatherLights(model, impl, *hit, options.light_samples, rng, &r);
-          const ShadingMaterial& sm = impl.material(hit->region);
-          if (renderers[p.lighting] && HasSpecularLobe(sm.model)) {
+          const render::ShadingMaterial& sm = impl.material(hit->region);
+          if (renderers[p.lighting] && recon::HasSpecularLobe(sm.model)) {
             // Its own random stream: the lights' samples stay those of a scene without lobes.
             const uint64_t stream = uint64_t(k) * 65537 + uint64_t(x);
-            Pcg32 room_rng = PixelSampleRng(options.seed + 29, stream, 1);
+            render::Pcg32 room_rng = render::PixelSampleRng(options.seed + 29, stream, 1);
             GatherRoom(*renderers[p.lighting], sm, *hit, options.seed * 1000003 + stream, room_rng,
                        &r);
           }
@@ -435,7 +437,7 @@ ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out) {
 }
 
 ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
-                                const PixelHoldout& holdout, bool held_out) {
+                                const solver::PixelHoldout& holdout, bool held_out) {
   ResidualSums s;
   for (size_t i = 0; i < sims.size(); ++i) {
     const Image& rec = photos.recorded[i];
@@ -451,4 +453,4 @@ ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>
   return s;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

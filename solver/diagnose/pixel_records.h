@@ -12,7 +12,7 @@
 #include "solver/inverse/photo_model.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 // One light sample at a record's surface point: direction to the light and the irradiance it
 // brings (value·cos/pdf, divided by the sample count), unoccluded samples only.
@@ -76,7 +76,7 @@ inline bool UsablePixel(const Image& photo, const Image* mask, double clip, int 
 
 // Reads every photo; a pixel is valid when finite, below the photo's clip level, inside its mask,
 // and its footprint (centre and four corners) lies on one reflective region.
-PhotoSet LoadPhotoSet(const Scene& scene);
+PhotoSet LoadPhotoSet(const recon::Scene& scene);
 
 // Per photo, one value per pixel (row-major): nonzero where a simulation renders the pixel.
 using PixelMasks = std::vector<std::vector<uint8_t>>;
@@ -102,17 +102,18 @@ struct Simulation {
 // renders those of its pixels that `sim` lacks, and the result equals, bit for bit, one call for
 // them all (each pixel's paths have their own random streams). The variance's window reads
 // unrendered pixels as 0: it is exact where the 5 × 5 window around a pixel is rendered.
-void SimulatePhotos(const Scene& model, const DiagnoseOptions& options, uint64_t seed,
+void SimulatePhotos(const recon::Scene& model, const DiagnoseOptions& options, uint64_t seed,
                     Simulation* sim, const PixelMasks* only = nullptr);
 
 // The pixels a step's held-out test reads (HeldOutGain): the held-out blocks widened by the
 // variance's window (2 pixels), and every `grid`-th pixel in x and y (for an estimate of the
 // fitted pixels' residual).
-PixelMasks HeldOutTestMasks(const Scene& model, const PixelHoldout& holdout, int grid);
+PixelMasks HeldOutTestMasks(const recon::Scene& model, const solver::PixelHoldout& holdout,
+                            int grid);
 
 // The residual samples of `model` (a complete scene): every pixel_stride-th valid pixel, with the
 // renders' variance per pixel when `variance` is given (SimulatePhotos'). `sims` complete.
-std::vector<PixelRecord> BuildRecords(const Scene& model, const PhotoSet& photos,
+std::vector<PixelRecord> BuildRecords(const recon::Scene& model, const PhotoSet& photos,
                                       const std::vector<Image>& sims,
                                       const DiagnoseOptions& options,
                                       const std::vector<Image>* variance = nullptr);
@@ -138,6 +139,6 @@ ResidualSums Residual(const std::vector<PixelRecord>& records, bool held_out);
 
 // Residual over every valid pixel of the photos (not only the records' stride).
 ResidualSums ResidualOverPhotos(const PhotoSet& photos, const std::vector<Image>& sims,
-                                const PixelHoldout& holdout, bool held_out);
+                                const solver::PixelHoldout& holdout, bool held_out);
 
-}  // namespace igi
+}  // namespace igi::diagnose

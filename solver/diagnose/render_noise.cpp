@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace igi {
+namespace igi::diagnose {
 
 RenderNoise ChooseSpp(const PhotoSet& photos, const Simulation& sim, int spp, int spp_max,
                       double share) {
@@ -51,4 +51,4 @@ Json RenderNoiseJson(const RenderNoise& n, double share) {
           {"render_variance_share_wanted", share}};
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

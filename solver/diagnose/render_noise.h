@@ -11,7 +11,7 @@
 #include "solver/diagnose/pixel_records.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 // The noise of photos and renders over the valid pixels, as shares of the photos' mean square
 // (the scale of the residuals igi-diagnose reports).
@@ -32,4 +32,4 @@ RenderNoise ChooseSpp(const PhotoSet& photos, const Simulation& sim, int spp, in
 
 Json RenderNoiseJson(const RenderNoise& n, double share);
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <unordered_map>
 
-namespace igi {
+namespace igi::diagnose {
 
 ResidualFitter::ResidualFitter(const std::vector<PixelRecord>& records, std::vector<int> cell,
                                int num_cells, bool nuisance, int block_px)
@@ -197,7 +197,7 @@ double EitherZ(double z1, double z2) {
   return best > 0 && p > 0 ? UpperQuantile(2 * p) : best;
 }
 
-std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
+std::vector<int> RecordCells(const recon::Scene& model, const std::vector<PixelRecord>& records,
                              double cell_m, int* num_cells) {
   std::unordered_map<int64_t, int> ids;
   std::vector<int> cell(records.size());
@@ -217,7 +217,7 @@ std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>&
   return cell;
 }
 
-RecordSubset::RecordSubset(const Scene& model, const std::vector<PixelRecord>& records,
+RecordSubset::RecordSubset(const recon::Scene& model, const std::vector<PixelRecord>& records,
                            double cell_m, bool nuisance, int block_px, int stride, int region)
     : stride_(std::max(1, stride)) {
   for (size_t i = 0; i < records.size(); ++i) {
@@ -236,8 +236,8 @@ RecordSubset::RecordSubset(const Scene& model, const std::vector<PixelRecord>& r
       std::make_unique<ResidualFitter>(records_, std::move(cells), num_cells, nuisance, block_px);
 }
 
-RecordSubset::RecordSubset(const Scene& model, std::vector<PixelRecord> records, double cell_m,
-                           bool nuisance, int block_px)
+RecordSubset::RecordSubset(const recon::Scene& model, std::vector<PixelRecord> records,
+                           double cell_m, bool nuisance, int block_px)
     : records_(std::move(records)), stride_(1) {
   int num_cells = 0;
   std::vector<int> cells = RecordCells(model, records_, cell_m, &num_cells);
@@ -271,4 +271,4 @@ double SignedRankZ(std::vector<double> values) {
   return w / std::sqrt(n * (n + 1) * (2 * n + 1) / 6);
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -21,7 +21,7 @@
 
 #include "solver/diagnose/pixel_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct ResidualFit {
   Eigen::VectorXd coef;                      // empty: singular
@@ -142,7 +142,7 @@ double SignedRankZ(std::vector<double> values);
 
 // Cells for `model`'s records: per region, or per (region, voxel of `cell_m`) where the region
 // has an albedo map.
-std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>& records,
+std::vector<int> RecordCells(const recon::Scene& model, const std::vector<PixelRecord>& records,
                              double cell_m, int* num_cells);
 
 // A subset of the records with its own fitter (cells by the same rule, the same nuisance and
@@ -152,12 +152,12 @@ std::vector<int> RecordCells(const Scene& model, const std::vector<PixelRecord>&
 // `region` only when it is >= 0.
 class RecordSubset {
  public:
-  RecordSubset(const Scene& model, const std::vector<PixelRecord>& records, double cell_m,
+  RecordSubset(const recon::Scene& model, const std::vector<PixelRecord>& records, double cell_m,
                bool nuisance, int block_px, int stride, int region = -1);
   // Every record as given (a candidate's own copy whose outlier marks it changed: records taken
   // out of its fit or back into it), with its fitter; stride 1.
-  RecordSubset(const Scene& model, std::vector<PixelRecord> records, double cell_m, bool nuisance,
-               int block_px);
+  RecordSubset(const recon::Scene& model, std::vector<PixelRecord> records, double cell_m,
+               bool nuisance, int block_px);
   RecordSubset(const RecordSubset&) = delete;
   RecordSubset& operator=(const RecordSubset&) = delete;
 
@@ -302,4 +302,4 @@ ResidualFit ResidualFitter::FitImpl(int k, F basis, G offset, bool noise_free, i
   return fit;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -6,7 +6,7 @@
 #include <optional>
 #include <unordered_map>
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using CellKey = int64_t;
@@ -142,7 +142,7 @@ TextureEvidence Evaluate(const std::string& name, const CellGrid& a, const CellG
 
 }  // namespace
 
-std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
+std::vector<TextureEvidence> FindTexturedRegions(const recon::Scene& model,
                                                  const std::vector<PixelRecord>& records,
                                                  const std::vector<bool>& solved,
                                                  const TextureEvidenceOptions& options) {
@@ -185,4 +185,4 @@ std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

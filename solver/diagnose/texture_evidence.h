@@ -25,7 +25,7 @@
 #include "recon/scene.h"
 #include "solver/diagnose/pixel_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 struct TextureEvidenceOptions {
   double cell_m = 0.05;  // surface cell, metres
@@ -61,9 +61,9 @@ struct TextureEvidence {
 
 // One entry per region whose ρd the model solved (`solved[r]` true) and that has records; the
 // training records (not held out, not outliers) are used.
-std::vector<TextureEvidence> FindTexturedRegions(const Scene& model,
+std::vector<TextureEvidence> FindTexturedRegions(const recon::Scene& model,
                                                  const std::vector<PixelRecord>& records,
                                                  const std::vector<bool>& solved,
                                                  const TextureEvidenceOptions& options);
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -1,7 +1,6 @@
 #include "solver/export/export.h"
 
 #include <fmt/format.h>
-
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -10,28 +9,19 @@
 #include "solver/export/export_gltf.h"
 #include "solver/export/export_mitsuba.h"
 #include "solver/export/export_radiance.h"
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::exporter {
 
-std::string_view ExportFormatName(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::kRadiance:
-      return "radiance";
-    case ExportFormat::kMitsuba:
-      return "mitsuba";
-    case ExportFormat::kGltf:
-      return "gltf";
-  }
-  return "?";
-}
+constexpr EnumNames<ExportFormat, 3> kExportFormatNames{{{ExportFormat::kRadiance, "radiance"},
+                                                         {ExportFormat::kMitsuba, "mitsuba"},
+                                                         {ExportFormat::kGltf, "gltf"}}};
 
+std::string_view ExportFormatName(ExportFormat format) { return kExportFormatNames.Name(format); }
 std::optional<ExportFormat> ExportFormatFromName(std::string_view name) {
-  for (ExportFormat f : {ExportFormat::kRadiance, ExportFormat::kMitsuba, ExportFormat::kGltf}) {
-    if (ExportFormatName(f) == name) return f;
-  }
-  return std::nullopt;
+  return kExportFormatNames.FromName(name);
 }
 
 void ExportOptions::Validate() const {
@@ -87,9 +77,9 @@ void CheckExportDir(const std::filesystem::path& out_dir) {
   }
 }
 
-void CheckExportableScene(const Scene& scene) {
+void CheckExportableScene(const recon::Scene& scene) {
   ProblemList problems;
-  for (const Material& m : scene.materials) {
+  for (const recon::Material& m : scene.materials) {
     const auto missing = m.MissingForRendering();
     if (!missing.empty()) {
       problems.Add(scene.file.string(), "materials." + m.name, Join(missing, ", "),
@@ -99,7 +89,7 @@ void CheckExportableScene(const Scene& scene) {
   problems.ThrowIfAny();
 }
 
-ExportReport ExportScene(const Scene& scene, const std::filesystem::path& out_dir,
+ExportReport ExportScene(const recon::Scene& scene, const std::filesystem::path& out_dir,
                          const ExportOptions& options) {
   options.Validate();
   CheckExportableScene(scene);
@@ -139,4 +129,4 @@ ExportReport ExportScene(const Scene& scene, const std::filesystem::path& out_di
   return report;
 }
 
-}  // namespace igi
+}  // namespace igi::exporter

@@ -23,7 +23,7 @@
 #include "recon/scene.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::exporter {
 
 enum class ExportFormat { kRadiance, kMitsuba, kGltf };
 std::string_view ExportFormatName(ExportFormat format);
@@ -68,11 +68,11 @@ struct ExportReport {
 void CheckExportDir(const std::filesystem::path& out_dir);
 
 // Checks that every material of `scene` is complete (InputError listing every missing value).
-void CheckExportableScene(const Scene& scene);
+void CheckExportableScene(const recon::Scene& scene);
 
 // Writes the export of `scene` into `out_dir` (see the top of this file) and returns its report
 // (also written as out_dir/export_report.json).
-ExportReport ExportScene(const Scene& scene, const std::filesystem::path& out_dir,
+ExportReport ExportScene(const recon::Scene& scene, const std::filesystem::path& out_dir,
                          const ExportOptions& options);
 
-}  // namespace igi
+}  // namespace igi::exporter

@@ -8,7 +8,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
 
-namespace igi::export_internal {
+namespace igi::exporter::internal {
 
 std::string SafeName(std::string_view name) {
   std::string out(name);
@@ -20,7 +20,7 @@ std::string SafeName(std::string_view name) {
   return out.empty() ? std::string("_") : out;
 }
 
-std::vector<RegionMesh> SplitByRegion(const TriangleMesh& mesh) {
+std::vector<RegionMesh> SplitByRegion(const recon::TriangleMesh& mesh) {
   std::vector<RegionMesh> regions(mesh.region_names.size());
   std::vector<std::map<int, int>> remap(regions.size());
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
@@ -42,7 +42,7 @@ std::vector<RegionMesh> SplitByRegion(const TriangleMesh& mesh) {
   return regions;
 }
 
-RegionMesh WholeMesh(const TriangleMesh& mesh) {
+RegionMesh WholeMesh(const recon::TriangleMesh& mesh) {
   return {mesh.positions, mesh.normals, mesh.uvs, mesh.triangles};
 }
 
@@ -63,19 +63,19 @@ std::string ObjText(const RegionMesh& mesh) {
   return text;
 }
 
-BrdfParams ParamsOf(const Material& material) {
-  BrdfParams p;
+render::BrdfParams ParamsOf(const recon::Material& material) {
+  render::BrdfParams p;
   p.model = material.brdf;
   p.rho_d = RegionRhoD(material);
   if (material.rho_s) p.rho_s = *material.rho_s;
   if (material.alpha) p.alpha = *material.alpha;
   if (material.alpha_x) p.alpha_x = *material.alpha_x;
   if (material.alpha_y) p.alpha_y = *material.alpha_y;
-  p.ior = material.ior.value_or(Material::kDefaultIor);
+  p.ior = material.ior.value_or(recon::Material::kDefaultIor);
   return p;
 }
 
-Eigen::Vector3d RegionRhoD(const Material& material) {
+Eigen::Vector3d RegionRhoD(const recon::Material& material) {
   if (material.rho_d) return *material.rho_d;
   if (!material.rho_d_map) return Eigen::Vector3d::Zero();
   const Image image = ReadImage(*material.rho_d_map, 3);
@@ -87,17 +87,17 @@ Eigen::Vector3d RegionRhoD(const Material& material) {
   return n > 0 ? Eigen::Vector3d(sum / n) : Eigen::Vector3d::Zero();
 }
 
-LobeFit FitAndReport(const Material& material, const LobeFitOptions& options,
+LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& options,
                      std::string_view target_label, ExportReport* report) {
-  const BrdfParams params = ParamsOf(material);
+  const render::BrdfParams params = ParamsOf(material);
   const LobeFit fit = FitSpecularLobe(params, options);
   std::string how = fmt::format(
       "{} specular lobe fitted by {} (least squares of f cos(i) cos(o), view angles up to {} "
       "deg): alpha {:.6g}, scale {:.6g}; relative error {:.3g} (up to 88 deg: {:.3g})",
-      BrdfModelName(material.brdf), target_label, options.max_theta_o_deg, fit.alpha, fit.scale,
-      fit.relative_error, fit.relative_error_to_88deg);
-  if (IsAnisotropic(material.brdf)) how += "; anisotropy dropped (isotropic fit)";
-  if (HasFresnel(material.brdf)) how += "; igi's Schlick weight folded into the fit";
+      recon::BrdfModelName(material.brdf), target_label, options.max_theta_o_deg, fit.alpha,
+      fit.scale, fit.relative_error, fit.relative_error_to_88deg);
+  if (recon::IsAnisotropic(material.brdf)) how += "; anisotropy dropped (isotropic fit)";
+  if (recon::HasFresnel(material.brdf)) how += "; igi's Schlick weight folded into the fit";
   report->Add("materials." + material.name, how, fit.relative_error);
   return fit;
 }
@@ -114,4 +114,4 @@ std::string Num(double value) {
   return fmt::format("{:.9g}", value);
 }
 
-}  // namespace igi::export_internal
+}  // namespace igi::exporter::internal

@@ -14,7 +14,7 @@
 #include "solver/export/ward_fit.h"
 #include "solver/render/brdf.h"
 
-namespace igi::export_internal {
+namespace igi::exporter::internal {
 
 // `name` with every character outside [A-Za-z0-9_.-] replaced by '_' (RADIANCE identifiers,
 // file names, XML ids).
@@ -27,20 +27,20 @@ struct RegionMesh {
   std::vector<Eigen::Vector3i> triangles;
 };
 // One RegionMesh per region of `mesh` (index = region); regions without triangles are empty.
-std::vector<RegionMesh> SplitByRegion(const TriangleMesh& mesh);
-RegionMesh WholeMesh(const TriangleMesh& mesh);
+std::vector<RegionMesh> SplitByRegion(const recon::TriangleMesh& mesh);
+RegionMesh WholeMesh(const recon::TriangleMesh& mesh);
 
 // Wavefront OBJ with v/vt/vn (vt as stored: u right, v up).
 std::string ObjText(const RegionMesh& mesh);
 
 // The material as BrdfParams (absent values zero / 0.1).
-BrdfParams ParamsOf(const Material& material);
+render::BrdfParams ParamsOf(const recon::Material& material);
 // The region's diffuse albedo: rho_d, or the mean of rho_d_map when only the map is given.
-Eigen::Vector3d RegionRhoD(const Material& material);
+Eigen::Vector3d RegionRhoD(const recon::Material& material);
 
 // Fits the material's specular lobe to `target` and records the approximation in `report`
 // under "materials.<name>" with the fitted error.
-LobeFit FitAndReport(const Material& material, const LobeFitOptions& options,
+LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& options,
                      std::string_view target_label, ExportReport* report);
 
 // Writes `text` to dir/relative and records the file in the report.
@@ -50,4 +50,4 @@ void WriteText(const std::filesystem::path& dir, const std::string& relative,
 // printf-like number for text formats: up to 9 significant digits, no trailing zeros.
 std::string Num(double value);
 
-}  // namespace igi::export_internal
+}  // namespace igi::exporter::internal

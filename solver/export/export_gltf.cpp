@@ -11,11 +11,11 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
-using export_internal::RegionMesh;
-using export_internal::SafeName;
+using internal::RegionMesh;
+using internal::SafeName;
 
 constexpr int kFloat = 5126, kUInt32 = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
@@ -42,7 +42,7 @@ double SrgbEncode(double c) {
 
 class GltfBuilder {
  public:
-  GltfBuilder(const Scene& scene, const std::filesystem::path& dir, ExportReport* report)
+  GltfBuilder(const recon::Scene& scene, const std::filesystem::path& dir, ExportReport* report)
       : scene_(scene), dir_(dir), report_(report) {
     doc_["asset"] = {{"version", "2.0"}, {"generator", "igi-export"}};
     for (const char* key : {"scenes", "nodes", "meshes", "materials", "accessors", "bufferViews",
@@ -59,15 +59,15 @@ class GltfBuilder {
  private:
   int AddAccessor(const void* data, size_t bytes, int target, Json accessor);
   int AddMesh(const std::string& name, const RegionMesh& mesh, int material);
-  int AddMaterial(const Material& m);
-  int AddTexture(const Material& m);
+  int AddMaterial(const recon::Material& m);
+  int AddTexture(const recon::Material& m);
   void AddNode(Json node) {
     roots_.push_back(int(doc_["nodes"].size()));
     doc_["nodes"].push_back(std::move(node));
   }
-  Json LightFor(const Light& light);
+  Json LightFor(const recon::Light& light);
 
-  const Scene& scene_;
+  const recon::Scene& scene_;
   std::filesystem::path dir_;
   ExportReport* report_;
   Json doc_;
@@ -117,7 +117,7 @@ int GltfBuilder::AddMesh(const std::string& name, const RegionMesh& mesh, int ma
   return int(doc_["meshes"].size()) - 1;
 }
 
-int GltfBuilder::AddTexture(const Material& m) {
+int GltfBuilder::AddTexture(const recon::Material& m) {
   Image image = ReadImage(*m.rho_d_map, 3);
   for (float& v : image.pixels) v = float(SrgbEncode(v));
   image.metadata.clear();
@@ -135,11 +135,11 @@ int GltfBuilder::AddTexture(const Material& m) {
   return int(doc_["textures"].size()) - 1;
 }
 
-int GltfBuilder::AddMaterial(const Material& m) {
+int GltfBuilder::AddMaterial(const recon::Material& m) {
   Json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   Json material = {{"name", m.name}, {"doubleSided", true}};
   Json ext;
-  if (m.brdf == BrdfModel::kEmitter) {
+  if (m.brdf == recon::BrdfModel::kEmitter) {
     pbr["baseColorFactor"] = {0.0, 0.0, 0.0, 1.0};
     const double peak = m.radiance->maxCoeff();
     material["emissiveFactor"] =
@@ -147,7 +147,7 @@ int GltfBuilder::AddMaterial(const Material& m) {
     ext["KHR_materials_emissive_strength"] = {{"emissiveStrength", peak}};
   } else {
     Eigen::Vector3d base =
-        m.brdf == BrdfModel::kBlack ? Eigen::Vector3d::Zero() : export_internal::RegionRhoD(m);
+        m.brdf == recon::BrdfModel::kBlack ? Eigen::Vector3d::Zero() : internal::RegionRhoD(m);
     if (m.rho_d_map) {
       pbr["baseColorTexture"] = {{"index", AddTexture(m)}};
       base.setOnes();
@@ -156,10 +156,10 @@ int GltfBuilder::AddMaterial(const Material& m) {
     base = base.cwiseMin(1.0);
     pbr["baseColorFactor"] = {base.x(), base.y(), base.z(), 1.0};
     Json specular = {{"specularFactor", 0.0}};
-    if (HasSpecularLobe(m.brdf)) {
+    if (recon::HasSpecularLobe(m.brdf)) {
       LobeFitOptions options;
       options.target = LobeTarget::kGgxSchlick;
-      const LobeFit fit = export_internal::FitAndReport(m, options, "glTF GGX + Schlick", report_);
+      const LobeFit fit = internal::FitAndReport(m, options, "glTF GGX + Schlick", report_);
       pbr["roughnessFactor"] = std::min(1.0, std::sqrt(fit.alpha));
       const Eigen::Vector3d f0 = fit.scale * *m.rho_s / std::max(1e-12, m.rho_s->mean());
       specular = {{"specularFactor", 1.0}, {"specularColorFactor", Array3(f0 / 0.04)}};
@@ -174,7 +174,7 @@ int GltfBuilder::AddMaterial(const Material& m) {
 }
 
 void GltfBuilder::AddRegions() {
-  const std::vector<RegionMesh> regions = export_internal::SplitByRegion(scene_.mesh);
+  const std::vector<RegionMesh> regions = internal::SplitByRegion(scene_.mesh);
   for (size_t r = 0; r < regions.size(); ++r) {
     if (regions[r].triangles.empty()) continue;
     const int material = AddMaterial(scene_.materials[r]);
@@ -184,33 +184,35 @@ void GltfBuilder::AddRegions() {
 }
 // The angle (radians) where the spot's relative intensity first falls below `fraction` of its
 // axis value (at most 90°).
-double SpotAngle(const SpotProfile& profile, double fraction) {
+double SpotAngle(const recon::SpotProfile& profile, double fraction) {
   const double axis = profile.Relative(0, 0);
   for (double deg = 0.05; deg < 90; deg += 0.05) {
-    if (profile.Relative(deg * kPi / 180, 0) < fraction * axis) return deg * kPi / 180;
+    if (profile.Relative(deg * render::kPi / 180, 0) < fraction * axis)
+      return deg * render::kPi / 180;
   }
-  return kPi / 2;
+  return render::kPi / 2;
 }
 
-Json GltfBuilder::LightFor(const Light& light) {
+Json GltfBuilder::LightFor(const recon::Light& light) {
   Json out = {{"name", light.name}};
   const std::string item = "lights." + light.name;
   switch (light.type) {
-    case LightType::kPoint:
+    case recon::LightType::kPoint:
       out["type"] = "point";
       ColorIntensity(light.intensity, &out);
       break;
-    case LightType::kSpot: {
+    case recon::LightType::kSpot: {
       ColorIntensity(light.intensity, &out);
-      const SpotProfile& p = light.profile;
-      if (p.kind == SpotProfile::Kind::kNone) {
+      const recon::SpotProfile& p = light.profile;
+      if (p.kind == recon::SpotProfile::Kind::kNone) {
         out["type"] = "point";
         break;
       }
       out["type"] = "spot";
       double inner = SpotAngle(p, 0.9), outer = SpotAngle(p, 0.1);
-      if (p.kind == SpotProfile::Kind::kCone) {
-        inner = p.inner_deg * kPi / 180, outer = std::min(p.outer_deg, 90.0) * kPi / 180;
+      if (p.kind == recon::SpotProfile::Kind::kCone) {
+        inner = p.inner_deg * render::kPi / 180,
+        outer = std::min(p.outer_deg, 90.0) * render::kPi / 180;
         report_->Add(item,
                      "cone falloff: glTF's smooth falloff between inner and outer angles "
                      "replaces the smoothstep");
@@ -222,46 +224,47 @@ Json GltfBuilder::LightFor(const Light& light) {
       out["spot"] = {{"innerConeAngle", std::min(inner, outer - 1e-4)}, {"outerConeAngle", outer}};
       break;
     }
-    case LightType::kDirectional:
+    case recon::LightType::kDirectional:
       out["type"] = "directional";
       ColorIntensity(light.irradiance, &out);
       break;
-    case LightType::kSphere:
+    case recon::LightType::kSphere:
       out["type"] = "point";
-      ColorIntensity(light.radiance * kPi * light.radius * light.radius, &out);
+      ColorIntensity(light.radiance * render::kPi * light.radius * light.radius, &out);
       report_->Add(item,
                    "sphere light as a point light of intensity radiance*pi*r^2 (exact at "
                    "distances >> r; no visible sphere)");
       break;
-    case LightType::kArea:
-    case LightType::kAmbient:
+    case recon::LightType::kArea:
+    case recon::LightType::kAmbient:
       break;
   }
   return out;
 }
 
 void GltfBuilder::AddLights() {
-  for (const Light& light : scene_.lights) {
-    if (light.type == LightType::kArea) {
-      Material emitter;
+  for (const recon::Light& light : scene_.lights) {
+    if (light.type == recon::LightType::kArea) {
+      recon::Material emitter;
       emitter.name = "light." + light.name;
-      emitter.brdf = BrdfModel::kEmitter;
+      emitter.brdf = recon::BrdfModel::kEmitter;
       emitter.radiance = light.radiance;
       const int material = AddMaterial(emitter);
-      const int mesh = AddMesh(emitter.name, export_internal::WholeMesh(light.mesh), material);
+      const int mesh = AddMesh(emitter.name, internal::WholeMesh(light.mesh), material);
       AddNode({{"name", emitter.name}, {"mesh", mesh}});
       continue;
     }
-    if (light.type == LightType::kAmbient) {
+    if (light.type == recon::LightType::kAmbient) {
       report_->Add("lights." + light.name, "ambient light left out: glTF has no such light");
       continue;
     }
     lights_.push_back(LightFor(light));
     Json node = {{"name", light.name}};
     node["extensions"]["KHR_lights_punctual"]["light"] = int(lights_.size()) - 1;
-    const Eigen::Vector3d at = light.type == LightType::kSphere ? light.center : light.position;
-    if (light.type != LightType::kDirectional) node["translation"] = Array3(at);
-    if (light.type == LightType::kSpot || light.type == LightType::kDirectional) {
+    const Eigen::Vector3d at =
+        light.type == recon::LightType::kSphere ? light.center : light.position;
+    if (light.type != recon::LightType::kDirectional) node["translation"] = Array3(at);
+    if (light.type == recon::LightType::kSpot || light.type == recon::LightType::kDirectional) {
       // The light shines along its node's −z.
       const Eigen::Matrix3d frame = FrameFromAxis(-light.direction.normalized());
       node["rotation"] = Rotation(frame);
@@ -276,7 +279,7 @@ void GltfBuilder::AddLights() {
 }
 
 void GltfBuilder::AddCameras() {
-  for (const Camera& camera : scene_.cameras) {
+  for (const recon::Camera& camera : scene_.cameras) {
     const double yfov = 2 * std::atan(camera.height / (2 * camera.focal_y_px()));
     doc_["cameras"].push_back({{"name", camera.name},
                                {"type", "perspective"},
@@ -297,7 +300,7 @@ void GltfBuilder::AddCameras() {
                          std::abs(camera.principal_y_px() - 0.5 * camera.height) < 1e-6;
     const bool square =
         std::abs(camera.focal_x_px() - camera.focal_y_px()) < 1e-6 * camera.focal_x_px();
-    if (!centred || !square || camera.model == CameraModel::kOpenCv) {
+    if (!centred || !square || camera.model == recon::CameraModel::kOpenCv) {
       report_->Add("cameras." + camera.name,
                    "glTF perspective keeps yfov and aspect only: principal point offset, fx != fy "
                    "and lens distortion dropped");
@@ -310,7 +313,7 @@ void GltfBuilder::Write() {
   doc_["scene"] = 0;
   if (!lights_.empty()) doc_["extensions"]["KHR_lights_punctual"]["lights"] = lights_;
   Json lightings = Json::object();
-  for (const Lighting& lighting : scene_.lightings) {
+  for (const recon::Lighting& lighting : scene_.lightings) {
     Json names = Json::array();
     for (int l : lighting.lights) names.push_back(scene_.lights[l].name);
     lightings[lighting.name] = names;
@@ -323,12 +326,12 @@ void GltfBuilder::Write() {
   doc_["buffers"] = Json::array({{{"uri", "scene.bin"}, {"byteLength", bin_.size()}}});
   WriteFileAtomic(dir_ / "scene.bin", bin_);
   report_->files.push_back("scene.bin");
-  export_internal::WriteText(dir_, "scene.gltf", doc_.dump(1), report_);
+  internal::WriteText(dir_, "scene.gltf", doc_.dump(1), report_);
 }
 
 }  // namespace
 
-void WriteGltfExport(const Scene& scene, const ExportOptions& /*options*/,
+void WriteGltfExport(const recon::Scene& scene, const ExportOptions& /*options*/,
                      const std::filesystem::path& dir, ExportReport* report) {
   GltfBuilder builder(scene, dir, report);
   builder.AddRegions();
@@ -337,4 +340,4 @@ void WriteGltfExport(const Scene& scene, const ExportOptions& /*options*/,
   builder.Write();
 }
 
-}  // namespace igi
+}  // namespace igi::exporter

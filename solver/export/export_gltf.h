@@ -30,9 +30,9 @@
 #include "recon/scene.h"
 #include "solver/export/export.h"
 
-namespace igi {
+namespace igi::exporter {
 
-void WriteGltfExport(const Scene& scene, const ExportOptions& options,
+void WriteGltfExport(const recon::Scene& scene, const ExportOptions& options,
                      const std::filesystem::path& dir, ExportReport* report);
 
-}  // namespace igi
+}  // namespace igi::exporter

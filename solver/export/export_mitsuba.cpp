@@ -7,11 +7,11 @@
 #include "solver/export/export_common.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
-using export_internal::Num;
-using export_internal::SafeName;
+using internal::Num;
+using internal::SafeName;
 
 std::string Rgb(const std::string& name, const Eigen::Vector3d& v) {
   return fmt::format("<rgb name=\"{}\" value=\"{}, {}, {}\"/>", name, Num(v.x()), Num(v.y()),
@@ -35,9 +35,9 @@ std::string LookAt(const Eigen::Vector3d& origin, const Eigen::Vector3d& target,
 }
 
 // The diffuse reflectance: a bitmap of rho_d_map (written as EXR) or an rgb value.
-std::string DiffuseValue(const Material& m, const std::string& name,
+std::string DiffuseValue(const recon::Material& m, const std::string& name,
                          const std::filesystem::path& dir, ExportReport* report) {
-  if (!m.rho_d_map) return Rgb(name, export_internal::RegionRhoD(m));
+  if (!m.rho_d_map) return Rgb(name, internal::RegionRhoD(m));
   const std::string relative = "textures/" + SafeName(m.name) + ".exr";
   std::filesystem::create_directories(dir / "textures");
   Image image = ReadImage(*m.rho_d_map, 3);
@@ -53,12 +53,13 @@ std::string DiffuseValue(const Material& m, const std::string& name,
       name, relative);
 }
 
-std::string BsdfText(const Material& m, const std::filesystem::path& dir, ExportReport* report) {
+std::string BsdfText(const recon::Material& m, const std::filesystem::path& dir,
+                     ExportReport* report) {
   const std::string id = SafeName(m.name);
   std::string inner;
-  if (m.brdf == BrdfModel::kEmitter || m.brdf == BrdfModel::kBlack) {
+  if (m.brdf == recon::BrdfModel::kEmitter || m.brdf == recon::BrdfModel::kBlack) {
     inner = "<bsdf type=\"diffuse\">" + Rgb("reflectance", Eigen::Vector3d::Zero()) + "</bsdf>";
-  } else if (!HasSpecularLobe(m.brdf) || !(m.rho_s->mean() > 0)) {
+  } else if (!recon::HasSpecularLobe(m.brdf) || !(m.rho_s->mean() > 0)) {
     inner = "<bsdf type=\"diffuse\">" + DiffuseValue(m, "reflectance", dir, report) + "</bsdf>";
   } else {
     const double f0 = std::clamp(m.rho_s->mean(), 1e-4, 0.5);
@@ -67,7 +68,7 @@ std::string BsdfText(const Material& m, const std::filesystem::path& dir, Export
     options.target = LobeTarget::kBeckmannDielectric;
     options.target_ior = eta;
     const LobeFit fit =
-        export_internal::FitAndReport(m, options, "Mitsuba roughplastic (beckmann)", report);
+        internal::FitAndReport(m, options, "Mitsuba roughplastic (beckmann)", report);
     report->Add("materials." + m.name,
                 "roughplastic's diffuse term carries Fresnel transmittances and internal "
                 "reflection: diffuse_reflectance = rho_d is not compensated");
@@ -79,15 +80,15 @@ std::string BsdfText(const Material& m, const std::filesystem::path& dir, Export
             Rgb("specular_reflectance", spec) + "</bsdf>";
   }
   return fmt::format("  <!-- {} ({}) -->\n  <bsdf type=\"twosided\" id=\"bsdf.{}\">{}</bsdf>\n",
-                     m.name, BrdfModelName(m.brdf), id, inner);
+                     m.name, recon::BrdfModelName(m.brdf), id, inner);
 }
 
-std::string SensorText(const Camera& camera, int spp, ExportReport* report) {
+std::string SensorText(const recon::Camera& camera, int spp, ExportReport* report) {
   const Eigen::Matrix3d world_from_cam =
       camera.cam_from_world.rotation.toRotationMatrix().transpose();
   const Eigen::Vector3d c = camera.CenterInWorld();
-  const double fov = 2 * std::atan(camera.width / (2 * camera.focal_x_px())) * 180 / kPi;
-  if (camera.model == CameraModel::kOpenCv ||
+  const double fov = 2 * std::atan(camera.width / (2 * camera.focal_x_px())) * 180 / render::kPi;
+  if (camera.model == recon::CameraModel::kOpenCv ||
       std::abs(camera.focal_x_px() - camera.focal_y_px()) > 1e-6 * camera.focal_x_px()) {
     report->Add("cameras." + camera.name,
                 "Mitsuba perspective has one focal length and no distortion: fy and lens "
@@ -116,30 +117,30 @@ std::string SensorText(const Camera& camera, int spp, ExportReport* report) {
 }
 
 // The 90% and 10% angles (degrees, at most 90) of a spot profile.
-double SpotAngleDeg(const SpotProfile& profile, double fraction) {
+double SpotAngleDeg(const recon::SpotProfile& profile, double fraction) {
   const double axis = profile.Relative(0, 0);
   for (double deg = 0.05; deg < 90; deg += 0.05) {
-    if (profile.Relative(deg * kPi / 180, 0) < fraction * axis) return deg;
+    if (profile.Relative(deg * render::kPi / 180, 0) < fraction * axis) return deg;
   }
   return 90;
 }
 
-std::string EmitterText(const Light& light, ExportReport* report) {
+std::string EmitterText(const recon::Light& light, ExportReport* report) {
   const std::string item = "lights." + light.name;
   switch (light.type) {
-    case LightType::kPoint:
+    case recon::LightType::kPoint:
       return "  <emitter type=\"point\" id=\"" + SafeName(light.name) + "\">" +
              Point("point", "position", light.position) + Rgb("intensity", light.intensity) +
              "</emitter>\n";
-    case LightType::kSpot: {
-      const SpotProfile& p = light.profile;
-      if (p.kind == SpotProfile::Kind::kNone) {
+    case recon::LightType::kSpot: {
+      const recon::SpotProfile& p = light.profile;
+      if (p.kind == recon::SpotProfile::Kind::kNone) {
         return "  <emitter type=\"point\" id=\"" + SafeName(light.name) + "\">" +
                Point("point", "position", light.position) + Rgb("intensity", light.intensity) +
                "</emitter>\n";
       }
       double beam = SpotAngleDeg(p, 0.9), cutoff = SpotAngleDeg(p, 0.1);
-      if (p.kind == SpotProfile::Kind::kCone) beam = p.inner_deg, cutoff = p.outer_deg;
+      if (p.kind == recon::SpotProfile::Kind::kCone) beam = p.inner_deg, cutoff = p.outer_deg;
       report->Add(item, "spot profile as Mitsuba's spot (beam_width " + Num(beam) +
                             " deg, cutoff_angle " + Num(cutoff) + " deg, its own falloff)");
       const Eigen::Vector3d up = FrameFromAxis(light.direction).col(0);
@@ -148,20 +149,20 @@ std::string EmitterText(const Light& light, ExportReport* report) {
              Float("cutoff_angle", cutoff) +
              LookAt(light.position, light.position + light.direction, up) + "</emitter>\n";
     }
-    case LightType::kDirectional:
+    case recon::LightType::kDirectional:
       return "  <emitter type=\"directional\" id=\"" + SafeName(light.name) + "\">" +
              Point("vector", "direction", light.direction) + Rgb("irradiance", light.irradiance) +
              "</emitter>\n";
-    case LightType::kSphere:
+    case recon::LightType::kSphere:
       return "  <shape type=\"sphere\" id=\"" + SafeName(light.name) + "\">" +
              Point("point", "center", light.center) + Float("radius", light.radius) +
              "<bsdf type=\"diffuse\">" + Rgb("reflectance", Eigen::Vector3d::Zero()) +
              "</bsdf><emitter type=\"area\">" + Rgb("radiance", light.radiance) +
              "</emitter></shape>\n";
-    case LightType::kAmbient:
+    case recon::LightType::kAmbient:
       return "  <emitter type=\"constant\" id=\"" + SafeName(light.name) + "\">" +
              Rgb("radiance", light.radiance) + "</emitter>\n";
-    case LightType::kArea:
+    case recon::LightType::kArea:
       return "  <shape type=\"obj\" id=\"" + SafeName(light.name) +
              "\"><string name=\"filename\" value=\"meshes/light." + SafeName(light.name) +
              ".obj\"/><bsdf type=\"diffuse\">" + Rgb("reflectance", Eigen::Vector3d::Zero()) +
@@ -173,33 +174,33 @@ std::string EmitterText(const Light& light, ExportReport* report) {
 
 }  // namespace
 
-void WriteMitsubaExport(const Scene& scene, const ExportOptions& options,
+void WriteMitsubaExport(const recon::Scene& scene, const ExportOptions& options,
                         const std::filesystem::path& dir, ExportReport* report) {
-  using export_internal::WriteText;
-  const auto regions = export_internal::SplitByRegion(scene.mesh);
+  using internal::WriteText;
+  const auto regions = internal::SplitByRegion(scene.mesh);
   std::string common;
-  for (const Camera& camera : scene.cameras) {
+  for (const recon::Camera& camera : scene.cameras) {
     common += SensorText(camera, options.mitsuba_spp, report);
   }
   for (size_t r = 0; r < regions.size(); ++r) {
     if (regions[r].triangles.empty()) continue;
-    const Material& m = scene.materials[r];
+    const recon::Material& m = scene.materials[r];
     const std::string id = SafeName(m.name);
     common += BsdfText(m, dir, report);
-    WriteText(dir, "meshes/" + id + ".obj", export_internal::ObjText(regions[r]), report);
+    WriteText(dir, "meshes/" + id + ".obj", internal::ObjText(regions[r]), report);
     common += "  <shape type=\"obj\" id=\"" + id + "\"><string name=\"filename\" value=\"meshes/" +
               id + ".obj\"/><ref id=\"bsdf." + id + "\"/>";
-    if (m.brdf == BrdfModel::kEmitter) {
+    if (m.brdf == recon::BrdfModel::kEmitter) {
       common += "<emitter type=\"area\">" + Rgb("radiance", *m.radiance) + "</emitter>";
     }
     common += "</shape>\n";
   }
-  for (const Light& light : scene.lights) {
-    if (light.type != LightType::kArea) continue;
+  for (const recon::Light& light : scene.lights) {
+    if (light.type != recon::LightType::kArea) continue;
     WriteText(dir, "meshes/light." + SafeName(light.name) + ".obj",
-              export_internal::ObjText(export_internal::WholeMesh(light.mesh)), report);
+              internal::ObjText(internal::WholeMesh(light.mesh)), report);
   }
-  for (const Lighting& lighting : scene.lightings) {
+  for (const recon::Lighting& lighting : scene.lightings) {
     std::string xml = "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- igi-export: lighting " +
                       lighting.name +
                       "; mapping in solver/export/export_mitsuba.h -->\n<scene version=\"3.0.0\">\n"
@@ -212,4 +213,4 @@ void WriteMitsubaExport(const Scene& scene, const ExportOptions& options,
   }
 }
 
-}  // namespace igi
+}  // namespace igi::exporter

@@ -25,9 +25,9 @@
 #include "recon/scene.h"
 #include "solver/export/export.h"
 
-namespace igi {
+namespace igi::exporter {
 
-void WriteMitsubaExport(const Scene& scene, const ExportOptions& options,
+void WriteMitsubaExport(const recon::Scene& scene, const ExportOptions& options,
                         const std::filesystem::path& dir, ExportReport* report);
 
-}  // namespace igi
+}  // namespace igi::exporter

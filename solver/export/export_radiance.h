@@ -42,9 +42,9 @@
 #include "recon/scene.h"
 #include "solver/export/export.h"
 
-namespace igi {
+namespace igi::exporter {
 
-void WriteRadianceExport(const Scene& scene, const ExportOptions& options,
+void WriteRadianceExport(const recon::Scene& scene, const ExportOptions& options,
                          const std::filesystem::path& dir, ExportReport* report);
 
-}  // namespace igi
+}  // namespace igi::exporter

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 // One (wo, wi) pair of the fitting grid with its weight cos²θi·cos²θo·dωi·dωo.
@@ -22,11 +22,12 @@ std::vector<DirectionPair> BuildPairs(double alpha_grid, bool anisotropic,
   std::vector<DirectionPair> pairs;
   const int n_o = options.theta_o_steps, n_h = options.half_steps;
   const int n_phi_o = anisotropic ? 8 : 1;
-  const double theta_o_max = options.max_theta_o_deg * kPi / 180.0, t_max = 8.0;
+  const double theta_o_max = options.max_theta_o_deg * render::kPi / 180.0, t_max = 8.0;
   for (int io = 0; io < n_o; ++io) {
     const double theta_o = (io + 0.5) * theta_o_max / n_o;
     for (int jo = 0; jo < n_phi_o; ++jo) {
-      const double phi_o = (jo + 0.5) * kPi / n_phi_o;  // lobes are symmetric under φ -> φ + π
+      const double phi_o =
+          (jo + 0.5) * render::kPi / n_phi_o;  // lobes are symmetric under φ -> φ + π
       const Eigen::Vector3d wo(std::sin(theta_o) * std::cos(phi_o),
                                std::sin(theta_o) * std::sin(phi_o), std::cos(theta_o));
       const double w_o = std::cos(theta_o) * std::cos(theta_o) * std::sin(theta_o);
@@ -35,7 +36,7 @@ std::vector<DirectionPair> BuildPairs(double alpha_grid, bool anisotropic,
         const double theta_h = std::atan(alpha_grid * t);
         const double dtheta_dt = alpha_grid / (1.0 + alpha_grid * alpha_grid * t * t);
         for (int jh = 0; jh < n_h; ++jh) {
-          const double phi_h = (jh + 0.5) * 2.0 * kPi / n_h;
+          const double phi_h = (jh + 0.5) * 2.0 * render::kPi / n_h;
           const Eigen::Vector3d h(std::sin(theta_h) * std::cos(phi_h),
                                   std::sin(theta_h) * std::sin(phi_h), std::cos(theta_h));
           const double c = wo.dot(h);
@@ -61,13 +62,13 @@ double SmithG1Beckmann(const Eigen::Vector3d& v, double alpha) {
 
 // The fit of `source` (grey ρs) at roughness `alpha` over `pairs`: k solved in closed form (the
 // target is affine in k) unless `fixed_scale` is given; the relative RMS error.
-LobeFit FitAt(const BrdfParams& source, const std::vector<DirectionPair>& pairs,
+LobeFit FitAt(const render::BrdfParams& source, const std::vector<DirectionPair>& pairs,
               const LobeFitOptions& options, double alpha, const double* fixed_scale) {
   double aa = 0, ab = 0, norm = 0;
   std::vector<double> a(pairs.size()), b(pairs.size()), f(pairs.size());
   for (size_t p = 0; p < pairs.size(); ++p) {
     const auto& q = pairs[p];
-    f[p] = EvalBrdf(source, q.wo, q.wi).x();
+    f[p] = render::EvalBrdf(source, q.wo, q.wi).x();
     b[p] = TargetLobeValue(options.target, alpha, 0.0, options.target_ior, q.wo, q.wi);
     a[p] = TargetLobeValue(options.target, alpha, 1.0, options.target_ior, q.wo, q.wi) - b[p];
     aa += q.weight * a[p] * a[p];
@@ -115,7 +116,7 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
   if (wo.z() <= 0 || wi.z() <= 0) return 0.0;
   const Eigen::Matrix<double, 3, 1> o = wo, i = wi;
   if (target == LobeTarget::kWardGmd) {
-    return scale * SpecularFactor<double>(BrdfModel::kWardGmd, alpha, alpha, o, i);
+    return scale * render::SpecularFactor<double>(recon::BrdfModel::kWardGmd, alpha, alpha, o, i);
   }
   const Eigen::Vector3d h = (wo + wi).normalized();
   const double c = std::max(0.0, h.dot(wi));
@@ -123,12 +124,12 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
   const double a2 = alpha * alpha;
   if (target == LobeTarget::kBeckmannDielectric) {
     const double tan2 = (1.0 - cos_h2) / cos_h2;
-    const double d = std::exp(-tan2 / a2) / (kPi * a2 * cos_h2 * cos_h2);
+    const double d = std::exp(-tan2 / a2) / (render::kPi * a2 * cos_h2 * cos_h2);
     const double g = SmithG1Beckmann(wo, alpha) * SmithG1Beckmann(wi, alpha);
     return scale * DielectricFresnel(c, target_ior) * d * g / (4.0 * wo.z() * wi.z());
   }
   const double denom = cos_h2 * (a2 - 1.0) + 1.0;
-  const double d = a2 / (kPi * denom * denom);
+  const double d = a2 / (render::kPi * denom * denom);
   const double nl = wi.z(), nv = wo.z();
   const double v =
       0.5 / (nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2));
@@ -136,16 +137,16 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
   return (scale + (1.0 - scale) * m) * d * v;
 }
 
-LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options) {
-  if (!HasSpecularLobe(source.model)) {
+LobeFit FitSpecularLobe(const render::BrdfParams& source, const LobeFitOptions& options) {
+  if (!recon::HasSpecularLobe(source.model)) {
     throw std::invalid_argument("FitSpecularLobe: the source model has no specular lobe");
   }
-  BrdfParams src = source;
+  render::BrdfParams src = source;
   src.rho_d.setZero();
   src.rho_s.setConstant(source.rho_s.mean());
   const double alpha_grid = std::max(src.AlphaX(), src.AlphaY());
   const std::vector<DirectionPair> pairs =
-      BuildPairs(alpha_grid, IsAnisotropic(src.model), options);
+      BuildPairs(alpha_grid, recon::IsAnisotropic(src.model), options);
   // For a roughness, the best k (closed form: the target is affine in k) and the error.
   auto fit_at = [&](double alpha) { return FitAt(src, pairs, options, alpha, nullptr); };
   // Golden section on log α over [α/4, 4α] (the lobes' widths are within a factor 2).
@@ -166,10 +167,10 @@ LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options)
   LobeFit best = f1.relative_error < f2.relative_error ? f1 : f2;
   LobeFitOptions wide = options;
   wide.max_theta_o_deg = 88;
-  const auto wide_pairs = BuildPairs(alpha_grid, IsAnisotropic(src.model), wide);
+  const auto wide_pairs = BuildPairs(alpha_grid, recon::IsAnisotropic(src.model), wide);
   best.relative_error_to_88deg =
       FitAt(src, wide_pairs, options, best.alpha, &best.scale).relative_error;
   return best;
 }
 
-}  // namespace igi
+}  // namespace igi::exporter

@@ -16,7 +16,7 @@
 
 #include "solver/render/brdf.h"
 
-namespace igi {
+namespace igi::exporter {
 
 enum class LobeTarget {
   // RADIANCE plastic/metal = contract ward_gmd: k·S_gmd(α); k is the fitted (grey) ρs.
@@ -53,7 +53,7 @@ struct LobeFit {
 // Fits the specular lobe of `source` (its ρs taken as grey: the mean of rho_s; rho_d ignored;
 // the *_fresnel models include their Fresnel weight; anisotropic models are fitted by an
 // isotropic lobe). `source` must have a specular lobe and pass CheckBrdfParams.
-LobeFit FitSpecularLobe(const BrdfParams& source, const LobeFitOptions& options = {});
+LobeFit FitSpecularLobe(const render::BrdfParams& source, const LobeFitOptions& options = {});
 
 // The target lobes' specular BRDF values (local frame, z = normal; 0 below the surface), exposed
 // for tests and reports. `scale` is k of LobeTarget.
@@ -63,4 +63,4 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
 // Unpolarised Fresnel reflectance of a dielectric of relative index `eta` (> 1) at cosine `c`.
 double DielectricFresnel(double c, double eta);
 
-}  // namespace igi
+}  // namespace igi::exporter

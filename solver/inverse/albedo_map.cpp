@@ -10,7 +10,7 @@
 #include "solver/inverse/texel_splat.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::solver {
 
 namespace {
 
@@ -331,7 +331,7 @@ AlbedoComparison CompareAlbedoMaps(const Image& estimate, const Image* seen, con
       ++texels;
       const Eigen::Vector2d uv((x + 0.5) / truth.width, 1.0 - (y + 0.5) / truth.height);
       if (seen != nullptr && !LookupSeen(*seen, uv)) continue;
-      const Eigen::Vector3d v = SampleTexture(estimate, uv);
+      const Eigen::Vector3d v = render::SampleTexture(estimate, uv);
       for (int c = 0; c < 3; ++c) {
         const double d = v[c] - truth.at(x, y, std::min(c, truth.channels - 1));
         sum += d * d;
@@ -449,4 +449,4 @@ TexelDetail SharedTexelDetail(const Image& a, const Image& b, const std::vector<
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -17,7 +17,7 @@
 #include "solver/inverse/uv_charts.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 
 class AlbedoMapBuilder {
  public:
@@ -134,4 +134,4 @@ inline constexpr int kTexelDetailTile = 16;
 // NaN (both fields) when fewer than 64 texels are shared or a channel's mean is not positive.
 TexelDetail SharedTexelDetail(const Image& a, const Image& b, const std::vector<int>& both);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -5,7 +5,7 @@
 
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::solver {
 
 MapLight MapLightOf(const MapStageData& d) {
   const SolveOptions& o = d.options;
@@ -77,7 +77,7 @@ void AddObservations(const MapStageData& d, int r, const MapLight& light, int ph
     // (from the model, not the observation: a test on the observed radiance would favour the
     // bright texels near highlights)
     const double diffuse_pred =
-        (d.materials.PatchAlbedo(d.patches, o.patch).cwiseProduct(light.e[i]) / kPi).sum();
+        (d.materials.PatchAlbedo(d.patches, o.patch).cwiseProduct(light.e[i]) / render::kPi).sum();
     const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
     const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
     if (!(w > 0)) continue;
@@ -88,7 +88,8 @@ void AddObservations(const MapStageData& d, int r, const MapLight& light, int ph
     // evens out over the texel's observations instead of dominating.
     const Eigen::Vector3d& e_i = light.e[i];
     if (!(e_i.minCoeff() > 0)) continue;
-    builder->Add(o.triangle, o.b1, o.b2, w * kPi * diffuse.cwiseProduct(m.map_scale), w * e_i);
+    builder->Add(o.triangle, o.b1, o.b2, w * render::kPi * diffuse.cwiseProduct(m.map_scale),
+                 w * e_i);
   }
 }
 
@@ -135,4 +136,4 @@ bool WritesMap(const MapStageData& d, size_t r, const RegionAtlas& atlas, const 
   return t.variation > kTexelTextureMin && t.z > kTexelTextureZ;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -18,11 +18,11 @@
 #include "solver/inverse/uv_charts.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 
 // What the stage reads; every reference outlives the call.
 struct MapStageData {
-  const Scene& scene;
+  const recon::Scene& scene;
   const SolveOptions& options;
   const ObservationSet& obs;
   const MaterialEstimate& materials;
@@ -91,4 +91,4 @@ inline constexpr double kTexelTextureZ = 3.0;
 bool WritesMap(const MapStageData& d, size_t r, const RegionAtlas& atlas, const MapLight& light,
                TexelDetail* detail);
 
-}  // namespace igi
+}  // namespace igi::solver

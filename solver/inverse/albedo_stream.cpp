@@ -28,7 +28,7 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // One pixel's contribution to its region's map.
@@ -60,15 +60,15 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
   const ObservationGrid grid_in_photo(scene, obs, mapped, 3 * radius, true);
   std::vector<AlbedoMapBuilder> builders;
   for (const RegionAtlas& atlas : atlases) builders.emplace_back(atlas);
-  const double cos_edge = std::cos(10.0 * kPi / 180.0);
+  const double cos_edge = std::cos(10.0 * render::kPi / 180.0);
   const int stride = options.pixel_stride;
   Progress progress("igi-solve: albedo maps", int64_t(scene.photos.size()), 2.0,
                     options.show_progress && ProgressAllowed());
   for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Photo& photo = scene.photos[i];
-    const Camera& cam = scene.cameras[photo.camera];
+    const recon::Photo& photo = scene.photos[i];
+    const recon::Camera& cam = scene.cameras[photo.camera];
     const int l = photo.lighting;
-    const RayScene& geometry = *lighting_scenes[l];
+    const render::RayScene& geometry = *lighting_scenes[l];
     const LoadedPhoto loaded = LoadPhoto(int(i));
     const std::vector<uint8_t>* mask = loaded.mask.empty() ? nullptr : &loaded.mask;
     const double saturation =
@@ -86,7 +86,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
               continue;
             }
             const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-            const std::optional<SurfaceHit> hit = geometry.TraceSurface(eye, dir);
+            const std::optional<render::SurfaceHit> hit = geometry.TraceSurface(eye, dir);
             if (!hit || !mapped[hit->region]) continue;
             const auto quarter = QuarterPixelNormals(geometry, cam, x, y, *hit, cos_edge, 0.01);
             if (!quarter) continue;
@@ -101,7 +101,8 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             q.n_s = hit->n_s;
             q.view = -dir;
             if (options.pixel_footprint) q.footprint = PixelFootprint(o);
-            Pcg32 rng = PixelSampleRng(options.seed ^ 0xa1bed0, PixelKey(int(i), x, y), 0);
+            render::Pcg32 rng =
+                render::PixelSampleRng(options.seed ^ 0xa1bed0, PixelKey(int(i), x, y), 0);
             std::vector<DirectSample> direct;
             const Eigen::Vector3d e_direct = GatherDirectAt(geometry, q, options.light_samples,
                                                             options.footprint_samples, rng, &direct)
@@ -111,7 +112,7 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
                 (e_direct + e_indirect).cwiseQuotient((light.e[j]).cwiseMax(1e-300));
             const Eigen::Vector3d e = map_e[j].cwiseProduct(ratio);
             Eigen::Vector3d t = Eigen::Vector3d::Zero();
-            if (HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
+            if (recon::HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
               // The pixel's own direct lobe, and the indirect part of T at the nearest
               // observation of the same photo (of any photo when it has none near).
               const double spread =
@@ -126,12 +127,12 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             // As the maps from the observations (AlbedoMapOf): each weighted by its diffuse share.
             const int patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
             const double diffuse_pred =
-                (materials.PatchAlbedo(patches, patch).cwiseProduct(e) / kPi).sum();
+                (materials.PatchAlbedo(patches, patch).cwiseProduct(e) / render::kPi).sum();
             const double share = diffuse_pred / std::max(1e-12, diffuse_pred + spec.sum());
             const double w = std::clamp(2.0 * share - 1.0, 0.0, 1.0);
             if (!(w > 0) || !(e.minCoeff() > 0)) continue;
             per_row[row].push_back({map_of[hit->region], hit->triangle, hit->b1, hit->b2,
-                                    w * kPi * diffuse.cwiseProduct(m.map_scale), w * e});
+                                    w * render::kPi * diffuse.cwiseProduct(m.map_scale), w * e});
           }
         },
         options.num_threads);
@@ -157,4 +158,4 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
   return maps;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

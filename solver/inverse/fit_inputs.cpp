@@ -1,8 +1,8 @@
 #include "solver/inverse/fit_inputs.h"
 
-namespace igi {
+namespace igi::solver {
 
-std::vector<RegionFitInput> FitInputs(const Scene& scene, const PatchSet& patches,
+std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet& patches,
                                       const ObservationSet& obs, const LightModel& light,
                                       const MaterialEstimate& materials, int stage,
                                       bool grey_specular, bool held_out_albedo,
@@ -31,7 +31,7 @@ std::vector<RegionFitInput> FitInputs(const Scene& scene, const PatchSet& patche
       in.alpha_y = m.params.alpha_y;
     }
     in.ior = m.params.ior;
-    if (m.last_fit.fitted && HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
+    if (m.last_fit.fitted && recon::HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
     in.use_held_albedo = held_out_albedo;
     in.num_slots = static_cast<int>(materials.region_patches[r].size());
@@ -68,4 +68,4 @@ std::vector<RegionFitInput> FitInputs(const Scene& scene, const PatchSet& patche
   return inputs;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

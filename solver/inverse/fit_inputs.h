@@ -12,7 +12,7 @@
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
 
-namespace igi {
+namespace igi::solver {
 
 // The inputs of the regions with an unknown that some photo sees (their indices in *regions,
 // ascending), one per region. A sample per fit observation (obs.in_fit) of such a region: its
@@ -21,10 +21,10 @@ namespace igi {
 // local frame and its incident samples, read in place (`light` must outlive the inputs). Stage 2
 // (`stage`) keeps stage 1's decision whether the albedo varies; a region fitted before starts its α
 // search there.
-std::vector<RegionFitInput> FitInputs(const Scene& scene, const PatchSet& patches,
+std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet& patches,
                                       const ObservationSet& obs, const LightModel& light,
                                       const MaterialEstimate& materials, int stage,
                                       bool grey_specular, bool held_out_albedo,
                                       std::vector<int>* regions);
 
-}  // namespace igi
+}  // namespace igi::solver

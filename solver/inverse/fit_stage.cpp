@@ -10,15 +10,15 @@
 #include "solver/inverse/fit_inputs.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 Json ParamsJson(const MaterialState& m) {
   Json j;
   j["rho_d"] = {m.params.rho_d[0], m.params.rho_d[1], m.params.rho_d[2]};
-  if (HasSpecularLobe(m.params.model)) {
+  if (recon::HasSpecularLobe(m.params.model)) {
     j["rho_s"] = {m.params.rho_s[0], m.params.rho_s[1], m.params.rho_s[2]};
-    if (IsAnisotropic(m.params.model)) {
+    if (recon::IsAnisotropic(m.params.model)) {
       j["alpha_x"] = m.params.alpha_x;
       j["alpha_y"] = m.params.alpha_y;
     } else {
@@ -45,7 +45,8 @@ JointUpdate JointParams(const StageData& d, const MaterialEstimate& materials,
                         const LightModel& light, const std::vector<int>& regions,
                         const std::vector<RegionFitResult>& fits) {
   const ObservationSet& obs = d.obs;
-  constexpr int kD = Renderer::kLnRhoD, kS = Renderer::kLnRhoS, kA = Renderer::kLnAlpha;
+  constexpr int kD = render::Renderer::kLnRhoD, kS = render::Renderer::kLnRhoS,
+                kA = render::Renderer::kLnAlpha;
   const size_t num_regions = materials.size();
   const Eigen::Vector3d none = Eigen::Vector3d::Constant(NAN);
   JointUpdate out;
@@ -69,12 +70,12 @@ JointUpdate JointParams(const StageData& d, const MaterialEstimate& materials,
     if (m.unknown_rho_d && m.params.rho_d.allFinite() && f.rho_d.allFinite()) {
       unknowns.push_back({int(k), kD});
     }
-    if (!lobes || !HasSpecularLobe(m.params.model) || m.no_highlight) continue;
+    if (!lobes || !recon::HasSpecularLobe(m.params.model) || m.no_highlight) continue;
     if (m.unknown_rho_s && m.params.rho_s.allFinite() && f.rho_s.allFinite()) {
       unknowns.push_back({int(k), kS});
     }
     if (m.unknown_alpha && m.params.AlphaX() > 0 && m.params.AlphaY() > 0 && f.alpha_x > 0) {
-      BrdfParams fitted = m.params;
+      render::BrdfParams fitted = m.params;
       fitted.alpha = f.alpha, fitted.alpha_x = f.alpha_x, fitted.alpha_y = f.alpha_y;
       const double lx = std::log(fitted.AlphaX() / m.params.AlphaX());
       const double ly = std::log(fitted.AlphaY() / m.params.AlphaY());
@@ -191,7 +192,7 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
     MaterialState& m = materials[regions[k]];
     const RegionFitResult& f = results[k];
     if (!f.fitted) continue;
-    const BrdfParams old = m.params;
+    const render::BrdfParams old = m.params;
     if (m.unknown_rho_d) {
       // The refinement gathers all indirect light from the model, whose albedos then feed back
       // on themselves: a full step can overshoot (too bright a model darkens the next albedos);
@@ -277,4 +278,4 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
   return change;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

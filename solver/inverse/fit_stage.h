@@ -18,11 +18,11 @@
 #include "solver/inverse/solve.h"
 #include "solver/inverse/solve_options.h"
 
-namespace igi {
+namespace igi::solver {
 
 // What the stages read besides the estimate they update; every reference outlives the call.
 struct StageData {
-  const Scene& scene;
+  const recon::Scene& scene;
   const SolveOptions& options;
   const ObservationSet& obs;
   const PatchSet& patches;
@@ -59,4 +59,4 @@ JointUpdate JointParams(const StageData& d, const MaterialEstimate& materials,
 double FitRegions(const StageData& d, const LightModel& light, int stage, int iteration,
                   MaterialEstimate* materials, SolveSummary* summary);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -12,7 +12,7 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 struct PointSamples {
@@ -24,42 +24,45 @@ struct PointSamples {
 };
 
 // The frame in which the solver evaluates a region's lobe (SolverState::LocalFrame).
-Frame ShadingFrame(const Material& m, const Eigen::Vector3d& n) {
-  if (IsAnisotropic(m.brdf) && m.tangent) return Frame::FromNormalTangent(n, *m.tangent);
-  return Frame::FromNormal(n);
+render::Frame ShadingFrame(const recon::Material& m, const Eigen::Vector3d& n) {
+  if (recon::IsAnisotropic(m.brdf) && m.tangent)
+    return render::Frame::FromNormalTangent(n, *m.tangent);
+  return render::Frame::FromNormal(n);
 }
 
 // One direction about the mirror of wo (local frame), drawn from a mixture of a cosine lobe and
 // Ward lobes of roughness lobe_alpha and lobe_alpha/4 in equal shares, with the mixture's
 // density: an unbiased one-sample estimate of any lobe's integral (HemisphereDirections' mixture).
-bool SampleBounce(const Eigen::Vector3d& wo, double lobe_alpha, Pcg32& rng, Eigen::Vector3d* wi,
-                  double* weight) {
-  BrdfParams broad, narrow;
-  broad.model = narrow.model = BrdfModel::kWard;
+bool SampleBounce(const Eigen::Vector3d& wo, double lobe_alpha, render::Pcg32& rng,
+                  Eigen::Vector3d* wi, double* weight) {
+  render::BrdfParams broad, narrow;
+  broad.model = narrow.model = recon::BrdfModel::kWard;
   broad.rho_s = narrow.rho_s = Eigen::Vector3d::Ones();
   broad.alpha = lobe_alpha;
   narrow.alpha = 0.25 * lobe_alpha;
   const double pick = rng.UniformDouble();
   const Eigen::Vector2d u = rng.Uniform2D();
   if (pick < 1.0 / 3) {
-    *wi = SampleCosineHemisphere(u);
+    *wi = render::SampleCosineHemisphere(u);
   } else {
-    const BrdfSample bs = SampleBrdf(pick < 2.0 / 3 ? broad : narrow, wo, 0.5, u);
+    const render::BrdfSample bs = render::SampleBrdf(pick < 2.0 / 3 ? broad : narrow, wo, 0.5, u);
     if (!bs.Valid()) return false;
     *wi = bs.wi;
   }
   if (!(wi->z() > 0)) return false;
-  const double pdf =
-      (CosineHemispherePdf(wi->z()) + BrdfPdf(broad, wo, *wi) + BrdfPdf(narrow, wo, *wi)) / 3.0;
+  const double pdf = (render::CosineHemispherePdf(wi->z()) + render::BrdfPdf(broad, wo, *wi) +
+                      render::BrdfPdf(narrow, wo, *wi)) /
+                     3.0;
   if (!(pdf > 0)) return false;
   *weight = wi->z() / pdf;
   return true;
 }
 
 // The specular bounce at `hit` of an indirect ray along `dir`; false where none can be drawn.
-bool TraceBounce(const RayScene& scene, const PatchSet& patches, const SurfaceHit& hit,
-                 const Eigen::Vector3d& dir, double lobe_alpha, Pcg32& rng, PointSamples* out) {
-  const Frame frame = ShadingFrame(scene.scene().materials[hit.region], hit.n_s);
+bool TraceBounce(const render::RayScene& scene, const PatchSet& patches,
+                 const render::SurfaceHit& hit, const Eigen::Vector3d& dir, double lobe_alpha,
+                 render::Pcg32& rng, PointSamples* out) {
+  const render::Frame frame = ShadingFrame(scene.scene().materials[hit.region], hit.n_s);
   const Eigen::Vector3d wo = frame.ToLocal(-dir);
   if (!(wo.z() > 0)) return false;
   Eigen::Vector3d wi;
@@ -72,9 +75,9 @@ bool TraceBounce(const RayScene& scene, const PatchSet& patches, const SurfaceHi
   b.wi = wi.cast<float>();
   b.weight = static_cast<float>(weight);
   ++out->rays;
-  const std::optional<SurfaceHit> next =
+  const std::optional<render::SurfaceHit> next =
       scene.TraceSurface(hit.position + hit.n_geo * scene.ray_epsilon(), wi_world);
-  if (next && IsReflective(scene.scene().materials[next->region].brdf)) {
+  if (next && recon::IsReflective(scene.scene().materials[next->region].brdf)) {
     b.patch = patches.PatchOf(next->triangle, next->b1, next->b2);
   }
   out->bounces.push_back(b);
@@ -85,16 +88,16 @@ bool TraceBounce(const RayScene& scene, const PatchSet& patches, const SurfaceHi
 // occluded): its irradiance is exactly πL. It is kept as k stratified cosine-weighted directions
 // about the shading normal, each carrying πL/k, so that the irradiance is exact (no light samples,
 // no rays) and the glossy fits still see the directions it arrives from.
-void GatherAmbient(const Eigen::Vector3d& radiance, const GatherQuery& q, int k, Pcg32& rng,
+void GatherAmbient(const Eigen::Vector3d& radiance, const GatherQuery& q, int k, render::Pcg32& rng,
                    PointSamples* out) {
-  const Frame frame = Frame::FromNormal(q.n_s);
+  const render::Frame frame = render::Frame::FromNormal(q.n_s);
   const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
   k = side * side;
   for (int s = 0; s < k; ++s) {
     const Eigen::Vector2d u(((s % side) + rng.UniformDouble()) / side,
                             ((s / side) + rng.UniformDouble()) / side);
     DirectSample d;
-    d.wi = frame.ToWorld(SampleCosineHemisphere(u)).cast<float>();
+    d.wi = frame.ToWorld(render::SampleCosineHemisphere(u)).cast<float>();
     d.value = (radiance * (std::numbers::pi / k)).cast<float>();
     out->point.e_direct += d.value;
     out->direct.push_back(d);
@@ -112,7 +115,7 @@ int CoprimeStride(int k) {
 
 // The pixel point (u, v) of sample s of k: stratified over a side×side grid for the first side²
 // samples (in a shuffled order), random after.
-Eigen::Vector2d PixelStratum(int s, int k, Pcg32& rng) {
+Eigen::Vector2d PixelStratum(int s, int k, render::Pcg32& rng) {
   const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
   Eigen::Vector2d u = rng.Uniform2D();
   if (s < side * side) {
@@ -122,18 +125,18 @@ Eigen::Vector2d PixelStratum(int s, int k, Pcg32& rng) {
   return u;
 }
 
-void GatherDirect(const RayScene& scene, const GatherQuery& q, int light_samples,
-                  int footprint_samples, Pcg32& rng, PointSamples* out) {
+void GatherDirect(const render::RayScene& scene, const GatherQuery& q, int light_samples,
+                  int footprint_samples, render::Pcg32& rng, PointSamples* out) {
   const double eps = scene.ray_epsilon();
   const bool footprint = q.footprint.has_value();
   for (int l = 0; l < scene.num_lights(); ++l) {
-    const LightType type = scene.light_type(l);
-    if (type == LightType::kAmbient) {
+    const recon::LightType type = scene.light_type(l);
+    if (type == recon::LightType::kAmbient) {
       GatherAmbient(scene.light(l)->radiance, q, 4 * light_samples, rng, out);
       continue;
     }
-    const bool delta =
-        type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
+    const bool delta = type == recon::LightType::kPoint || type == recon::LightType::kSpot ||
+                       type == recon::LightType::kDirectional;
     const int k = delta ? (footprint ? std::max(1, footprint_samples) : 1) : light_samples;
     const int side = std::max(1, static_cast<int>(std::sqrt(double(k))));
     for (int s = 0; s < k; ++s) {
@@ -148,7 +151,7 @@ void GatherDirect(const RayScene& scene, const GatherQuery& q, int light_samples
         const Eigen::Vector2d px = PixelStratum(s, k, rng);
         position = q.FootprintPoint(px.x(), px.y());
       }
-      const LightSample ls = scene.SampleLight(l, position, u);
+      const render::LightSample ls = scene.SampleLight(l, position, u);
       if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0)) continue;
       const double cos_geo = ls.wi.dot(q.n_geo), cos_s = ls.wi.dot(q.n_s);
       if (!(cos_geo > 0) || !(cos_s > 0)) continue;
@@ -168,8 +171,8 @@ void GatherDirect(const RayScene& scene, const GatherQuery& q, int light_samples
 
 }  // namespace
 
-Eigen::Vector3f GatherDirectAt(const RayScene& scene, const GatherQuery& query, int light_samples,
-                               int footprint_samples, Pcg32& rng,
+Eigen::Vector3f GatherDirectAt(const render::RayScene& scene, const GatherQuery& query,
+                               int light_samples, int footprint_samples, render::Pcg32& rng,
                                std::vector<DirectSample>* samples) {
   PointSamples ps;
   GatherDirect(scene, query, light_samples, footprint_samples, rng, &ps);
@@ -179,8 +182,8 @@ Eigen::Vector3f GatherDirectAt(const RayScene& scene, const GatherQuery& query, 
 
 namespace {
 
-void GatherIndirect(const RayScene& scene, const PatchSet& patches, const GatherQuery& q,
-                    const GatherOptions& options, Pcg32& rng, PointSamples* out) {
+void GatherIndirect(const render::RayScene& scene, const PatchSet& patches, const GatherQuery& q,
+                    const GatherOptions& options, render::Pcg32& rng, PointSamples* out) {
   const double eps = scene.ray_epsilon();
   for (const WeightedDirection& d :
        HemisphereDirections(q, options.indirect_rays, options.lobe_alpha, rng)) {
@@ -188,10 +191,12 @@ void GatherIndirect(const RayScene& scene, const PatchSet& patches, const Gather
     is.wi = d.wi.cast<float>();
     is.weight = static_cast<float>(d.weight);
     ++out->rays;
-    const std::optional<SurfaceHit> hit = scene.TraceSurface(q.position + q.n_geo * eps, d.wi);
-    if (hit && IsReflective(scene.scene().materials[hit->region].brdf)) {
+    const std::optional<render::SurfaceHit> hit =
+        scene.TraceSurface(q.position + q.n_geo * eps, d.wi);
+    if (hit && recon::IsReflective(scene.scene().materials[hit->region].brdf)) {
       is.patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);
-      if (options.specular_bounces && HasSpecularLobe(scene.scene().materials[hit->region].brdf) &&
+      if (options.specular_bounces &&
+          recon::HasSpecularLobe(scene.scene().materials[hit->region].brdf) &&
           TraceBounce(scene, patches, *hit, d.wi, options.lobe_alpha, rng, out)) {
         is.bounce = static_cast<int>(out->bounces.size()) - 1;  // local; rebased in Gather()
       }
@@ -214,17 +219,17 @@ Eigen::Vector3d GatherQuery::FootprintPoint(double u, double v) const {
 }
 
 std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
-                                                    Pcg32& rng) {
+                                                    render::Pcg32& rng) {
   // A mixture of three strategies with fixed shares (cosine, a broad Ward lobe of roughness
   // lobe_alpha and a narrow one of a quarter of it, both about the view's mirror direction);
   // each direction is weighted with the mixture's density (the balance heuristic), so the
   // estimate is unbiased for any BRDF while sharp lobes still get samples.
   std::vector<WeightedDirection> out;
   if (n <= 0) return out;
-  const Frame frame = Frame::FromNormal(q.n_s);
+  const render::Frame frame = render::Frame::FromNormal(q.n_s);
   const bool lobe = q.lobe && q.view.squaredNorm() > 0;
-  BrdfParams broad, narrow;
-  broad.model = narrow.model = BrdfModel::kWard;
+  render::BrdfParams broad, narrow;
+  broad.model = narrow.model = recon::BrdfModel::kWard;
   broad.rho_s = narrow.rho_s = Eigen::Vector3d::Ones();
   broad.alpha = lobe_alpha;
   narrow.alpha = 0.25 * lobe_alpha;
@@ -242,16 +247,18 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
       if (s < side * side) {
         u = Eigen::Vector2d(((s % side) + u.x()) / side, ((s / side) + u.y()) / side);
       }
-      wi_local = SampleCosineHemisphere(u);
+      wi_local = render::SampleCosineHemisphere(u);
     } else {
-      const BrdfSample bs = SampleBrdf(s < n_cos + n_broad ? broad : narrow, wo, 0.5, u);
+      const render::BrdfSample bs =
+          render::SampleBrdf(s < n_cos + n_broad ? broad : narrow, wo, 0.5, u);
       if (!bs.Valid()) continue;
       wi_local = bs.wi;
     }
     if (!(wi_local.z() > 0)) continue;
-    double pdf = p_cos * CosineHemispherePdf(wi_local.z());
+    double pdf = p_cos * render::CosineHemispherePdf(wi_local.z());
     if (lobe)
-      pdf += p_broad * BrdfPdf(broad, wo, wi_local) + p_narrow * BrdfPdf(narrow, wo, wi_local);
+      pdf += p_broad * render::BrdfPdf(broad, wo, wi_local) +
+             p_narrow * render::BrdfPdf(narrow, wo, wi_local);
     const Eigen::Vector3d wi = frame.ToWorld(wi_local);
     if (!(wi.dot(q.n_geo) > 0) || !(pdf > 0)) continue;
     out.push_back({wi, wi_local.z() / (pdf * n)});
@@ -259,7 +266,7 @@ std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n,
   return out;
 }
 
-GatherSet Gather(const RayScene& scene, const PatchSet& patches,
+GatherSet Gather(const render::RayScene& scene, const PatchSet& patches,
                  const std::vector<GatherQuery>& queries, const GatherOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const int64_t n = static_cast<int64_t>(queries.size());
@@ -273,7 +280,7 @@ GatherSet Gather(const RayScene& scene, const PatchSet& patches,
       [&](int64_t c) {
         std::vector<PointSamples>& chunk = results[c];
         for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
-          Pcg32 rng = PixelSampleRng(options.seed, uint64_t(i), 0x5eed);
+          render::Pcg32 rng = render::PixelSampleRng(options.seed, uint64_t(i), 0x5eed);
           PointSamples ps;
           GatherDirect(scene, queries[i], options.light_samples, options.footprint_samples, rng,
                        &ps);
@@ -320,4 +327,4 @@ GatherSet Gather(const RayScene& scene, const PatchSet& patches,
   return set;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -28,7 +28,7 @@
 #include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct DirectSample {
   Eigen::Vector3f wi = Eigen::Vector3f::UnitZ();
@@ -120,15 +120,15 @@ struct WeightedDirection {
   double weight = 0;
 };
 std::vector<WeightedDirection> HemisphereDirections(const GatherQuery& q, int n, double lobe_alpha,
-                                                    Pcg32& rng);
+                                                    render::Pcg32& rng);
 
-GatherSet Gather(const RayScene& scene, const PatchSet& patches,
+GatherSet Gather(const render::RayScene& scene, const PatchSet& patches,
                  const std::vector<GatherQuery>& queries, const GatherOptions& options);
 
 // The direct light at one query point alone (Gather's direct samples for it): appends its
 // samples to *samples and returns their sum, the direct irradiance.
-Eigen::Vector3f GatherDirectAt(const RayScene& scene, const GatherQuery& query, int light_samples,
-                               int footprint_samples, Pcg32& rng,
+Eigen::Vector3f GatherDirectAt(const render::RayScene& scene, const GatherQuery& query,
+                               int light_samples, int footprint_samples, render::Pcg32& rng,
                                std::vector<DirectSample>* samples);
 
-}  // namespace igi
+}  // namespace igi::solver

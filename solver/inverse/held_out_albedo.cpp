@@ -5,7 +5,7 @@
 
 #include "solver/inverse/texel_splat.h"
 
-namespace igi {
+namespace igi::solver {
 
 HeldOutAlbedo::Splat HeldOutAlbedo::SplatOf(int triangle, double b1, double b2) const {
   const TexelSplat t = BilinearTexelSplat(*atlas_, triangle, b1, b2);
@@ -61,4 +61,4 @@ Eigen::Vector3d HeldOutAlbedo::At(int photo, int triangle, double b1, double b2)
   return used >= 0.5 ? Eigen::Vector3d(sum / used) : none;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -15,7 +15,7 @@
 
 #include "solver/inverse/uv_charts.h"
 
-namespace igi {
+namespace igi::solver {
 
 class HeldOutAlbedo {
  public:
@@ -49,4 +49,4 @@ class HeldOutAlbedo {
   std::unordered_map<int64_t, Sums> per_photo_;  // per (photo, texel)
 };
 
-}  // namespace igi
+}  // namespace igi::solver

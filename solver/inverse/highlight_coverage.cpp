@@ -16,7 +16,7 @@
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 using Eigen::Vector3d;
@@ -27,18 +27,18 @@ constexpr double kHalfFieldDeg = 30.0;
 // A camera closer to the surface than this fraction of the wanted distance is not proposed.
 constexpr double kMinDistanceFraction = 0.1;
 
-bool RoughnessKnown(const Material& m) {
-  return IsAnisotropic(m.brdf) ? (m.alpha_x.has_value() && m.alpha_y.has_value())
-                               : m.alpha.has_value();
+bool RoughnessKnown(const recon::Material& m) {
+  return recon::IsAnisotropic(m.brdf) ? (m.alpha_x.has_value() && m.alpha_y.has_value())
+                                      : m.alpha.has_value();
 }
 
-bool NeedsCoverage(const Material& m) {
-  return HasSpecularLobe(m.brdf) && (!m.rho_s.has_value() || !RoughnessKnown(m));
+bool NeedsCoverage(const recon::Material& m) {
+  return recon::HasSpecularLobe(m.brdf) && (!m.rho_s.has_value() || !RoughnessKnown(m));
 }
 
-double LobeAlpha(const Material& m, const HighlightCoverageOptions& options) {
+double LobeAlpha(const recon::Material& m, const HighlightCoverageOptions& options) {
   if (!RoughnessKnown(m)) return options.alpha_assumed;
-  const double a = IsAnisotropic(m.brdf) ? std::sqrt(*m.alpha_x * *m.alpha_y) : *m.alpha;
+  const double a = recon::IsAnisotropic(m.brdf) ? std::sqrt(*m.alpha_x * *m.alpha_y) : *m.alpha;
   return a > 0 ? a : options.alpha_assumed;
 }
 
@@ -50,16 +50,18 @@ struct LightDir {
 };
 
 // Samples of `light` above the surface (n_geo) at p: one for delta lights, `samples` otherwise.
-void SampleLightDirs(const RayScene& impl, int light, const Vector3d& p, const Vector3d& n_geo,
-                     int samples, Pcg32* rng, std::vector<LightDir>* out) {
-  const LightType type = impl.light_type(light);
-  if (type == LightType::kAmbient) return;  // light from everywhere: no highlight to place
-  const bool delta =
-      type == LightType::kPoint || type == LightType::kSpot || type == LightType::kDirectional;
+void SampleLightDirs(const render::RayScene& impl, int light, const Vector3d& p,
+                     const Vector3d& n_geo, int samples, render::Pcg32* rng,
+                     std::vector<LightDir>* out) {
+  const recon::LightType type = impl.light_type(light);
+  if (type == recon::LightType::kAmbient) return;  // light from everywhere: no highlight to place
+  const bool delta = type == recon::LightType::kPoint || type == recon::LightType::kSpot ||
+                     type == recon::LightType::kDirectional;
   const int count = delta ? 1 : samples;
   for (int s = 0; s < count; ++s) {
     const double u0 = rng->UniformDouble(), u1 = rng->UniformDouble();
-    const LightSample ls = impl.SampleLight(light, p, Vector3d(u0, u1, rng->UniformDouble()));
+    const render::LightSample ls =
+        impl.SampleLight(light, p, Vector3d(u0, u1, rng->UniformDouble()));
     if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) continue;
     out->push_back({ls.wi, ls.distance, light});
   }
@@ -67,7 +69,8 @@ void SampleLightDirs(const RayScene& impl, int light, const Vector3d& p, const V
 
 // The shadow test of the renderer (solver/render/render.cpp): offset origin, segment stopped short
 // of the light.
-bool Shadowed(const RayScene& impl, const Vector3d& p, const Vector3d& n_geo, const LightDir& d) {
+bool Shadowed(const render::RayScene& impl, const Vector3d& p, const Vector3d& n_geo,
+              const LightDir& d) {
   const double eps = impl.ray_epsilon();
   const double distance =
       std::isfinite(d.distance) ? d.distance - std::max(4 * eps, 1e-6 * d.distance) : d.distance;
@@ -86,14 +89,14 @@ double TanRatio(const Vector3d& n, const Vector3d& wi, const Vector3d& view, dou
 
 // The smallest tanθh / α over the unshadowed light samples seen by one observation. Samples are
 // tested for shadow in order of increasing ratio, so usually one shadow ray suffices.
-double ObservationMinRatio(const RayScene& impl, const Observation& o, double alpha,
+double ObservationMinRatio(const render::RayScene& impl, const Observation& o, double alpha,
                            const HighlightCoverageOptions& options, uint64_t index) {
   const Vector3d p = o.position.cast<double>();
   const Vector3d n = o.normal.cast<double>().normalized();
   const Vector3d v = o.view.cast<double>().normalized();
   Vector3d n_geo = impl.face_normal(o.triangle);
   if (n_geo.dot(v) < 0) n_geo = -n_geo;
-  Pcg32 rng(options.seed, index);
+  render::Pcg32 rng(options.seed, index);
   std::vector<LightDir> dirs;
   for (int l = 0; l < impl.num_lights(); ++l) {
     SampleLightDirs(impl, l, p, n_geo, options.light_samples, &rng, &dirs);
@@ -110,8 +113,9 @@ double ObservationMinRatio(const RayScene& impl, const Observation& o, double al
   return kInf;
 }
 
-const RayScene* LightingScene(const Scene& scene,
-                              const std::vector<std::unique_ptr<RayScene>>& scenes, int photo) {
+const render::RayScene* LightingScene(const recon::Scene& scene,
+                                      const std::vector<std::unique_ptr<render::RayScene>>& scenes,
+                                      int photo) {
   if (photo < 0 || photo >= static_cast<int>(scene.photos.size())) return nullptr;
   const int lighting = scene.photos[photo].lighting;
   if (lighting < 0 || lighting >= static_cast<int>(scenes.size())) return nullptr;
@@ -119,8 +123,8 @@ const RayScene* LightingScene(const Scene& scene,
 }
 
 // Fills observed, highlight_pixels, observations, photos and min_tan_theta_h_over_alpha.
-void AnalyseObservations(const Scene& scene, const std::vector<Observation>& observations,
-                         const std::vector<std::unique_ptr<RayScene>>& scenes,
+void AnalyseObservations(const recon::Scene& scene, const std::vector<Observation>& observations,
+                         const std::vector<std::unique_ptr<render::RayScene>>& scenes,
                          const HighlightCoverageOptions& options, const std::vector<int>& slot,
                          std::vector<RegionHighlightCoverage>* coverage) {
   const int64_t count = static_cast<int64_t>(observations.size());
@@ -131,7 +135,7 @@ void AnalyseObservations(const Scene& scene, const std::vector<Observation>& obs
       [&](int64_t i) {
         const Observation& o = observations[i];
         if (o.region < 0 || o.region >= static_cast<int>(slot.size()) || slot[o.region] < 0) return;
-        const RayScene* impl = LightingScene(scene, scenes, o.photo);
+        const render::RayScene* impl = LightingScene(scene, scenes, o.photo);
         if (impl == nullptr) return;
         if (o.triangle < 0 || o.triangle >= static_cast<int>(impl->scene().mesh.num_triangles())) {
           throw Error(fmt::format("observation {}: triangle {} out of range", i, o.triangle));
@@ -169,9 +173,9 @@ struct SurfacePoint {
 };
 
 // `count` points uniform by area over the region's triangles; `area` receives the region area.
-std::vector<SurfacePoint> SampleRegion(const Scene& scene, int region, int count, uint64_t seed,
-                                       double* area) {
-  const TriangleMesh& mesh = scene.mesh;
+std::vector<SurfacePoint> SampleRegion(const recon::Scene& scene, int region, int count,
+                                       uint64_t seed, double* area) {
+  const recon::TriangleMesh& mesh = scene.mesh;
   std::vector<int> tris;
   std::vector<double> cdf;
   double total = 0;
@@ -184,13 +188,13 @@ std::vector<SurfacePoint> SampleRegion(const Scene& scene, int region, int count
   *area = total;
   std::vector<SurfacePoint> points;
   if (!(total > 0)) return points;
-  Pcg32 rng(seed, 1000003u + static_cast<uint64_t>(region));
+  render::Pcg32 rng(seed, 1000003u + static_cast<uint64_t>(region));
   for (int i = 0; i < count; ++i) {
     const double target = rng.UniformDouble() * total;
     size_t k = std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin();
     k = std::min(k, cdf.size() - 1);
     const int t = tris[k];
-    const Eigen::Vector3d b = SampleUniformTriangle(rng.Uniform2D());
+    const Eigen::Vector3d b = render::SampleUniformTriangle(rng.Uniform2D());
     const Eigen::Vector3i& v = mesh.triangles[t];
     SurfacePoint sp;
     sp.n_geo = mesh.FaceNormal(t).cast<double>();
@@ -212,11 +216,11 @@ struct LitPoint {
   std::vector<LightDir> dirs;
 };
 
-std::vector<LitPoint> LightRegion(const RayScene& impl, int light,
+std::vector<LitPoint> LightRegion(const render::RayScene& impl, int light,
                                   const std::vector<SurfacePoint>& points,
                                   const HighlightCoverageOptions& options) {
   std::vector<LitPoint> lit;
-  Pcg32 rng(options.seed, 7777u + static_cast<uint64_t>(light));
+  render::Pcg32 rng(options.seed, 7777u + static_cast<uint64_t>(light));
   for (const SurfacePoint& sp : points) {
     for (double side : {1.0, -1.0}) {  // surfaces reflect on both sides
       LitPoint lp{{sp.p, side * sp.n, side * sp.n_geo}, {}};
@@ -242,13 +246,13 @@ struct Bounds {
 };
 
 // Everything the scene holds — geometry, cameras, lights — with a margin of 5 % of its size.
-Bounds SceneBounds(const Scene& scene) {
+Bounds SceneBounds(const recon::Scene& scene) {
   Bounds b;
   for (const Eigen::Vector3f& p : scene.mesh.positions) b.Add(p.cast<double>());
-  for (const Camera& c : scene.cameras) b.Add(c.CenterInWorld());
-  for (const Light& l : scene.lights) {
-    if (l.type == LightType::kPoint || l.type == LightType::kSpot) b.Add(l.position);
-    if (l.type == LightType::kSphere) {
+  for (const recon::Camera& c : scene.cameras) b.Add(c.CenterInWorld());
+  for (const recon::Light& l : scene.lights) {
+    if (l.type == recon::LightType::kPoint || l.type == recon::LightType::kSpot) b.Add(l.position);
+    if (l.type == recon::LightType::kSphere) {
       b.Add(l.center - Vector3d::Constant(l.radius));
       b.Add(l.center + Vector3d::Constant(l.radius));
     }
@@ -272,8 +276,8 @@ double BoxExit(const Bounds& b, const Vector3d& o, const Vector3d& d) {
 
 // A camera centre along the mirror direction of the light at lp, `distance` away or shortened
 // to stay in front of the first surface hit and inside the scene's bounds.
-std::optional<Vector3d> MirrorCamera(const RayScene& impl, const LitPoint& lp, double distance,
-                                     const Bounds& bounds) {
+std::optional<Vector3d> MirrorCamera(const render::RayScene& impl, const LitPoint& lp,
+                                     double distance, const Bounds& bounds) {
   Vector3d l = Vector3d::Zero();
   for (const LightDir& d : lp.dirs) l += d.wi;
   l.normalize();
@@ -281,14 +285,15 @@ std::optional<Vector3d> MirrorCamera(const RayScene& impl, const LitPoint& lp, d
   if (!(r.dot(lp.s.n_geo) > 0.05)) return std::nullopt;  // grazing or below the surface
   const Vector3d o = lp.s.p + lp.s.n_geo * impl.ray_epsilon();
   double d = std::min(distance, BoxExit(bounds, o, r));
-  if (const std::optional<RayHit> hit = impl.Intersect(o, r, d)) d = std::min(d, 0.9 * hit->t);
+  if (const std::optional<render::RayHit> hit = impl.Intersect(o, r, d))
+    d = std::min(d, 0.9 * hit->t);
   if (!(d >= kMinDistanceFraction * distance)) return std::nullopt;
   return lp.s.p + r * d;
 }
 
 // Whether a camera at c sees lp's highlight: in front, unoccluded, inside the lobe.
-bool SeesHighlight(const RayScene& impl, const LitPoint& lp, const Vector3d& c, double alpha,
-                   double factor) {
+bool SeesHighlight(const render::RayScene& impl, const LitPoint& lp, const Vector3d& c,
+                   double alpha, double factor) {
   const Vector3d to = c - lp.s.p;
   const double dist = to.norm();
   if (!(dist > 0)) return false;
@@ -303,7 +308,7 @@ bool SeesHighlight(const RayScene& impl, const LitPoint& lp, const Vector3d& c, 
 
 // Number of lit points whose highlight a camera at c looking at `target` sees in its field;
 // zero when it does not see target's own highlight.
-int ScoreCamera(const RayScene& impl, const std::vector<LitPoint>& lit, size_t target,
+int ScoreCamera(const render::RayScene& impl, const std::vector<LitPoint>& lit, size_t target,
                 const Vector3d& c, double alpha, double factor) {
   if (!SeesHighlight(impl, lit[target], c, alpha, factor)) return 0;
   const Vector3d axis = (lit[target].s.p - c).normalized();
@@ -316,7 +321,7 @@ int ScoreCamera(const RayScene& impl, const std::vector<LitPoint>& lit, size_t t
   return count;
 }
 
-std::string LightName(const Light* light) {
+std::string LightName(const recon::Light* light) {
   return light != nullptr ? light->name : std::string("the emitting surfaces");
 }
 
@@ -329,7 +334,7 @@ std::string SuggestionText(const HighlightSuggestion& s, const std::string& regi
 }
 
 struct SuggestContext {
-  const Scene* scene;
+  const recon::Scene* scene;
   const std::vector<SurfacePoint>* points;
   double region_area = 0;
   double distance = 0;
@@ -338,8 +343,9 @@ struct SuggestContext {
 };
 
 // The best camera for one light of one lighting, or nullopt when no point offers one.
-std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx, const RayScene& impl,
-                                                   int light, const RegionHighlightCoverage& c) {
+std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx,
+                                                   const render::RayScene& impl, int light,
+                                                   const RegionHighlightCoverage& c) {
   const std::vector<LitPoint> lit = LightRegion(impl, light, *ctx.points, *ctx.options);
   std::vector<int> score(lit.size(), 0);
   std::vector<Vector3d> camera(lit.size(), Vector3d::Zero());
@@ -365,10 +371,10 @@ std::optional<HighlightSuggestion> SuggestForLight(const SuggestContext& ctx, co
 
 // Median distance from the cameras to the region: over the region's observations, else over
 // the cameras' distances to the sampled points' centroid, else a quarter of the scene's size.
-double WantedDistance(const Scene& scene, const std::vector<Observation>& observations, int region,
-                      const std::vector<SurfacePoint>& points, const Bounds& b) {
+double WantedDistance(const recon::Scene& scene, const std::vector<Observation>& observations,
+                      int region, const std::vector<SurfacePoint>& points, const Bounds& b) {
   std::vector<Vector3d> centres;
-  for (const Photo& p : scene.photos) {
+  for (const recon::Photo& p : scene.photos) {
     centres.push_back(p.camera >= 0 && p.camera < static_cast<int>(scene.cameras.size())
                           ? scene.cameras[p.camera].CenterInWorld()
                           : Vector3d::Constant(kInf));
@@ -382,15 +388,16 @@ double WantedDistance(const Scene& scene, const std::vector<Observation>& observ
   if (d.empty() && !points.empty()) {
     Vector3d centroid = Vector3d::Zero();
     for (const SurfacePoint& sp : points) centroid += sp.p / static_cast<double>(points.size());
-    for (const Camera& cam : scene.cameras) d.push_back((cam.CenterInWorld() - centroid).norm());
+    for (const recon::Camera& cam : scene.cameras)
+      d.push_back((cam.CenterInWorld() - centroid).norm());
   }
   if (d.empty()) return 0.25 * (b.hi - b.lo).norm();
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
 }
 
-void Suggest(const Scene& scene, const std::vector<Observation>& observations,
-             const std::vector<std::unique_ptr<RayScene>>& scenes,
+void Suggest(const recon::Scene& scene, const std::vector<Observation>& observations,
+             const std::vector<std::unique_ptr<render::RayScene>>& scenes,
              const HighlightCoverageOptions& options, RegionHighlightCoverage* c) {
   double area = 0;
   const std::vector<SurfacePoint> points =
@@ -398,7 +405,7 @@ void Suggest(const Scene& scene, const std::vector<Observation>& observations,
   if (points.empty()) return;
   SuggestContext ctx{&scene, &points, area, 0, SceneBounds(scene), &options};
   ctx.distance = WantedDistance(scene, observations, c->region, points, ctx.bounds);
-  for (const std::unique_ptr<RayScene>& impl : scenes) {
+  for (const std::unique_ptr<render::RayScene>& impl : scenes) {
     if (impl == nullptr) continue;
     for (int l = 0; l < impl->num_lights(); ++l) {
       if (auto s = SuggestForLight(ctx, *impl, l, *c)) c->suggestions.push_back(std::move(*s));
@@ -442,14 +449,14 @@ void HighlightCoverageOptions::Validate() const {
 }
 
 std::vector<RegionHighlightCoverage> AnalyseHighlightCoverage(
-    const Scene& scene, const std::vector<Observation>& observations,
-    const std::vector<std::unique_ptr<RayScene>>& lighting_scenes,
+    const recon::Scene& scene, const std::vector<Observation>& observations,
+    const std::vector<std::unique_ptr<render::RayScene>>& lighting_scenes,
     const HighlightCoverageOptions& options) {
   options.Validate();
   std::vector<RegionHighlightCoverage> coverage;
   std::vector<int> slot(scene.materials.size(), -1);
   for (size_t m = 0; m < scene.materials.size(); ++m) {
-    const Material& material = scene.materials[m];
+    const recon::Material& material = scene.materials[m];
     if (!NeedsCoverage(material)) continue;
     slot[m] = static_cast<int>(coverage.size());
     RegionHighlightCoverage c;
@@ -500,4 +507,4 @@ Json HighlightCoverageJson(const std::vector<RegionHighlightCoverage>& coverage)
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -20,7 +20,7 @@
 #include "solver/render/render.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct HighlightCoverageOptions {
   double alpha_assumed = 0.1;    // roughness used where the region's α is unknown (lobe width)
@@ -61,11 +61,11 @@ struct RegionHighlightCoverage {
 // null for a lighting not photographed (observations under a null lighting are not analysed;
 // suggestions use the non-null lightings only).
 std::vector<RegionHighlightCoverage> AnalyseHighlightCoverage(
-    const Scene& scene, const std::vector<Observation>& observations,
-    const std::vector<std::unique_ptr<RayScene>>& lighting_scenes,
+    const recon::Scene& scene, const std::vector<Observation>& observations,
+    const std::vector<std::unique_ptr<render::RayScene>>& lighting_scenes,
     const HighlightCoverageOptions& options);
 
 // A JSON array for report.json: one object per region (infinity written as null).
 Json HighlightCoverageJson(const std::vector<RegionHighlightCoverage>& coverage);
 
-}  // namespace igi
+}  // namespace igi::solver

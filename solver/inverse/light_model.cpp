@@ -7,7 +7,7 @@
 #include "solver/render/brdf.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 
 std::vector<Eigen::Vector3d> NeighbourMean(const ObservationSet& obs,
                                            const std::vector<LightingState>& lightings,
@@ -47,7 +47,7 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
       [&](int64_t i) {
         const Observation& o = obs[i];
         const MaterialState& m = materials[o.region];
-        if (!HasSpecularLobe(m.params.model)) return;
+        if (!recon::HasSpecularLobe(m.params.model)) return;
         const Eigen::Vector3d wo =
             materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
         const double ax = WidenedAlpha(m.params.AlphaX(), o.lobe_blur2);
@@ -64,8 +64,9 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
   return out;
 }
 
-Eigen::Vector3d DirectSpecularTerm(const BrdfParams& p, double blur2, const Frame& frame,
-                                   const Eigen::Vector3d& view, const DirectSample* d, int64_t n) {
+Eigen::Vector3d DirectSpecularTerm(const render::BrdfParams& p, double blur2,
+                                   const render::Frame& frame, const Eigen::Vector3d& view,
+                                   const DirectSample* d, int64_t n) {
   const double ax = WidenedAlpha(p.AlphaX(), blur2), ay = WidenedAlpha(p.AlphaY(), blur2);
   const Eigen::Vector3d wo = frame.ToLocal(view);
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
@@ -77,7 +78,8 @@ Eigen::Vector3d DirectSpecularTerm(const BrdfParams& p, double blur2, const Fram
   return t;
 }
 
-std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const ObservationSet& obs,
+std::vector<Eigen::Vector3d> DirectSpecularTerms(const recon::Scene& scene,
+                                                 const ObservationSet& obs,
                                                  const MaterialEstimate& materials,
                                                  const LightModel& light, int num_threads) {
   std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
@@ -85,8 +87,8 @@ std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const Obser
       0, int64_t(obs.size()),
       [&](int64_t i) {
         const Observation& o = obs[i];
-        const BrdfParams& p = materials[o.region].params;
-        if (!HasSpecularLobe(p.model)) return;
+        const render::BrdfParams& p = materials[o.region].params;
+        if (!recon::HasSpecularLobe(p.model)) return;
         const LightingState& st = light.lightings[scene.photos[o.photo].lighting];
         const GatherPoint& gp = st.gather.points[light.point[i]];
         out[i] = DirectSpecularTerm(
@@ -102,7 +104,7 @@ std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const Obser
 // reserved for `more` samples to follow: the list is allocated once at its final size (grown by
 // doubling, a glossy observation's 16 + 512 directions took 1024 slots).
 std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
-                                          const Frame& frame, int64_t more) {
+                                          const render::Frame& frame, int64_t more) {
   std::vector<IncidentLocal> inc;
   inc.reserve(size_t(gp.direct_end - gp.direct_begin + more));
   for (int64_t d = gp.direct_begin; d < gp.direct_end; ++d) {
@@ -122,7 +124,7 @@ void BuildPatchLobes(const PatchSet& patches, const MaterialEstimate& materials,
     st->lobe_begin[p] = static_cast<int>(st->lobes.size());
     const GatherPoint& gp = st->gather.points[st->first_patch_point + p];
     const int n = int(gp.direct_end - gp.direct_begin);
-    if (n > 0 && HasSpecularLobe(materials[patches.patch_region[p]].params.model)) {
+    if (n > 0 && recon::HasSpecularLobe(materials[patches.patch_region[p]].params.model)) {
       const int groups = std::min(4, n);
       for (int g = 0; g < groups; ++g) {
         DirectSample rep;
@@ -154,7 +156,7 @@ Eigen::Vector3d PatchSpecular(const PatchSet& patches, const MaterialEstimate& m
   if (st.lobe_begin[q] == st.lobe_begin[q + 1] || !(m.params.rho_s.maxCoeff() > 0)) {
     return Eigen::Vector3d::Zero();
   }
-  const Frame frame = materials.LocalFrame(r, patches.normal[q].cast<double>());
+  const render::Frame frame = materials.LocalFrame(r, patches.normal[q].cast<double>());
   const Eigen::Vector3d wo = frame.ToLocal(toward);
   if (!(wo.z() > 0)) return Eigen::Vector3d::Zero();
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
@@ -213,9 +215,10 @@ void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
     for (int q = 0; q < patches.size(); ++q) {
       if (count[q] > 0) {
         st->patch_d[q] = (sum[q] / count[q]).cast<float>();
-      } else if (IsReflective(materials[patches.patch_region[q]].params.model)) {
+      } else if (recon::IsReflective(materials[patches.patch_region[q]].params.model)) {
         st->patch_d[q] =
-            (materials.PatchAlbedo(patches, q).cwiseProduct(st->patch_e[q].cast<double>()) / kPi)
+            (materials.PatchAlbedo(patches, q).cwiseProduct(st->patch_e[q].cast<double>()) /
+             render::kPi)
                 .cast<float>();
       } else {
         st->patch_d[q].setZero();
@@ -252,8 +255,8 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
           const int i = st.obs[k];
           const Observation& o = obs[i];
           const GatherPoint& gp = st.gather.points[light->point[i]];
-          const bool glossy = HasSpecularLobe(materials[o.region].params.model);
-          const Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
+          const bool glossy = recon::HasSpecularLobe(materials[o.region].params.model);
+          const render::Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
           if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
@@ -275,4 +278,4 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
   }
 }
 
-}  // namespace igi
+}  // namespace igi::solver

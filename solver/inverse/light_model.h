@@ -17,7 +17,7 @@
 #include "solver/inverse/region_fit.h"
 #include "solver/render/render.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct LightingState {
   bool active = false;
@@ -40,7 +40,7 @@ struct JointSums {
   std::vector<Eigen::Vector3d> d_e, d_t, t;
   void Resize(size_t n) {
     regions = n;
-    const size_t k = n * n * Renderer::kDerivativeKinds;
+    const size_t k = n * n * render::Renderer::kDerivativeKinds;
     d_e.assign(k, Eigen::Vector3d::Zero());
     d_t.assign(k, Eigen::Vector3d::Zero());
     t.assign(n, Eigen::Vector3d::Zero());
@@ -48,7 +48,7 @@ struct JointSums {
   // Region `r`'s observation: its derivative rows and its T.
   void Add(int r, const std::vector<Eigen::Vector3d>& de, const std::vector<Eigen::Vector3d>& dt,
            const Eigen::Vector3d& tr) {
-    const size_t row = regions * Renderer::kDerivativeKinds, o = size_t(r) * row;
+    const size_t row = regions * render::Renderer::kDerivativeKinds, o = size_t(r) * row;
     for (size_t j = 0; j < row; ++j) d_e[o + j] += de[j], d_t[o + j] += dt[j];
     t[r] += tr;
   }
@@ -59,7 +59,7 @@ struct JointSums {
   }
   // Row r's entry for region j's parameter `kind`.
   const Eigen::Vector3d& E(const std::vector<Eigen::Vector3d>& v, int r, int j, int kind) const {
-    return v[(size_t(r) * regions + j) * Renderer::kDerivativeKinds + kind];
+    return v[(size_t(r) * regions + j) * render::Renderer::kDerivativeKinds + kind];
   }
 };
 
@@ -106,12 +106,14 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
 // The direct part of a point's specular term T: Σ S·W·v over its direct samples d[0..n) (world
 // directions) with the lobe of `p` widened by the spread of normals `blur2` (as SpecularTerms),
 // in `frame`, seen from `view` (world, unit).
-Eigen::Vector3d DirectSpecularTerm(const BrdfParams& p, double blur2, const Frame& frame,
-                                   const Eigen::Vector3d& view, const DirectSample* d, int64_t n);
+Eigen::Vector3d DirectSpecularTerm(const render::BrdfParams& p, double blur2,
+                                   const render::Frame& frame, const Eigen::Vector3d& view,
+                                   const DirectSample* d, int64_t n);
 
 // Per observation: DirectSpecularTerm over its gather point's direct samples; zero for regions
 // without a lobe.
-std::vector<Eigen::Vector3d> DirectSpecularTerms(const Scene& scene, const ObservationSet& obs,
+std::vector<Eigen::Vector3d> DirectSpecularTerms(const recon::Scene& scene,
+                                                 const ObservationSet& obs,
                                                  const MaterialEstimate& materials,
                                                  const LightModel& light, int num_threads);
 
@@ -141,6 +143,6 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
 // A gather point's direct samples in the local shading frame, with room reserved for `more`
 // samples to follow.
 std::vector<IncidentLocal> DirectIncident(const LightingState& st, const GatherPoint& gp,
-                                          const Frame& frame, int64_t more);
+                                          const render::Frame& frame, int64_t more);
 
-}  // namespace igi
+}  // namespace igi::solver

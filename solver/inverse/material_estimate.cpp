@@ -3,19 +3,19 @@
 #include "solver/inverse/held_out_albedo.h"
 #include "solver/render/ray_scene.h"
 
-namespace igi {
+namespace igi::solver {
 
-MaterialEstimate MaterialEstimate::FromScene(const Scene& scene, const PatchSet& patches) {
+MaterialEstimate MaterialEstimate::FromScene(const recon::Scene& scene, const PatchSet& patches) {
   MaterialEstimate out;
   const size_t n = scene.materials.size();
   out.regions.resize(n);
   for (size_t r = 0; r < n; ++r) {
-    const Material& m = scene.materials[r];
+    const recon::Material& m = scene.materials[r];
     MaterialState& s = out.regions[r];
     s.params.model = m.brdf;
-    s.reflective = IsReflective(m.brdf);
+    s.reflective = recon::IsReflective(m.brdf);
     if (!s.reflective) continue;
-    const bool spec = HasSpecularLobe(m.brdf), aniso = IsAnisotropic(m.brdf);
+    const bool spec = recon::HasSpecularLobe(m.brdf), aniso = recon::IsAnisotropic(m.brdf);
     s.unknown_rho_d = !m.rho_d && !m.rho_d_map;
     s.unknown_rho_s = spec && !m.rho_s;
     s.unknown_alpha = spec && (aniso ? !(m.alpha_x && m.alpha_y) : !m.alpha);
@@ -24,7 +24,7 @@ MaterialEstimate MaterialEstimate::FromScene(const Scene& scene, const PatchSet&
     s.params.alpha = m.alpha.value_or(0.1);
     s.params.alpha_x = m.alpha_x.value_or(m.alpha.value_or(0.1));
     s.params.alpha_y = m.alpha_y.value_or(m.alpha.value_or(0.1));
-    s.params.ior = m.ior.value_or(Material::kDefaultIor);
+    s.params.ior = m.ior.value_or(recon::Material::kDefaultIor);
     s.tangent = m.tangent;
     if (m.rho_d_map) s.known_map = std::make_shared<const Image>(ReadImage(*m.rho_d_map, 3));
   }
@@ -41,10 +41,11 @@ MaterialEstimate MaterialEstimate::FromScene(const Scene& scene, const PatchSet&
   return out;
 }
 
-Frame MaterialEstimate::LocalFrame(int region, const Eigen::Vector3d& n) const {
+render::Frame MaterialEstimate::LocalFrame(int region, const Eigen::Vector3d& n) const {
   const MaterialState& m = regions[region];
-  if (IsAnisotropic(m.params.model) && m.tangent) return Frame::FromNormalTangent(n, *m.tangent);
-  return Frame::FromNormal(n);
+  if (recon::IsAnisotropic(m.params.model) && m.tangent)
+    return render::Frame::FromNormalTangent(n, *m.tangent);
+  return render::Frame::FromNormal(n);
 }
 
 Eigen::Vector3d MaterialEstimate::PatchAlbedo(const PatchSet& patches, int q) const {
@@ -53,7 +54,7 @@ Eigen::Vector3d MaterialEstimate::PatchAlbedo(const PatchSet& patches, int q) co
   return v.allFinite() ? v : regions[r].params.rho_d;
 }
 
-Eigen::Vector3d MaterialEstimate::KnownAlbedo(const TriangleMesh& mesh,
+Eigen::Vector3d MaterialEstimate::KnownAlbedo(const recon::TriangleMesh& mesh,
                                               const Observation& o) const {
   const MaterialState& m = regions[o.region];
   if (m.known_map && mesh.has_uvs()) {
@@ -61,7 +62,7 @@ Eigen::Vector3d MaterialEstimate::KnownAlbedo(const TriangleMesh& mesh,
     const Eigen::Vector2d uv =
         ((1.0f - o.b1 - o.b2) * mesh.uvs[t[0]] + o.b1 * mesh.uvs[t[1]] + o.b2 * mesh.uvs[t[2]])
             .cast<double>();
-    return SampleTexture(*m.known_map, uv);
+    return render::SampleTexture(*m.known_map, uv);
   }
   return m.params.rho_d;
 }
@@ -70,15 +71,16 @@ Eigen::Vector3d MaterialEstimate::KnownAlbedo(const TriangleMesh& mesh,
 // ρs, πT/E (held_lobe): the albedo is their difference at the ρs being fitted, so that the fit
 // takes ρs from both (solver/inverse/region_fit.h) instead of from the previous iteration.
 void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d>& e,
-                    const std::vector<Eigen::Vector3d>& t, const TriangleMesh& mesh,
+                    const std::vector<Eigen::Vector3d>& t, const recon::TriangleMesh& mesh,
                     double texel_size_m, MaterialEstimate* estimate) {
   estimate->held_rho_d.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   estimate->held_lobe.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   estimate->held_atlases.resize(estimate->size());
   for (size_t r = 0; r < estimate->size(); ++r) {
     const MaterialState& m = (*estimate)[r];
-    if (!m.NeedsFit() || !m.unknown_rho_d || m.no_highlight || !HasSpecularLobe(m.params.model) ||
-        !m.last_fit.fitted || !m.last_fit.albedo_varies || m.observations == 0) {
+    if (!m.NeedsFit() || !m.unknown_rho_d || m.no_highlight ||
+        !recon::HasSpecularLobe(m.params.model) || !m.last_fit.fitted ||
+        !m.last_fit.albedo_varies || m.observations == 0) {
       continue;
     }
     std::unique_ptr<RegionAtlas>& atlas = estimate->held_atlases[r];
@@ -99,10 +101,10 @@ void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d
       // to the highlight than a dark one, raising the held-out albedo where the lobe is fitted
       // (on the true floor texture with exact radiances, the patch's albedo moved rho_s by
       // several per cent, the region's mean by 0.2 %).
-      const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(e[i]) / kPi;
+      const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(e[i]) / render::kPi;
       if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
-      held.Add(o.photo, o.triangle, o.b1, o.b2, kPi * o.radiance.cast<double>(), e[i]);
-      lobe.Add(o.photo, o.triangle, o.b1, o.b2, kPi * t[i], e[i]);
+      held.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * o.radiance.cast<double>(), e[i]);
+      lobe.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * t[i], e[i]);
     }
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
@@ -113,4 +115,4 @@ void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d
   }
 }
 
-}  // namespace igi
+}  // namespace igi::solver

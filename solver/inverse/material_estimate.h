@@ -18,10 +18,10 @@
 #include "solver/render/sampling.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct MaterialState {
-  BrdfParams params;  // complete: known values, or the current estimate
+  render::BrdfParams params;  // complete: known values, or the current estimate
   bool reflective = false;
   bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
   bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
@@ -54,7 +54,7 @@ struct MaterialEstimate {
 
   // The scene's materials as the solve starts: known values as given, unknowns at a
   // placeholder (ρd 0.5, ρs 0, α 0.1), every patch of `patches` in its region's slots.
-  static MaterialEstimate FromScene(const Scene& scene, const PatchSet& patches);
+  static MaterialEstimate FromScene(const recon::Scene& scene, const PatchSet& patches);
 
   size_t size() const { return regions.size(); }
   MaterialState& operator[](size_t r) { return regions[r]; }
@@ -66,11 +66,11 @@ struct MaterialEstimate {
 
   // The frame a region's lobe is evaluated in at shading normal n (brdf.h): the material's
   // tangent for an anisotropic model.
-  Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
+  render::Frame LocalFrame(int region, const Eigen::Vector3d& n) const;
   // Patch q's albedo: its own where its region is fitted per patch, else its region's.
   Eigen::Vector3d PatchAlbedo(const PatchSet& patches, int q) const;
   // The given albedo at an observation: its region's map where it has one, else its ρd.
-  Eigen::Vector3d KnownAlbedo(const TriangleMesh& mesh, const Observation& o) const;
+  Eigen::Vector3d KnownAlbedo(const recon::TriangleMesh& mesh, const Observation& o) const;
 };
 
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every fit sample's
@@ -79,7 +79,7 @@ struct MaterialEstimate {
 // estimate->held_rho_d and held_lobe (solver/inverse/held_out_albedo.h). `e` and `t`: per
 // observation, its irradiance and its specular term per unit ρs.
 void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d>& e,
-                    const std::vector<Eigen::Vector3d>& t, const TriangleMesh& mesh,
+                    const std::vector<Eigen::Vector3d>& t, const recon::TriangleMesh& mesh,
                     double texel_size_m, MaterialEstimate* estimate);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -7,7 +7,7 @@
 
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 struct CellKey {
@@ -156,4 +156,4 @@ void NeighbourMean(const std::vector<NeighbourPoint>& points,
       num_threads);
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-namespace igi {
+namespace igi::solver {
 
 struct NeighbourPoint {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();
@@ -29,4 +29,4 @@ void NeighbourMean(const std::vector<NeighbourPoint>& points,
                    std::vector<Eigen::Vector3d>* out,
                    const std::vector<float>* point_radius = nullptr);
 
-}  // namespace igi
+}  // namespace igi::solver

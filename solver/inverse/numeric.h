@@ -7,7 +7,7 @@
 #include <bit>
 #include <cmath>
 
-namespace igi {
+namespace igi::solver {
 
 // exp(x) for −2^21 < x <= 0 in float: relative error under 4e−7 for x > −2, under 5e−6 down to
 // −87, and 0 below about −87 (where the result would be subnormal). 2^(x·log2 e) split into an
@@ -75,4 +75,4 @@ double BrentMinimum(double a, double b, double tol, int max_evals, F&& f) {
   return x;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -9,13 +9,13 @@
 #include "solver/render/sampling.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 
-bool NearHighlight(const RayScene& lighting, const Eigen::Vector3d& position,
+bool NearHighlight(const render::RayScene& lighting, const Eigen::Vector3d& position,
                    const Eigen::Vector3d& view, const Eigen::Vector3d& normal) {
   for (int l = 0; l < lighting.num_lights(); ++l) {
-    if (lighting.light_type(l) == LightType::kAmbient) continue;
-    const LightSample s = lighting.SampleLight(l, position, Eigen::Vector3d(0.5, 0.5, 0.5));
+    if (lighting.light_type(l) == recon::LightType::kAmbient) continue;
+    const render::LightSample s = lighting.SampleLight(l, position, Eigen::Vector3d(0.5, 0.5, 0.5));
     const Eigen::Vector3d h = (s.wi + view).normalized();
     const double c = h.dot(normal);
     if (c > 0 && (1 - c * c) < 0.36 * c * c) return true;
@@ -33,30 +33,29 @@ bool ObservationDraw::Draws(int photo, int x, int y, int stride, int region, boo
     if (cx % b != b / 2 || cy % b != b / 2) return false;  // not the centre of its block
     *x0 = (cx - b / 2) * stride, *y0 = (cy - b / 2) * stride, *size = b * stride;
   }
-  return InHashedSubset(PixelKey(photo, *x0, *y0), Threshold(region, near));
+  return render::InHashedSubset(PixelKey(photo, *x0, *y0), Threshold(region, near));
 }
 
-double PixelsAtStride(const Scene& scene, int pixel_stride) {
+double PixelsAtStride(const recon::Scene& scene, int pixel_stride) {
   double n = 0;
-  for (const Photo& p : scene.photos) {
-    const Camera& cam = scene.cameras[p.camera];
+  for (const recon::Photo& p : scene.photos) {
+    const recon::Camera& cam = scene.cameras[p.camera];
     n += double((cam.width + pixel_stride - 1) / pixel_stride) *
          double((cam.height + pixel_stride - 1) / pixel_stride);
   }
   return n;
 }
 
-std::vector<RegionPixelCensus> CensusPixels(const Scene& scene,
-                                            const std::vector<const RayScene*>& lighting_scenes,
-                                            const std::vector<char>& lobe_class,
-                                            const ObservationDrawOptions& options) {
+std::vector<RegionPixelCensus> CensusPixels(
+    const recon::Scene& scene, const std::vector<const render::RayScene*>& lighting_scenes,
+    const std::vector<char>& lobe_class, const ObservationDrawOptions& options) {
   const size_t regions = scene.materials.size();
   std::vector<RegionPixelCensus> census(regions);
   const int stride = options.pixel_stride;
   for (size_t i = 0; i < scene.photos.size(); ++i) {
-    const Photo& photo = scene.photos[i];
-    const Camera& cam = scene.cameras[photo.camera];
-    const RayScene* geometry = lighting_scenes[photo.lighting];
+    const recon::Photo& photo = scene.photos[i];
+    const recon::Camera& cam = scene.cameras[photo.camera];
+    const render::RayScene* geometry = lighting_scenes[photo.lighting];
     if (geometry == nullptr) continue;
     const int cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
     // Every step-th pixel of the stride's grid in x and y, each standing for step² of them.
@@ -76,8 +75,8 @@ std::vector<RegionPixelCensus> CensusPixels(const Scene& scene,
             const int x = gx * step * stride + stride / 2;
             if (x >= cam.width) break;
             const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-            const std::optional<SurfaceHit> hit = geometry->TraceSurface(center, dir);
-            if (!hit || !IsReflective(scene.materials[hit->region].brdf)) continue;
+            const std::optional<render::SurfaceHit> hit = geometry->TraceSurface(center, dir);
+            if (!hit || !recon::IsReflective(scene.materials[hit->region].brdf)) continue;
             const bool near =
                 lobe_class[hit->region] && NearHighlight(*geometry, hit->position, -dir, hit->n_s);
             (near ? counts[hit->region].near : counts[hit->region].rest) += weight;
@@ -165,4 +164,4 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
   return d;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -35,7 +35,7 @@
 #include "recon/scene.h"
 #include "solver/render/ray_scene.h"
 
-namespace igi {
+namespace igi::solver {
 
 // The key of pixel (x, y) of photo `photo` for the hashed draws (sampling.h InHashedSubset); an
 // observation's key is that of its top-left pixel (Observation::x, y).
@@ -45,7 +45,7 @@ inline uint64_t PixelKey(int photo, int x, int y) {
 
 // Whether a surface point (world position, unit view toward the camera, unit shading normal) is
 // near a possible highlight of a light of `lighting`: tanθh < 0.6 toward some non-ambient light.
-bool NearHighlight(const RayScene& lighting, const Eigen::Vector3d& position,
+bool NearHighlight(const render::RayScene& lighting, const Eigen::Vector3d& position,
                    const Eigen::Vector3d& view, const Eigen::Vector3d& normal);
 
 // Per region: the estimated number of pixels at the stride that see it, near a highlight and not.
@@ -102,14 +102,13 @@ struct ObservationDrawOptions {
 };
 
 // Pixels of every photo at the stride (the observations there are at most).
-double PixelsAtStride(const Scene& scene, int pixel_stride);
+double PixelsAtStride(const recon::Scene& scene, int pixel_stride);
 
 // The census (above) of every photo; `lighting_scenes` per lighting (null: unused), `lobe_class`
 // per region.
-std::vector<RegionPixelCensus> CensusPixels(const Scene& scene,
-                                            const std::vector<const RayScene*>& lighting_scenes,
-                                            const std::vector<char>& lobe_class,
-                                            const ObservationDrawOptions& options);
+std::vector<RegionPixelCensus> CensusPixels(
+    const recon::Scene& scene, const std::vector<const render::RayScene*>& lighting_scenes,
+    const std::vector<char>& lobe_class, const ObservationDrawOptions& options);
 
 // The probabilities (above) for `census`: each region's needs first (its highlight candidates up
 // to max_highlight_samples, its other pixels up to max_fit_samples; scaled down together when
@@ -119,4 +118,4 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
                                     const std::vector<char>& lobe_class,
                                     const ObservationDrawOptions& options);
 
-}  // namespace igi
+}  // namespace igi::solver

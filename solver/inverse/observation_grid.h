@@ -12,15 +12,15 @@
 #include "recon/scene.h"
 #include "solver/inverse/observation_set.h"
 
-namespace igi {
+namespace igi::solver {
 
 class ObservationGrid {
  public:
   // The observations of the regions r with regions[r] nonzero, in cells of `cell` metres, grouped
   // by their photo's lighting or (by_photo) by their photo. `scene` is the observations' (for
   // their photos' lightings); both must outlive the grid.
-  ObservationGrid(const Scene& scene, const ObservationSet& obs, const std::vector<char>& regions,
-                  double cell, bool by_photo = false)
+  ObservationGrid(const recon::Scene& scene, const ObservationSet& obs,
+                  const std::vector<char>& regions, double cell, bool by_photo = false)
       : scene_(scene), obs_(obs), cell_(cell), by_photo_(by_photo) {
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
@@ -75,11 +75,11 @@ class ObservationGrid {
     return (uint64_t(g & 0xff) << 56) ^ (uint64_t(region & 0xfff) << 44) ^
            (u(c.x()) << 24 | u(c.y()) << 4) ^ (u(c.z()) * 0x9e3779b1ULL);
   }
-  const Scene& scene_;
+  const recon::Scene& scene_;
   const ObservationSet& obs_;
   double cell_;
   bool by_photo_;
   std::unordered_map<uint64_t, std::vector<int>> cells_;
 };
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -4,7 +4,7 @@
 
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // Marks about `count` of `indices` (into `obs`) in `chosen` (all when there are no more), each
@@ -21,7 +21,7 @@ size_t DrawSubset(const std::vector<Observation>& obs, const std::vector<int>& i
   const double p = indices.empty() ? 0.0 : collected * (double(count) / double(indices.size()));
   for (int i : indices) {
     const Observation& o = obs[i];
-    if (InHashedSubset(PixelKey(o.photo, o.x, o.y), p)) {
+    if (render::InHashedSubset(PixelKey(o.photo, o.x, o.y), p)) {
       (*chosen)[i] = 1;
       ++marked;
     }
@@ -56,4 +56,4 @@ void SelectFitSamples(const std::vector<char>& fitted, const std::vector<char>& 
   }
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -14,7 +14,7 @@
 #include "solver/inverse/observation_draw.h"
 #include "solver/inverse/observations.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct ObservationSet {
   std::vector<Observation> items;
@@ -53,4 +53,4 @@ struct ObservationSet {
 void SelectFitSamples(const std::vector<char>& fitted, const std::vector<char>& near_highlight,
                       size_t max_highlight_samples, size_t max_fit_samples, ObservationSet* set);
 
-}  // namespace igi
+}  // namespace igi::solver

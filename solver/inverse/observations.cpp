@@ -10,7 +10,7 @@
 #include "solver/render/ray_scene.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 
 double AutoSaturation(const Image& image) {
   float max_value = 0;
@@ -44,24 +44,22 @@ namespace {
 
 // Whether `h` lies on the smooth piece of `centre`'s region: the same region, its normal at a
 // cosine above cos_min from the centre's, off the centre's face plane by under max_offset·centre.t.
-bool OnPieceOf(const std::optional<SurfaceHit>& h, const SurfaceHit& centre, double cos_min,
-               double max_offset) {
+bool OnPieceOf(const std::optional<render::SurfaceHit>& h, const render::SurfaceHit& centre,
+               double cos_min, double max_offset) {
   return h && h->region == centre.region && h->n_s.dot(centre.n_s) > cos_min &&
          std::abs(centre.n_geo.dot(h->position - centre.position)) < max_offset * centre.t;
 }
 
 }  // namespace
 
-std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(const RayScene& geometry,
-                                                                  const Camera& camera, int x,
-                                                                  int y, const SurfaceHit& centre,
-                                                                  double cos_min, double max_offset,
-                                                                  int size) {
+std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(
+    const render::RayScene& geometry, const recon::Camera& camera, int x, int y,
+    const render::SurfaceHit& centre, double cos_min, double max_offset, int size) {
   const Eigen::Vector3d eye = camera.CenterInWorld();
   std::array<Eigen::Vector3d, 4> normals;
   for (int k = 0; k < 4; ++k) {
     const double ox = ((k & 1) ? 0.75 : 0.25) * size, oy = ((k & 2) ? 0.75 : 0.25) * size;
-    const std::optional<SurfaceHit> h =
+    const std::optional<render::SurfaceHit> h =
         geometry.TraceSurface(eye, camera.WorldRayFromImg(Eigen::Vector2d(x + ox, y + oy)));
     if (!OnPieceOf(h, centre, cos_min, max_offset)) return std::nullopt;
     normals[k] = h->n_s;
@@ -83,25 +81,24 @@ PixelUse CheckPixel(const Image& radiance, const std::vector<uint8_t>* mask, int
   return clipped ? PixelUse::kClipped : PixelUse::kUsable;
 }
 
-std::vector<Observation> CollectObservations(const Scene& scene, int photo_index,
-                                             const Image& radiance,
-                                             const std::vector<uint8_t>* mask,
-                                             const RayScene& geometry, const PatchSet& patches,
-                                             const ObservationOptions& options,
-                                             PhotoObservationStats* stats) {
-  const Photo& photo = scene.photos[photo_index];
-  const Camera& camera = scene.cameras[photo.camera];
+std::vector<Observation> CollectObservations(
+    const recon::Scene& scene, int photo_index, const Image& radiance,
+    const std::vector<uint8_t>* mask, const render::RayScene& geometry, const PatchSet& patches,
+    const ObservationOptions& options, PhotoObservationStats* stats) {
+  const recon::Photo& photo = scene.photos[photo_index];
+  const recon::Camera& camera = scene.cameras[photo.camera];
   const double saturation = options.saturation > 0 ? options.saturation : AutoSaturation(radiance);
   const Eigen::Vector3d center = camera.CenterInWorld();
   const int stride = options.pixel_stride;
   const int rows = (camera.height + stride - 1) / stride;
   std::vector<std::vector<Observation>> per_row(rows);
   std::vector<PhotoObservationStats> row_stats(rows);
-  const double cos_edge = std::cos(10.0 * kPi / 180.0);
+  const double cos_edge = std::cos(10.0 * render::kPi / 180.0);
   // The observation of the square of `size` pixels at (x0, y0) whose centre ray `dir` meets
   // `hit`, of radiance `value`, its normals at the square's quarter points `quarter`.
-  auto make = [&](int x0, int y0, int size, const SurfaceHit& hit, const Eigen::Vector3d& dir,
-                  const Eigen::Vector3f& value, const std::array<Eigen::Vector3d, 4>& quarter) {
+  auto make = [&](int x0, int y0, int size, const render::SurfaceHit& hit,
+                  const Eigen::Vector3d& dir, const Eigen::Vector3f& value,
+                  const std::array<Eigen::Vector3d, 4>& quarter) {
     Observation o;
     o.photo = photo_index;
     o.x = x0, o.y = y0, o.size = size;
@@ -133,8 +130,8 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
     }
     const Eigen::Vector3d dir =
         camera.WorldRayFromImg(Eigen::Vector2d(x0 + 0.5 * size, y0 + 0.5 * size));
-    const std::optional<SurfaceHit> hit = geometry.TraceSurface(center, dir);
-    if (!hit || !IsReflective(scene.materials[hit->region].brdf)) return std::nullopt;
+    const std::optional<render::SurfaceHit> hit = geometry.TraceSurface(center, dir);
+    if (!hit || !recon::IsReflective(scene.materials[hit->region].brdf)) return std::nullopt;
     for (int y = y0 + stride / 2; y < y0 + size; y += stride) {
       for (int x = x0 + stride / 2; x < x0 + size; x += stride) {
         const Eigen::Vector2d px(x + 0.5, y + 0.5);
@@ -165,8 +162,8 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
             continue;
           }
           const Eigen::Vector3d dir = camera.WorldRayFromImg(Eigen::Vector2d(x + 0.5, yy + 0.5));
-          const std::optional<SurfaceHit> hit = geometry.TraceSurface(center, dir);
-          if (!hit || !IsReflective(scene.materials[hit->region].brdf)) {
+          const std::optional<render::SurfaceHit> hit = geometry.TraceSurface(center, dir);
+          if (!hit || !recon::IsReflective(scene.materials[hit->region].brdf)) {
             ++st.background;
             continue;
           }
@@ -220,4 +217,4 @@ std::vector<Observation> CollectObservations(const Scene& scene, int photo_index
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

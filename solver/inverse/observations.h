@@ -23,7 +23,7 @@
 #include "solver/render/render.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct Observation {
   int photo = -1;        // index into Scene::photos
@@ -81,8 +81,9 @@ double PixelNormalSpread(const std::array<Eigen::Vector3d, 4>& quarter, const Ei
 // cosine of `cos_min` or less from the centre's, or meets a point off the centre's face plane by
 // `max_offset`·centre.t or more.
 std::optional<std::array<Eigen::Vector3d, 4>> QuarterPixelNormals(
-    const RayScene& geometry, const Camera& camera, int x, int y, const SurfaceHit& centre,
-    double cos_min, double max_offset = std::numeric_limits<double>::infinity(), int size = 1);
+    const render::RayScene& geometry, const recon::Camera& camera, int x, int y,
+    const render::SurfaceHit& centre, double cos_min,
+    double max_offset = std::numeric_limits<double>::infinity(), int size = 1);
 
 // The roughness a pixel sees: α widened by its spread of normals (√(α² + spread)).
 inline double WidenedAlpha(double alpha, double spread) {
@@ -103,10 +104,9 @@ double AutoSaturation(const Image& image);
 // The observations of photo `photo` (its linear radiance image and optional 8-bit mask of the
 // photo's size, row by row, 0 = ignore), traced through `geometry`, the ray queries on the
 // photo's lighting.
-std::vector<Observation> CollectObservations(const Scene& scene, int photo, const Image& radiance,
-                                             const std::vector<uint8_t>* mask,
-                                             const RayScene& geometry, const PatchSet& patches,
-                                             const ObservationOptions& options,
-                                             PhotoObservationStats* stats);
+std::vector<Observation> CollectObservations(
+    const recon::Scene& scene, int photo, const Image& radiance, const std::vector<uint8_t>* mask,
+    const render::RayScene& geometry, const PatchSet& patches, const ObservationOptions& options,
+    PhotoObservationStats* stats);
 
-}  // namespace igi
+}  // namespace igi::solver

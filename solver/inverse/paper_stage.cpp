@@ -10,7 +10,7 @@
 #include "solver/inverse/observation_grid.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::solver {
 
 namespace {
 
@@ -80,7 +80,7 @@ std::vector<float> SmoothingRadii(const StageData& d, const LightModel& light, s
   if (!(d.options.smoothing_accuracy > 0)) return radii;
   const ObservationSet& obs = d.obs;
   const double min_d = 0.5 * d.patch_size_m;
-  const TriangleMesh& mesh = d.scene.mesh;
+  const recon::TriangleMesh& mesh = d.scene.mesh;
   auto curved = [&](int t) {
     if (!mesh.has_normals()) return false;
     const Eigen::Vector3i& v = mesh.triangles[t];
@@ -167,11 +167,11 @@ double FitUnobservedAlbedos(const StageData& d, MaterialEstimate* estimate, Ligh
       const Observation& o = obs[i];
       const MaterialState& m = materials[o.region];
       if (!m.reflective || m.observations == 0 || m.known_map) continue;
-      if (HasSpecularLobe(m.params.model)) continue;
+      if (recon::HasSpecularLobe(m.params.model)) continue;
       if (m.unknown_rho_d && !m.last_fit.fitted) continue;
       const Eigen::Vector3d radiance = o.radiance.cast<double>();
       if (!(radiance.sum() > 0)) continue;
-      const Eigen::Vector3d l = kPi * radiance;
+      const Eigen::Vector3d l = render::kPi * radiance;
       const Eigen::Vector3d b = (e1[i] - e0[i]).cwiseQuotient(rho1 - rho0);
       const Eigen::Vector3d a = e0[i] - b.cwiseProduct(rho0);
       if (!l.allFinite() || !a.allFinite() || !b.allFinite()) continue;
@@ -274,4 +274,4 @@ void RunPaperStage(const StageData& d, MaterialEstimate* estimate, LightModel* l
   }
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -12,7 +12,7 @@
 #include "solver/inverse/material_estimate.h"
 #include "solver/inverse/solve.h"
 
-namespace igi {
+namespace igi::solver {
 
 // Per observation, where the draw thinned the observations (obs.draw.census): the distance
 // within which 32 observations of its region under its lighting lie (normals within ~25°, itself
@@ -51,4 +51,4 @@ double FitUnobservedAlbedos(const StageData& d, MaterialEstimate* materials, Lig
 void RunPaperStage(const StageData& d, MaterialEstimate* materials, LightModel* light,
                    SolveSummary* summary);
 
-}  // namespace igi
+}  // namespace igi::solver

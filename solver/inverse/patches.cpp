@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // Sub-triangles of a k-grid, numbered row by row (i = floor(b1·k)): row i holds k−i "up" cells
@@ -23,7 +23,7 @@ int PatchSet::PatchOf(int triangle, double b1, double b2) const {
   return triangle_first[triangle] + CellIndex(k, i, j, down);
 }
 
-PatchSet BuildPatches(const TriangleMesh& mesh, double patch_size_m) {
+PatchSet BuildPatches(const recon::TriangleMesh& mesh, double patch_size_m) {
   PatchSet set;
   const int n = static_cast<int>(mesh.num_triangles());
   set.triangle_first.resize(n + 1);
@@ -77,4 +77,4 @@ PatchSet BuildPatches(const TriangleMesh& mesh, double patch_size_m) {
   return set;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -11,7 +11,7 @@
 
 #include "recon/mesh.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct PatchSet {
   std::vector<int> triangle_first;  // first patch of each triangle; size = triangles + 1
@@ -30,6 +30,6 @@ struct PatchSet {
 
 // Splits every triangle of `mesh` so that patch edges are at most `patch_size_m` (k at most 64
 // per triangle edge). patch_size_m must be > 0.
-PatchSet BuildPatches(const TriangleMesh& mesh, double patch_size_m);
+PatchSet BuildPatches(const recon::TriangleMesh& mesh, double patch_size_m);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace igi {
+namespace igi::solver {
 
 bool PixelHoldout::HeldOut(int photo, int x, int y) const {
   return fraction > 0 && Draw(photo, x, y) < fraction;
@@ -26,11 +26,12 @@ double PixelHoldout::Draw(int photo, int x, int y) const {
   return double(z >> 11) * 0x1.0p-53;
 }
 
-bool HasPhotoModel(const Photo& photo, const Camera& camera) {
+bool HasPhotoModel(const recon::Photo& photo, const recon::Camera& camera) {
   return photo.HasResponse() || photo.exposure_scale != 1.0 || camera.HasVignetting();
 }
 
-Image LinearRadianceOfPhoto(const Photo& photo, const Camera& camera, const Image& recorded) {
+Image LinearRadianceOfPhoto(const recon::Photo& photo, const recon::Camera& camera,
+                            const Image& recorded) {
   Image out = recorded;
   if (!HasPhotoModel(photo, camera)) return out;
   for (int y = 0; y < out.height; ++y) {
@@ -46,9 +47,9 @@ Image LinearRadianceOfPhoto(const Photo& photo, const Camera& camera, const Imag
   return out;
 }
 
-void ApplyExposureAndResponse(const Photo& photo, Image* render) {
+void ApplyExposureAndResponse(const recon::Photo& photo, Image* render) {
   if (!photo.HasResponse() && photo.exposure_scale == 1.0) return;
   for (float& v : render->pixels) v = float(photo.RecordedFromLinear(v * photo.exposure_scale));
 }
 
-}  // namespace igi
+}  // namespace igi::solver

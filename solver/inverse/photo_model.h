@@ -12,7 +12,7 @@
 #include "recon/scene.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 
 // Pixels are held out in square blocks chosen by a hash of (photo, block, seed); fraction 0 =
 // nothing held out.
@@ -31,12 +31,13 @@ struct PixelHoldout {
 };
 
 // True when the photo's values are not plain radiance (a response, a scale or vignetting).
-bool HasPhotoModel(const Photo& photo, const Camera& camera);
+bool HasPhotoModel(const recon::Photo& photo, const recon::Camera& camera);
 
 // Radiance from recorded values: inverse response, / exposure scale, / vignetting.
-Image LinearRadianceOfPhoto(const Photo& photo, const Camera& camera, const Image& recorded);
+Image LinearRadianceOfPhoto(const recon::Photo& photo, const recon::Camera& camera,
+                            const Image& recorded);
 
 // Recorded values from a render (which carries the camera's vignetting): × scale, response.
-void ApplyExposureAndResponse(const Photo& photo, Image* render);
+void ApplyExposureAndResponse(const recon::Photo& photo, Image* render);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -11,14 +11,14 @@
 #include "solver/render/sampling.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 using ScaleSample = PhotoScaleSample;
 
 bool IsReference(const MaterialState& m) {
   if (!m.reflective || m.NeedsFit() || m.observations == 0) return false;
-  return !HasSpecularLobe(m.params.model) || !(m.params.rho_s.maxCoeff() > 0);
+  return !recon::HasSpecularLobe(m.params.model) || !(m.params.rho_s.maxCoeff() > 0);
 }
 
 // k over `samples` (P − b = k·a) as the ratio of sums Σ(P − b)/Σa, with its standard error
@@ -124,8 +124,8 @@ std::vector<ScaleSample> ReferenceSamples(const SolverState& s, int channel, dou
     const double e_direct = s.light.e_direct[i][channel];
     const double e_indirect = s.light.e[i][channel] - e_direct;
     if (!(rho[channel] > 0) || !(e_direct > 0)) continue;
-    out.push_back({o.radiance[channel], rho[channel] / kPi * e_direct,
-                   rho[channel] / kPi * e_indirect, o.patch});
+    out.push_back({o.radiance[channel], rho[channel] / render::kPi * e_direct,
+                   rho[channel] / render::kPi * e_indirect, o.patch});
     share += e_direct / std::max(1e-300, e_direct + e_indirect);
   }
   if (direct_share && !out.empty()) *direct_share = share / out.size();
@@ -267,4 +267,4 @@ PhotoScaleEstimate RunStage1WithPhotoScale(SolverState* s) {
   return est;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

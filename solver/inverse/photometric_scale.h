@@ -29,7 +29,7 @@
 #include <utility>
 #include <vector>
 
-namespace igi {
+namespace igi::solver {
 
 struct SolverState;
 
@@ -67,4 +67,4 @@ std::vector<std::string> PhotoScaleReferenceRegions(const SolverState& state);
 // direct light on it is too weak to measure k.
 PhotoScaleEstimate RunStage1WithPhotoScale(SolverState* state);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -13,10 +13,11 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
-Eigen::Vector3d FaceNormalToward(const TriangleMesh& mesh, int triangle, const Eigen::Vector3d& v) {
+Eigen::Vector3d FaceNormalToward(const recon::TriangleMesh& mesh, int triangle,
+                                 const Eigen::Vector3d& v) {
   const Eigen::Vector3d fn = mesh.FaceNormal(triangle).cast<double>();
   return fn.dot(v) >= 0 ? fn : -fn;
 }
@@ -30,17 +31,17 @@ uint64_t Mix(uint64_t a, uint64_t b) {
 
 }  // namespace
 
-RenderCost RenderIncident(const StageData& d, const Scene& model,
+RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
                           const std::vector<double>& ray_epsilon, const MaterialEstimate& materials,
                           uint64_t round, LightModel* out) {
   const auto start = std::chrono::steady_clock::now();
-  const Scene& scene = d.scene;
+  const recon::Scene& scene = d.scene;
   const SolveOptions& options = d.options;
   const ObservationSet& obs = d.obs;
   LightModel& light = *out;
-  std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
+  std::vector<std::unique_ptr<render::Renderer>> renderers(scene.lightings.size());
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
-    if (light.lightings[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+    if (light.lightings[l].active) renderers[l] = std::make_unique<render::Renderer>(model, int(l));
   }
   std::atomic<uint64_t> rays{0};
   // The joint update also needs the derivatives of each region's fitted light with respect to
@@ -50,7 +51,7 @@ RenderCost RenderIncident(const StageData& d, const Scene& model,
   // not depend on the threads.
   const bool joint = IsJointUpdate(options.refine_update);
   const size_t num_regions = materials.size();
-  const size_t row = num_regions * Renderer::kDerivativeKinds;
+  const size_t row = num_regions * render::Renderer::kDerivativeKinds;
   // At most 64 chunks (each holds regions² × kinds sums), of at least 256 observations.
   const int64_t num_obs = int64_t(obs.size());
   const int64_t num_chunks = std::clamp<int64_t>((num_obs + 255) / 256, 1, 64);
@@ -72,15 +73,15 @@ RenderCost RenderIncident(const StageData& d, const Scene& model,
           const LightingState& st = light.lightings[l];
           const GatherPoint& gp = st.gather.points[light.point[i]];
           const MaterialState& m = materials[o.region];
-          const bool glossy = HasSpecularLobe(m.params.model);
-          const Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
+          const bool glossy = recon::HasSpecularLobe(m.params.model);
+          const render::Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           GatherQuery q;
           q.position = o.position.cast<double>();
           q.view = o.view.cast<double>();
           q.n_geo = FaceNormalToward(scene.mesh, o.triangle, q.view);
           q.n_s = o.normal.cast<double>();
           q.lobe = glossy;
-          Pcg32 rng = PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
+          render::Pcg32 rng = render::PixelSampleRng(Mix(options.seed, round), uint64_t(i), 0x2e7);
           // Glossy observations that the fits use get four times the rays: noise in the
           // specular term T would bias ρs low (regression dilution).
           // The last round's: more where a region has few observations (FinalRoundRays), so that
@@ -149,4 +150,4 @@ RenderCost RenderIncident(const StageData& d, const Scene& model,
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -11,7 +11,7 @@
 #include "solver/inverse/light_model.h"
 #include "solver/inverse/material_estimate.h"
 
-namespace igi {
+namespace igi::solver {
 
 // What one RenderIncident cost.
 struct RenderCost {
@@ -28,8 +28,8 @@ struct RenderCost {
 // depends on their count only, so that the sums do not depend on the threads.
 // `ray_epsilon` per lighting (the offset of a ray's origin from the surface); `round` seeds the
 // paths (0 < round ≤ --refine-iterations).
-RenderCost RenderIncident(const StageData& d, const Scene& model,
+RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
                           const std::vector<double>& ray_epsilon, const MaterialEstimate& materials,
                           uint64_t round, LightModel* light);
 
-}  // namespace igi
+}  // namespace igi::solver

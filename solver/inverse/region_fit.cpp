@@ -8,13 +8,14 @@
 
 #include "solver/inverse/numeric.h"
 #include "solver/render/brdf.h"
+#include "tools/common/enum_names.h"
 
-namespace igi {
+namespace igi::solver {
 
-double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
+double SpecularWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
                       const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
-  double s = SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
-  if (HasFresnel(model) && s > 0) s *= FresnelWeight<double>(ior, wo, wi);
+  double s = render::SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
+  if (recon::HasFresnel(model) && s > 0) s *= render::FresnelWeight<double>(ior, wo, wi);
   return s;
 }
 
@@ -37,7 +38,7 @@ Prepared Prepare(const RegionFitInput& in) {
   Eigen::Vector3d sum_l = Eigen::Vector3d::Zero(), sum_e = sum_l;
   for (const FitSample& s : in.samples) {
     sum_l += s.observed.cwiseMax(0.0);
-    sum_e += s.irradiance / kPi;
+    sum_e += s.irradiance / render::kPi;
   }
   const size_t n = std::max<size_t>(1, in.samples.size());
   const Eigen::Vector3d mean = sum_l / n;
@@ -45,10 +46,11 @@ Prepared Prepare(const RegionFitInput& in) {
     Eigen::Vector3d w;
     for (int c = 0; c < 3; ++c) {
       const double ratio = sum_e[c] > 0 ? sum_l[c] / sum_e[c] : 0.0;
-      w[c] = 1.0 / std::sqrt((ratio * s.irradiance[c] / kPi + 0.1 * mean[c]) * mean[c] + 1e-24);
+      w[c] = 1.0 /
+             std::sqrt((ratio * s.irradiance[c] / render::kPi + 0.1 * mean[c]) * mean[c] + 1e-24);
     }
     p.w.push_back(w);
-    p.a.push_back(s.irradiance / kPi);
+    p.a.push_back(s.irradiance / render::kPi);
   }
   return p;
 }
@@ -72,7 +74,7 @@ class LobeTable {
   // Built once per region fit from all its samples; any subset of them (the held-albedo
   // variant's) finds its rows by incident range (Rows).
   explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
-    if (!HasSpecularLobe(in.model)) return;
+    if (!recon::HasSpecularLobe(in.model)) return;
     std::vector<std::pair<const IncidentLocal*, int>> order;  // (incident, sample)
     order.reserve(in.samples.size());
     int64_t entries = 0;
@@ -103,8 +105,8 @@ class LobeTable {
         const IncidentLocal& inc = s.incident[k];
         const Eigen::Vector3d wi = inc.Wi().cast<double>();
         double qx = 0, qy = 0, g = 0;
-        if (!SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
-        if (HasFresnel(in.model)) g *= FresnelWeight<double>(in.ior, wo, wi);
+        if (!render::SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
+        if (recon::HasFresnel(in.model)) g *= render::FresnelWeight<double>(in.ior, wo, wi);
         const Eigen::Vector3d gv = g * inc.Value().cast<double>();
         if (!(g > 0.0) || !gv.allFinite()) continue;
         row.push_back({float(qx), float(qy), gv.cast<float>()});
@@ -157,7 +159,7 @@ class LobeTable {
   std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, const std::vector<int>& rows,
                                      double ax, double ay) const {
     std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
-    if (!HasSpecularLobe(model_)) return t;
+    if (!recon::HasSpecularLobe(model_)) return t;
     std::vector<float> f;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
@@ -177,7 +179,7 @@ class LobeTable {
         sum = WeightedSum(f.data(), b, e - b) * scale;
       }
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
-        sum -= s.held_lobe.cwiseProduct(s.irradiance) / kPi;
+        sum -= s.held_lobe.cwiseProduct(s.irradiance) / render::kPi;
       }
       t[i] = sum;
     }
@@ -205,7 +207,7 @@ class LobeTable {
     for (; k < n; ++k) sum += double(f[k]) * Eigen::Vector3d(gr_[b + k], gg_[b + k], gb_[b + k]);
     return sum;
   }
-  BrdfModel model_;
+  recon::BrdfModel model_;
   std::vector<const IncidentLocal*> starts_;  // each row's incident list, ascending
   std::vector<int> begin_;                    // each row's first entry (+1: the end)
   std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
@@ -254,7 +256,7 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
     }
   }
   LinearSolution sol;
-  const bool spec = HasSpecularLobe(in.model);
+  const bool spec = recon::HasSpecularLobe(in.model);
   if (spec && (in.rho_s_grey || in.rho_s_rgb)) {
     sol.rho_s = in.rho_s_rgb ? *in.rho_s_rgb : Eigen::Vector3d::Constant(*in.rho_s_grey);
   } else if (spec && in.grey_specular) {
@@ -300,12 +302,12 @@ struct AlphaSearch {
 AlphaSearch SearchAlpha(const RegionFitInput& in, const Prepared& pr, bool per_patch,
                         const LobeTable& table) {
   AlphaSearch best;
-  const bool aniso = IsAnisotropic(in.model);
+  const bool aniso = recon::IsAnisotropic(in.model);
   const std::vector<int> rows = table.Rows(in);
   auto eval = [&](double ax, double ay) {
     return SolveLinear(in, pr, table.Terms(in, rows, ax, ay), per_patch);
   };
-  if (!HasSpecularLobe(in.model)) {
+  if (!recon::HasSpecularLobe(in.model)) {
     best.linear = eval(0.1, 0.1);
     return best;
   }
@@ -405,7 +407,7 @@ struct SampleResidual {
     T ax = T(ax_fixed), ay = T(ay_fixed);
     if (block_a >= 0) {
       ax = p[block_a][0];
-      ay = IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
+      ay = recon::IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
     }
     const V3 t = table->Term<T>(row, ax, ay);
     for (int c = 0; c < 3; ++c) {
@@ -426,8 +428,8 @@ struct Polish {
 Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaSearch& start,
                       const RegionFitOptions& options, const LobeTable& table) {
   Polish out;
-  const bool spec = HasSpecularLobe(in.model);
-  const bool aniso = IsAnisotropic(in.model);
+  const bool spec = recon::HasSpecularLobe(in.model);
+  const bool aniso = recon::IsAnisotropic(in.model);
   const bool fit_s = spec && !in.rho_s_grey && !in.rho_s_rgb;
   const bool fit_a = spec && !(aniso ? (in.alpha_x && in.alpha_y) : bool(in.alpha));
   out.rho_d =
@@ -529,7 +531,8 @@ double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>&
     const FitSample& s = in.samples[i];
     Eigen::Vector3d rd = in.fit_rho_d ? slot_rho_d[per_patch ? s.slot : 0] : s.rho_d_known;
     if (!rd.allFinite()) continue;
-    const Eigen::Vector3d pred = rd.cwiseProduct(s.irradiance) / kPi + rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d pred =
+        rd.cwiseProduct(s.irradiance) / render::kPi + rho_s.cwiseProduct(t[i]);
     num += (pred - s.observed).squaredNorm();
     den += s.observed.squaredNorm();
   }
@@ -621,21 +624,12 @@ bool FitWithHeldAlbedo(const RegionFitInput& in, RegionFitInput* held) {
 
 }  // namespace
 
-std::string_view AlbedoModelName(AlbedoModel model) {
-  switch (model) {
-    case AlbedoModel::kConstant:
-      return "constant";
-    case AlbedoModel::kPerPatch:
-      return "per_patch";
-  }
-  return "?";
-}
+constexpr EnumNames<AlbedoModel, 2> kAlbedoModelNames{
+    {{AlbedoModel::kConstant, "constant"}, {AlbedoModel::kPerPatch, "per_patch"}}};
 
+std::string_view AlbedoModelName(AlbedoModel model) { return kAlbedoModelNames.Name(model); }
 std::optional<AlbedoModel> AlbedoModelFromName(std::string_view name) {
-  for (AlbedoModel m : {AlbedoModel::kConstant, AlbedoModel::kPerPatch}) {
-    if (AlbedoModelName(m) == name) return m;
-  }
-  return std::nullopt;
+  return kAlbedoModelNames.FromName(name);
 }
 
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
@@ -757,4 +751,4 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   return r;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -26,7 +26,7 @@
 
 #include "recon/brdf_model.h"
 
-namespace igi {
+namespace igi::solver {
 
 // One sample of the light arriving at an observation, in its local shading frame: the direction
 // wi (unit) and the value v. 16 bytes: the direction as 16-bit octahedral coordinates (within
@@ -92,7 +92,7 @@ struct FitSample {
 // What a region's fit knows and decides, apart from its samples.
 struct RegionFitSettings {
   std::string name;
-  BrdfModel model = BrdfModel::kLambert;
+  recon::BrdfModel model = recon::BrdfModel::kLambert;
   bool fit_rho_d = true;             // false: FitSample::rho_d_known is used
   std::optional<double> rho_s_grey;  // known ρs (grey) or unknown
   std::optional<Eigen::Vector3d> rho_s_rgb;
@@ -160,7 +160,7 @@ struct RegionFitOptions {
 RegionFitResult FitRegion(const RegionFitInput& input, const RegionFitOptions& options);
 
 // The colourless specular factor times the Fresnel weight, S·W, for one sample (double).
-double SpecularWeight(BrdfModel model, double alpha_x, double alpha_y, double ior,
+double SpecularWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
                       const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
 
-}  // namespace igi
+}  // namespace igi::solver

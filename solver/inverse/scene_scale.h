@@ -16,7 +16,7 @@
 #include "recon/scene.h"
 #include "solver/render/ray_scene.h"
 
-namespace igi {
+namespace igi::solver {
 
 inline constexpr double kDiagonalPerFreePath = 3.5;
 
@@ -29,11 +29,11 @@ struct SceneScale {
 
 // `geometry`: a render scene of `scene` (any lighting; light geometry is passed through), null
 // for the diagonal alone. `pixels_per_camera` origins per camera on a regular grid.
-SceneScale MeasureSceneScale(const Scene& scene, const RayScene* geometry,
+SceneScale MeasureSceneScale(const recon::Scene& scene, const render::RayScene* geometry,
                              int pixels_per_camera = 2048);
 
 // MeasureSceneScale on a render scene of the scene's first lighting (the diagonal alone when it
 // has none).
-SceneScale MeasureSceneScale(const Scene& scene);
+SceneScale MeasureSceneScale(const recon::Scene& scene);
 
-}  // namespace igi
+}  // namespace igi::solver

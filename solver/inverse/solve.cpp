@@ -18,12 +18,13 @@
 #include "solver/render/ray_scene.h"
 #include "solver/render/render.h"
 #include "solver/render/sampling.h"
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/memory.h"
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -33,26 +34,15 @@ double Since(Clock::time_point t) {
 
 }  // namespace
 
-std::string_view RegionStatusName(RegionStatus status) {
-  switch (status) {
-    case RegionStatus::kKnown:
-      return "known";
-    case RegionStatus::kSolved:
-      return "solved";
-    case RegionStatus::kUnobserved:
-      return "unobserved";
-    case RegionStatus::kNoHighlight:
-      return "no_highlight";
-  }
-  return "?";
-}
+constexpr EnumNames<RegionStatus, 4> kRegionStatusNames{
+    {{RegionStatus::kKnown, "known"},
+     {RegionStatus::kSolved, "solved"},
+     {RegionStatus::kUnobserved, "unobserved"},
+     {RegionStatus::kNoHighlight, "no_highlight"}}};
 
+std::string_view RegionStatusName(RegionStatus status) { return kRegionStatusNames.Name(status); }
 std::optional<RegionStatus> RegionStatusFromName(std::string_view name) {
-  for (RegionStatus s : {RegionStatus::kKnown, RegionStatus::kSolved, RegionStatus::kUnobserved,
-                         RegionStatus::kNoHighlight}) {
-    if (RegionStatusName(s) == name) return s;
-  }
-  return std::nullopt;
+  return kRegionStatusNames.FromName(name);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -62,7 +52,7 @@ std::optional<RegionStatus> RegionStatusFromName(std::string_view name) {
 // and highlight coverage.
 void SolverState::Prepare() {
   BuildLightingScenes();
-  const RayScene* geometry = nullptr;
+  const render::RayScene* geometry = nullptr;
   for (const auto& s : lighting_scenes) geometry = geometry ? geometry : s.get();
   const SceneScale scale = MeasureSceneScale(scene, geometry);
   summary.scene_diagonal_m = scale.diagonal_m;
@@ -85,8 +75,8 @@ void SolverState::Prepare() {
 // are linearised, their clipped pixels masked out first, as the clip level is a recorded value),
 // and an 8-bit mask (0 = ignore; empty: every pixel) with the held-out pixels masked out.
 SolverState::LoadedPhoto SolverState::LoadPhoto(int i) const {
-  const Photo& p = scene.photos[i];
-  const Camera& cam = scene.cameras[p.camera];
+  const recon::Photo& p = scene.photos[i];
+  const recon::Camera& cam = scene.cameras[p.camera];
   LoadedPhoto out;
   out.radiance = ReadImage(p.file, 3);
   if (out.radiance.width != cam.width || out.radiance.height != cam.height) {
@@ -136,17 +126,17 @@ void SolverState::PlanObservations() {
   const size_t n = materials.size();
   std::vector<char> lobe_class(n, 0);
   for (size_t r = 0; r < n; ++r) {
-    lobe_class[r] = materials[r].NeedsFit() && HasSpecularLobe(materials[r].params.model);
+    lobe_class[r] = materials[r].NeedsFit() && recon::HasSpecularLobe(materials[r].params.model);
   }
   const double fixed = memory.fixed_bytes + memory.photo_bytes;
   if (fixed > memory.budget_bytes) {
     size_t largest = 0;
     for (size_t i = 0; i < scene.photos.size(); ++i) {
-      const Camera& a = scene.cameras[scene.photos[i].camera];
-      const Camera& b = scene.cameras[scene.photos[largest].camera];
+      const recon::Camera& a = scene.cameras[scene.photos[i].camera];
+      const recon::Camera& b = scene.cameras[scene.photos[largest].camera];
       if (double(a.width) * a.height > double(b.width) * b.height) largest = i;
     }
-    const Camera& cam = scene.cameras[scene.photos[largest].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[largest].camera];
     throw InputError(DescribeProblem(
         scene.file.string(), "photos[" + std::to_string(largest) + "].file",
         fmt::format("{} ({}x{})", scene.photos[largest].file.string(), cam.width, cam.height),
@@ -190,7 +180,7 @@ void SolverState::PlanObservations() {
   d.max_fit_samples = options.max_fit_samples;
   d.max_block = options.max_observation_block;
   d.num_threads = options.num_threads;
-  std::vector<const RayScene*> geometry(lighting_scenes.size(), nullptr);
+  std::vector<const render::RayScene*> geometry(lighting_scenes.size(), nullptr);
   for (size_t l = 0; l < lighting_scenes.size(); ++l) geometry[l] = lighting_scenes[l].get();
   const std::vector<RegionPixelCensus> census = CensusPixels(scene, geometry, lobe_class, d);
   // The census's share of pixels on regions with a lobe, and their fit samples.
@@ -243,7 +233,8 @@ void SolverState::BuildLightingScenes() {
     if (lighting_scenes[l]) continue;
     if (scene.lightings[l].lights.empty()) {
       bool emitter = false;
-      for (const Material& m : scene.materials) emitter |= m.brdf == BrdfModel::kEmitter;
+      for (const recon::Material& m : scene.materials)
+        emitter |= m.brdf == recon::BrdfModel::kEmitter;
       if (!emitter) {
         problems.Add(scene.file.string(), "photos[" + std::to_string(i) + "].lighting",
                      scene.lightings[l].name,
@@ -252,7 +243,7 @@ void SolverState::BuildLightingScenes() {
         continue;
       }
     }
-    lighting_scenes[l] = std::make_unique<RayScene>(scene, l);
+    lighting_scenes[l] = std::make_unique<render::RayScene>(scene, l);
   }
   problems.ThrowIfAny();
 }
@@ -316,19 +307,19 @@ void SolverState::SelectFitSamples() {
     const Observation& o = obs[i];
     const MaterialState& m = materials[o.region];
     near[i] =
-        m.NeedsFit() && HasSpecularLobe(m.params.model) &&
+        m.NeedsFit() && recon::HasSpecularLobe(m.params.model) &&
         NearHighlight(*lighting_scenes[scene.photos[o.photo].lighting], o.position.cast<double>(),
                       o.view.cast<double>(), o.normal.cast<double>());
   }
-  igi::SelectFitSamples(fitted, near, size_t(options.max_highlight_samples),
-                        size_t(options.max_fit_samples), &obs);
+  igi::solver::SelectFitSamples(fitted, near, size_t(options.max_highlight_samples),
+                                size_t(options.max_fit_samples), &obs);
 }
 
 // The footprint of observation o's pixel or block (solver/inverse/gather.h): ray directions at unit
 // depth, so that they are affine in the pixel coordinates (exactly for PINHOLE; OPENCV's distortion
 // is linearised over the pixel).
 GatherQuery::Footprint SolverState::PixelFootprint(const Observation& o) const {
-  const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+  const recon::Camera& cam = scene.cameras[scene.photos[o.photo].camera];
   const Eigen::Quaterniond world_from_cam = cam.cam_from_world.rotation.conjugate();
   auto ray = [&](double u, double v) -> Eigen::Vector3d {
     const Eigen::Vector3d d =
@@ -370,7 +361,7 @@ void SolverState::GatherAll() {
       q.n_geo = fn.dot(o.view.cast<double>()) >= 0 ? fn : -fn;
       q.n_s = o.normal.cast<double>();
       q.view = o.view.cast<double>();
-      q.lobe = HasSpecularLobe(materials[o.region].params.model);
+      q.lobe = recon::HasSpecularLobe(materials[o.region].params.model);
       if (options.pixel_footprint) q.footprint = PixelFootprint(o);
       light.point[i] = static_cast<int>(queries.size());
       st.obs.push_back(int(i));
@@ -408,7 +399,7 @@ void SolverState::SummariseRegions() {
     if (m.unknown_rho_d) rs.unknowns.push_back("rho_d");
     if (m.unknown_rho_s) rs.unknowns.push_back("rho_s");
     if (m.unknown_alpha) {
-      if (IsAnisotropic(m.params.model)) {
+      if (recon::IsAnisotropic(m.params.model)) {
         rs.unknowns.push_back("alpha_x");
         rs.unknowns.push_back("alpha_y");
       } else {
@@ -436,7 +427,7 @@ void SolverState::ChooseTexelSize() {
   std::vector<double> footprints, photo_footprints;
   for (size_t i = 0; i < obs.size(); i += 7) {
     const Observation& o = obs[i];
-    const Camera& cam = scene.cameras[scene.photos[o.photo].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[o.photo].camera];
     const double d = (cam.CenterInWorld() - o.position.cast<double>()).norm();
     // The observations' spacing on the photo: the stride, widened where they were drawn.
     photo_footprints.push_back(d / cam.params[0] * options.pixel_stride);
@@ -535,7 +526,7 @@ int ScaleMapHeldAtOne(const Eigen::Vector3d& factor, Image* map) {
 // igi-diagnose can look for its cause.
 void SolverState::BoundReflectances(size_t r) {
   RegionSolution& rs = summary.regions[r];
-  BrdfParams& p = materials[r].params;
+  render::BrdfParams& p = materials[r].params;
   Eigen::Vector3d map_factor = Eigen::Vector3d::Ones();
   for (int c = 0; c < 3; ++c) {
     if (p.rho_d[c] > 1) {
@@ -562,4 +553,4 @@ void SolverState::BoundReflectances(size_t r) {
   }
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -41,7 +41,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 
 // What became of a region: kKnown (nothing to estimate), kSolved, kUnobserved (unknowns but no
 // observation: values are placeholders, or ρd fitted to the light it bounces), kNoHighlight (ρs
@@ -56,7 +56,7 @@ struct RegionSolution {
   RegionStatus status = RegionStatus::kKnown;  // RegionStatus (above); kKnown by default
   std::vector<std::string> unknowns;           // scene.json keys estimated
   RegionFitResult stage1, stage2;              // stage2 == final (stage1 when refinement is off)
-  BrdfParams final_params;                     // every value of the solved material
+  render::BrdfParams final_params;             // every value of the solved material
   int observations = 0;
   // Albedo map (when estimated): the image, its file name under the output folder, coverage.
   std::optional<Image> albedo_map;
@@ -166,14 +166,14 @@ struct SolveSummary {
   // The solved scene.json document (paths relative to the output folder) and any mesh with
   // generated texture charts (written as geometry/solved.obj).
   Json scene_document;
-  std::optional<TriangleMesh> charted_mesh;
+  std::optional<recon::TriangleMesh> charted_mesh;
 };
 
 // Solves `scene` (loaded with complete geometry). `out_dir` is only used to express the paths
 // of the returned scene document relative to it; nothing is written. Throws InputError for bad
 // input (a photographed lighting without light, a photo with no valid pixel, a photo whose size
 // differs from its camera's).
-SolveSummary Solve(const Scene& scene, const SolveOptions& options,
+SolveSummary Solve(const recon::Scene& scene, const SolveOptions& options,
                    const std::filesystem::path& out_dir);
 
 // The input scene.json document with every material value filled in
@@ -181,7 +181,7 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
 // them, rho_d_map where a map was estimated ("albedo/<region>.exr"), geometry replaced by
 // "geometry/solved.obj" when texture charts were generated; every other relative path rewritten
 // relative to `out_dir`.
-Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary,
+Json SolvedSceneDocument(const recon::Scene& scene, const SolveSummary& summary,
                          const std::filesystem::path& out_dir);
 
 // report.json (solver/inverse/solve_output.cpp).
@@ -192,4 +192,4 @@ Json SolveReportJson(const SolveSummary& summary, const SolveOptions& options);
 void WriteSolveOutputs(const SolveSummary& summary, const SolveOptions& options,
                        const std::filesystem::path& out_dir);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -29,7 +29,7 @@
 #include "solver/render/ray_scene.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::solver {
 
 // An albedo map as scene.json holds it when its region's fitted ρd exceeds 1 in some channel
 // (BoundReflectances): each channel whose `factor` is not 1 (1/ρd where ρd > 1) scaled by it and
@@ -47,13 +47,13 @@ inline constexpr int kReportMaxSide = 640;
 int ReportStride(int width, int height, int pixel_stride);
 
 struct SolverState {
-  const Scene& scene;
+  const recon::Scene& scene;
   SolveOptions options;
   SolveSummary summary;
   PatchSet patches;
   // The memory estimate (solver/inverse/solve_memory.h), planned before any photo is read.
   SolveMemoryEstimate memory;
-  std::vector<std::unique_ptr<RayScene>> lighting_scenes;  // per lighting (null: unused)
+  std::vector<std::unique_ptr<render::RayScene>> lighting_scenes;  // per lighting (null: unused)
   // The solve's three products, each a plain structure that the stages read and write: the
   // observations (and the draw they were collected under), the material estimate, and the
   // light modelled at the observations.
@@ -61,7 +61,7 @@ struct SolverState {
   MaterialEstimate materials;
   LightModel light;
 
-  SolverState(const Scene& s, const SolveOptions& o) : scene(s), options(o) {}
+  SolverState(const recon::Scene& s, const SolveOptions& o) : scene(s), options(o) {}
 
   // solve.cpp
   void Prepare();  // everything before the rays (Solve() then gathers and fits)
@@ -115,11 +115,11 @@ struct SolverState {
   // albedos), whatever the options write; as_written, exactly the regions BuildAlbedoMaps gives
   // a map (WritesMap) get the map from the observations (AlbedoMapOf): the report renders the
   // model scene.json holds.
-  Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
-                      const std::filesystem::path& temp_dir, bool as_written = false) const;
+  recon::Scene CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
+                             const std::filesystem::path& temp_dir, bool as_written = false) const;
   // The model's residual rendered at the observed pixels (report.json's render_residual, and
   // stage 2's acceptance test); `model` is CompleteScene's as_written.
-  void RenderResiduals(Scene model, int stage);
+  void RenderResiduals(recon::Scene model, int stage);
   // The albedo-map stage's view of the solve (solver/inverse/albedo_map_stage.h).
   MapStageData MapData() const;
   void BuildAlbedoMaps();
@@ -139,4 +139,4 @@ struct SolverState {
   void BoundReflectances(size_t r);
 };
 
-}  // namespace igi
+}  // namespace igi::solver

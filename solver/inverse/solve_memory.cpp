@@ -9,7 +9,7 @@
 #include "solver/render/brdf.h"
 #include "tools/common/memory.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // The process before it holds anything of the solve: its libraries, the thread pool, the scene.
@@ -18,15 +18,16 @@ constexpr double kProcessBytes = 256.0 * 1024 * 1024;
 constexpr double kTriangleBytes = 256;
 
 // Direct-light samples per gathered point: the largest over the photographed lightings.
-double DirectSamples(const Scene& scene, const SolveOptions& options) {
+double DirectSamples(const recon::Scene& scene, const SolveOptions& options) {
   double most = 1;
-  for (const Lighting& lighting : scene.lightings) {
+  for (const recon::Lighting& lighting : scene.lightings) {
     double n = 0;
     for (int index : lighting.lights) {
-      const Light& light = scene.lights[index];
-      const bool delta = light.type == LightType::kPoint || light.type == LightType::kSpot ||
-                         light.type == LightType::kDirectional;
-      if (light.type == LightType::kAmbient) continue;
+      const recon::Light& light = scene.lights[index];
+      const bool delta = light.type == recon::LightType::kPoint ||
+                         light.type == recon::LightType::kSpot ||
+                         light.type == recon::LightType::kDirectional;
+      if (light.type == recon::LightType::kAmbient) continue;
       n +=
           delta ? (options.pixel_footprint ? options.footprint_samples : 1) : options.light_samples;
     }
@@ -42,7 +43,7 @@ double SolveMemoryBudgetBytes(const SolveOptions& options) {
                                    : double(DefaultMemoryBudgetBytes());
 }
 
-SolveMemoryEstimate EstimateSolveMemory(const Scene& scene, const SolveOptions& options,
+SolveMemoryEstimate EstimateSolveMemory(const recon::Scene& scene, const SolveOptions& options,
                                         int patches) {
   SolveMemoryEstimate e;
   e.budget_bytes = SolveMemoryBudgetBytes(options);
@@ -71,14 +72,14 @@ SolveMemoryEstimate EstimateSolveMemory(const Scene& scene, const SolveOptions& 
                         (direct + 4 * std::max(rays, stage2_rays)) * 6 * sizeof(float);
 
   double lightings = 0;
-  for (const Lighting& l : scene.lightings) lightings += l.lights.empty() ? 0.0 : 1.0;
+  for (const recon::Lighting& l : scene.lightings) lightings += l.lights.empty() ? 0.0 : 1.0;
   lightings = std::max(1.0, lightings);
   const double triangles = double(scene.mesh.triangles.size());
   e.fixed_bytes = kProcessBytes + triangles * kTriangleBytes * lightings +
                   patches * (gathered + 200) * lightings;
   double largest = 0;
-  for (const Photo& p : scene.photos) {
-    const Camera& cam = scene.cameras[p.camera];
+  for (const recon::Photo& p : scene.photos) {
+    const recon::Camera& cam = scene.cameras[p.camera];
     const double pixels = double(cam.width) * cam.height;
     largest = std::max(largest, pixels);
     const double report = std::min(pixels, double(kReportMaxSide) * kReportMaxSide);
@@ -89,4 +90,4 @@ SolveMemoryEstimate EstimateSolveMemory(const Scene& scene, const SolveOptions& 
   return e;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -17,7 +17,7 @@
 #include "recon/scene.h"
 #include "solver/inverse/solve_options.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct SolveMemoryEstimate {
   double budget_bytes = 0;  // the budget it was planned against
@@ -36,10 +36,10 @@ struct SolveMemoryEstimate {
 };
 
 // The estimate for `scene` under `options` with `patches` patches.
-SolveMemoryEstimate EstimateSolveMemory(const Scene& scene, const SolveOptions& options,
+SolveMemoryEstimate EstimateSolveMemory(const recon::Scene& scene, const SolveOptions& options,
                                         int patches);
 
 // The memory budget `options` set, in bytes (memory_budget GiB, or DefaultMemoryBudgetBytes()).
 double SolveMemoryBudgetBytes(const SolveOptions& options);
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -18,16 +18,17 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // The mesh with per-corner vertices carrying each atlas's UVs (other regions keep theirs).
-TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases) {
+recon::TriangleMesh ApplyAtlases(const recon::TriangleMesh& mesh,
+                                 const std::vector<RegionAtlas>& atlases) {
   std::vector<const RegionAtlas*> of_region(mesh.region_names.size(), nullptr);
   for (const RegionAtlas& a : atlases) {
     if (a.generated && a.region >= 0 && a.region < int(of_region.size())) of_region[a.region] = &a;
   }
-  TriangleMesh out;
+  recon::TriangleMesh out;
   out.region_names = mesh.region_names;
   out.triangle_region = mesh.triangle_region;
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
@@ -51,9 +52,10 @@ TriangleMesh ApplyAtlases(const TriangleMesh& mesh, const std::vector<RegionAtla
 
 }  // namespace
 
-Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
-                                 const std::filesystem::path& temp_dir, bool as_written) const {
-  Scene model = scene;
+recon::Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<Image>* maps,
+                                        const std::filesystem::path& temp_dir,
+                                        bool as_written) const {
+  recon::Scene model = scene;
   const MapStageData data = MapData();
   const MapLight map_light = MapLightOf(data);
   atlases->clear();
@@ -62,12 +64,12 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
   for (size_t r = 0; r < materials.size(); ++r) {
     const MaterialState& m = materials[r];
     if (!m.reflective) continue;
-    Material& out = model.materials[r];
+    recon::Material& out = model.materials[r];
     if (!out.rho_d_map) out.rho_d = m.params.rho_d;
-    if (HasSpecularLobe(m.params.model)) {
+    if (recon::HasSpecularLobe(m.params.model)) {
       out.rho_s = m.params.rho_s;
       out.alpha = m.params.alpha;
-      if (IsAnisotropic(m.params.model)) {
+      if (recon::IsAnisotropic(m.params.model)) {
         out.alpha_x = m.params.alpha_x;
         out.alpha_y = m.params.alpha_y;
       }
@@ -102,16 +104,16 @@ Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::vector<
   return model;
 }
 
-void SolverState::RenderResiduals(Scene model, int stage) {
+void SolverState::RenderResiduals(recon::Scene model, int stage) {
   const auto start = std::chrono::steady_clock::now();
   // Two independent renders of kSpp/2 paths: Σ(r1 − p)(r2 − p) estimates Σ(r − p)² of the
   // noise-free render r without the render's own Monte Carlo variance (whose size at a few
   // paths per pixel would otherwise swamp the model's error).
   constexpr int kSpp = 16;
   summary.render_residual_spp = kSpp;
-  std::vector<std::unique_ptr<Renderer>> renderers(scene.lightings.size());
+  std::vector<std::unique_ptr<render::Renderer>> renderers(scene.lightings.size());
   for (size_t l = 0; l < scene.lightings.size(); ++l) {
-    if (light.lightings[l].active) renderers[l] = std::make_unique<Renderer>(model, int(l));
+    if (light.lightings[l].active) renderers[l] = std::make_unique<render::Renderer>(model, int(l));
   }
   std::vector<Eigen::Vector3d> pred(obs.size()), pred1(obs.size()), pred2(obs.size());
   Progress progress(fmt::format("igi-solve: rendering the stage-{} model", stage),
@@ -121,12 +123,12 @@ void SolverState::RenderResiduals(Scene model, int stage) {
       [&](int64_t i) {
         progress.Add(1);
         const Observation& o = obs[i];
-        const Photo& p = scene.photos[o.photo];
-        const Camera& cam = scene.cameras[p.camera];
+        const recon::Photo& p = scene.photos[o.photo];
+        const recon::Camera& cam = scene.cameras[p.camera];
         // Each path through its own point of the pixel or block (the photo's pixel is the mean
         // over its footprint; igi-render's box filter), stratified 2×2 per half.
         const uint64_t seed = options.seed * 7919 + uint64_t(i) * 2;
-        Pcg32 rng = PixelSampleRng(seed, uint64_t(i), 0xf00);
+        render::Pcg32 rng = render::PixelSampleRng(seed, uint64_t(i), 0xf00);
         Eigen::Vector3d half[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
         for (int k = 0; k < kSpp; ++k) {
           const int cell = (k / 2) % 4;
@@ -146,7 +148,7 @@ void SolverState::RenderResiduals(Scene model, int stage) {
   std::vector<double> num(scene.photos.size(), 0), den(scene.photos.size(), 0);
   double all_num = 0, all_den = 0;
   for (size_t k = 0; k < scene.photos.size(); ++k) {
-    const Camera& cam = scene.cameras[scene.photos[k].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[k].camera];
     PhotoResidual& pr = summary.residuals[k];
     pr.file = scene.photos[k].file.filename().string();
     const int stride = report_stride[k] = ReportStride(cam.width, cam.height, options.pixel_stride);
@@ -201,7 +203,7 @@ void SolverState::RefineRound(int round, const std::filesystem::path& temp_dir) 
   std::vector<RegionAtlas> atlases;
   std::vector<Image> maps;
   std::filesystem::create_directories(temp_dir);
-  const Scene model = CompleteScene(&atlases, &maps, temp_dir);
+  const recon::Scene model = CompleteScene(&atlases, &maps, temp_dir);
   const StageData stage = Stage();
   const RenderCost cost =
       RenderIncident(stage, model, RayEpsilons(), materials, uint64_t(round), &light);
@@ -334,7 +336,7 @@ void SolverState::BuildAlbedoMaps() {
   if (!generated.empty()) summary.charted_mesh = ApplyAtlases(scene.mesh, generated);
 }
 
-SolveSummary Solve(const Scene& scene, const SolveOptions& options,
+SolveSummary Solve(const recon::Scene& scene, const SolveOptions& options,
                    const std::filesystem::path& out_dir) {
   options.Validate();
   const auto start = std::chrono::steady_clock::now();
@@ -374,4 +376,4 @@ SolveSummary Solve(const Scene& scene, const SolveOptions& options,
   return std::move(s.summary);
 }
 
-}  // namespace igi
+}  // namespace igi::solver

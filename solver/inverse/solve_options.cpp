@@ -7,9 +7,10 @@
 #include <optional>
 #include <string_view>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // The text of a choice's problem, or nullopt when the choice is valid: with `typed` (the flag's
@@ -23,68 +24,43 @@ std::optional<std::string> BadChoice(E value, std::string_view (*name)(E),
   return std::to_string(int(value));
 }
 
-// The name of `value` among `values` with their `names` ("?" for a value outside them), and the
-// value a name spells (nullopt for any other name).
-template <typename E, size_t N>
-std::string_view NameOf(E value, const E (&values)[N], const std::string_view (&names)[N]) {
-  for (size_t i = 0; i < N; ++i) {
-    if (values[i] == value) return names[i];
-  }
-  return "?";
-}
-template <typename E, size_t N>
-std::optional<E> ValueOf(std::string_view name, const E (&values)[N],
-                         const std::string_view (&names)[N]) {
-  for (size_t i = 0; i < N; ++i) {
-    if (names[i] == name) return values[i];
-  }
-  return std::nullopt;
-}
-
-constexpr SpecularColour kSpecularColours[] = {SpecularColour::kGrey, SpecularColour::kRgb};
-constexpr std::string_view kSpecularColourNames[] = {"grey", "rgb"};
-constexpr AlbedoMaps kAlbedoMaps[] = {AlbedoMaps::kAuto, AlbedoMaps::kAll, AlbedoMaps::kNone};
-constexpr std::string_view kAlbedoMapsNames[] = {"auto", "all", "none"};
-constexpr AlbedoMapPass kAlbedoMapPasses[] = {AlbedoMapPass::kAuto, AlbedoMapPass::kAlways,
-                                              AlbedoMapPass::kNever};
-constexpr std::string_view kAlbedoMapPassNames[] = {"auto", "always", "never"};
-constexpr RefineUpdate kRefineUpdates[] = {RefineUpdate::kIndependent, RefineUpdate::kJoint,
-                                           RefineUpdate::kJointAlbedo};
-constexpr std::string_view kRefineUpdateNames[] = {"independent", "joint", "joint_albedo"};
-constexpr PhotoScaleMode kPhotoScaleModes[] = {PhotoScaleMode::kGiven, PhotoScaleMode::kSolve};
-constexpr std::string_view kPhotoScaleModeNames[] = {"given", "solve"};
+constexpr EnumNames<SpecularColour, 2> kSpecularColourNames{
+    {{SpecularColour::kGrey, "grey"}, {SpecularColour::kRgb, "rgb"}}};
+constexpr EnumNames<AlbedoMaps, 3> kAlbedoMapsNames{
+    {{AlbedoMaps::kAuto, "auto"}, {AlbedoMaps::kAll, "all"}, {AlbedoMaps::kNone, "none"}}};
+constexpr EnumNames<AlbedoMapPass, 3> kAlbedoMapPassNames{{{AlbedoMapPass::kAuto, "auto"},
+                                                           {AlbedoMapPass::kAlways, "always"},
+                                                           {AlbedoMapPass::kNever, "never"}}};
+constexpr EnumNames<RefineUpdate, 3> kRefineUpdateNames{
+    {{RefineUpdate::kIndependent, "independent"},
+     {RefineUpdate::kJoint, "joint"},
+     {RefineUpdate::kJointAlbedo, "joint_albedo"}}};
+constexpr EnumNames<PhotoScaleMode, 2> kPhotoScaleModeNames{
+    {{PhotoScaleMode::kGiven, "given"}, {PhotoScaleMode::kSolve, "solve"}}};
 
 }  // namespace
 
 std::string_view SpecularColourName(SpecularColour colour) {
-  return NameOf(colour, kSpecularColours, kSpecularColourNames);
+  return kSpecularColourNames.Name(colour);
 }
 std::optional<SpecularColour> SpecularColourFromName(std::string_view name) {
-  return ValueOf(name, kSpecularColours, kSpecularColourNames);
+  return kSpecularColourNames.FromName(name);
 }
-std::string_view AlbedoMapsName(AlbedoMaps maps) {
-  return NameOf(maps, kAlbedoMaps, kAlbedoMapsNames);
-}
+std::string_view AlbedoMapsName(AlbedoMaps maps) { return kAlbedoMapsNames.Name(maps); }
 std::optional<AlbedoMaps> AlbedoMapsFromName(std::string_view name) {
-  return ValueOf(name, kAlbedoMaps, kAlbedoMapsNames);
+  return kAlbedoMapsNames.FromName(name);
 }
-std::string_view AlbedoMapPassName(AlbedoMapPass pass) {
-  return NameOf(pass, kAlbedoMapPasses, kAlbedoMapPassNames);
-}
+std::string_view AlbedoMapPassName(AlbedoMapPass pass) { return kAlbedoMapPassNames.Name(pass); }
 std::optional<AlbedoMapPass> AlbedoMapPassFromName(std::string_view name) {
-  return ValueOf(name, kAlbedoMapPasses, kAlbedoMapPassNames);
+  return kAlbedoMapPassNames.FromName(name);
 }
-std::string_view RefineUpdateName(RefineUpdate update) {
-  return NameOf(update, kRefineUpdates, kRefineUpdateNames);
-}
+std::string_view RefineUpdateName(RefineUpdate update) { return kRefineUpdateNames.Name(update); }
 std::optional<RefineUpdate> RefineUpdateFromName(std::string_view name) {
-  return ValueOf(name, kRefineUpdates, kRefineUpdateNames);
+  return kRefineUpdateNames.FromName(name);
 }
-std::string_view PhotoScaleModeName(PhotoScaleMode mode) {
-  return NameOf(mode, kPhotoScaleModes, kPhotoScaleModeNames);
-}
+std::string_view PhotoScaleModeName(PhotoScaleMode mode) { return kPhotoScaleModeNames.Name(mode); }
 std::optional<PhotoScaleMode> PhotoScaleModeFromName(std::string_view name) {
-  return ValueOf(name, kPhotoScaleModes, kPhotoScaleModeNames);
+  return kPhotoScaleModeNames.FromName(name);
 }
 
 int FinalRoundRays(int refine_final_rays, int observations) {
@@ -178,4 +154,4 @@ void SolveOptions::SetChoices(const SolveChoiceFlags& flags) {
   Problems(*this, &flags).ThrowIfAny();
 }
 
-}  // namespace igi
+}  // namespace igi::solver

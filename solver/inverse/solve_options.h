@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace igi {
+namespace igi::solver {
 
 // The specular reflectance's colour: one ρs for every channel (kGrey: dielectrics, RADIANCE
 // plastic) or one per channel (kRgb: metals).
@@ -212,4 +212,4 @@ constexpr bool IsJointUpdate(RefineUpdate update) {
   return update == RefineUpdate::kJoint || update == RefineUpdate::kJointAlbedo;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

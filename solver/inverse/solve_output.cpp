@@ -11,7 +11,7 @@
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 namespace fs = std::filesystem;
 namespace {
 
@@ -24,7 +24,7 @@ std::string SeenFile(const std::string& map_file) {
 Json Num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json Vec(const Eigen::Vector3d& v) { return Json::array({Num(v[0]), Num(v[1]), Num(v[2])}); }
 
-Json FitJson(const RegionFitResult& f, BrdfModel model) {
+Json FitJson(const RegionFitResult& f, recon::BrdfModel model) {
   Json j;
   if (!f.fitted) {
     j["fitted"] = false;
@@ -33,10 +33,10 @@ Json FitJson(const RegionFitResult& f, BrdfModel model) {
   }
   j["rho_d"] = Vec(f.rho_d);
   j["sigma_rho_d"] = Vec(f.sigma_rho_d);
-  if (HasSpecularLobe(model)) {
+  if (recon::HasSpecularLobe(model)) {
     j["rho_s"] = Vec(f.rho_s);
     j["sigma_rho_s"] = Num(f.sigma_rho_s);
-    if (IsAnisotropic(model)) {
+    if (recon::IsAnisotropic(model)) {
       j["alpha_x"] = Num(f.alpha_x);
       j["alpha_y"] = Num(f.alpha_y);
       j["sigma_alpha_x"] = Num(f.sigma_alpha_x);
@@ -56,8 +56,9 @@ Json FitJson(const RegionFitResult& f, BrdfModel model) {
 
 }  // namespace
 
-Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const fs::path& out) {
-  SceneDocument doc(scene.document);
+Json SolvedSceneDocument(const recon::Scene& scene, const SolveSummary& summary,
+                         const fs::path& out) {
+  recon::SceneDocument doc(scene.document);
   doc.RebasePaths(scene.dir, out);
   if (summary.charted_mesh) doc.SetGeometryFiles({"geometry/solved.obj"});
   if (summary.photo_scale) {
@@ -68,14 +69,14 @@ Json SolvedSceneDocument(const Scene& scene, const SolveSummary& summary, const 
   for (size_t r = 0; r < scene.materials.size(); ++r) {
     const std::string& name = scene.materials[r].name;
     const RegionSolution& rs = summary.regions[r];
-    const BrdfParams& p = rs.final_params;
-    if (!IsReflective(scene.materials[r].brdf)) continue;
+    const render::BrdfParams& p = rs.final_params;
+    if (!recon::IsReflective(scene.materials[r].brdf)) continue;
     doc.SetMaterialValue(name, "rho_d", Vec(p.rho_d));
     if (!rs.albedo_map_file.empty()) doc.SetMaterialValue(name, "rho_d_map", rs.albedo_map_file);
-    if (HasSpecularLobe(p.model)) {
+    if (recon::HasSpecularLobe(p.model)) {
       const bool grey = p.rho_s[0] == p.rho_s[1] && p.rho_s[1] == p.rho_s[2];
       doc.SetMaterialValue(name, "rho_s", grey ? Json(p.rho_s[0]) : Vec(p.rho_s));
-      if (IsAnisotropic(p.model)) {
+      if (recon::IsAnisotropic(p.model)) {
         doc.SetMaterialValue(name, "alpha_x", p.alpha_x);
         doc.SetMaterialValue(name, "alpha_y", p.alpha_y);
       } else {
@@ -282,4 +283,4 @@ void WriteSolveOutputs(const SolveSummary& s, const SolveOptions& o, const fs::p
   WriteJsonFile(out / "scene.json", s.scene_document);
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -7,7 +7,7 @@
 #include "solver/inverse/solve.h"
 #include "tools/common/html_report.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 std::string Fmt(double v, int digits = 4) {
@@ -23,12 +23,12 @@ std::string Rgb(const Eigen::Vector3d& v) {
 void ParameterTable(HtmlReport* page, const SolveSummary& s) {
   std::vector<std::vector<std::string>> rows, classes;
   for (const RegionSolution& r : s.regions) {
-    const BrdfParams& p = r.final_params;
+    const render::BrdfParams& p = r.final_params;
     const RegionFitResult& f1 = r.stage1;
     const RegionFitResult& f2 = r.stage2;
-    const bool spec = HasSpecularLobe(p.model);
+    const bool spec = recon::HasSpecularLobe(p.model);
     std::string alpha1 = "", alpha2 = "";
-    if (spec && IsAnisotropic(p.model)) {
+    if (spec && recon::IsAnisotropic(p.model)) {
       alpha1 = fmt::format("{} / {}", Fmt(f1.alpha_x), Fmt(f1.alpha_y));
       alpha2 = fmt::format("{} / {}", FmtPm(f2.alpha_x, f2.sigma_alpha_x),
                            FmtPm(f2.alpha_y, f2.sigma_alpha_y));
@@ -37,7 +37,7 @@ void ParameterTable(HtmlReport* page, const SolveSummary& s) {
       alpha2 = FmtPm(p.alpha, f2.sigma_alpha);
     }
     const bool fitted = f2.fitted;
-    rows.push_back({r.name, std::string(BrdfModelName(p.model)),
+    rows.push_back({r.name, std::string(recon::BrdfModelName(p.model)),
                     std::string(RegionStatusName(r.status)), std::to_string(r.observations),
                     fitted ? Rgb(f1.rho_d) : "", Rgb(p.rho_d),
                     spec && fitted ? Fmt(f1.rho_s.mean()) : "",
@@ -144,4 +144,4 @@ void WriteSolveReportHtml(const SolveSummary& s, const Json& /*report*/,
   page.Write(path);
 }
 
-}  // namespace igi
+}  // namespace igi::solver

@@ -8,7 +8,7 @@
 
 #include "solver/inverse/uv_charts.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct TexelSplat {
   int x[4] = {0, 0, 0, 0}, y[4] = {0, 0, 0, 0};  // clamped texel columns and rows
@@ -34,4 +34,4 @@ inline TexelSplat BilinearTexelSplat(const RegionAtlas& atlas, int triangle, dou
   return s;
 }
 
-}  // namespace igi
+}  // namespace igi::solver

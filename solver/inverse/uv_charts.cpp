@@ -12,7 +12,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::solver {
 
 namespace {
 
@@ -38,7 +38,7 @@ struct Face {
   double area_m2 = 0;
 };
 
-Face MakeFace(const TriangleMesh& mesh, int t) {
+Face MakeFace(const recon::TriangleMesh& mesh, int t) {
   const Eigen::Vector3i& tri = mesh.triangles[t];
   const Eigen::Vector3d p0 = mesh.positions[tri[0]].cast<double>();
   const Eigen::Vector3d cross = (mesh.positions[tri[1]].cast<double>() - p0)
@@ -53,7 +53,8 @@ Face MakeFace(const TriangleMesh& mesh, int t) {
 
 // Area-weighted world length (metres) of a unit step in u and in v, or nullopt-like false when
 // the region's UVs are not usable.
-bool MeshUvScale(const TriangleMesh& mesh, const std::vector<int>& tris, Eigen::Vector2d* scale_m) {
+bool MeshUvScale(const recon::TriangleMesh& mesh, const std::vector<int>& tris,
+                 Eigen::Vector2d* scale_m) {
   if (!mesh.has_uvs() || mesh.uvs.size() != mesh.positions.size()) return false;
   double good_area = 0, bad_area = 0;
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
@@ -84,7 +85,7 @@ bool MeshUvScale(const TriangleMesh& mesh, const std::vector<int>& tris, Eigen::
   return true;
 }
 
-void FillFromMeshUvs(const TriangleMesh& mesh, const Eigen::Vector2d& scale_m,
+void FillFromMeshUvs(const recon::TriangleMesh& mesh, const Eigen::Vector2d& scale_m,
                      const AtlasOptions& options, RegionAtlas* atlas) {
   const double largest_m = scale_m.maxCoeff();
   atlas->texel_size_m = std::max(options.texel_size_m, largest_m / options.max_size);
@@ -105,7 +106,8 @@ void FillFromMeshUvs(const TriangleMesh& mesh, const Eigen::Vector2d& scale_m,
 
 // Per local triangle, the local triangles sharing an edge with it (positions welded exactly, so
 // meshes with unshared vertices, e.g. flat-shaded ones, still connect).
-std::vector<std::vector<int>> Neighbours(const TriangleMesh& mesh, const std::vector<int>& tris) {
+std::vector<std::vector<int>> Neighbours(const recon::TriangleMesh& mesh,
+                                         const std::vector<int>& tris) {
   std::map<std::array<float, 3>, int> weld;
   std::vector<std::pair<uint64_t, int>> edges;  // (edge key, local triangle)
   edges.reserve(tris.size() * 3);
@@ -261,7 +263,7 @@ Eigen::Vector2d BestDirection(const std::vector<Eigen::Vector2d>& points) {
   return best;
 }
 
-ProjectedChart ProjectChart(const TriangleMesh& mesh, const std::vector<int>& tris,
+ProjectedChart ProjectChart(const recon::TriangleMesh& mesh, const std::vector<int>& tris,
                             const std::vector<Face>& faces, const std::vector<int>& members) {
   Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
   for (int m : members) normal_sum += faces[m].normal * faces[m].area_m2;
@@ -401,7 +403,8 @@ double FittingTexelSize(const std::vector<ProjectedChart>& charts, const AtlasOp
   return big;
 }
 
-void GenerateCharts(const TriangleMesh& mesh, const AtlasOptions& options, RegionAtlas* atlas) {
+void GenerateCharts(const recon::TriangleMesh& mesh, const AtlasOptions& options,
+                    RegionAtlas* atlas) {
   const std::vector<int>& tris = atlas->triangles;
   std::vector<Face> faces;
   for (int t : tris) faces.push_back(MakeFace(mesh, t));
@@ -460,7 +463,8 @@ Eigen::Vector2d RegionAtlas::UvAt(int triangle, double b1, double b2) const {
          b2 * uv[2].cast<double>();
 }
 
-RegionAtlas BuildRegionAtlas(const TriangleMesh& mesh, int region, const AtlasOptions& options) {
+RegionAtlas BuildRegionAtlas(const recon::TriangleMesh& mesh, int region,
+                             const AtlasOptions& options) {
   options.Validate();
   if (region < 0 || region >= static_cast<int>(mesh.region_names.size())) {
     throw Error("BuildRegionAtlas: region " + std::to_string(region) + " is not in the mesh");
@@ -496,7 +500,7 @@ RegionAtlas BuildRegionAtlas(const TriangleMesh& mesh, int region, const AtlasOp
   return atlas;
 }
 
-void WriteObjWithAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases,
+void WriteObjWithAtlases(const recon::TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases,
                          const std::filesystem::path& path) {
   std::vector<const RegionAtlas*> atlas_of(mesh.region_names.size(), nullptr);
   for (const RegionAtlas& atlas : atlases) {
@@ -543,4 +547,4 @@ void WriteObjWithAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas
   WriteFileAtomic(path, text);
 }
 
-}  // namespace igi
+}  // namespace igi::solver

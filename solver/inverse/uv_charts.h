@@ -15,7 +15,7 @@
 
 #include "recon/mesh.h"
 
-namespace igi {
+namespace igi::solver {
 
 struct AtlasOptions {
   double texel_size_m = 0.01;  // world size of one texel (metres), > 0
@@ -58,14 +58,15 @@ struct RegionAtlas {
 // bounding rectangle, at exactly the texel size, and shelf-packs the chart rectangles with
 // gutters. Throws InputError when the region has no triangles, igi::Error when even the largest
 // texel size tried cannot fit the charts into max_size.
-RegionAtlas BuildRegionAtlas(const TriangleMesh& mesh, int region, const AtlasOptions& options);
+RegionAtlas BuildRegionAtlas(const recon::TriangleMesh& mesh, int region,
+                             const AtlasOptions& options);
 
 // Writes every triangle of `mesh` as OBJ: `v` per vertex, `vt` per triangle corner, `vn` per
 // vertex (when the mesh has normals), faces grouped by region in region order (`usemtl NAME`),
 // each group's triangles in mesh order. Corner UVs come from the atlas of the triangle's region in
 // `atlases` when there is one, else from the mesh's UVs, else (0, 0). Atomic. Throws igi::Error
 // when an atlas does not belong to this mesh (size mismatch) or the write fails.
-void WriteObjWithAtlases(const TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases,
+void WriteObjWithAtlases(const recon::TriangleMesh& mesh, const std::vector<RegionAtlas>& atlases,
                          const std::filesystem::path& path);
 
-}  // namespace igi
+}  // namespace igi::solver

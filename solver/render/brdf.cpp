@@ -5,7 +5,7 @@
 #include <string>
 #include <utility>
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 void CheckRgb(const Eigen::Vector3d& rho, const std::string& key,
@@ -30,15 +30,15 @@ double Mean(const Eigen::Vector3d& v) { return (v[0] + v[1] + v[2]) / 3.0; }
 std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
   std::vector<BrdfParamProblem> problems;
   CheckRgb(params.rho_d, "rho_d", &problems);
-  if (HasSpecularLobe(params.model)) {
+  if (recon::HasSpecularLobe(params.model)) {
     CheckRgb(params.rho_s, "rho_s", &problems);
-    if (IsAnisotropic(params.model)) {
+    if (recon::IsAnisotropic(params.model)) {
       CheckAlpha(params.alpha_x, "alpha_x", &problems);
       CheckAlpha(params.alpha_y, "alpha_y", &problems);
     } else {
       CheckAlpha(params.alpha, "alpha", &problems);
     }
-    if (HasFresnel(params.model) && !(std::isfinite(params.ior) && params.ior > 1.0)) {
+    if (recon::HasFresnel(params.model) && !(std::isfinite(params.ior) && params.ior > 1.0)) {
       problems.push_back({"ior", params.ior, "must be finite and > 1"});
     }
   }
@@ -46,7 +46,7 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
 }
 
 double SpecularLobeProbability(const BrdfParams& params) {
-  if (!HasSpecularLobe(params.model)) return 0.0;
+  if (!recon::HasSpecularLobe(params.model)) return 0.0;
   const double diffuse = Mean(params.rho_d);
   const double specular = Mean(params.rho_s);
   const double total = diffuse + specular;
@@ -78,9 +78,10 @@ BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& w
   // cosθh = h.z/|h| and wo·ĥ = |h|/2 (since |wo + wi|² = 2 + 2 wo·wi).
   out.pdf += p_specular * lobe * h2 / (2.0 * kPi * ax * ay * hz2 * h.z());
   if (above) {
-    double s = IsGmd(params.model) ? h2 * lobe / (kPi * ax * ay * hz2 * hz2)
-                                   : lobe / (4.0 * kPi * ax * ay * std::sqrt(wo.z() * wi.z()));
-    if (HasFresnel(params.model)) s *= FresnelWeight<double>(params.ior, wo, wi);
+    double s = recon::IsGmd(params.model)
+                   ? h2 * lobe / (kPi * ax * ay * hz2 * hz2)
+                   : lobe / (4.0 * kPi * ax * ay * std::sqrt(wo.z() * wi.z()));
+    if (recon::HasFresnel(params.model)) s *= FresnelWeight<double>(params.ior, wo, wi);
     out.f += params.rho_s * s;
   }
   return out;
@@ -120,4 +121,4 @@ double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen:
   return EvalBrdfAndPdf(params, wo, wi).pdf;
 }
 
-}  // namespace igi
+}  // namespace igi::render

@@ -49,7 +49,7 @@
 #include "recon/brdf_model.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::render {
 
 // The `"brdf"` names of docs/scene-format.md that are reflectance models ("emitter" and "black" are
 // not: the renderer handles them).
@@ -61,7 +61,7 @@ namespace igi {
 // ignore `alpha`; lambert reads rho_d only. Roughnesses are dimensionless (RMS slope), > 0.
 template <typename T>
 struct BrdfParamsT {
-  BrdfModel model = BrdfModel::kLambert;
+  recon::BrdfModel model = recon::BrdfModel::kLambert;
   Eigen::Matrix<T, 3, 1> rho_d = Eigen::Matrix<T, 3, 1>::Zero();  // diffuse albedo, RGB
   Eigen::Matrix<T, 3, 1> rho_s = Eigen::Matrix<T, 3, 1>::Zero();  // specular reflectance, RGB
   T alpha = T(0.1);
@@ -70,8 +70,8 @@ struct BrdfParamsT {
   T ior = T(1.5);  // index of refraction, read by the *_fresnel models only; > 1
 
   // The roughness along t and along b that the model uses.
-  T AlphaX() const { return IsAnisotropic(model) ? alpha_x : alpha; }
-  T AlphaY() const { return IsAnisotropic(model) ? alpha_y : alpha; }
+  T AlphaX() const { return recon::IsAnisotropic(model) ? alpha_x : alpha; }
+  T AlphaY() const { return recon::IsAnisotropic(model) ? alpha_y : alpha; }
 };
 using BrdfParams = BrdfParamsT<double>;
 
@@ -90,32 +90,32 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params);
 // wi is at or below the surface. Isotropic models take alpha_x = alpha_y = alpha. For a
 // *_fresnel model it is S of the plain model (without the Fresnel weight W).
 template <typename T>
-T SpecularFactor(BrdfModel model, const T& alpha_x, const T& alpha_y,
+T SpecularFactor(recon::BrdfModel model, const T& alpha_x, const T& alpha_y,
                  const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
   using std::exp;
   using std::sqrt;
-  if (!HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return T(0.0);
+  if (!recon::HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return T(0.0);
   const Eigen::Matrix<T, 3, 1> h = wo + wi;
   const T hz2 = h.z() * h.z();
   const T slope_x = h.x() / alpha_x;
   const T slope_y = h.y() / alpha_y;
   const T lobe = exp(-(slope_x * slope_x + slope_y * slope_y) / hz2);
-  if (IsGmd(model)) return h.squaredNorm() * lobe / (T(kPi) * alpha_x * alpha_y * hz2 * hz2);
+  if (recon::IsGmd(model)) return h.squaredNorm() * lobe / (T(kPi) * alpha_x * alpha_y * hz2 * hz2);
   return lobe / (T(4.0 * kPi) * alpha_x * alpha_y * sqrt(wo.z() * wi.z()));
 }
 
 // SpecularFactor split into the parts that do not depend on the roughness, for searches over α:
 // S = g·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y). False (parts unset) when S is 0 at every α (no lobe,
 // or wo or wi at or below the surface).
-inline bool SpecularFactorParts(BrdfModel model, const Eigen::Vector3d& wo,
+inline bool SpecularFactorParts(recon::BrdfModel model, const Eigen::Vector3d& wo,
                                 const Eigen::Vector3d& wi, double* q_x, double* q_y, double* g) {
-  if (!HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return false;
+  if (!recon::HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return false;
   const Eigen::Vector3d h = wo + wi;
   const double hz2 = h.z() * h.z();
   *q_x = h.x() * h.x() / hz2;
   *q_y = h.y() * h.y() / hz2;
-  *g = IsGmd(model) ? h.squaredNorm() / (kPi * hz2 * hz2)
-                    : 1.0 / (4.0 * kPi * std::sqrt(wo.z() * wi.z()));
+  *g = recon::IsGmd(model) ? h.squaredNorm() / (kPi * hz2 * hz2)
+                           : 1.0 / (4.0 * kPi * std::sqrt(wo.z() * wi.z()));
   return true;
 }
 
@@ -138,9 +138,9 @@ Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matri
                                 const Eigen::Matrix<T, 3, 1>& wi) {
   if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) return Eigen::Matrix<T, 3, 1>::Zero();
   Eigen::Matrix<T, 3, 1> f = params.rho_d * T(kInvPi);
-  if (HasSpecularLobe(params.model)) {
+  if (recon::HasSpecularLobe(params.model)) {
     T s = SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
-    if (HasFresnel(params.model)) s *= FresnelWeight<T>(params.ior, wo, wi);
+    if (recon::HasFresnel(params.model)) s *= FresnelWeight<T>(params.ior, wo, wi);
     f += params.rho_s * s;
   }
   return f;
@@ -190,7 +190,8 @@ BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& w
 // the direction. wo at or below the surface gives an invalid sample. Lambert ignores u_lobe.
 inline BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo, double u_lobe,
                              const Eigen::Vector2d& u) {
-  if (HasSpecularLobe(params.model)) return brdf_internal::SampleGlossyBrdf(params, wo, u_lobe, u);
+  if (recon::HasSpecularLobe(params.model))
+    return brdf_internal::SampleGlossyBrdf(params, wo, u_lobe, u);
   BrdfSample sample;  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd exactly
   if (!(wo.z() > 0.0)) return sample;
   sample.lobe = BrdfLobe::kDiffuse;
@@ -209,7 +210,8 @@ double BrdfPdf(const BrdfParams& params, const Eigen::Vector3d& wo, const Eigen:
 // EvalBrdf and BrdfPdf together (BrdfEval above).
 inline BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& wo,
                                const Eigen::Vector3d& wi) {
-  if (HasSpecularLobe(params.model)) return brdf_internal::EvalGlossyBrdfAndPdf(params, wo, wi);
+  if (recon::HasSpecularLobe(params.model))
+    return brdf_internal::EvalGlossyBrdfAndPdf(params, wo, wi);
   BrdfEval out;  // lambert: no lobe choice, no half vector
   if (!(wo.z() > 0.0)) return out;
   if (wi.z() > 0.0) out.f = params.rho_d * kInvPi;
@@ -217,4 +219,4 @@ inline BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& 
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::render

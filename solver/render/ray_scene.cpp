@@ -2,14 +2,15 @@
 
 #include "solver/render/render_internal.h"
 
-namespace igi {
+namespace igi::render {
 
-RayScene::RayScene(const Scene& scene, int lighting) : scene_(BuildRenderScene(scene, lighting)) {}
+RayScene::RayScene(const recon::Scene& scene, int lighting)
+    : scene_(BuildRenderScene(scene, lighting)) {}
 RayScene::~RayScene() = default;
 RayScene::RayScene(RayScene&&) noexcept = default;
 RayScene& RayScene::operator=(RayScene&&) noexcept = default;
 
-const Scene& RayScene::scene() const { return *scene_->scene; }
+const recon::Scene& RayScene::scene() const { return *scene_->scene; }
 int RayScene::lighting() const { return scene_->lighting; }
 double RayScene::ray_epsilon() const { return scene_->ray_epsilon; }
 
@@ -27,7 +28,7 @@ std::optional<SurfaceHit> RayScene::TraceSurface(const Eigen::Vector3d& origin,
                                                  const Eigen::Vector3d& dir) const {
   const std::optional<Hit> hit = scene_->Intersect(origin, dir);
   if (!hit || hit->geometry != 0 || hit->sphere_light >= 0) return std::nullopt;
-  const TriangleMesh& mesh = scene_->scene->mesh;
+  const recon::TriangleMesh& mesh = scene_->scene->mesh;
   SurfaceHit s;
   s.triangle = hit->primitive;
   s.b1 = hit->u;
@@ -60,8 +61,8 @@ bool RayScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& di
 }
 
 int RayScene::num_lights() const { return static_cast<int>(scene_->lights.size()); }
-LightType RayScene::light_type(int light) const { return scene_->lights[light].type; }
-const Light* RayScene::light(int light) const { return scene_->lights[light].light; }
+recon::LightType RayScene::light_type(int light) const { return scene_->lights[light].type; }
+const recon::Light* RayScene::light(int light) const { return scene_->lights[light].light; }
 
 LightSample RayScene::SampleLight(int light, const Eigen::Vector3d& point,
                                   const Eigen::Vector3d& u) const {
@@ -73,4 +74,4 @@ const Eigen::Vector3d& RayScene::face_normal(int triangle) const {
 }
 const ShadingMaterial& RayScene::material(int region) const { return scene_->materials[region]; }
 
-}  // namespace igi
+}  // namespace igi::render

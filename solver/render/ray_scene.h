@@ -14,13 +14,13 @@
 #include "solver/render/brdf.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::render {
 
 struct RenderScene;  // the renderer's prepared scene (solver/render/render_internal.h)
 
 // A surface's reflectance, ready to shade.
 struct ShadingMaterial {
-  BrdfModel model = BrdfModel::kLambert;
+  recon::BrdfModel model = recon::BrdfModel::kLambert;
   BrdfParams params;                                   // rho_d replaced per hit when textured
   std::optional<Eigen::Vector3d> tangent;              // anisotropic models (world)
   std::shared_ptr<const Image> rho_d_map;              // linear albedo texture
@@ -28,7 +28,7 @@ struct ShadingMaterial {
 };
 
 // `m` ready to shade (its albedo map read, if any; unknown values as placeholders).
-ShadingMaterial MakeShadingMaterial(const Material& m);
+ShadingMaterial MakeShadingMaterial(const recon::Material& m);
 
 // Texture lookup: bilinear, u right and v up (v = 0 is the bottom row); coordinates outside
 // [0, 1] repeat, texels at the borders clamp. RGB of a 3-channel linear texture.
@@ -65,12 +65,12 @@ class RayScene {
  public:
   // `scene` must have complete materials and outlive this object. Throws InputError as the
   // Renderer does (no light and no emitter material, an unreadable texture).
-  RayScene(const Scene& scene, int lighting);
+  RayScene(const recon::Scene& scene, int lighting);
   ~RayScene();
   RayScene(RayScene&&) noexcept;
   RayScene& operator=(RayScene&&) noexcept;
 
-  const Scene& scene() const;
+  const recon::Scene& scene() const;
   int lighting() const;
   // Offset along the normal that keeps a ray leaving a surface from hitting it again, metres.
   double ray_epsilon() const;
@@ -91,8 +91,8 @@ class RayScene {
   // The lighting's emitters: its lights, then (when the scene has emitter materials) one
   // emitter standing for all of their triangles, of type kArea.
   int num_lights() const;
-  LightType light_type(int light) const;
-  const Light* light(int light) const;  // nullptr for the emitter-material set
+  recon::LightType light_type(int light) const;
+  const recon::Light* light(int light) const;  // nullptr for the emitter-material set
   // A direction toward `light` from `point`, from the uniform numbers `u` in [0, 1)³.
   LightSample SampleLight(int light, const Eigen::Vector3d& point, const Eigen::Vector3d& u) const;
 
@@ -108,4 +108,4 @@ class RayScene {
   std::unique_ptr<RenderScene> scene_;
 };
 
-}  // namespace igi
+}  // namespace igi::render

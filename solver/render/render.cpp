@@ -19,7 +19,7 @@
 #include "tools/common/parallel.h"
 #include "tools/common/progress.h"
 
-namespace igi {
+namespace igi::render {
 
 Eigen::Vector3d SampleTexture(const Image& tex, Eigen::Vector2d uv) {
   for (int k = 0; k < 2; ++k) {
@@ -123,13 +123,13 @@ VertexShares AlbedoShares(const Eigen::Vector3d& rho_d, const Eigen::Vector3d& a
 
 // The uniform numbers SampleLight reads for a light of `type`: none for the delta lights, two for
 // a sphere (the cone's θ and φ), three otherwise (triangle, then a point on it).
-Eigen::Vector3d LightNumbers(LightType type, Pcg32& rng) {
+Eigen::Vector3d LightNumbers(recon::LightType type, Pcg32& rng) {
   switch (type) {
-    case LightType::kPoint:
-    case LightType::kSpot:
-    case LightType::kDirectional:
+    case recon::LightType::kPoint:
+    case recon::LightType::kSpot:
+    case recon::LightType::kDirectional:
       return Eigen::Vector3d::Zero();
-    case LightType::kSphere: {
+    case recon::LightType::kSphere: {
       const double u0 = rng.UniformDouble();
       return {u0, rng.UniformDouble(), 0.0};
     }
@@ -146,7 +146,7 @@ class PathTracer {
   PathTracer(const RenderScene& impl, const RenderOptions& options)
       : impl_(impl), options_(options) {
     for (int l = 0; l < static_cast<int>(impl.lights.size()); ++l) {
-      if (impl.lights[l].type == LightType::kAmbient) {
+      if (impl.lights[l].type == recon::LightType::kAmbient) {
         ambient_ += impl.lights[l].light->radiance;
       } else {
         sampled_lights_.push_back(l);
@@ -210,7 +210,7 @@ Eigen::Vector3d PathTracer::AddAmbient(PathState* s, const BrdfParams& params,
                                        Eigen::Vector3d* albedo) const {
   *albedo = params.rho_d;
   if (!(ambient_.maxCoeff() > 0) || !(wo_local.z() > 0)) return Eigen::Vector3d::Zero();
-  if (HasSpecularLobe(params.model) && params.rho_s.maxCoeff() > 0) {
+  if (recon::HasSpecularLobe(params.model) && params.rho_s.maxCoeff() > 0) {
     BrdfParams lobe = params;  // ρd = 0: the draw comes from the specular lobe, pdf its own
     lobe.rho_d.setZero();
     const BrdfSample bs = SampleBrdf(lobe, wo_local, 0.0, rng.Uniform2D());
@@ -239,8 +239,8 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
   // reach, with MIS weight 1 there (fireflies of the light's full radiance). Delta lights keep
   // the shading point itself (exact falloff).
   const Eigen::Vector3d origin = p + n_geo * impl_.ray_epsilon;
-  const LightType type = impl_.lights[light].type;
-  const bool hittable = type == LightType::kSphere || type == LightType::kArea;
+  const recon::LightType type = impl_.lights[light].type;
+  const bool hittable = type == recon::LightType::kSphere || type == recon::LightType::kArea;
   const LightSample ls = impl_.SampleLight(light, hittable ? origin : p, LightNumbers(type, rng));
   if (!(ls.pdf > 0) || !(ls.value.maxCoeff() > 0) || !(ls.wi.dot(n_geo) > 0)) return none;
   const Eigen::Vector3d wi_local = frame.ToLocal(ls.wi);
@@ -267,8 +267,8 @@ Eigen::Vector3d PathTracer::SampleDirectLight(PathState* s, const Eigen::Vector3
 Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, Pcg32& rng,
                                   uint64_t* rays, bool reflected_only,
                                   PathDerivative* derivative) const {
-  const Scene& scene = *impl_.scene;
-  const TriangleMesh& mesh = scene.mesh;
+  const recon::Scene& scene = *impl_.scene;
+  const recon::TriangleMesh& mesh = scene.mesh;
   PathState s;
   for (int bounce = 0;; ++bounce) {
     ++s.rays;
@@ -276,7 +276,7 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     if (!hit) break;
     const Eigen::Vector3d p = origin + hit->t * dir;
     if (hit->sphere_light >= 0) {
-      const Light& l = *impl_.lights[hit->sphere_light].light;
+      const recon::Light& l = *impl_.lights[hit->sphere_light].light;
       if (!(reflected_only && bounce == 0)) {
         const Eigen::Vector3d term =
             AddEmission(&s, hit->sphere_light, l.radiance, dir, p, (p - l.center).normalized());
@@ -303,7 +303,7 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
           AddEmission(&s, impl_.emitter_material_light, m.emission, dir, p, n_geo);
       if (derivative != nullptr) derivative->Add(term);
     }
-    if (!IsReflective(m.model)) break;  // emitters and black surfaces absorb
+    if (!recon::IsReflective(m.model)) break;  // emitters and black surfaces absorb
     const double b0 = 1.0 - hit->u - hit->v;
     const Eigen::Vector3i& tri = mesh.triangles[tri_index];
     Eigen::Vector3d n_s = n_geo;
@@ -348,7 +348,7 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
     }
 
     // Lambert has one lobe: no number to pick it.
-    const double u_lobe = HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;
+    const double u_lobe = recon::HasSpecularLobe(params.model) ? rng.UniformDouble() : 0.0;
     const Eigen::Vector2d u_dir = rng.Uniform2D();
     const BrdfSample bs = SampleBrdf(params, wo_local, u_lobe, u_dir);
     if (!bs.Valid()) break;
@@ -373,8 +373,8 @@ Eigen::Vector3d PathTracer::Trace(Eigen::Vector3d origin, Eigen::Vector3d dir, P
   return s.radiance;
 }
 
-Camera ScaledCamera(const Camera& camera, int width, int height) {
-  Camera out = camera;
+recon::Camera ScaledCamera(const recon::Camera& camera, int width, int height) {
+  recon::Camera out = camera;
   if (width <= 0 || height <= 0 || (width == camera.width && height == camera.height)) return out;
   const double sx = double(width) / camera.width, sy = double(height) / camera.height;
   out.params[0] *= sx;
@@ -400,14 +400,14 @@ void RenderOptions::Validate() const {
   check((width == 0) == (height == 0), "--width/--height", width, "give both or neither");
 }
 
-Renderer::Renderer(const Scene& scene, int lighting) : rays_(scene, lighting) {}
+Renderer::Renderer(const recon::Scene& scene, int lighting) : rays_(scene, lighting) {}
 Renderer::~Renderer() = default;
 
-Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
+Image Renderer::Render(const recon::Camera& camera_in, const RenderOptions& options,
                        RenderSummary* summary) const {
   options.Validate();
   const auto start = std::chrono::steady_clock::now();
-  const Camera camera = ScaledCamera(camera_in, options.width, options.height);
+  const recon::Camera camera = ScaledCamera(camera_in, options.width, options.height);
   const std::vector<uint8_t>* mask = options.pixel_mask;
   if (mask && mask->size() != size_t(camera.width) * camera.height) {
     throw InputError(DescribeProblem("", "pixel_mask", std::to_string(mask->size()),
@@ -421,7 +421,7 @@ Image Renderer::Render(const Camera& camera_in, const RenderOptions& options,
   const Eigen::Vector3d center = camera.CenterInWorld();
   // PINHOLE rays straight from the intrinsics and a rotation matrix (what WorldRayFromImg
   // computes, without its per-call quaternion rotation); OPENCV goes through WorldRayFromImg.
-  const bool pinhole = camera.model == CameraModel::kPinhole;
+  const bool pinhole = camera.model == recon::CameraModel::kPinhole;
   const Eigen::Matrix3d world_from_cam =
       camera.cam_from_world.rotation.conjugate().toRotationMatrix();
   auto camera_ray = [&](double px, double py) -> Eigen::Vector3d {
@@ -528,4 +528,4 @@ Eigen::Vector3d Renderer::ReflectedRadiance(const Eigen::Vector3d& origin,
   return MeanRadiance(rays_.internal(), origin, direction, spp, seed, true, d_ln_params);
 }
 
-}  // namespace igi
+}  // namespace igi::render

@@ -16,7 +16,7 @@
 #include "solver/render/ray_scene.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::render {
 
 struct RenderOptions {
   int spp = 64;             // samples (paths) per pixel, >= 1
@@ -50,13 +50,13 @@ class Renderer {
   // `scene` must have complete materials (SceneLoadOptions::require_complete_materials) and
   // outlive the renderer. Throws InputError when the lighting has no light and the scene no
   // emitter material, or a texture cannot be read.
-  Renderer(const Scene& scene, int lighting);
+  Renderer(const recon::Scene& scene, int lighting);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
   // Renders `camera`'s view (linear radiance, RGB).
-  Image Render(const Camera& camera, const RenderOptions& options,
+  Image Render(const recon::Camera& camera, const RenderOptions& options,
                RenderSummary* summary = nullptr) const;
 
   // Radiance arriving along one ray (world frame), estimated with `spp` paths; for tests and
@@ -89,4 +89,4 @@ class Renderer {
   RayScene rays_;
 };
 
-}  // namespace igi
+}  // namespace igi::render

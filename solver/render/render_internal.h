@@ -14,7 +14,7 @@
 #include "solver/render/sampling.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::render {
 
 // A set of emitting triangles sampled by area (an area light, or the scene's emitter
 // materials). Triangles emit `radiance` from their front (counter-clockwise) side.
@@ -27,8 +27,9 @@ struct TriangleEmitter {
 
 // One emitter of the lighting.
 struct RenderLight {
-  LightType type = LightType::kPoint;  // kArea also stands for emitter-material triangles
-  const Light* light = nullptr;        // nullptr for the emitter-material set
+  recon::LightType type =
+      recon::LightType::kPoint;         // kArea also stands for emitter-material triangles
+  const recon::Light* light = nullptr;  // nullptr for the emitter-material set
   Eigen::Matrix3d spot_frame = Eigen::Matrix3d::Identity();
   TriangleEmitter triangles;  // kArea
 };
@@ -55,7 +56,7 @@ struct TriangleShading {
 
 // The prepared scene of one lighting (RayScene's and the Renderer's).
 struct RenderScene {
-  const Scene* scene = nullptr;
+  const recon::Scene* scene = nullptr;
   int lighting = -1;
   std::vector<ShadingMaterial> materials;   // per scene material
   std::vector<RenderLight> lights;          // emitters of the lighting
@@ -89,6 +90,6 @@ struct RenderScene {
 };
 
 // Builds the Embree scene, materials and lights (render_scene.cpp).
-std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting);
+std::unique_ptr<RenderScene> BuildRenderScene(const recon::Scene& scene, int lighting);
 
-}  // namespace igi
+}  // namespace igi::render

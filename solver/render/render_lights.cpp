@@ -5,7 +5,7 @@
 
 #include "solver/render/render_internal.h"
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 // Picks a triangle by area and a uniform point on it; returns the point, its front normal and
@@ -26,17 +26,17 @@ int SampleTriangle(const TriangleEmitter& e, const Eigen::Vector3d& u, Eigen::Ve
 LightSample RenderScene::SampleLight(int index, const Eigen::Vector3d& point,
                                         const Eigen::Vector3d& u) const {
   const RenderLight& rl = lights[index];
-  const Light* light = rl.light;
+  const recon::Light* light = rl.light;
   LightSample s;
   switch (rl.type) {
-    case LightType::kPoint:
-    case LightType::kSpot: {
+    case recon::LightType::kPoint:
+    case recon::LightType::kSpot: {
       const Eigen::Vector3d to_light = light->position - point;
       s.distance = to_light.norm();
       if (!(s.distance > 0)) return s;
       s.wi = to_light / s.distance;
       double relative = 1.0;
-      if (rl.type == LightType::kSpot) {
+      if (rl.type == recon::LightType::kSpot) {
         const Eigen::Vector3d out = rl.spot_frame.transpose() * (-s.wi);  // light -> point
         const double theta = std::acos(std::clamp(out.z(), -1.0, 1.0));
         relative = light->profile.Relative(theta, std::atan2(out.y(), out.x()));
@@ -46,14 +46,14 @@ LightSample RenderScene::SampleLight(int index, const Eigen::Vector3d& point,
       s.delta = true;
       return s;
     }
-    case LightType::kDirectional:
+    case recon::LightType::kDirectional:
       s.wi = -light->direction;
       s.distance = std::numeric_limits<double>::infinity();
       s.value = light->irradiance;
       s.pdf = 1.0;
       s.delta = true;
       return s;
-    case LightType::kSphere: {
+    case recon::LightType::kSphere: {
       const SphereSample ss = SampleSphereFromPoint(point, light->center, light->radius,
                                                     Eigen::Vector2d(u[0], u[1]));
       if (!(ss.pdf > 0)) return s;
@@ -63,7 +63,7 @@ LightSample RenderScene::SampleLight(int index, const Eigen::Vector3d& point,
       s.pdf = ss.pdf;
       return s;
     }
-    case LightType::kArea: {
+    case recon::LightType::kArea: {
       Eigen::Vector3d p, n;
       const int t = SampleTriangle(rl.triangles, u, &p, &n);
       const Eigen::Vector3d to_light = p - point;
@@ -77,7 +77,7 @@ LightSample RenderScene::SampleLight(int index, const Eigen::Vector3d& point,
       s.pdf = d2 / (cos_light * rl.triangles.total_area);
       return s;
     }
-    case LightType::kAmbient: {
+    case recon::LightType::kAmbient: {
       // Uniform directions; no distance: the ambient light is never occluded. Treated as a
       // delta light for MIS (no BRDF-sampled ray ever reaches it). The path tracer does not
       // call this (it evaluates ambient light exactly at each vertex, render.cpp AddAmbient);
@@ -97,13 +97,13 @@ double RenderScene::LightPdf(int index, const Eigen::Vector3d& point,
                                 const Eigen::Vector3d& dir, const Eigen::Vector3d& hit_point,
                                 const Eigen::Vector3d& hit_normal) const {
   const RenderLight& rl = lights[index];
-  if (rl.type == LightType::kSphere) {
+  if (rl.type == recon::LightType::kSphere) {
     return SphereFromPointPdf(point, rl.light->center, rl.light->radius, dir);
   }
-  if (rl.type != LightType::kArea) return 0.0;
+  if (rl.type != recon::LightType::kArea) return 0.0;
   const double cos_light = -hit_normal.dot(dir);
   if (!(cos_light > 0)) return 0.0;
   return (hit_point - point).squaredNorm() / (cos_light * rl.triangles.total_area);
 }
 
-}  // namespace igi
+}  // namespace igi::render

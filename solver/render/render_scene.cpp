@@ -8,7 +8,7 @@
 
 #include "solver/render/render_internal.h"
 
-namespace igi {
+namespace igi::render {
 
 struct RenderScene::Embree {
   RTCDevice device = nullptr;
@@ -47,18 +47,19 @@ unsigned AttachTriangles(RTCDevice device, RTCScene rtc_scene,
 
 }  // namespace
 
-ShadingMaterial MakeShadingMaterial(const Material& m) {
+ShadingMaterial MakeShadingMaterial(const recon::Material& m) {
   ShadingMaterial s;
   s.model = m.brdf;
-  s.params.model = IsReflective(m.brdf) ? m.brdf : BrdfModel::kLambert;
+  s.params.model = recon::IsReflective(m.brdf) ? m.brdf : recon::BrdfModel::kLambert;
   s.params.rho_d = m.rho_d.value_or(Eigen::Vector3d::Zero());
   s.params.rho_s = m.rho_s.value_or(Eigen::Vector3d::Zero());
   s.params.alpha = m.alpha.value_or(0.1);
   s.params.alpha_x = m.alpha_x.value_or(0.1);
   s.params.alpha_y = m.alpha_y.value_or(0.1);
-  s.params.ior = m.ior.value_or(Material::kDefaultIor);
+  s.params.ior = m.ior.value_or(recon::Material::kDefaultIor);
   s.tangent = m.tangent;
-  if (m.brdf == BrdfModel::kEmitter) s.emission = m.radiance.value_or(Eigen::Vector3d::Zero());
+  if (m.brdf == recon::BrdfModel::kEmitter)
+    s.emission = m.radiance.value_or(Eigen::Vector3d::Zero());
   if (m.rho_d_map) {
     s.rho_d_map = std::make_shared<const Image>(ReadImage(*m.rho_d_map, 3));
     if (!m.rho_d) {  // the mean albedo, for anything that needs a region value
@@ -88,7 +89,7 @@ void AddTriangle(TriangleEmitter* e, const Eigen::Vector3d& a, const Eigen::Vect
 }
 
 // Unit geometric normals in double precision (front = counter-clockwise).
-std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
+std::vector<Eigen::Vector3d> FaceNormals(const recon::TriangleMesh& mesh) {
   std::vector<Eigen::Vector3d> normals(mesh.num_triangles());
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
     const Eigen::Vector3i& tri = mesh.triangles[t];
@@ -102,7 +103,7 @@ std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
 
 // The per-triangle shading records of the scene mesh (after emitter_triangle_index is set).
 std::vector<TriangleShading> TriangleRecords(const RenderScene& impl) {
-  const TriangleMesh& mesh = impl.scene->mesh;
+  const recon::TriangleMesh& mesh = impl.scene->mesh;
   const std::vector<Eigen::Vector3d> normals = FaceNormals(mesh);
   std::vector<TriangleShading> records(mesh.num_triangles());
   // Vertex normals this close to the face normal shade as the face itself (flat shading).
@@ -125,18 +126,19 @@ std::vector<TriangleShading> TriangleRecords(const RenderScene& impl) {
 
 }  // namespace
 
-std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting) {
+std::unique_ptr<RenderScene> BuildRenderScene(const recon::Scene& scene, int lighting) {
   auto impl = std::make_unique<RenderScene>();
   impl->scene = &scene;
   impl->lighting = lighting;
-  for (const Material& m : scene.materials) impl->materials.push_back(MakeShadingMaterial(m));
+  for (const recon::Material& m : scene.materials)
+    impl->materials.push_back(MakeShadingMaterial(m));
 
   impl->embree = std::make_unique<RenderScene::Embree>();
   impl->embree->device = rtcNewDevice(nullptr);
   if (impl->embree->device == nullptr) throw Error("cannot create the Embree device");
   impl->embree->scene = rtcNewScene(impl->embree->device);
   rtcSetSceneBuildQuality(impl->embree->scene, RTC_BUILD_QUALITY_HIGH);
-  const TriangleMesh& mesh = scene.mesh;
+  const recon::TriangleMesh& mesh = scene.mesh;
   AttachTriangles(impl->embree->device, impl->embree->scene, mesh.positions, mesh.triangles);
   impl->area_light_of_geometry.push_back(-1);
   impl->area_normals.emplace_back();
@@ -148,13 +150,13 @@ std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting) 
   impl->ray_epsilon = 1e-5 * extent;
 
   for (int index : scene.lightings[lighting].lights) {
-    const Light& light = scene.lights[index];
+    const recon::Light& light = scene.lights[index];
     RenderLight rl;
     rl.type = light.type;
     rl.light = &light;
-    if (light.type == LightType::kSpot) rl.spot_frame = FrameFromAxis(light.direction);
-    if (light.type == LightType::kArea) {
-      const TriangleMesh& lm = light.mesh;
+    if (light.type == recon::LightType::kSpot) rl.spot_frame = FrameFromAxis(light.direction);
+    if (light.type == recon::LightType::kArea) {
+      const recon::TriangleMesh& lm = light.mesh;
       for (const Eigen::Vector3i& t : lm.triangles) {
         AddTriangle(&rl.triangles, lm.positions[t[0]].cast<double>(),
                     lm.positions[t[1]].cast<double>(), lm.positions[t[2]].cast<double>(),
@@ -164,12 +166,13 @@ std::unique_ptr<RenderScene> BuildRenderScene(const Scene& scene, int lighting) 
       impl->area_light_of_geometry.push_back(static_cast<int>(impl->lights.size()));
       impl->area_normals.push_back(FaceNormals(lm));
     }
-    if (light.type == LightType::kSphere) impl->sphere_lights.push_back(int(impl->lights.size()));
+    if (light.type == recon::LightType::kSphere)
+      impl->sphere_lights.push_back(int(impl->lights.size()));
     impl->lights.push_back(std::move(rl));
   }
   // Triangles of "emitter" materials form one more light, sampled by area.
   RenderLight emitters;
-  emitters.type = LightType::kArea;
+  emitters.type = recon::LightType::kArea;
   impl->emitter_triangle_index.assign(mesh.num_triangles(), -1);
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
     const ShadingMaterial& m = impl->materials[mesh.triangle_region[t]];
@@ -271,7 +274,7 @@ bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d&
                            double distance, int target) const {
   if (!(distance > 0)) return false;  // ambient light: nothing occludes it
   for (int i : sphere_lights) {
-    const Light& l = *lights[i].light;
+    const recon::Light& l = *lights[i].light;
     if (i != target && IntersectSphere(origin, dir, l.center, l.radius) < distance) return true;
   }
   RTCIntersectContext context;
@@ -281,4 +284,4 @@ bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   return ray.tfar == -std::numeric_limits<float>::infinity();
 }
 
-}  // namespace igi
+}  // namespace igi::render

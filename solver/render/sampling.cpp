@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 double SafeSqrt(double v) { return std::sqrt(std::max(0.0, v)); }
@@ -83,4 +83,4 @@ double SphereFromPointPdf(const Eigen::Vector3d& point, const Eigen::Vector3d& c
   return 1.0 / (2.0 * kPi * (sin2_max / (1.0 + cos_max)));
 }
 
-}  // namespace igi
+}  // namespace igi::render

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <numbers>
 
-namespace igi {
+namespace igi::render {
 
 inline constexpr double kPi = std::numbers::pi;
 inline constexpr double kInvPi = std::numbers::inv_pi;
@@ -286,4 +286,4 @@ inline double BalanceHeuristic(int nf, double f_pdf, int ng, double g_pdf) {
   return f / (f + g);
 }
 
-}  // namespace igi
+}  // namespace igi::render

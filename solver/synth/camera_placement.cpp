@@ -7,7 +7,7 @@
 #include "solver/render/sampling.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 using Eigen::Vector3d;
@@ -20,7 +20,7 @@ bool InsideRoom(const SynthRoom& room, const Vector3d& p, double margin) {
 }
 
 // Area-weighted random point on the region's triangles: (point, triangle).
-std::pair<Vector3d, int> SampleRegionPoint(const SynthMesh& mesh, int region, Pcg32* rng) {
+std::pair<Vector3d, int> SampleRegionPoint(const SynthMesh& mesh, int region, render::Pcg32* rng) {
   double total = 0;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     if (mesh.triangle_region[t] == region) total += mesh.TriangleArea(int(t));
@@ -33,7 +33,7 @@ std::pair<Vector3d, int> SampleRegionPoint(const SynthMesh& mesh, int region, Pc
     pick -= mesh.TriangleArea(int(t));
     if (pick <= 0) break;
   }
-  const Vector3d w = SampleUniformTriangle(rng->Uniform2D());
+  const Vector3d w = render::SampleUniformTriangle(rng->Uniform2D());
   const Eigen::Vector3i& tri = mesh.triangles[chosen];
   return {
       w[0] * mesh.positions[tri[0]] + w[1] * mesh.positions[tri[1]] + w[2] * mesh.positions[tri[2]],
@@ -52,7 +52,7 @@ struct Incidence {
 
 // The best mirror viewpoint of the lamp's highlight on `region` over 96 sampled points (384 for
 // a narrow incidence window).
-Candidate BestHighlightView(const SynthRoom& room, const std::string& region, Pcg32* rng,
+Candidate BestHighlightView(const SynthRoom& room, const std::string& region, render::Pcg32* rng,
                             const std::vector<Vector3d>& taken, const Incidence& incidence = {}) {
   const SynthMesh& mesh = room.mesh;
   const int region_index = mesh.FindRegion(region);
@@ -85,8 +85,8 @@ Candidate BestHighlightView(const SynthRoom& room, const std::string& region, Pc
 
 }  // namespace
 
-Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d& target, int width,
-                    int height, double fov_deg) {
+recon::Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d& target,
+                           int width, int height, double fov_deg) {
   const Vector3d forward = (target - eye).normalized();
   const Vector3d up = std::abs(forward.z()) > 0.95 ? Vector3d::UnitY() : Vector3d::UnitZ();
   const Vector3d right = forward.cross(up).normalized();
@@ -95,9 +95,9 @@ Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d
   r.row(0) = right.transpose();
   r.row(1) = down.transpose();
   r.row(2) = forward.transpose();
-  Camera cam;
+  recon::Camera cam;
   cam.name = name;
-  cam.model = CameraModel::kPinhole;
+  cam.model = recon::CameraModel::kPinhole;
   cam.width = width;
   cam.height = height;
   const double f = 0.5 * width / std::tan(0.5 * fov_deg * std::numbers::pi / 180.0);
@@ -110,7 +110,7 @@ Camera LookAtCamera(const std::string& name, const Vector3d& eye, const Vector3d
 std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions& options) {
   std::vector<PlacedCamera> cameras;
   std::vector<Vector3d> eyes;
-  Pcg32 rng(options.seed, 0xca3e7a);
+  render::Pcg32 rng(options.seed, 0xca3e7a);
   auto name = [&] { return "cam" + std::to_string(cameras.size()); };
   for (const std::string& region : room.glossy_regions) {
     if (int(cameras.size()) >= options.cameras) break;
@@ -167,4 +167,4 @@ std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions
   return cameras;
 }
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -13,10 +13,10 @@
 #include "solver/synth/room_builder.h"
 #include "solver/synth/synth_options.h"
 
-namespace igi {
+namespace igi::synth {
 
 struct PlacedCamera {
-  Camera camera;              // PINHOLE, options' size and field of view
+  recon::Camera camera;       // PINHOLE, options' size and field of view
   std::string target_region;  // glossy region whose highlight it sees; "" = overview
   Eigen::Vector3d highlight_point = Eigen::Vector3d::Zero();  // world, metres
   Eigen::Vector2d highlight_pixel = Eigen::Vector2d::Zero();  // continuous pixel coordinates
@@ -24,11 +24,11 @@ struct PlacedCamera {
 
 // A PINHOLE camera at `eye` looking at `target` with world +z up (+y when looking nearly
 // straight up or down); horizontal field of view `fov_deg`, principal point at the centre.
-Camera LookAtCamera(const std::string& name, const Eigen::Vector3d& eye,
-                    const Eigen::Vector3d& target, int width, int height, double fov_deg);
+recon::Camera LookAtCamera(const std::string& name, const Eigen::Vector3d& eye,
+                           const Eigen::Vector3d& target, int width, int height, double fov_deg);
 
 // options.cameras cameras named cam0, cam1, … (deterministic for options.seed). Throws Error
 // when a glossy region offers no viewpoint (a room-builder bug, not user input).
 std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions& options);
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -10,7 +10,7 @@
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 using Eigen::Vector3d;
@@ -259,26 +259,28 @@ Json Response(Params& p, PhotoEffects* post) {
               {"applies_to", "every photo of scene.json (not brackets or validation renders)"}};
 }
 
-Json PoseError(Params& p, const std::vector<Camera>& cameras, uint64_t seed, SynthScenes* s) {
+Json PoseError(Params& p, const std::vector<recon::Camera>& cameras, uint64_t seed,
+               SynthScenes* s) {
   std::vector<std::string> names;
-  for (const Camera& c : cameras) names.push_back(c.name);
+  for (const recon::Camera& c : cameras) names.push_back(c.name);
   const std::string name = p.Name("camera", names.front(), names);
   const double angle_deg = p.Number("rotation_deg", 1.0, 0.0, 45.0);
   const double shift_m = p.Number("translation_m", 0.02, 0.0, 1.0);
-  Pcg32 rng(seed, 0x9053);
-  const Vector3d axis = p.Direction("axis").value_or(SampleUniformSphere(rng.Uniform2D()));
-  const Vector3d dir = p.Direction("direction").value_or(SampleUniformSphere(rng.Uniform2D()));
+  render::Pcg32 rng(seed, 0x9053);
+  const Vector3d axis = p.Direction("axis").value_or(render::SampleUniformSphere(rng.Uniform2D()));
+  const Vector3d dir =
+      p.Direction("direction").value_or(render::SampleUniformSphere(rng.Uniform2D()));
   p.Finish();
-  Camera cam;
-  for (const Camera& c : cameras) {
+  recon::Camera cam;
+  for (const recon::Camera& c : cameras) {
     if (c.name == name) cam = c;
   }
   const Vector3d center = cam.CenterInWorld() + shift_m * dir;
-  const Eigen::Quaterniond delta(Eigen::AngleAxisd(angle_deg * kPi / 180.0, axis));
-  Camera declared = cam;
+  const Eigen::Quaterniond delta(Eigen::AngleAxisd(angle_deg * render::kPi / 180.0, axis));
+  recon::Camera declared = cam;
   declared.cam_from_world.rotation = (delta * cam.cam_from_world.rotation).normalized();
   declared.cam_from_world.translation = -(declared.cam_from_world.rotation * center);
-  s->declared_scene["cameras"][name] = CameraJson(declared);
+  s->declared_scene["cameras"][name] = recon::CameraJson(declared);
   return Json{{"camera", name},
               {"rotation_deg", angle_deg},
               {"axis_cam", Vec(axis)},
@@ -287,8 +289,8 @@ Json PoseError(Params& p, const std::vector<Camera>& cameras, uint64_t seed, Syn
               {"model",
                "declared R = AngleAxis(rotation_deg, axis_cam) * true R; declared "
                "centre = true centre + translation_m * direction_world"},
-              {"true", CameraJson(cam)},
-              {"declared", CameraJson(declared)}};
+              {"true", recon::CameraJson(cam)},
+              {"declared", recon::CameraJson(declared)}};
 }
 
 Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -359,7 +361,7 @@ Json SpecularAsDiffuse(Params& p, const SynthRoom& room, SynthScenes* s) {
 
 }  // namespace
 
-double PhotoEffects::VignettingFactor(const Camera& camera, double x, double y) const {
+double PhotoEffects::VignettingFactor(const recon::Camera& camera, double x, double y) const {
   if (!vignetting) return 1.0;
   const double dx = x - camera.principal_x_px(), dy = y - camera.principal_y_px();
   const double half_diag2 =
@@ -368,7 +370,7 @@ double PhotoEffects::VignettingFactor(const Camera& camera, double x, double y) 
   return 1.0 + vignetting->first * r2 + vignetting->second * r2 * r2;
 }
 
-void PhotoEffects::ApplyBeforeSensor(const std::string& photo_file, const Camera& camera,
+void PhotoEffects::ApplyBeforeSensor(const std::string& photo_file, const recon::Camera& camera,
                                      Image* image) const {
   const auto scale_it = exposure_scale.find(photo_file);
   const double scale = scale_it == exposure_scale.end() ? 1.0 : scale_it->second;
@@ -396,7 +398,7 @@ namespace {
 // The effects that change the photos after they were made, or a declared value only: params of
 // `spec`'s effect, or nullopt when it changes what is rendered.
 std::optional<Json> PhotoEffect(const EffectSpec& spec, Params& p,
-                                const std::vector<Camera>& cameras,
+                                const std::vector<recon::Camera>& cameras,
                                 const std::vector<std::string>& photo_files, uint64_t seed,
                                 SynthScenes* s, PhotoEffects* post) {
   const std::string& n = spec.name;
@@ -428,7 +430,7 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
                   const std::vector<PlacedCamera>& cameras,
                   const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
                   PhotoEffects* post) {
-  std::vector<Camera> plain;
+  std::vector<recon::Camera> plain;
   for (const PlacedCamera& c : cameras) plain.push_back(c.camera);
   Json list = Json::array();
   for (const EffectSpec& spec : specs) {
@@ -440,7 +442,8 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
   return list;
 }
 
-Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs, const std::vector<Camera>& cameras,
+Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs,
+                       const std::vector<recon::Camera>& cameras,
                        const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
                        PhotoEffects* post) {
   Json list = Json::array();
@@ -457,4 +460,4 @@ Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs, const std::vector<C
   return list;
 }
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -41,7 +41,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 
 // The two scene documents (igi-scene JSON, paths relative to the scene folder) and the extra
 // files the true one needs (relative path -> OBJ text).
@@ -58,11 +58,12 @@ struct PhotoEffects {
   std::optional<std::pair<double, double>> response;    // exponent, reference
 
   // Optical and exposure effects, applied to the true radiance before the sensor.
-  void ApplyBeforeSensor(const std::string& photo_file, const Camera& camera, Image* image) const;
+  void ApplyBeforeSensor(const std::string& photo_file, const recon::Camera& camera,
+                         Image* image) const;
   // The camera response, applied to the photo as written.
   void ApplyAfterSensor(Image* image) const;
   // The vignetting factor at continuous pixel (x, y) of `camera` (1 without vignetting).
-  double VignettingFactor(const Camera& camera, double x, double y) const;
+  double VignettingFactor(const recon::Camera& camera, double x, double y) const;
 };
 
 // Applies `specs` in order. `photo_files` are the photos of scene.json ("photos/cam0_L0.exr").
@@ -75,8 +76,9 @@ Json ApplyEffects(const std::vector<EffectSpec>& specs, const SynthRoom& room,
 // The effects of `specs` that change a capture's photos after they were made (any renderer's or
 // camera's), or a declared value only: vignetting, exposure_scale, camera_response, pose_error.
 // `cameras` are the capture's. Throws InputError "--effect: NAME: ...: RULE" for any other.
-Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs, const std::vector<Camera>& cameras,
+Json ApplyPhotoEffects(const std::vector<EffectSpec>& specs,
+                       const std::vector<recon::Camera>& cameras,
                        const std::vector<std::string>& photo_files, uint64_t seed, SynthScenes* s,
                        PhotoEffects* post);
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -6,7 +6,7 @@
 
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 using Eigen::Vector2d;
@@ -26,7 +26,7 @@ Image MakeFloorTexture(uint64_t seed, bool grain_on = true) {
   constexpr int kSize = 128;
   constexpr int kTiles = 4;
   Image img(kSize, kSize, 3);
-  Pcg32 tile_rng(seed, 0x7115);
+  render::Pcg32 tile_rng(seed, 0x7115);
   std::vector<Vector3d> tile_albedo;
   for (int i = 0; i < kTiles * kTiles; ++i) {
     const double base = 0.30 + 0.30 * tile_rng.UniformDouble();
@@ -38,7 +38,7 @@ Image MakeFloorTexture(uint64_t seed, bool grain_on = true) {
       const int tx = x / tile_px, ty = y / tile_px;
       const int lx = x % tile_px, ly = y % tile_px;
       const bool grout = lx < 1 || ly < 1;
-      Pcg32 grain_rng(seed ^ 0x9a11, uint64_t(y) * kSize + x);
+      render::Pcg32 grain_rng(seed ^ 0x9a11, uint64_t(y) * kSize + x);
       const double grain = grain_on ? 1.0 + 0.06 * (grain_rng.UniformDouble() - 0.5) : 1.0;
       const Vector3d a = grout ? Vector3d(0.12, 0.12, 0.11) : tile_albedo[ty * kTiles + tx] * grain;
       for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(a[c]);
@@ -82,7 +82,7 @@ Image GaussianBlur(const Image& in, double sigma) {
 std::vector<float> ValueNoise(int size, uint64_t seed) {
   std::vector<double> sum(size_t(size) * size, 0.0);
   for (int cells = 4, octave = 0; cells <= 256; cells *= 2, ++octave) {
-    Pcg32 rng(seed, 0x5eed + octave);
+    render::Pcg32 rng(seed, 0x5eed + octave);
     std::vector<double> grid(size_t(cells + 1) * (cells + 1));
     for (double& g : grid) g = rng.UniformDouble();
     for (int y = 0; y < size; ++y) {
@@ -211,7 +211,7 @@ Eigen::Vector3d ImageMean(const Image& image) {
 
 SynthRoom BuildRoom(const SynthOptions& options) {
   SynthRoom room;
-  const std::string g(BrdfModelName(options.glossy_brdf));
+  const std::string g(recon::BrdfModelName(options.glossy_brdf));
   AddRoomShell(room.size, &room.mesh);
   room.mesh.AddBox({2.8, 2.6}, 0.0, {0.9, 0.7, 0.6}, 25.0, "glossy_box");
   room.mesh.AddSphere({1.3, 1.4, 0.35}, 0.35, 16, 32, "glossy_sphere");
@@ -247,4 +247,4 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   return room;
 }
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -17,7 +17,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 
 struct SynthLamp {
   std::string name;
@@ -54,4 +54,4 @@ Json LampJson(const SynthLamp& lamp);
 // Mean of a texture's RGB over its pixels (the region mean of an affinely mapped plane).
 Eigen::Vector3d ImageMean(const Image& image);
 
-}  // namespace igi
+}  // namespace igi::synth

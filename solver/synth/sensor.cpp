@@ -7,17 +7,17 @@
 #include "tools/common/error.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
-double Normal(Pcg32* rng) {
+double Normal(render::Pcg32* rng) {
   const double u1 = rng->UniformDouble();
   const double u2 = rng->UniformDouble();
-  return std::sqrt(-2.0 * std::log(1.0 - u1)) * std::cos(2.0 * kPi * u2);
+  return std::sqrt(-2.0 * std::log(1.0 - u1)) * std::cos(2.0 * render::kPi * u2);
 }
 
 // Poisson(mean) exactly for small means (Knuth), Gaussian N(mean, mean) from 30 on.
-double Poisson(double mean, Pcg32* rng) {
+double Poisson(double mean, render::Pcg32* rng) {
   if (!(mean > 0)) return 0;
   if (mean >= 30) return mean + std::sqrt(mean) * Normal(rng);
   const double limit = std::exp(-mean);
@@ -35,7 +35,7 @@ double Gain(const SensorOptions& o) {
 }
 
 // Electrons of one pixel channel: shot and read noise, clipped at the full well.
-double NoisyElectrons(double mean_e, double read_noise_e, Pcg32* rng) {
+double NoisyElectrons(double mean_e, double read_noise_e, render::Pcg32* rng) {
   return Poisson(std::max(mean_e, 0.0), rng) + read_noise_e * Normal(rng);
 }
 
@@ -208,7 +208,7 @@ SensorResult SimulateSensor(const Image& radiance, const SensorOptions& o, doubl
       [&](int64_t y) {
         for (int x = 0; x < radiance.width; ++x) {
           const uint64_t pixel = uint64_t(y) * radiance.width + x;
-          Pcg32 rng = PixelSampleRng(seed, pixel, 0x5e5);
+          render::Pcg32 rng = render::PixelSampleRng(seed, pixel, 0x5e5);
           bool saturated = false;
           for (int c = 0; c < 3; ++c) {
             const double l = radiance.at(x, int(y), std::min(c, radiance.channels - 1));
@@ -252,7 +252,8 @@ std::vector<Bracket> MakeBrackets(const Image& radiance, const SensorOptions& se
         0, radiance.height,
         [&](int64_t y) {
           for (int x = 0; x < radiance.width; ++x) {
-            Pcg32 rng = PixelSampleRng(seed, uint64_t(y) * radiance.width + x, 0xb0 + i);
+            render::Pcg32 rng =
+                render::PixelSampleRng(seed, uint64_t(y) * radiance.width + x, 0xb0 + i);
             for (int c = 0; c < 3; ++c) {
               const double mean = radiance.at(x, int(y), std::min(c, radiance.channels - 1)) * kt;
               const double e = noisy ? NoisyElectrons(mean, sensor.read_noise_e, &rng) : mean;
@@ -267,4 +268,4 @@ std::vector<Bracket> MakeBrackets(const Image& radiance, const SensorOptions& se
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -20,7 +20,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 
 class ResponseCurve {
  public:
@@ -77,4 +77,4 @@ std::vector<Bracket> MakeBrackets(const Image& radiance, const SensorOptions& se
                                   double mid_exposure_s, bool noisy, uint64_t seed,
                                   int num_threads = 0);
 
-}  // namespace igi
+}  // namespace igi::synth

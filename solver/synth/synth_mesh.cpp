@@ -5,7 +5,7 @@
 #include <numbers>
 #include <sstream>
 
-namespace igi {
+namespace igi::synth {
 
 int SynthMesh::FindRegion(const std::string& name) const {
   for (size_t i = 0; i < region_names.size(); ++i) {
@@ -160,4 +160,4 @@ bool SegmentVisible(const SynthMesh& mesh, const Eigen::Vector3d& a, const Eigen
   return !IntersectRay(mesh, a, d / length, epsilon, length - epsilon).has_value();
 }
 
-}  // namespace igi
+}  // namespace igi::synth

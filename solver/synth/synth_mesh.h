@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace igi {
+namespace igi::synth {
 
 struct SynthMesh {
   std::vector<Eigen::Vector3d> positions;
@@ -58,4 +58,4 @@ std::optional<MeshHit> IntersectRay(const SynthMesh& mesh, const Eigen::Vector3d
 bool SegmentVisible(const SynthMesh& mesh, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                     double epsilon = 1e-4);
 
-}  // namespace igi
+}  // namespace igi::synth

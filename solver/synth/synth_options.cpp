@@ -6,10 +6,11 @@
 #include <cmath>
 #include <string_view>
 
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 std::string Str(double v) {
@@ -79,11 +80,12 @@ ProblemList SynthProblems(const SynthOptions& o, const SynthChoiceFlags* typed) 
   }
   if (o.spp < 1 || o.spp > 1 << 20) p.Add("--spp", "", std::to_string(o.spp), "must be >= 1");
   // Any BrdfModel has a name; only the two Ward models are the glossy regions' choices.
-  const std::optional<BrdfModel> glossy =
-      typed ? BrdfModelFromName(typed->glossy_brdf) : std::optional<BrdfModel>(o.glossy_brdf);
-  if (glossy != BrdfModel::kWard && glossy != BrdfModel::kWardGmd) {
+  const std::optional<recon::BrdfModel> glossy =
+      typed ? recon::BrdfModelFromName(typed->glossy_brdf)
+            : std::optional<recon::BrdfModel>(o.glossy_brdf);
+  if (glossy != recon::BrdfModel::kWard && glossy != recon::BrdfModel::kWardGmd) {
     p.Add("--glossy-brdf", "",
-          ChoiceText(o.glossy_brdf, BrdfModelName, typed ? &typed->glossy_brdf : nullptr),
+          ChoiceText(o.glossy_brdf, recon::BrdfModelName, typed ? &typed->glossy_brdf : nullptr),
           "must be ward or ward_gmd");
   }
   if (typed ? !LampShapeFromName(typed->lamp) : !LampShapeFromName(LampShapeName(o.lamp))) {
@@ -145,55 +147,30 @@ ProblemList SynthProblems(const SynthOptions& o, const SynthChoiceFlags* typed) 
 
 }  // namespace
 
+constexpr EnumNames<BracketFormat, 2> kBracketFormatNames{
+    {{BracketFormat::kPng, "png"}, {BracketFormat::kTif, "tif"}}};
+
 std::string_view BracketFormatName(BracketFormat format) {
-  switch (format) {
-    case BracketFormat::kPng:
-      return "png";
-    case BracketFormat::kTif:
-      return "tif";
-  }
-  return "?";
+  return kBracketFormatNames.Name(format);
 }
-
 std::optional<BracketFormat> BracketFormatFromName(std::string_view name) {
-  for (BracketFormat f : {BracketFormat::kPng, BracketFormat::kTif}) {
-    if (BracketFormatName(f) == name) return f;
-  }
-  return std::nullopt;
+  return kBracketFormatNames.FromName(name);
 }
 
-std::string_view LampShapeName(LampShape shape) {
-  switch (shape) {
-    case LampShape::kSphere:
-      return "sphere";
-    case LampShape::kPoint:
-      return "point";
-  }
-  return "?";
-}
+constexpr EnumNames<LampShape, 2> kLampShapeNames{
+    {{LampShape::kSphere, "sphere"}, {LampShape::kPoint, "point"}}};
 
+std::string_view LampShapeName(LampShape shape) { return kLampShapeNames.Name(shape); }
 std::optional<LampShape> LampShapeFromName(std::string_view name) {
-  for (LampShape s : {LampShape::kSphere, LampShape::kPoint}) {
-    if (LampShapeName(s) == name) return s;
-  }
-  return std::nullopt;
+  return kLampShapeNames.FromName(name);
 }
 
-std::string_view FloorTextureName(FloorTexture texture) {
-  switch (texture) {
-    case FloorTexture::kTiles:
-      return "tiles";
-    case FloorTexture::kSmooth:
-      return "smooth";
-  }
-  return "?";
-}
+constexpr EnumNames<FloorTexture, 2> kFloorTextureNames{
+    {{FloorTexture::kTiles, "tiles"}, {FloorTexture::kSmooth, "smooth"}}};
 
+std::string_view FloorTextureName(FloorTexture texture) { return kFloorTextureNames.Name(texture); }
 std::optional<FloorTexture> FloorTextureFromName(std::string_view name) {
-  for (FloorTexture t : {FloorTexture::kTiles, FloorTexture::kSmooth}) {
-    if (FloorTextureName(t) == name) return t;
-  }
-  return std::nullopt;
+  return kFloorTextureNames.FromName(name);
 }
 
 const std::vector<std::string>& SupportedEffects() {
@@ -259,11 +236,11 @@ void BracketOptions::Validate() const { BracketProblems(*this, nullptr).ThrowIfA
 void SynthOptions::Validate() const { SynthProblems(*this, nullptr).ThrowIfAny(); }
 
 void SynthOptions::SetChoices(const SynthChoiceFlags& flags) {
-  if (const auto g = BrdfModelFromName(flags.glossy_brdf)) glossy_brdf = *g;
+  if (const auto g = recon::BrdfModelFromName(flags.glossy_brdf)) glossy_brdf = *g;
   if (const auto l = LampShapeFromName(flags.lamp)) lamp = *l;
   if (const auto t = FloorTextureFromName(flags.floor_texture)) floor_texture = *t;
   if (const auto f = BracketFormatFromName(flags.bracket_format)) brackets.format = *f;
   SynthProblems(*this, &flags).ThrowIfAny();
 }
 
-}  // namespace igi
+}  // namespace igi::synth

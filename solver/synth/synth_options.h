@@ -18,7 +18,7 @@
 
 #include "recon/brdf_model.h"
 
-namespace igi {
+namespace igi::synth {
 
 // One --effect switch: NAME or NAME:key=value,key=value (values are numbers, names or
 // number lists separated by '/', e.g. tangent=1/0/0).
@@ -106,7 +106,7 @@ struct SynthOptions {
   int spp = 64;         // render samples per pixel
   uint64_t seed = 1;    // same seed, same options -> same files
   // The glossy regions' true model: BrdfModel::kWard (default) or kWardGmd.
-  BrdfModel glossy_brdf = BrdfModel::kWard;
+  recon::BrdfModel glossy_brdf = recon::BrdfModel::kWard;
   LampShape lamp = LampShape::kSphere;  // kSphere (default; r = 4 cm) or kPoint
   // The photographed lamp's centre (default (2.3, 1.7, 2.4), below the ceiling; inside the room).
   std::optional<Eigen::Vector3d> lamp_position;
@@ -156,4 +156,4 @@ struct SynthOptions {
   void SetChoices(const SynthChoiceFlags& flags);
 };
 
-}  // namespace igi
+}  // namespace igi::synth

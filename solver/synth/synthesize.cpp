@@ -18,7 +18,7 @@
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 namespace fs = std::filesystem;
@@ -109,7 +109,7 @@ struct Rendered {
 
 class Pipeline {
  public:
-  Pipeline(const SynthOptions& options, const Scene& true_scene,
+  Pipeline(const SynthOptions& options, const recon::Scene& true_scene,
            const std::vector<PlacedCamera>& cameras, const PhotoEffects& post,
            const ResponseCurve* response)
       : o_(options), scene_(true_scene), cameras_(cameras), post_(post), response_(response) {}
@@ -118,11 +118,11 @@ class Pipeline {
     const int lighting = scene_.FindLighting(job.lighting);
     auto it = renderers_.find(lighting);
     if (it == renderers_.end()) {
-      it = renderers_.emplace(lighting, std::make_unique<Renderer>(scene_, lighting)).first;
+      it = renderers_.emplace(lighting, std::make_unique<render::Renderer>(scene_, lighting)).first;
     }
-    RenderOptions ro;
+    render::RenderOptions ro;
     ro.spp = o_.spp;
-    ro.seed = MixBits(o_.seed * 0x100000001b3ULL + stream);
+    ro.seed = render::MixBits(o_.seed * 0x100000001b3ULL + stream);
     ro.num_threads = o_.num_threads;
     const auto start = Clock::now();
     Image image = it->second->Render(TrueCamera(job), ro);
@@ -141,8 +141,9 @@ class Pipeline {
     const double exposure_s = ChooseExposure(linear, o_.sensor);
     Image out = linear;
     if (o_.noise == NoiseModel::kRealistic) {
-      SensorResult sr = SimulateSensor(linear, o_.sensor, exposure_s,
-                                       MixBits(o_.seed ^ (0x5e0500ULL + index)), o_.num_threads);
+      SensorResult sr =
+          SimulateSensor(linear, o_.sensor, exposure_s,
+                         render::MixBits(o_.seed ^ (0x5e0500ULL + index)), o_.num_threads);
       out = std::move(sr.photo);
       truth["exposure_s"] = exposure_s;
       truth["saturated_pixels"] = sr.saturated_pixels;
@@ -164,9 +165,9 @@ class Pipeline {
                 Rendered* r) {
     const std::string stem = fs::path(job.file).stem().string();
     const std::string dir = "brackets/" + stem;
-    const auto brackets = MakeBrackets(linear, o_.sensor, o_.brackets, *response_, exposure_s,
-                                       o_.noise == NoiseModel::kRealistic,
-                                       MixBits(o_.seed ^ (0xb7ac0000ULL + index)), o_.num_threads);
+    const auto brackets = MakeBrackets(
+        linear, o_.sensor, o_.brackets, *response_, exposure_s, o_.noise == NoiseModel::kRealistic,
+        render::MixBits(o_.seed ^ (0xb7ac0000ULL + index)), o_.num_threads);
     std::string times = "# exposure time (s) of each image of this folder, in file order\n";
     Json exposures = Json::array();
     for (size_t i = 0; i < brackets.size(); ++i) {
@@ -198,15 +199,15 @@ class Pipeline {
   }
 
  private:
-  const Camera& TrueCamera(const PhotoJob& job) const {
+  const recon::Camera& TrueCamera(const PhotoJob& job) const {
     return scene_.cameras[scene_.FindCamera(cameras_[job.camera].camera.name)];
   }
   const SynthOptions& o_;
-  const Scene& scene_;
+  const recon::Scene& scene_;
   const std::vector<PlacedCamera>& cameras_;
   const PhotoEffects& post_;
   const ResponseCurve* response_;
-  std::map<int, std::unique_ptr<Renderer>> renderers_;
+  std::map<int, std::unique_ptr<render::Renderer>> renderers_;
 };
 
 Json SensorTruth(const SynthOptions& o) {
@@ -262,7 +263,8 @@ Json BaseScene(const SynthRoom& room, const std::vector<PlacedCamera>& cameras) 
                {"lights", room.LightsJson()},
                {"lightings", room.LightingsJson()},
                {"cameras", Json::object()}};
-  for (const PlacedCamera& c : cameras) base["cameras"][c.camera.name] = CameraJson(c.camera);
+  for (const PlacedCamera& c : cameras)
+    base["cameras"][c.camera.name] = recon::CameraJson(c.camera);
   return base;
 }
 
@@ -305,13 +307,13 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
 
 // --from: the capture of options.from with its photos given the photo effects.
 SynthSummary HideInCapture(const SynthOptions& options, Clock::time_point start) {
-  const Scene source = LoadScene(options.from);
-  const Json source_doc = AbsoluteScenePaths(source.document, source.dir);
+  const recon::Scene source = recon::LoadScene(options.from);
+  const Json source_doc = recon::AbsoluteScenePaths(source.document, source.dir);
   // Each photo is written as photos/NAME.exr (NAME: its file's stem, with its index when two
   // photos share one).
   std::vector<std::string> photo_files;
   std::map<std::string, int> stems;
-  for (const Photo& p : source.photos) ++stems[p.file.stem().string()];
+  for (const recon::Photo& p : source.photos) ++stems[p.file.stem().string()];
   for (size_t i = 0; i < source.photos.size(); ++i) {
     const std::string stem = source.photos[i].file.stem().string();
     photo_files.push_back("photos/" + (stems[stem] > 1 ? std::to_string(i) + "_" : "") + stem +
@@ -329,7 +331,7 @@ SynthSummary HideInCapture(const SynthOptions& options, Clock::time_point start)
   fs::create_directories(out / "truth");
   SynthSummary summary;
   for (size_t i = 0; i < source.photos.size(); ++i) {
-    const Photo& p = source.photos[i];
+    const recon::Photo& p = source.photos[i];
     Image image = ReadImage(p.file, 3);
     post.ApplyBeforeSensor(photo_files[i], source.cameras[p.camera], &image);
     post.ApplyAfterSensor(&image);
@@ -385,9 +387,9 @@ SynthSummary Synthesize(const SynthOptions& options) {
   WriteExr(out / room.floor_albedo_file, room.floor_albedo);
   for (const auto& [file, image] : room.region_textures) WriteExr(out / file, image);
   WriteJsonFile(out / "truth/scene.json", RelocateToTruthFolder(scenes.true_scene));
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.require_complete_materials = true;
-  const Scene true_scene = LoadScene(out / "truth/scene.json", load);
+  const recon::Scene true_scene = recon::LoadScene(out / "truth/scene.json", load);
 
   Rendered r;
   Pipeline pipeline(options, true_scene, cameras, post, response ? &*response : nullptr);
@@ -415,4 +417,4 @@ SynthSummary Synthesize(const SynthOptions& options) {
   return summary;
 }
 
-}  // namespace igi
+}  // namespace igi::synth

@@ -23,7 +23,7 @@
 
 #include "solver/synth/synth_options.h"
 
-namespace igi {
+namespace igi::synth {
 
 struct SynthSummary {
   std::vector<std::string> photos;      // relative to the folder
@@ -38,4 +38,4 @@ struct SynthSummary {
 // (render and noise streams depend only on the seed and the photo's index).
 SynthSummary Synthesize(const SynthOptions& options);
 
-}  // namespace igi
+}  // namespace igi::synth

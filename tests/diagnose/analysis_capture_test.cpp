@@ -12,7 +12,7 @@
 #include "tests/solver/test_scenes.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -25,7 +25,7 @@ using test::WriteText;
 // and a mask that leaves out its top-left pixel.
 struct TwoPhotos {
   fs::path dir;
-  Scene scene;
+  recon::Scene scene;
   Image a, b, b_mask;
 };
 
@@ -72,7 +72,7 @@ TwoPhotos WriteTwoPhotos(const std::string& name) {
          {"mask", "b_mask.png"},
          {"response", {{"exponent", 0.8}, {"reference", 0.2}}}}}}};
   WriteJsonFile(t.dir / "scene.json", doc);
-  t.scene = LoadScene(t.dir / "scene.json");
+  t.scene = recon::LoadScene(t.dir / "scene.json");
   return t;
 }
 
@@ -105,10 +105,11 @@ TEST(ReduceCapture, BlockMeansMaskTheUnusableBlocksAndTheIntrinsicsFollow) {
   EXPECT_EQ(c.cameras.at("a").factor, 3);
   EXPECT_EQ(c.cameras.at("a").width, 12);
   EXPECT_EQ(c.cameras.at("b").height, 8);
-  const Scene r = LoadScene(c.scene_file);  // the sizes agree with the photos: it loads
+  const recon::Scene r =
+      recon::LoadScene(c.scene_file);  // the sizes agree with the photos: it loads
   ASSERT_EQ(r.photos.size(), 2u);
   for (int k = 0; k < 2; ++k) {
-    const Camera &full = t.scene.cameras[k], &small = r.cameras[k];
+    const recon::Camera &full = t.scene.cameras[k], &small = r.cameras[k];
     EXPECT_EQ(small.width, full.width / 3);
     EXPECT_EQ(small.height, full.height / 3);
     for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.1, 0.2, 0), Eigen::Vector3d(-0.4, 0.3, 0)}) {
@@ -136,7 +137,7 @@ TEST(ReduceCapture, BlockMeansMaskTheUnusableBlocksAndTheIntrinsicsFollow) {
     }
   }
   // Photo b: means of the linear values, encoded again; the masked pixel's block is masked.
-  const Photo& pb = t.scene.photos[1];
+  const recon::Photo& pb = t.scene.photos[1];
   const Image b = ReadImage(r.photos[1].file, 3);
   const Image b_mask = ReadImage(*r.photos[1].mask, 1);
   EXPECT_DOUBLE_EQ(r.photos[1].response_exponent, 0.8);
@@ -181,11 +182,11 @@ TEST(AtDeclaredSize, PutsBackThePhotosAndIntrinsicsAndKeepsWhatWasFitted) {
   EXPECT_EQ(back["photos"][1]["exposure_scale"], 1.3);
   // It is a scene of the declared photos again.
   WriteJsonFile(t.dir / "back.json", back);
-  const Scene s = LoadScene(t.dir / "back.json");
+  const recon::Scene s = recon::LoadScene(t.dir / "back.json");
   EXPECT_EQ(s.cameras[0].width, 37);
   EXPECT_DOUBLE_EQ(s.photos[1].exposure_scale, 1.3);
   fs::remove_all(t.dir);
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

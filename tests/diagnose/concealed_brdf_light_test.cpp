@@ -17,7 +17,7 @@
 
 #include "tests/diagnose/concealed_fixture.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using test::ConcealedOutcome;
@@ -87,4 +87,4 @@ TEST(ConcealedBrdfLightTest, LightEmissionProfile) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

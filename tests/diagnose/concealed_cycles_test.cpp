@@ -13,7 +13,7 @@
 
 #include "tests/diagnose/concealed_fixture.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -73,4 +73,4 @@ TEST(CyclesControlTest, NothingHiddenNothingReported) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -26,7 +26,7 @@
 
 #include "tests/diagnose/concealed_fixture.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -103,4 +103,4 @@ TEST(ConcealedGeometryTest, PoseErrorIsNamedFirst) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

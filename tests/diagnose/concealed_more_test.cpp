@@ -42,7 +42,7 @@
 
 #include "tests/diagnose/concealed_fixture.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using test::ConcealedOutcome;
@@ -91,4 +91,4 @@ INSTANTIATE_TEST_SUITE_P(SlowPairs, ConcealedMoreTest,
                          testing::Values("vignetting+exposure_scale"));
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

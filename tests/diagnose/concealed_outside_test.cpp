@@ -13,7 +13,7 @@
 #include "tests/diagnose/concealed_fixture.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -127,4 +127,4 @@ TEST(RadianceControlTest, NothingHiddenNothingReported) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -16,7 +16,7 @@
 #include "tests/diagnose/concealed_fixture.h"
 #include "tests/e2e/chromium_check.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -81,9 +81,9 @@ TEST(ConcealedControlTest, NothingHiddenNothingReported) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // Photos larger than --analysis-megapixels are diagnosed as the means of pixel blocks: a capture
@@ -162,4 +162,4 @@ TEST(DiagnoseBadInputTest, ExitsTwoWithOneLineAndWritesNothing) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -11,7 +11,7 @@
 
 #include "tests/diagnose/concealed_fixture.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using test::ConcealedOutcome;
@@ -118,4 +118,4 @@ TEST(ConcealedUnknownMaterialsTest, SpecularLobeShapeIsNamedOnAGrazingView) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

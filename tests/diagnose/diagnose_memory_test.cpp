@@ -10,19 +10,19 @@
 #include "tools/common/error.h"
 #include "tools/common/memory.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // 10 photos of 12 MP (4000×3000) from one camera; nothing is read.
-Scene TwelveMegapixelCapture() {
-  Scene scene;
+recon::Scene TwelveMegapixelCapture() {
+  recon::Scene scene;
   scene.file = "capture/scene.json";
-  Camera cam;
+  recon::Camera cam;
   cam.name = "dslr";
   cam.width = 4000, cam.height = 3000;
   scene.cameras = {cam};
   for (int i = 0; i < 10; ++i) {
-    Photo p;
+    recon::Photo p;
     p.camera = 0;
     p.file = "photos/" + std::to_string(i) + ".exr";
     scene.photos.push_back(p);
@@ -67,4 +67,4 @@ TEST(DiagnoseMemory, ACaptureAnalysedAtFullSizeOverTheBudgetIsRefusedWithOneLine
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -44,7 +44,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 namespace fs = std::filesystem;
@@ -185,4 +185,4 @@ TEST(DiligentDiagnoseTest, FindsOnlyPlausiblePhysicsOnTheRealBall) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -19,7 +19,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using namespace test::room;
@@ -151,16 +151,16 @@ TEST(EffectTest, SupportScopeSelectsExactlyTheSupportBlocks) {
 // The default PlanTrial refits from the declared document with the candidate written into it
 // (Write), the albedo maps and the photos' valid pixels unchanged.
 TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
-  const Scene model = RoomModel();
+  const recon::Scene model = RoomModel();
   const Json declared = {
       {"lights", {{"lamp", {{"type", "point"}, {"intensity", {8.0, 8.0, 8.0}}}}}},
       {"lightings", {{"L0", {"lamp"}}}}};
   const PhotoSet photos;
   const std::vector<Image> sims;
   const std::vector<PixelRecord> records;
-  const PixelHoldout holdout;
+  const solver::PixelHoldout holdout;
   const DiagnoseOptions options;
-  const MapMode maps{AlbedoMaps::kAuto, {"floor"}};
+  const MapMode maps{solver::AlbedoMaps::kAuto, {"floor"}};
   const DiagnosisModel m{model,   model,   declared, photos, sims, records,
                          holdout, options, maps,     false,  0.05, {}};
   CandidateResult c;
@@ -171,7 +171,7 @@ TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
   Json expected = declared;
   expected["lights"]["lamp"]["intensity"] = {4.0, 4.0, 4.0};
   EXPECT_EQ(plan.document, expected) << plan.document.dump();
-  EXPECT_EQ(plan.maps.maps, AlbedoMaps::kAuto);
+  EXPECT_EQ(plan.maps.maps, solver::AlbedoMaps::kAuto);
   EXPECT_EQ(plan.maps.only, std::vector<std::string>{"floor"});
   EXPECT_FALSE(plan.photos.has_value());
 }
@@ -181,7 +181,7 @@ TEST(EffectTest, TheDefaultPlanTrialWritesTheCandidateIntoTheDeclaredDocument) {
 // lobe change on a Lambertian region) is left out, one that could not be fitted for a reason
 // (vignetting without declared cameras) is kept with its note.
 TEST(EvaluateCandidatesTest, FitsTheCandidatesNotExcludedInTheEffectsOrder) {
-  const Scene model = RoomModelWithPhotos();
+  const recon::Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = RoomRecords(2.0, 1.0, 3);
   std::vector<std::string> excluded = {"ambient_light",
@@ -211,7 +211,7 @@ TEST(EvaluateCandidatesTest, FitsTheCandidatesNotExcludedInTheEffectsOrder) {
 
 // RecordSubset: one record in `stride` with no pattern, or one region's records.
 TEST(RecordSubsetTest, AQuarterOrOneRegion) {
-  const Scene model = RoomModel();
+  const recon::Scene model = RoomModel();
   const std::vector<PixelRecord> records = RoomRecords(2.0, 1.0, 3);
   const RecordSubset every(model, records, 0.05, true, 8, 1);
   EXPECT_EQ(every.records().size(), records.size());
@@ -298,4 +298,4 @@ TEST(RankForTrialsTest, AFitThatExplainsMoreThanTheResidualIsAFailure) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -11,14 +11,14 @@
 
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 constexpr int kW = 160, kH = 120;
 
 // A pinhole camera at `eye` looking at `target` (z up in the world; image y down).
-Camera LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  Camera c;
+recon::Camera LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  recon::Camera c;
   c.width = kW;
   c.height = kH;
   c.params = {138.56, 138.56, 80.0, 60.0};
@@ -82,8 +82,8 @@ std::vector<CarveView> Views(const Truth& truth) {
   return views;
 }
 
-TriangleMesh Floor() {
-  TriangleMesh m;
+recon::TriangleMesh Floor() {
+  recon::TriangleMesh m;
   m.positions = {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}};
   m.triangles = {{0, 1, 2}, {0, 2, 3}};
   return m;
@@ -213,7 +213,7 @@ TEST(MissingGeometryTest, OneViewCarvesNothing) {
 // (5× the value) are not; unusable pixels are unknown.
 TEST(MissingGeometryTest, BlobsAreCoherentRegionsNotFireflies) {
   Image sim(kW, kH, 3), rec(kW, kH, 3), usable(kW, kH, 1, 1.0f);
-  Pcg32 rng(7, 1);
+  render::Pcg32 rng(7, 1);
   for (int y = 0; y < kH; ++y) {
     for (int x = 0; x < kW; ++x) {
       for (int c = 0; c < 3; ++c) {
@@ -248,4 +248,4 @@ TEST(MissingGeometryTest, BlobsAreCoherentRegionsNotFireflies) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -14,21 +14,21 @@
 
 namespace igi::test {
 
-inline PixelRecord OneLightRecord(int photo, int x, int y, int region,
-                                  const Eigen::Vector3d& position, const Eigen::Vector3d& normal,
-                                  const Eigen::Vector3d& view, const Eigen::Vector3f& albedo,
-                                  const Eigen::Vector3d& wi, double irradiance, double distance) {
-  PixelRecord r;
+inline diagnose::PixelRecord OneLightRecord(
+    int photo, int x, int y, int region, const Eigen::Vector3d& position,
+    const Eigen::Vector3d& normal, const Eigen::Vector3d& view, const Eigen::Vector3f& albedo,
+    const Eigen::Vector3d& wi, double irradiance, double distance) {
+  diagnose::PixelRecord r;
   r.photo = photo;
   r.x = x;
   r.y = y;
-  r.held_out = PixelHoldout{0.25, 8, 3}.HeldOut(photo, x, y);
+  r.held_out = solver::PixelHoldout{0.25, 8, 3}.HeldOut(photo, x, y);
   r.region = region;
   r.position = position.cast<float>();
   r.normal = normal.cast<float>();
   r.view = view.cast<float>();
   r.albedo = albedo;
-  RecordLightSample ls;
+  diagnose::RecordLightSample ls;
   ls.light = 0;
   ls.wi = wi.cast<float>();
   ls.irradiance = Eigen::Vector3f::Constant(float(irradiance));
@@ -38,9 +38,9 @@ inline PixelRecord OneLightRecord(int photo, int x, int y, int region,
 }
 
 // Candidate `c` written into `doc` by its effect (Effect::Write).
-inline void WriteCandidate(const CandidateResult& c, Json* doc) {
-  SceneDocument written(std::move(*doc));
-  FindEffect(MakeEffects(), c.effect)->Write(c, &written);
+inline void WriteCandidate(const diagnose::CandidateResult& c, Json* doc) {
+  recon::SceneDocument written(std::move(*doc));
+  diagnose::FindEffect(diagnose::MakeEffects(), c.effect)->Write(c, &written);
   *doc = std::move(written).json();
 }
 

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 struct NoisyPair {
@@ -79,4 +79,4 @@ TEST(ChooseSpp, OnlyValidPixelsCount) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -11,7 +11,7 @@
 
 #include "solver/inverse/photo_model.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // A record at a random pixel of a 160×120 photo, held out by 16-px blocks.
@@ -21,7 +21,7 @@ PixelRecord RandomPixel(int photo, std::mt19937_64& rng) {
   r.photo = photo;
   r.x = int(u(rng) * 160);
   r.y = int(u(rng) * 120);
-  r.held_out = PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
+  r.held_out = solver::PixelHoldout{0.25, 16, 3}.HeldOut(r.photo, r.x, r.y);
   return r;
 }
 
@@ -138,13 +138,13 @@ TEST(BlockGainZTest, AThinEffectEverywherePasses) {
 }
 
 TEST(PhotoModelTest, LinearRadianceInvertsTheForwardModel) {
-  Camera cam;
+  recon::Camera cam;
   cam.width = 40;
   cam.height = 30;
   cam.params = {30, 30, 20, 15};
   cam.vignetting_k1 = -0.25;
   cam.vignetting_k2 = -0.05;
-  Photo photo;
+  recon::Photo photo;
   photo.exposure_scale = 1.3;
   photo.response_exponent = 0.8;
   photo.response_reference = 0.5;
@@ -158,17 +158,17 @@ TEST(PhotoModelTest, LinearRadianceInvertsTheForwardModel) {
       for (int c = 0; c < 3; ++c) recorded.at(x, y, c) *= float(v);
     }
   }
-  ApplyExposureAndResponse(photo, &recorded);
+  solver::ApplyExposureAndResponse(photo, &recorded);
   const double v00 = cam.VignettingFactor(Eigen::Vector2d(0.5, 0.5));
   EXPECT_NEAR(recorded.at(0, 0, 0), 0.5 * std::pow(0.01 * 1.3 * v00 / 0.5, 0.8), 1e-6);
-  const Image back = LinearRadianceOfPhoto(photo, cam, recorded);
+  const Image back = solver::LinearRadianceOfPhoto(photo, cam, recorded);
   for (size_t i = 0; i < back.pixels.size(); ++i) {
     ASSERT_NEAR(back.pixels[i], radiance.pixels[i], 1e-5 * radiance.pixels[i] + 1e-7);
   }
 }
 
 TEST(PhotoModelTest, HoldoutIsReproducibleAndHoldsTheFraction) {
-  const PixelHoldout h{0.25, 16, 7};
+  const solver::PixelHoldout h{0.25, 16, 7};
   int held = 0, total = 0;
   for (int p = 0; p < 4; ++p) {
     for (int y = 0; y < 480; y += 16) {
@@ -180,7 +180,7 @@ TEST(PhotoModelTest, HoldoutIsReproducibleAndHoldsTheFraction) {
     }
   }
   EXPECT_NEAR(double(held) / total, 0.25, 0.03);  // 4800 blocks: σ = 0.006
-  EXPECT_FALSE(PixelHoldout{}.HeldOut(0, 3, 3));
+  EXPECT_FALSE(solver::PixelHoldout{}.HeldOut(0, 3, 3));
 }
 
 // A basis free of the render's noise (an ambient light's separately rendered response) against a
@@ -245,4 +245,4 @@ TEST(ResidualFitTest, ANoiseFreeBasisIsNotCreditedWithTheRendersNoise) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -27,22 +27,22 @@ inline const Eigen::Vector3d kLamp(0, 0, 2.5);
 
 // The room's model: regions "floor" (0) and "wall" (1), the point lamp "lamp" of kIntensity at
 // kLamp, and one lighting "L0" of it. No photos.
-inline Scene RoomModel() {
-  Scene s;
+inline recon::Scene RoomModel() {
+  recon::Scene s;
   for (const char* name : {"floor", "wall"}) {
-    Material m;
+    recon::Material m;
     m.name = name;
-    m.brdf = BrdfModel::kLambert;
+    m.brdf = recon::BrdfModel::kLambert;
     m.rho_d = Eigen::Vector3d::Constant(kRho);
     s.materials.push_back(m);
   }
-  Light lamp;
+  recon::Light lamp;
   lamp.name = "lamp";
-  lamp.type = LightType::kPoint;
+  lamp.type = recon::LightType::kPoint;
   lamp.position = kLamp;
   lamp.intensity = Eigen::Vector3d::Constant(kIntensity);
   s.lights.push_back(lamp);
-  s.lightings.push_back(Lighting{"L0", {0}});
+  s.lightings.push_back(recon::Lighting{"L0", {0}});
   return s;
 }
 
@@ -66,10 +66,10 @@ inline RoomPoint DrawRoomPoint(std::mt19937_64& rng, bool wall, const Eigen::Vec
 }
 
 // RoomModel with the 4 photos of RoomRecords, cam0-3 under the lamp (lighting 0).
-inline Scene RoomModelWithPhotos() {
-  Scene s = RoomModel();
+inline recon::Scene RoomModelWithPhotos() {
+  recon::Scene s = RoomModel();
   for (int j = 0; j < 4; ++j) {
-    Photo ph;
+    recon::Photo ph;
     ph.file = "cam" + std::to_string(j) + "_L0.exr";
     ph.lighting = 0;
     s.photos.push_back(ph);
@@ -79,7 +79,7 @@ inline Scene RoomModelWithPhotos() {
 
 // Record i of the room: on the floor for even i, on the wall for odd, in photo i % 4, lit by the
 // lamp (its point in *q); its sim and recorded values are the caller's.
-inline PixelRecord RoomRecordAt(int i, std::mt19937_64& rng, RoomPoint* q) {
+inline diagnose::PixelRecord RoomRecordAt(int i, std::mt19937_64& rng, RoomPoint* q) {
   const bool wall = i % 2 == 1;
   *q = DrawRoomPoint(rng, wall, kLamp);
   return OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, q->p, q->n, q->n,
@@ -91,17 +91,17 @@ inline PixelRecord RoomRecordAt(int i, std::mt19937_64& rng, RoomPoint* q) {
 // direct light times peak·cos^power of the angle from −z, plus the bounce term scaled as the
 // light's flux (peak / (2·(power + 1)) of the isotropic lamp's: the spot sends nothing above its
 // horizon), through the response v = (u/ref)^exponent·ref (ref 0.05), 1 % noise.
-inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint64_t seed,
-                                            double peak = 1.0) {
+inline std::vector<diagnose::PixelRecord> RoomRecords(double power, double exponent, uint64_t seed,
+                                                      double peak = 1.0) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> g(0, 1);
   const double ref = 0.05;
-  std::vector<PixelRecord> out;
+  std::vector<diagnose::PixelRecord> out;
   for (int i = 0; i < 8000; ++i) {
     RoomPoint q;
-    PixelRecord r = RoomRecordAt(i, rng, &q);
-    const double direct = kRho / kPi * q.e;
+    diagnose::PixelRecord r = RoomRecordAt(i, rng, &q);
+    const double direct = kRho / render::kPi * q.e;
     const double cos_axis = q.wi.z();  // cos of the angle from −z of the direction lamp → point
     const double truth = peak * direct * std::pow(std::max(0.0, cos_axis), power) +
                          kBounce * peak / (2 * (power + 1));
@@ -118,15 +118,15 @@ inline std::vector<PixelRecord> RoomRecords(double power, double exponent, uint6
 // The room with a second point lamp "lamp2" of kIntensity at kLamp2 in lighting "L1", and 8
 // photos: cam0-3 under the lamp (photos 0-3), cam0-3 under lamp2 (photos 4-7).
 inline const Eigen::Vector3d kLamp2(-1, 1, 2.2);
-inline Scene TwoLightingRoomModel() {
-  Scene model = RoomModel();
-  Light lamp2 = model.lights[0];
+inline recon::Scene TwoLightingRoomModel() {
+  recon::Scene model = RoomModel();
+  recon::Light lamp2 = model.lights[0];
   lamp2.name = "lamp2";
   lamp2.position = kLamp2;
   model.lights.push_back(lamp2);
-  model.lightings.push_back(Lighting{"L1", {1}});
+  model.lightings.push_back(recon::Lighting{"L1", {1}});
   for (int j = 0; j < 8; ++j) {
-    Photo ph;
+    recon::Photo ph;
     ph.file = "cam" + std::to_string(j % 4) + "_L" + std::to_string(j / 4) + ".exr";
     ph.lighting = j / 4;
     model.photos.push_back(ph);
@@ -137,19 +137,20 @@ inline Scene TwoLightingRoomModel() {
 // 16 000 records of TwoLightingRoomModel's photos (photo i % 8, floor and wall in turns of 8),
 // each lit by its photo's lamp; the model's value is the lamp's direct light plus the bounce
 // term, the photo that value times `scale(photo)` with 1 % noise.
-inline std::vector<PixelRecord> TwoLightingRoomRecords(uint64_t seed,
-                                                       const std::function<double(int)>& scale) {
+inline std::vector<diagnose::PixelRecord> TwoLightingRoomRecords(
+    uint64_t seed, const std::function<double(int)>& scale) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> g(0, 1);
-  std::vector<PixelRecord> records;
+  std::vector<diagnose::PixelRecord> records;
   for (int i = 0; i < 16000; ++i) {
     const bool wall = (i / 8) % 2 == 1;
     const int photo = i % 8;
     const RoomPoint q = DrawRoomPoint(rng, wall, photo < 4 ? kLamp : kLamp2);
-    PixelRecord r = OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, q.p, q.n,
-                                   q.n, Eigen::Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
+    diagnose::PixelRecord r =
+        OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, q.p, q.n, q.n,
+                       Eigen::Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
     r.lights[0].light = photo < 4 ? 0 : 1;
-    const double sim = kRho / kPi * q.e + kBounce;
+    const double sim = kRho / render::kPi * q.e + kBounce;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(sim);
       r.recorded[c] = float(sim * scale(photo) * (1 + 0.01 * g(rng)));

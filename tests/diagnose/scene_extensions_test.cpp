@@ -11,7 +11,7 @@
 #include "tests/solver/test_scenes.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using test::DownCamera;
@@ -41,21 +41,22 @@ TEST(SceneExtensionsTest, AmbientLightAddsAlbedoTimesRadianceExactly) {
   const Json amb = {{"type", "ambient"}, {"radiance", {2.0, 2.0, 2.0}}};
   const Json sun = {{"type", "directional"}, {"direction", {0, 0.6, -0.8}},
                     {"irradiance", {1.0, 1.0, 1.0}}};
-  const Scene ambient_only = LoadTestScene(dir, PlaneScene({{"amb", amb}}, {"amb"}, camera));
-  ASSERT_EQ(ambient_only.lights[0].type, LightType::kAmbient);
-  const Scene with_sun =
+  const recon::Scene ambient_only = LoadTestScene(dir, PlaneScene({{"amb", amb}}, {"amb"}, camera));
+  ASSERT_EQ(ambient_only.lights[0].type, recon::LightType::kAmbient);
+  const recon::Scene with_sun =
       LoadTestScene(dir, PlaneScene({{"amb", amb}, {"sun", sun}}, {"amb", "sun"}, camera));
-  RenderOptions ro;
+  render::RenderOptions ro;
   ro.spp = 1;
-  const Image a = Renderer(ambient_only, 0).Render(ambient_only.cameras[0], ro);
-  const Image b = Renderer(with_sun, 0).Render(with_sun.cameras[0], ro);
+  const Image a = render::Renderer(ambient_only, 0).Render(ambient_only.cameras[0], ro);
+  const Image b = render::Renderer(with_sun, 0).Render(with_sun.cameras[0], ro);
   const double rho[3] = {0.5, 0.4, 0.2};
   for (int y = 0; y < 16; ++y) {
     for (int x = 0; x < 16; ++x) {
       for (int c = 0; c < 3; ++c) {
         // ρd·L, and ρd/π·E·cosθ of the sun (cos 0.8) on top: float rounding only (1e-6).
         EXPECT_NEAR(a.at(x, y, c), rho[c] * 2.0, 1e-6) << x << "," << y << "," << c;
-        EXPECT_NEAR(b.at(x, y, c), rho[c] * (2.0 + 0.8 / kPi), 1e-6) << x << "," << y << "," << c;
+        EXPECT_NEAR(b.at(x, y, c), rho[c] * (2.0 + 0.8 / render::kPi), 1e-6)
+            << x << "," << y << "," << c;
       }
     }
   }
@@ -71,28 +72,28 @@ TEST(SceneExtensionsTest, AmbientLightOnAGlossyLobeMatchesTheQuadrature) {
                         DownCamera(0, 0, 1, 16, 16, 20));
   doc["materials"]["plane"] = {{"brdf", "ward"}, {"rho_d", {0.2, 0.2, 0.2}},
                                {"rho_s", {0.3, 0.3, 0.3}}, {"alpha", 0.15}};
-  const Scene scene = LoadTestScene(dir, doc);
-  const Renderer renderer(scene, 0);
-  BrdfParams lobe;
-  lobe.model = BrdfModel::kWard;
+  const recon::Scene scene = LoadTestScene(dir, doc);
+  const render::Renderer renderer(scene, 0);
+  render::BrdfParams lobe;
+  lobe.model = recon::BrdfModel::kWard;
   lobe.rho_s = Eigen::Vector3d::Constant(0.3);
   lobe.alpha = 0.15;
   for (const double theta_deg : {0.0, 45.0, 70.0}) {
-    const double theta = theta_deg * kPi / 180;
+    const double theta = theta_deg * render::kPi / 180;
     const Eigen::Vector3d wo(std::sin(theta), 0, std::cos(theta));  // toward the viewer
     // Midpoint rule over (θi, φi), 1200 × 2400 cells: its error is far below the tolerance.
     const int n_theta = 1200, n_phi = 2400;
     double integral = 0;
     for (int i = 0; i < n_theta; ++i) {
-      const double ti = (i + 0.5) * (kPi / 2) / n_theta;
+      const double ti = (i + 0.5) * (render::kPi / 2) / n_theta;
       for (int j = 0; j < n_phi; ++j) {
-        const double pj = (j + 0.5) * 2 * kPi / n_phi;
+        const double pj = (j + 0.5) * 2 * render::kPi / n_phi;
         const Eigen::Vector3d wi(std::sin(ti) * std::cos(pj), std::sin(ti) * std::sin(pj),
                                  std::cos(ti));
-        integral += EvalBrdf(lobe, wo, wi)[0] * std::cos(ti) * std::sin(ti);
+        integral += render::EvalBrdf(lobe, wo, wi)[0] * std::cos(ti) * std::sin(ti);
       }
     }
-    integral *= (kPi / 2 / n_theta) * (2 * kPi / n_phi);
+    integral *= (render::kPi / 2 / n_theta) * (2 * render::kPi / n_phi);
     const double expected = 0.2 + integral;
     // 4096 paths along one ray (they end on the open plane after one vertex), one direction
     // drawn from the lobe per path: the mean's standard error is well under 0.5 % at these
@@ -117,13 +118,13 @@ TEST(SceneExtensionsTest, CameraVignettingScalesTheRender) {
   Json cam = DownCamera(0, 0, 1, 40, 30, 20);
   const Json lights = {{"sun", {{"type", "directional"}, {"direction", {0, 0, -1}},
                                 {"irradiance", {1, 1, 1}}}}};
-  const Scene plain = LoadTestScene(dir, PlaneScene(lights, {"sun"}, cam));
+  const recon::Scene plain = LoadTestScene(dir, PlaneScene(lights, {"sun"}, cam));
   cam["vignetting"] = {{"k1", -0.3}, {"k2", -0.1}};
-  const Scene vignetted = LoadTestScene(dir, PlaneScene(lights, {"sun"}, cam));
-  RenderOptions ro;
+  const recon::Scene vignetted = LoadTestScene(dir, PlaneScene(lights, {"sun"}, cam));
+  render::RenderOptions ro;
   ro.spp = 4;
-  const Image a = Renderer(plain, 0).Render(plain.cameras[0], ro);
-  const Image b = Renderer(vignetted, 0).Render(vignetted.cameras[0], ro);
+  const Image a = render::Renderer(plain, 0).Render(plain.cameras[0], ro);
+  const Image b = render::Renderer(vignetted, 0).Render(vignetted.cameras[0], ro);
   // Same seed, same paths: the ratio is the factor exactly (float rounding).
   for (const auto& [x, y] : std::vector<std::pair<int, int>>{{0, 0}, {20, 15}, {39, 29}, {10, 5}}) {
     const double f = vignetted.cameras[0].VignettingFactor(Eigen::Vector2d(x + 0.5, y + 0.5));
@@ -151,4 +152,4 @@ TEST(SceneExtensionsTest, BadValuesNameTheirKey) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

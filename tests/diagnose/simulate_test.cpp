@@ -9,7 +9,7 @@
 #include "solver/diagnose/pixel_records.h"
 #include "tests/solver/test_scenes.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using test::DownCamera;
@@ -20,7 +20,7 @@ using test::WriteText;
 
 // A floor under a sphere light (soft, noisy renders) seen by two cameras, one photo each; the
 // second photo has an exposure scale and a response (applied per half render for the variance).
-Scene TwoPhotoScene(const std::filesystem::path& dir) {
+recon::Scene TwoPhotoScene(const std::filesystem::path& dir) {
   WriteText(dir / "floor.obj", SquareObj("floor", 3.0));
   const Json doc = {
       {"format", "igi-scene"},
@@ -33,9 +33,9 @@ Scene TwoPhotoScene(const std::filesystem::path& dir) {
       {"lightings", {{"L", {"l"}}}},
       {"cameras",
        {{"a", DownCamera(0, 0, 3, 37, 29, 30)}, {"b", DownCamera(0.2, 0, 2, 40, 24, 25)}}}};
-  Scene scene = LoadTestScene(dir, doc);
+  recon::Scene scene = LoadTestScene(dir, doc);
   for (int c = 0; c < 2; ++c) {
-    Photo p;
+    recon::Photo p;
     p.file = dir / (scene.cameras[c].name + ".exr");
     p.camera = c;
     p.lighting = 0;
@@ -54,12 +54,12 @@ DiagnoseOptions Options() {
 
 TEST(SimulatePhotosTest, HeldOutTestMasksCoverTheBlocksTheirWindowAndTheGrid) {
   const auto dir = TempSceneDir("sim_masks");
-  const Scene scene = TwoPhotoScene(dir);
-  const PixelHoldout h{0.3, 6, 5};
+  const recon::Scene scene = TwoPhotoScene(dir);
+  const solver::PixelHoldout h{0.3, 6, 5};
   const PixelMasks masks = HeldOutTestMasks(scene, h, 8);
   ASSERT_EQ(masks.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
-    const Camera& cam = scene.cameras[scene.photos[i].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[i].camera];
     ASSERT_EQ(masks[i].size(), size_t(cam.width) * cam.height);
     size_t marked = 0, held = 0;
     for (int y = 0; y < cam.height; ++y) {
@@ -84,7 +84,7 @@ TEST(SimulatePhotosTest, HeldOutTestMasksCoverTheBlocksTheirWindowAndTheGrid) {
 // Cross-fitting's folds: fold 0 is exactly the held-out blocks, the fitted blocks split into
 // near-equal shares, a block is one fold, and a single fold leaves every fitted block in fold 1.
 TEST(SimulatePhotosTest, FoldsAreTheHeldOutBlocksAndSharesOfTheOthers) {
-  const PixelHoldout h{0.25, 8, 7};
+  const solver::PixelHoldout h{0.25, 8, 7};
   std::vector<int> count(4, 0);
   for (int photo = 0; photo < 4; ++photo) {
     for (int y = 0; y < 400; y += 8) {
@@ -101,7 +101,7 @@ TEST(SimulatePhotosTest, FoldsAreTheHeldOutBlocksAndSharesOfTheOthers) {
   }
   for (int f = 0; f < 4; ++f) EXPECT_NEAR(count[size_t(f)], 2500, 150) << "fold " << f;
   // No held-out blocks: every block in a fitted fold, still split evenly.
-  const PixelHoldout none{0, 8, 7};
+  const solver::PixelHoldout none{0, 8, 7};
   std::vector<int> split(3, 0);
   for (int y = 0; y < 800; y += 8) {
     for (int x = 0; x < 800; x += 8) ++split[size_t(none.Fold(0, x, y, 4) - 1)];
@@ -111,9 +111,9 @@ TEST(SimulatePhotosTest, FoldsAreTheHeldOutBlocksAndSharesOfTheOthers) {
 
 TEST(SimulatePhotosTest, PartsRenderedSeparatelyEqualOneRender) {
   const auto dir = TempSceneDir("sim_parts");
-  const Scene scene = TwoPhotoScene(dir);
+  const recon::Scene scene = TwoPhotoScene(dir);
   const DiagnoseOptions o = Options();
-  const PixelHoldout h{0.3, 6, 5};
+  const solver::PixelHoldout h{0.3, 6, 5};
   Simulation whole;
   SimulatePhotos(scene, o, 9, &whole);
   ASSERT_TRUE(whole.Complete());
@@ -160,4 +160,4 @@ TEST(SimulatePhotosTest, PartsRenderedSeparatelyEqualOneRender) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

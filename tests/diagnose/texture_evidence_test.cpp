@@ -10,7 +10,7 @@
 #include <functional>
 #include <random>
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // Records every 1.5 cm over the floor z = 0, seen by 4 photos with 12 % photo noise (a 16-spp
@@ -36,9 +36,9 @@ std::vector<PixelRecord> FloorRecords(const std::function<double(double, double)
   return out;
 }
 
-Scene FloorScene() {
-  Scene s;
-  Material m;
+recon::Scene FloorScene() {
+  recon::Scene s;
+  recon::Material m;
   m.name = "floor";
   s.materials.push_back(m);
   return s;
@@ -170,4 +170,4 @@ TEST(TextureEvidence, OnlySolvedRegionsAreTested) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -16,7 +16,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 const aiNode* FindNode(const aiNode* node, const std::string& name) {
@@ -38,7 +38,7 @@ std::map<std::string, const aiMaterial*> Materials(const aiScene* ai) {
 }
 
 TEST(ExportGltf, RadianceRoomLoadsInAssimp) {
-  const Scene scene = test::LoadRadianceRoom();
+  const recon::Scene scene = test::LoadRadianceRoom();
   const auto dir = test::UniqueTempDir("igi_export_gltf") / "out";
   ExportScene(scene, dir, {.format = ExportFormat::kGltf});
   Assimp::Importer importer;
@@ -86,11 +86,11 @@ TEST(ExportGltf, RadianceRoomLoadsInAssimp) {
   // The lamp: a point light of intensity radiance·π r² = 31.4159.
   const aiLight* lamp = ai->mLights[0];
   EXPECT_EQ(lamp->mType, aiLightSource_POINT);
-  EXPECT_NEAR(lamp->mColorDiffuse.r, 1000 * kPi * 0.01, 1e-3);
+  EXPECT_NEAR(lamp->mColorDiffuse.r, 1000 * render::kPi * 0.01, 1e-3);
 }
 
 TEST(ExportGltf, EveryLightTypeAndTexture) {
-  Scene scene = test::SyntheticScene();
+  recon::Scene scene = test::SyntheticScene();
   const auto dir = test::UniqueTempDir("igi_export_gltf");
   // A 4x2 albedo map on "matte": linear 0.5 grey.
   Image texture;
@@ -123,4 +123,4 @@ TEST(ExportGltf, EveryLightTypeAndTexture) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

@@ -12,7 +12,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 struct XmlSummary {
@@ -55,7 +55,7 @@ XmlSummary ReadXml(const std::string& text) {
 }
 
 TEST(ExportMitsuba, RadianceRoom) {
-  const Scene scene = test::LoadRadianceRoom();
+  const recon::Scene scene = test::LoadRadianceRoom();
   const auto dir = test::UniqueTempDir("igi_export_mi") / "out";
   ExportScene(scene, dir, {.format = ExportFormat::kMitsuba});
   for (const std::string lighting : {"L0", "L1"}) {
@@ -82,7 +82,7 @@ TEST(ExportMitsuba, RadianceRoom) {
 }
 
 TEST(ExportMitsuba, EveryLightType) {
-  Scene scene = test::SyntheticScene();
+  recon::Scene scene = test::SyntheticScene();
   const auto tmp = test::UniqueTempDir("igi_export_mi");
   const auto dir = tmp / "out";
   // A 4x2 linear albedo map on "matte": written as textures/matte.exr, values unchanged.
@@ -105,4 +105,4 @@ TEST(ExportMitsuba, EveryLightType) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

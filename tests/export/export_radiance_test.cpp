@@ -15,7 +15,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 struct Primitive {
@@ -81,7 +81,7 @@ std::map<std::string, std::vector<double>> ParseView(const std::filesystem::path
 }
 
 TEST(ExportRadiance, ReproducesTheReferenceRoom) {
-  const Scene scene = test::LoadRadianceRoom();
+  const recon::Scene scene = test::LoadRadianceRoom();
   const auto dir = test::UniqueTempDir("igi_export_rad") / "out";
   const ExportReport report = ExportScene(scene, dir, {.format = ExportFormat::kRadiance});
   const auto mine = ParseRad(dir / "scene.rad");
@@ -136,7 +136,7 @@ TEST(ExportRadiance, ReproducesTheReferenceRoom) {
 }
 
 TEST(ExportRadiance, MapsEveryMaterialAndLight) {
-  const Scene scene = test::SyntheticScene();
+  const recon::Scene scene = test::SyntheticScene();
   const auto dir = test::UniqueTempDir("igi_export_rad") / "out";
   const ExportReport report = ExportScene(scene, dir, {.format = ExportFormat::kRadiance});
   const auto prims = ParseRad(dir / "scene.rad");
@@ -176,7 +176,7 @@ TEST(ExportRadiance, MapsEveryMaterialAndLight) {
   EXPECT_EQ(Count(lights, "source"), 1);
   EXPECT_EQ(Count(lights, "polygon"), 2);
   // Point light: radiance I/(π r²) on a sphere of the default radius 0.01 m.
-  EXPECT_NEAR(Find(lights, "bulb.mat").reals[0], 10 / (kPi * 1e-4), 1e-3);
+  EXPECT_NEAR(Find(lights, "bulb.mat").reals[0], 10 / (render::kPi * 1e-4), 1e-3);
   // Spot (cone 20°..30°): spotlight of full angle 50° along the direction.
   EXPECT_NEAR(Find(lights, "spot.mat").reals[3], 50, 0.1);
   EXPECT_EQ(Find(lights, "spot.mat").reals[6], -1);
@@ -188,11 +188,11 @@ TEST(ExportRadiance, MapsEveryMaterialAndLight) {
   auto view = ParseView(dir / "cam.vf");
   EXPECT_NEAR(view["-vs"][0], -0.05, 1e-9);
   EXPECT_NEAR(view["-vl"][0], -0.05, 1e-9);
-  EXPECT_NEAR(view["-vh"][0], 2 * std::atan(1.0) * 180 / kPi, 1e-6);
+  EXPECT_NEAR(view["-vh"][0], 2 * std::atan(1.0) * 180 / render::kPi, 1e-6);
 }
 
 TEST(ExportRadiance, RefusesIncompleteMaterialsAndBusyFolders) {
-  Scene scene = test::SyntheticScene();
+  recon::Scene scene = test::SyntheticScene();
   const auto dir = test::UniqueTempDir("igi_export_rad");
   WriteFileAtomic(dir / "busy" / "keep.txt", "x");
   EXPECT_THROW(ExportScene(scene, dir / "busy", {.format = ExportFormat::kRadiance}), InputError);
@@ -203,4 +203,4 @@ TEST(ExportRadiance, RefusesIncompleteMaterialsAndBusyFolders) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

@@ -11,7 +11,7 @@
 #include "tools/common/atomic_file.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 using test::Quote;
@@ -78,4 +78,4 @@ TEST(IgiExport, BadInputExitsTwoAndWritesNothing) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

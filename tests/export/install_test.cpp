@@ -10,7 +10,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
 using test::Quote;
@@ -57,4 +57,4 @@ TEST(InstalledPackage, ConsumerFindsIgiAndLoadsAScene) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

@@ -4,11 +4,11 @@
 
 #include <gtest/gtest.h>
 
-namespace igi {
+namespace igi::exporter {
 namespace {
 
-BrdfParams Source(BrdfModel model, double alpha, double rho_s = 0.05) {
-  BrdfParams p;
+render::BrdfParams Source(recon::BrdfModel model, double alpha, double rho_s = 0.05) {
+  render::BrdfParams p;
   p.model = model;
   p.rho_s.setConstant(rho_s);
   p.alpha = alpha;
@@ -21,7 +21,7 @@ BrdfParams Source(BrdfModel model, double alpha, double rho_s = 0.05) {
 // (1e-9 in log α) and the residual vanishes.
 TEST(WardFit, GmdByGmdIsExact) {
   for (double alpha : {0.03, 0.1, 0.3}) {
-    const LobeFit fit = FitSpecularLobe(Source(BrdfModel::kWardGmd, alpha, 1.0));
+    const LobeFit fit = FitSpecularLobe(Source(recon::BrdfModel::kWardGmd, alpha, 1.0));
     EXPECT_NEAR(fit.alpha, alpha, 1e-6 * alpha);
     EXPECT_NEAR(fit.scale, 1.0, 1e-6);
     EXPECT_LT(fit.relative_error, 1e-5);
@@ -35,7 +35,7 @@ TEST(WardFit, GmdByGmdIsExact) {
 // 88°). The bounds leave ~20% headroom.
 TEST(WardFit, Ward1992ByGmdIsClose) {
   for (double alpha : {0.05, 0.1, 0.2}) {
-    const LobeFit fit = FitSpecularLobe(Source(BrdfModel::kWard, alpha, 1.0));
+    const LobeFit fit = FitSpecularLobe(Source(recon::BrdfModel::kWard, alpha, 1.0));
     std::printf("ward alpha %.2f -> ward_gmd: alpha %.4f scale %.4f error %.4f\n", alpha, fit.alpha,
                 fit.scale, fit.relative_error);
     EXPECT_NEAR(fit.alpha, alpha, 0.05 * alpha);
@@ -51,7 +51,7 @@ TEST(WardFit, Ward1992ByGmdIsClose) {
 // The Fresnel and shadowing terms the GMD Ward lacks make most of the error. Bounds: +20%.
 TEST(WardFit, GmdByMicrofacetTargets) {
   for (double alpha : {0.05, 0.1, 0.2}) {
-    const BrdfParams src = Source(BrdfModel::kWardGmd, alpha, 0.05);
+    const render::BrdfParams src = Source(recon::BrdfModel::kWardGmd, alpha, 0.05);
     LobeFitOptions beckmann;
     beckmann.target = LobeTarget::kBeckmannDielectric;
     beckmann.target_ior = (1 + std::sqrt(0.05)) / (1 - std::sqrt(0.05));
@@ -79,12 +79,12 @@ TEST(WardFit, TargetValuesAtNormalIncidence) {
   const double alpha = 0.2, eta = 1.5, f0 = 0.04;
   EXPECT_NEAR(DielectricFresnel(1.0, eta), f0, 1e-12);
   EXPECT_NEAR(TargetLobeValue(LobeTarget::kBeckmannDielectric, alpha, 1.0, eta, z, z),
-              f0 / (kPi * alpha * alpha) / 4.0, 1e-9);
+              f0 / (render::kPi * alpha * alpha) / 4.0, 1e-9);
   EXPECT_NEAR(TargetLobeValue(LobeTarget::kGgxSchlick, alpha, f0, 0, z, z),
-              f0 / (kPi * alpha * alpha) / 4.0, 1e-9);
+              f0 / (render::kPi * alpha * alpha) / 4.0, 1e-9);
   EXPECT_NEAR(TargetLobeValue(LobeTarget::kWardGmd, alpha, 1.0, 0, z, z),
-              1.0 / (kPi * alpha * alpha) / 4.0, 1e-9);
+              1.0 / (render::kPi * alpha * alpha) / 4.0, 1e-9);
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::exporter

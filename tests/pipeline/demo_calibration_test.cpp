@@ -15,7 +15,7 @@
 #include "tools/common/json.h"
 #include "tools/pipeline/demo.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace {
 namespace fs = std::filesystem;
 
@@ -246,4 +246,4 @@ TEST(DemoCalibrationTest, TruthOverTheSolvedMapsSeenTexels) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::pipeline

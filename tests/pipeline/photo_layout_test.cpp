@@ -9,7 +9,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace {
 namespace fs = std::filesystem;
 
@@ -87,4 +87,4 @@ TEST(PhotoLayoutTest, BrokenLayoutsAreInputErrors) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::pipeline

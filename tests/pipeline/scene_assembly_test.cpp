@@ -10,7 +10,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace {
 namespace fs = std::filesystem;
 
@@ -77,4 +77,4 @@ TEST(SceneAssemblyTest, TonemapKeepsSizeAndOrder) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -8,7 +8,7 @@
 
 #include "tests/temp_dir.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace {
 namespace fs = std::filesystem;
 
@@ -54,4 +54,4 @@ TEST(StageMarkerTest, RoundTripAndDamagedMarker) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 Camera MakeCamera(CameraModel model) {
@@ -62,4 +62,4 @@ TEST(CameraTest, ColmapModelsConvertExactly) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

@@ -21,7 +21,7 @@
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -745,4 +745,4 @@ TEST(ColmapModelBroken, ListsEveryProblemAndNamesMissingFiles) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

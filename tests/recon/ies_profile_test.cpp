@@ -13,7 +13,7 @@
 
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -319,4 +319,4 @@ TEST(IesProfileRead, MissingFileIsInputError) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

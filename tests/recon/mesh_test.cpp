@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 const std::filesystem::path kMini = std::filesystem::path(IGI_SOURCE_DIR) / "tests/data/scenes/mini";
@@ -87,4 +87,4 @@ TEST(MeshTest, ProblemsNameTheFile) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

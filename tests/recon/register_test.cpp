@@ -18,7 +18,7 @@
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -151,4 +151,4 @@ TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

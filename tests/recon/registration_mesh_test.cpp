@@ -11,7 +11,7 @@
 #include "recon/mesh_alignment.h"
 #include "recon/mesh_closest_point.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 using Eigen::Vector3d;
@@ -252,4 +252,4 @@ TEST(MeshAlignmentTest, RefinePosesAgainstMesh) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

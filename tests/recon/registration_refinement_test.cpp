@@ -17,7 +17,7 @@
 #include "recon/camera.h"
 #include "recon/registration.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 using Eigen::Vector2d;
@@ -349,4 +349,4 @@ TEST(RegistrationRefinementTest, PosesPhotoFromMarkersAlone) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

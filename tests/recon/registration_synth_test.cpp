@@ -48,7 +48,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -375,4 +375,4 @@ TEST(RegistrationSynthTest, RecoversKnownPosesOfTexturedRoom) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

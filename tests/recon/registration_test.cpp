@@ -13,7 +13,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -140,4 +140,4 @@ TEST(RegistrationTest, ReprojectionErrorOfExactModelIsZero) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

@@ -8,7 +8,7 @@
 #include "recon/scene.h"
 #include "tests/recon/corpus.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 class BrokenSceneTest : public ::testing::TestWithParam<CorpusCase> {};
@@ -33,4 +33,4 @@ INSTANTIATE_TEST_SUITE_P(Corpus, BrokenSceneTest, ::testing::ValuesIn(ReadCorpus
 TEST(BrokenSceneCorpus, HasAtLeast25Cases) { EXPECT_GE(ReadCorpus().size(), 25u); }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

@@ -11,7 +11,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -211,4 +211,4 @@ TEST(SceneDocumentTest, ValidateRejectsABadValueWithTheReadersError) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

@@ -9,7 +9,7 @@
 
 #include "recon/colmap_model.h"
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 namespace fs = std::filesystem;
@@ -182,9 +182,9 @@ TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon
 
-namespace igi {
+namespace igi::recon {
 namespace {
 
 // Cameras from a COLMAP model: each image becomes a camera named by its image name, and a
@@ -240,4 +240,4 @@ TEST(SceneTest, CamerasFromColmapModel) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::recon

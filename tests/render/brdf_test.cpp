@@ -11,7 +11,7 @@
 #include "chi_square.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 using test::IntegrateSphere;
@@ -19,18 +19,18 @@ using test::SidakLevel;
 using test::SphereHistogram;
 using test::TestDirections;
 
-constexpr BrdfModel kAllModels[] = {BrdfModel::kLambert,
-                                    BrdfModel::kWard,
-                                    BrdfModel::kWardGmd,
-                                    BrdfModel::kWardAniso,
-                                    BrdfModel::kWardGmdAniso,
-                                    BrdfModel::kWardFresnel,
-                                    BrdfModel::kWardGmdFresnel,
-                                    BrdfModel::kWardAnisoFresnel,
-                                    BrdfModel::kWardGmdAnisoFresnel};
-constexpr BrdfModel kFresnelModels[] = {BrdfModel::kWardFresnel, BrdfModel::kWardGmdFresnel,
-                                        BrdfModel::kWardAnisoFresnel,
-                                        BrdfModel::kWardGmdAnisoFresnel};
+constexpr recon::BrdfModel kAllModels[] = {recon::BrdfModel::kLambert,
+                                           recon::BrdfModel::kWard,
+                                           recon::BrdfModel::kWardGmd,
+                                           recon::BrdfModel::kWardAniso,
+                                           recon::BrdfModel::kWardGmdAniso,
+                                           recon::BrdfModel::kWardFresnel,
+                                           recon::BrdfModel::kWardGmdFresnel,
+                                           recon::BrdfModel::kWardAnisoFresnel,
+                                           recon::BrdfModel::kWardGmdAnisoFresnel};
+constexpr recon::BrdfModel kFresnelModels[] = {
+    recon::BrdfModel::kWardFresnel, recon::BrdfModel::kWardGmdFresnel,
+    recon::BrdfModel::kWardAnisoFresnel, recon::BrdfModel::kWardGmdAnisoFresnel};
 
 Eigen::Vector3d Dir(double theta_deg, double phi_deg) {
   const double t = theta_deg * kPi / 180.0;
@@ -38,7 +38,7 @@ Eigen::Vector3d Dir(double theta_deg, double phi_deg) {
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
 }
 
-BrdfParams Make(BrdfModel model, const Eigen::Vector3d& rho_d, const Eigen::Vector3d& rho_s,
+BrdfParams Make(recon::BrdfModel model, const Eigen::Vector3d& rho_d, const Eigen::Vector3d& rho_s,
                 double alpha_x, double alpha_y) {
   BrdfParams p;
   p.model = model;
@@ -50,7 +50,8 @@ BrdfParams Make(BrdfModel model, const Eigen::Vector3d& rho_d, const Eigen::Vect
   return p;
 }
 
-BrdfParams Grey(BrdfModel model, double rho_d, double rho_s, double alpha_x, double alpha_y) {
+BrdfParams Grey(recon::BrdfModel model, double rho_d, double rho_s, double alpha_x,
+                double alpha_y) {
   return Make(model, Eigen::Vector3d::Constant(rho_d), Eigen::Vector3d::Constant(rho_s), alpha_x,
               alpha_y);
 }
@@ -58,7 +59,7 @@ BrdfParams Grey(BrdfModel model, double rho_d, double rho_s, double alpha_x, dou
 // The specular part of docs/scene-format.md written a second way: through the angles θh, φh of the
 // normalised half vector, and for Ward-GMD through (h·h)/(h·n)⁴ = 1/(4 (wi·ĥ)² cos⁴θh). For a
 // *_fresnel model: the plain model's (the Fresnel weight is ReferenceFresnelWeight).
-double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vector3d& wo,
+double ReferenceSpecular(recon::BrdfModel model, double ax, double ay, const Eigen::Vector3d& wo,
                          const Eigen::Vector3d& wi) {
   const Eigen::Vector3d h_hat = (wo + wi).normalized();
   const double theta_h = std::acos(h_hat.z());
@@ -66,7 +67,7 @@ double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vec
   const double tan2 = std::pow(std::tan(theta_h), 2);
   const double c2 = std::pow(std::cos(phi_h), 2);
   const double lobe = std::exp(-tan2 * (c2 / (ax * ax) + (1.0 - c2) / (ay * ay)));
-  if (IsGmd(model)) {
+  if (recon::IsGmd(model)) {
     return lobe / (4.0 * kPi * ax * ay * std::pow(wi.dot(h_hat), 2) * std::pow(h_hat.z(), 4));
   }
   return lobe / (4.0 * kPi * ax * ay * std::sqrt(wi.z() * wo.z()));
@@ -74,9 +75,9 @@ double ReferenceSpecular(BrdfModel model, double ax, double ay, const Eigen::Vec
 
 // Schlick's F(θd) = F0 + (1 - F0)(1 - cosθd)⁵ over F0, θd the angle between wo and the
 // normalised half vector (written with wo, where the code uses |wo + wi|/2); 1 without Fresnel.
-double ReferenceFresnelWeight(BrdfModel model, double ior, const Eigen::Vector3d& wo,
+double ReferenceFresnelWeight(recon::BrdfModel model, double ior, const Eigen::Vector3d& wo,
                               const Eigen::Vector3d& wi) {
-  if (!HasFresnel(model)) return 1.0;
+  if (!recon::HasFresnel(model)) return 1.0;
   const double f0 = std::pow((ior - 1.0) / (ior + 1.0), 2);
   const double cos_d = wo.dot((wo + wi).normalized());
   return (f0 + (1.0 - f0) * std::pow(1.0 - cos_d, 5)) / f0;
@@ -85,29 +86,30 @@ double ReferenceFresnelWeight(BrdfModel model, double ior, const Eigen::Vector3d
 // ---- names and parameters -------------------------------------------------------------------
 
 TEST(BrdfModelTest, NamesRoundTrip) {
-  for (BrdfModel m : kAllModels) EXPECT_EQ(BrdfModelFromName(BrdfModelName(m)), m);
-  EXPECT_EQ(BrdfModelName(BrdfModel::kWardGmdAniso), "ward_gmd_aniso");
-  EXPECT_FALSE(IsReflective(*BrdfModelFromName("emitter")));
-  EXPECT_FALSE(IsReflective(*BrdfModelFromName("black")));
-  EXPECT_FALSE(BrdfModelFromName("Ward").has_value());
-  EXPECT_EQ(BrdfModelName(BrdfModel::kWardFresnel), "ward_fresnel");
-  EXPECT_EQ(BrdfModelName(BrdfModel::kWardGmdFresnel), "ward_gmd_fresnel");
-  EXPECT_EQ(BrdfModelName(BrdfModel::kWardAnisoFresnel), "ward_aniso_fresnel");
-  EXPECT_EQ(BrdfModelName(BrdfModel::kWardGmdAnisoFresnel), "ward_gmd_aniso_fresnel");
-  for (BrdfModel m : kFresnelModels) {
-    EXPECT_TRUE(HasSpecularLobe(m) && IsReflective(m) && HasFresnel(m));
-    EXPECT_FALSE(HasFresnel(WithoutFresnel(m)));
-    EXPECT_EQ(IsGmd(m), IsGmd(WithoutFresnel(m)));
-    EXPECT_EQ(IsAnisotropic(m), IsAnisotropic(WithoutFresnel(m)));
+  for (recon::BrdfModel m : kAllModels)
+    EXPECT_EQ(recon::BrdfModelFromName(recon::BrdfModelName(m)), m);
+  EXPECT_EQ(recon::BrdfModelName(recon::BrdfModel::kWardGmdAniso), "ward_gmd_aniso");
+  EXPECT_FALSE(recon::IsReflective(*recon::BrdfModelFromName("emitter")));
+  EXPECT_FALSE(recon::IsReflective(*recon::BrdfModelFromName("black")));
+  EXPECT_FALSE(recon::BrdfModelFromName("Ward").has_value());
+  EXPECT_EQ(recon::BrdfModelName(recon::BrdfModel::kWardFresnel), "ward_fresnel");
+  EXPECT_EQ(recon::BrdfModelName(recon::BrdfModel::kWardGmdFresnel), "ward_gmd_fresnel");
+  EXPECT_EQ(recon::BrdfModelName(recon::BrdfModel::kWardAnisoFresnel), "ward_aniso_fresnel");
+  EXPECT_EQ(recon::BrdfModelName(recon::BrdfModel::kWardGmdAnisoFresnel), "ward_gmd_aniso_fresnel");
+  for (recon::BrdfModel m : kFresnelModels) {
+    EXPECT_TRUE(recon::HasSpecularLobe(m) && recon::IsReflective(m) && recon::HasFresnel(m));
+    EXPECT_FALSE(recon::HasFresnel(recon::WithoutFresnel(m)));
+    EXPECT_EQ(recon::IsGmd(m), recon::IsGmd(recon::WithoutFresnel(m)));
+    EXPECT_EQ(recon::IsAnisotropic(m), recon::IsAnisotropic(recon::WithoutFresnel(m)));
   }
-  EXPECT_TRUE(IsGmd(BrdfModel::kWardGmdAnisoFresnel) &&
-              IsAnisotropic(BrdfModel::kWardGmdAnisoFresnel));
-  EXPECT_EQ(WithoutFresnel(BrdfModel::kWardGmd), BrdfModel::kWardGmd);
+  EXPECT_TRUE(recon::IsGmd(recon::BrdfModel::kWardGmdAnisoFresnel) &&
+              recon::IsAnisotropic(recon::BrdfModel::kWardGmdAnisoFresnel));
+  EXPECT_EQ(recon::WithoutFresnel(recon::BrdfModel::kWardGmd), recon::BrdfModel::kWardGmd);
 }
 
 TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
-  EXPECT_TRUE(CheckBrdfParams(Grey(BrdfModel::kWard, 0.5, 0.1, 0.2, 0.2)).empty());
-  BrdfParams p = Grey(BrdfModel::kWard, 0.5, 0.1, 0.0, 0.2);
+  EXPECT_TRUE(CheckBrdfParams(Grey(recon::BrdfModel::kWard, 0.5, 0.1, 0.2, 0.2)).empty());
+  BrdfParams p = Grey(recon::BrdfModel::kWard, 0.5, 0.1, 0.0, 0.2);
   p.rho_d[1] = -0.1;
   p.alpha_y = -1.0;  // ignored by an isotropic model
   auto problems = CheckBrdfParams(p);
@@ -115,23 +117,23 @@ TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
   EXPECT_EQ(problems[0].key, "rho_d[1]");
   EXPECT_EQ(problems[0].value, -0.1);
   EXPECT_EQ(problems[1].key, "alpha");
-  p.model = BrdfModel::kWardAniso;
+  p.model = recon::BrdfModel::kWardAniso;
   p.rho_d[1] = 0.1;
   p.alpha = -5.0;  // ignored by an anisotropic model
   problems = CheckBrdfParams(p);
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_EQ(problems[0].key, "alpha_x");
   EXPECT_EQ(problems[1].key, "alpha_y");
-  p.model = BrdfModel::kLambert;  // reads rho_d only
+  p.model = recon::BrdfModel::kLambert;  // reads rho_d only
   p.rho_s[2] = NAN;
   EXPECT_TRUE(CheckBrdfParams(p).empty());
   p.rho_d[2] = INFINITY;
   EXPECT_EQ(CheckBrdfParams(p).size(), 1u);
   // ior: read by the *_fresnel models only, must be > 1 (F0 > 0).
-  BrdfParams f = Grey(BrdfModel::kWard, 0.5, 0.1, 0.2, 0.2);
+  BrdfParams f = Grey(recon::BrdfModel::kWard, 0.5, 0.1, 0.2, 0.2);
   f.ior = 1.0;
   EXPECT_TRUE(CheckBrdfParams(f).empty());
-  f.model = BrdfModel::kWardGmdFresnel;
+  f.model = recon::BrdfModel::kWardGmdFresnel;
   problems = CheckBrdfParams(f);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].key, "ior");
@@ -142,10 +144,11 @@ TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
 }
 
 TEST(BrdfParamsTest, SpecularLobeProbabilityFollowsMeanAlbedos) {
-  EXPECT_DOUBLE_EQ(SpecularLobeProbability(Grey(BrdfModel::kWard, 0.4, 0.2, 0.1, 0.1)), 1.0 / 3);
-  EXPECT_EQ(SpecularLobeProbability(Grey(BrdfModel::kLambert, 0.4, 0.2, 0.1, 0.1)), 0.0);
-  EXPECT_EQ(SpecularLobeProbability(Grey(BrdfModel::kWardGmd, 0.0, 0.0, 0.1, 0.1)), 0.0);
-  EXPECT_EQ(SpecularLobeProbability(Grey(BrdfModel::kWardAniso, 0.0, 0.3, 0.1, 0.2)), 1.0);
+  EXPECT_DOUBLE_EQ(SpecularLobeProbability(Grey(recon::BrdfModel::kWard, 0.4, 0.2, 0.1, 0.1)),
+                   1.0 / 3);
+  EXPECT_EQ(SpecularLobeProbability(Grey(recon::BrdfModel::kLambert, 0.4, 0.2, 0.1, 0.1)), 0.0);
+  EXPECT_EQ(SpecularLobeProbability(Grey(recon::BrdfModel::kWardGmd, 0.0, 0.0, 0.1, 0.1)), 0.0);
+  EXPECT_EQ(SpecularLobeProbability(Grey(recon::BrdfModel::kWardAniso, 0.0, 0.3, 0.1, 0.2)), 1.0);
 }
 
 // ---- values ---------------------------------------------------------------------------------
@@ -157,47 +160,47 @@ TEST(BrdfEvalTest, MatchesLiteralValuesFromTheContractFormulas) {
   // operations.
   struct Case {
     double theta_o, phi_o, theta_i, phi_i;
-    BrdfModel model;
+    recon::BrdfModel model;
     double f[3];
   };
   // clang-format off
   const Case cases[] = {
-      {30, 20, 40, 215, BrdfModel::kWard,
+      {30, 20, 40, 215, recon::BrdfModel::kWard,
        {0.24127054747066087, 0.29155516323104735, 0.42395538337019933}},
-      {30, 20, 40, 215, BrdfModel::kWardGmd,
+      {30, 20, 40, 215, recon::BrdfModel::kWardGmd,
        {0.26118817015925311, 0.33139040860823177, 0.50362587412456816}},
-      {30, 20, 40, 215, BrdfModel::kWardAniso,
+      {30, 20, 40, 215, recon::BrdfModel::kWardAniso,
        {0.24656714823872172, 0.302148364767169, 0.44514178644244262}},
-      {30, 20, 40, 215, BrdfModel::kWardGmdAniso,
+      {30, 20, 40, 215, recon::BrdfModel::kWardGmdAniso,
        {0.26776949258805627, 0.3445530534658382, 0.52995116383978103}},
-      {60, 0, 55, 170, BrdfModel::kWard,
+      {60, 0, 55, 170, recon::BrdfModel::kWard,
        {0.27011614622872165, 0.34924636074716886, 0.53933777840244235}},
-      {60, 0, 55, 170, BrdfModel::kWardGmd,
+      {60, 0, 55, 170, recon::BrdfModel::kWardGmd,
        {0.36963202843275644, 0.54827812515523855, 0.93740130721858173}},
-      {60, 0, 55, 170, BrdfModel::kWardAniso,
+      {60, 0, 55, 170, recon::BrdfModel::kWardAniso,
        {0.27776687970547842, 0.36454782770068239, 0.56994071230946952}},
-      {60, 0, 55, 170, BrdfModel::kWardGmdAniso,
+      {60, 0, 55, 170, recon::BrdfModel::kWardGmdAniso,
        {0.38414434478644571, 0.57730275786261698, 0.99545057263333869}},
-      {10, 90, 80, -45, BrdfModel::kWard,
+      {10, 90, 80, -45, recon::BrdfModel::kWard,
        {0.15915511988962203, 0.12732430806896966, 0.095493673046043975}},
-      {10, 90, 80, -45, BrdfModel::kWardGmdAniso,
+      {10, 90, 80, -45, recon::BrdfModel::kWardGmdAniso,
        {0.15915494764538407, 0.12732396358049375, 0.095492984069092138}},
       // The Fresnel-weighted models with ior = 1.7 (c = |wo + wi|/2 = 0.822, 0.542, 0.216).
-      {30, 20, 40, 215, BrdfModel::kWardFresnel,
+      {30, 20, 40, 215, recon::BrdfModel::kWardFresnel,
        {0.24147140274572448, 0.29195687378117452, 0.42475880447045378}},
-      {30, 20, 40, 215, BrdfModel::kWardGmdAnisoFresnel,
+      {30, 20, 40, 215, recon::BrdfModel::kWardGmdAnisoFresnel,
        {0.26803516444640774, 0.34508439718254114, 0.5310138512731869}},
-      {60, 0, 55, 170, BrdfModel::kWardGmdFresnel,
+      {60, 0, 55, 170, recon::BrdfModel::kWardGmdFresnel,
        {0.42830857775844577, 0.66563122380661721, 1.1721075045213389}},
-      {60, 0, 55, 170, BrdfModel::kWardAnisoFresnel,
+      {60, 0, 55, 170, recon::BrdfModel::kWardAnisoFresnel,
        {0.31083337308670023, 0.43068081446312612, 0.70220668583435686}},
-      {80, 0, 75, 180, BrdfModel::kWardFresnel,
+      {80, 0, 75, 180, recon::BrdfModel::kWardFresnel,
        {2.4402983469669537, 4.6896107622236327, 9.2200665813553702}},
-      {80, 0, 75, 180, BrdfModel::kWardGmdFresnel,
+      {80, 0, 75, 180, recon::BrdfModel::kWardGmdFresnel,
        {10.521701932311395, 20.852417932912516, 41.545680922733133}},
-      {80, 0, 75, 180, BrdfModel::kWardAnisoFresnel,
+      {80, 0, 75, 180, recon::BrdfModel::kWardAnisoFresnel,
        {2.1130547162013773, 4.0351235006924799, 7.9110920582930655}},
-      {80, 0, 75, 180, BrdfModel::kWardGmdAnisoFresnel,
+      {80, 0, 75, 180, recon::BrdfModel::kWardGmdAnisoFresnel,
        {9.0351327429432065, 17.87927955417614, 35.599404165260381}},
   };
   // clang-format on
@@ -206,17 +209,18 @@ TEST(BrdfEvalTest, MatchesLiteralValuesFromTheContractFormulas) {
     p.ior = 1.7;  // read by the *_fresnel models only
     BrdfParams iso = p;
     iso.alpha = 0.2;
-    const BrdfParams& params = IsAnisotropic(c.model) ? p : iso;
+    const BrdfParams& params = recon::IsAnisotropic(c.model) ? p : iso;
     const Eigen::Vector3d f = EvalBrdf(params, Dir(c.theta_o, c.phi_o), Dir(c.theta_i, c.phi_i));
     for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(f[k], c.f[k], 1e-13 * c.f[k]) << BrdfModelName(c.model) << " channel " << k;
+      EXPECT_NEAR(f[k], c.f[k], 1e-13 * c.f[k])
+          << recon::BrdfModelName(c.model) << " channel " << k;
     }
   }
 }
 
 TEST(BrdfEvalTest, MatchesTheAngleFormOfEveryModel) {
   Pcg32 rng(1, 2);
-  for (BrdfModel model : kAllModels) {
+  for (recon::BrdfModel model : kAllModels) {
     for (double alpha : {0.05, 0.2, 0.6}) {
       BrdfParams p = Make(model, {0.3, 0.2, 0.1}, {0.04, 0.08, 0.5}, alpha, 1.7 * alpha);
       p.ior = 1.33 + alpha;
@@ -224,13 +228,15 @@ TEST(BrdfEvalTest, MatchesTheAngleFormOfEveryModel) {
         const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
         const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
         double s = 0.0;
-        if (HasSpecularLobe(model)) s = ReferenceSpecular(model, p.AlphaX(), p.AlphaY(), wo, wi);
+        if (recon::HasSpecularLobe(model))
+          s = ReferenceSpecular(model, p.AlphaX(), p.AlphaY(), wo, wi);
         const double w = ReferenceFresnelWeight(model, p.ior, wo, wi);
-        EXPECT_NEAR(HasFresnel(model) ? FresnelWeight(p.ior, wo, wi) : 1.0, w, 1e-12 * w);
+        EXPECT_NEAR(recon::HasFresnel(model) ? FresnelWeight(p.ior, wo, wi) : 1.0, w, 1e-12 * w);
         const Eigen::Vector3d expected = p.rho_d / kPi + p.rho_s * s * w;
         const Eigen::Vector3d f = EvalBrdf(p, wo, wi);
         // 1e-10 relative: acos/tan near θh = 0 lose a few digits in the reference.
-        EXPECT_NEAR((f - expected).norm(), 0.0, 1e-10 * expected.norm()) << BrdfModelName(model);
+        EXPECT_NEAR((f - expected).norm(), 0.0, 1e-10 * expected.norm())
+            << recon::BrdfModelName(model);
         EXPECT_NEAR(SpecularFactor(model, p.AlphaX(), p.AlphaY(), wo, wi), s, 1e-10 * s + 1e-300);
         const BrdfEval both = EvalBrdfAndPdf(p, wo, wi);
         EXPECT_NEAR((both.f - f).norm(), 0.0, 1e-14 * f.norm());
@@ -240,7 +246,7 @@ TEST(BrdfEvalTest, MatchesTheAngleFormOfEveryModel) {
 }
 
 TEST(BrdfEvalTest, IsZeroBelowTheSurfaceAndOneSided) {
-  for (BrdfModel model : kAllModels) {
+  for (recon::BrdfModel model : kAllModels) {
     const BrdfParams p = Grey(model, 0.5, 0.3, 0.2, 0.3);
     EXPECT_EQ(EvalBrdf(p, Dir(30, 0), Dir(100, 180)), Eigen::Vector3d::Zero());
     EXPECT_EQ(EvalBrdf(p, Dir(120, 0), Dir(30, 180)), Eigen::Vector3d::Zero());
@@ -249,8 +255,9 @@ TEST(BrdfEvalTest, IsZeroBelowTheSurfaceAndOneSided) {
     EXPECT_EQ(BrdfPdf(p, Dir(120, 0), Dir(30, 180)), 0.0);
     EXPECT_FALSE(SampleBrdf(p, Dir(120, 0), 0.5, {0.3, 0.3}).Valid());
   }
-  EXPECT_NEAR(EvalBrdf(Grey(BrdfModel::kLambert, 0.6, 0.9, 0.1, 0.1), Dir(10, 0), Dir(70, 3))[0],
-              0.6 / kPi, 1e-16);
+  EXPECT_NEAR(
+      EvalBrdf(Grey(recon::BrdfModel::kLambert, 0.6, 0.9, 0.1, 0.1), Dir(10, 0), Dir(70, 3))[0],
+      0.6 / kPi, 1e-16);
 }
 
 TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicrofacet) {
@@ -258,10 +265,10 @@ TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicroface
   // normal included), and W -> 1 everywhere as ior -> ∞ (F0 -> 1). Elsewhere W >= 1. Tolerances:
   // 1e-14 relative (rounding) at c = 1; at ior = 1e6, 1 - F0 = 4e-6, so W - 1 < 4e-6.
   Pcg32 rng(11, 12);
-  for (BrdfModel model : kFresnelModels) {
+  for (recon::BrdfModel model : kFresnelModels) {
     BrdfParams fresnel = Make(model, {0.3, 0.2, 0.1}, {0.2, 0.3, 0.4}, 0.12, 0.35);
     BrdfParams plain = fresnel;
-    plain.model = WithoutFresnel(model);
+    plain.model = recon::WithoutFresnel(model);
     for (int i = 0; i < 200; ++i) {
       const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
       const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
@@ -275,7 +282,7 @@ TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicroface
     }
     const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
     fresnel.ior = 1.5;
-    EXPECT_EQ(EvalBrdf(fresnel, n, n), EvalBrdf(plain, n, n)) << BrdfModelName(model);
+    EXPECT_EQ(EvalBrdf(fresnel, n, n), EvalBrdf(plain, n, n)) << recon::BrdfModelName(model);
   }
   // ior = 1.5: F0 = 0.04, so W = 1 + 24 (1 - c)⁵; opposite grazing directions (θ = 89°) have
   // c = cos 89° = 0.017452, W = 1 + 24 · 0.982548⁵ = 22.97755 (Python; 1e-6 relative: the printed
@@ -292,7 +299,7 @@ TEST(BrdfEvalTest, FresnelModelsEqualThePlainOnesAtNormalIncidenceOnTheMicroface
 // surface.
 TEST(BrdfEvalTest, SpecularFactorPartsGiveTheFactorAtAnyRoughness) {
   Pcg32 rng(5, 6);
-  for (BrdfModel model : kAllModels) {
+  for (recon::BrdfModel model : kAllModels) {
     for (int i = 0; i < 500; ++i) {
       const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
       const Eigen::Vector3d wi = SampleUniformHemisphere(rng.Uniform2D());
@@ -300,12 +307,12 @@ TEST(BrdfEvalTest, SpecularFactorPartsGiveTheFactorAtAnyRoughness) {
       double qx = 0, qy = 0, g = 0;
       const double s = SpecularFactor<double>(model, ax, ay, wo, wi);
       if (!SpecularFactorParts(model, wo, wi, &qx, &qy, &g)) {
-        EXPECT_FALSE(HasSpecularLobe(model));
+        EXPECT_FALSE(recon::HasSpecularLobe(model));
         EXPECT_EQ(s, 0.0);
         continue;
       }
       const double parts = g * std::exp(-(qx / (ax * ax) + qy / (ay * ay))) / (ax * ay);
-      EXPECT_NEAR(parts, s, 1e-12 * std::max(1.0, s)) << BrdfModelName(model);
+      EXPECT_NEAR(parts, s, 1e-12 * std::max(1.0, s)) << recon::BrdfModelName(model);
     }
     double qx = 0, qy = 0, g = 0;
     EXPECT_FALSE(SpecularFactorParts(model, {0, 0.6, -0.8}, {0, 0, 1}, &qx, &qy, &g));
@@ -315,7 +322,7 @@ TEST(BrdfEvalTest, SpecularFactorPartsGiveTheFactorAtAnyRoughness) {
 
 TEST(BrdfEvalTest, IsReciprocal) {
   Pcg32 rng(3, 4);
-  for (BrdfModel model : kAllModels) {
+  for (recon::BrdfModel model : kAllModels) {
     const BrdfParams p = Make(model, {0.3, 0.2, 0.1}, {0.2, 0.3, 0.4}, 0.12, 0.35);
     for (int i = 0; i < 1000; ++i) {
       const Eigen::Vector3d a = SampleUniformHemisphere(rng.Uniform2D());
@@ -328,11 +335,11 @@ TEST(BrdfEvalTest, IsReciprocal) {
 
 TEST(BrdfEvalTest, AnisotropicModelsReduceToIsotropicAndRotateWithTheTangent) {
   Pcg32 rng(5, 6);
-  const std::pair<BrdfModel, BrdfModel> pairs[] = {
-      {BrdfModel::kWardAniso, BrdfModel::kWard},
-      {BrdfModel::kWardGmdAniso, BrdfModel::kWardGmd},
-      {BrdfModel::kWardAnisoFresnel, BrdfModel::kWardFresnel},
-      {BrdfModel::kWardGmdAnisoFresnel, BrdfModel::kWardGmdFresnel}};
+  const std::pair<recon::BrdfModel, recon::BrdfModel> pairs[] = {
+      {recon::BrdfModel::kWardAniso, recon::BrdfModel::kWard},
+      {recon::BrdfModel::kWardGmdAniso, recon::BrdfModel::kWardGmd},
+      {recon::BrdfModel::kWardAnisoFresnel, recon::BrdfModel::kWardFresnel},
+      {recon::BrdfModel::kWardGmdAnisoFresnel, recon::BrdfModel::kWardGmdFresnel}};
   for (const auto& [aniso, iso] : pairs) {
     for (int i = 0; i < 200; ++i) {
       const Eigen::Vector3d wo = SampleUniformHemisphere(rng.Uniform2D());
@@ -349,7 +356,7 @@ TEST(BrdfEvalTest, AnisotropicModelsReduceToIsotropicAndRotateWithTheTangent) {
   }
   // The highlight stretches along the rougher direction: at the same tilt of h, the lobe is
   // higher along y when αy > αx.
-  const BrdfParams p = Grey(BrdfModel::kWardAniso, 0.0, 1.0, 0.1, 0.4);
+  const BrdfParams p = Grey(recon::BrdfModel::kWardAniso, 0.0, 1.0, 0.1, 0.4);
   EXPECT_GT(EvalBrdf(p, Dir(30, 90), Dir(40, 270))[0], EvalBrdf(p, Dir(30, 0), Dir(40, 180))[0]);
 }
 
@@ -359,7 +366,7 @@ TEST(BrdfEvalTest, JetDerivativesMatchFiniteDifferences) {
   using Jet = ceres::Jet<double, 5>;
   const Eigen::Vector3d wo = Dir(35, 10);
   const Eigen::Vector3d wi = Dir(42, 200);
-  for (BrdfModel model : kAllModels) {
+  for (recon::BrdfModel model : kAllModels) {
     // Parameters: 0 = rho_d[0], 1 = rho_s[0], 2 = alpha or alpha_x, 3 = alpha_y, 4 = ior.
     const double x0[5] = {0.4, 0.2, 0.18, 0.27, 1.6};
     auto eval = [&](const double* x) {
@@ -386,12 +393,13 @@ TEST(BrdfEvalTest, JetDerivativesMatchFiniteDifferences) {
       xp[k] += 1e-6;
       xm[k] -= 1e-6;
       const double fd = (eval(xp) - eval(xm)) / 2e-6;
-      EXPECT_NEAR(f.v[k], fd, 1e-7 * std::abs(fd) + 1e-9) << BrdfModelName(model) << " d" << k;
+      EXPECT_NEAR(f.v[k], fd, 1e-7 * std::abs(fd) + 1e-9)
+          << recon::BrdfModelName(model) << " d" << k;
     }
-    if (HasSpecularLobe(model)) {
+    if (recon::HasSpecularLobe(model)) {
       EXPECT_GT(std::abs(f.v[2]), 1e-3);  // α really moves f
     }
-    if (HasFresnel(model)) {
+    if (recon::HasFresnel(model)) {
       EXPECT_LT(f.v[4], -1e-4);  // a higher ior raises F0, so lowers F/F0 off normal incidence
     } else {
       EXPECT_EQ(f.v[4], 0.0);
@@ -412,23 +420,24 @@ double Albedo(const BrdfParams& p, const Eigen::Vector3d& wo) {
 }
 
 TEST(BrdfEnergyTest, LambertAlbedoIsRhoD) {
-  EXPECT_NEAR(Albedo(Grey(BrdfModel::kLambert, 0.7, 0.0, 0.1, 0.1), Dir(50, 0)), 0.7, 1e-9);
+  EXPECT_NEAR(Albedo(Grey(recon::BrdfModel::kLambert, 0.7, 0.0, 0.1, 0.1), Dir(50, 0)), 0.7, 1e-9);
 }
 
 TEST(BrdfEnergyTest, AlbedoMatchesReferenceQuadrature) {
   // Specular albedos (ρs = 1) from an independent 8000 × 8000 midpoint quadrature (θ, φ) of the
   // contract formulas, printed to 5 digits: tolerance 1e-5 (their rounding).
   struct Case {
-    BrdfModel model;
+    recon::BrdfModel model;
     double alpha, theta_o, albedo;
   };
-  for (const Case& c :
-       {Case{BrdfModel::kWardGmd, 0.05, 80, 0.95322}, Case{BrdfModel::kWardGmd, 0.1, 85, 0.81277},
-        Case{BrdfModel::kWardGmd, 0.5, 0, 0.75458}, Case{BrdfModel::kWard, 0.2, 60, 0.45885},
-        Case{BrdfModel::kWard, 0.5, 75, 0.27717}}) {
+  for (const Case& c : {Case{recon::BrdfModel::kWardGmd, 0.05, 80, 0.95322},
+                        Case{recon::BrdfModel::kWardGmd, 0.1, 85, 0.81277},
+                        Case{recon::BrdfModel::kWardGmd, 0.5, 0, 0.75458},
+                        Case{recon::BrdfModel::kWard, 0.2, 60, 0.45885},
+                        Case{recon::BrdfModel::kWard, 0.5, 75, 0.27717}}) {
     EXPECT_NEAR(Albedo(Grey(c.model, 0.0, 1.0, c.alpha, c.alpha), Dir(c.theta_o, 0)), c.albedo,
                 1e-5)
-        << BrdfModelName(c.model) << " alpha " << c.alpha << " theta " << c.theta_o;
+        << recon::BrdfModelName(c.model) << " alpha " << c.alpha << " theta " << c.theta_o;
   }
 }
 
@@ -437,13 +446,14 @@ TEST(BrdfEnergyTest, NoModelCreatesEnergyForPlausibleParameters) {
   // conserves energy (the diffuse albedo is ρd exactly). Checked for α in [0.05, 0.5] and
   // θo <= 80°. Ward-GMD stays near 1 for small α at all angles (0.99 at 0°, 0.95 at 80°,
   // α = 0.05) and falls to 0.75 at α = 0.5, its known off-specular loss.
-  for (BrdfModel model :
-       {BrdfModel::kWard, BrdfModel::kWardGmd, BrdfModel::kWardAniso, BrdfModel::kWardGmdAniso}) {
+  for (recon::BrdfModel model : {recon::BrdfModel::kWard, recon::BrdfModel::kWardGmd,
+                                 recon::BrdfModel::kWardAniso, recon::BrdfModel::kWardGmdAniso}) {
     for (double alpha : {0.05, 0.2, 0.5}) {
       for (double theta : {0.0, 45.0, 70.0, 80.0}) {
         const double a = Albedo(Grey(model, 0.0, 1.0, alpha, 0.6 * alpha), Dir(theta, 25));
-        EXPECT_LE(a, 1.0) << BrdfModelName(model) << " alpha " << alpha << " theta " << theta;
-        if (IsGmd(model)) {
+        EXPECT_LE(a, 1.0) << recon::BrdfModelName(model) << " alpha " << alpha << " theta "
+                          << theta;
+        if (recon::IsGmd(model)) {
           EXPECT_GT(a, 0.7) << "alpha " << alpha << " theta " << theta;
         }
       }
@@ -459,8 +469,9 @@ TEST(BrdfEnergyTest, FresnelWeightRaisesTheSpecularAlbedoMostTowardGrazing) {
   // loose brackets around W(cos θo) (the lobe averages W over its width).
   double previous = 0.0;
   for (double theta : {0.0, 30.0, 60.0, 80.0}) {
-    const double plain = Albedo(Grey(BrdfModel::kWardGmd, 0.0, 1.0, 0.1, 0.1), Dir(theta, 0));
-    BrdfParams p = Grey(BrdfModel::kWardGmdFresnel, 0.0, 1.0, 0.1, 0.1);
+    const double plain =
+        Albedo(Grey(recon::BrdfModel::kWardGmd, 0.0, 1.0, 0.1, 0.1), Dir(theta, 0));
+    BrdfParams p = Grey(recon::BrdfModel::kWardGmdFresnel, 0.0, 1.0, 0.1, 0.1);
     p.ior = 1.5;
     const double ratio = Albedo(p, Dir(theta, 0)) / plain;
     const double w_mirror = 1.0 + 24.0 * std::pow(1.0 - std::cos(theta * kPi / 180), 5);
@@ -476,8 +487,9 @@ TEST(BrdfEnergyTest, Ward1992LosesEnergyTowardGrazingWhereGmdDoesNot) {
   // cosθo (measured, ρs = 1, α = 0.05: 0.99, 0.86, 0.50, 0.26 at 0°, 30°, 60°, 75°); Ward-GMD
   // keeps it (0.997, 0.997, 0.994, 0.979). It never exceeds 1 for α <= 0.5 (test above).
   for (double theta : {30.0, 60.0, 75.0}) {
-    const double ward = Albedo(Grey(BrdfModel::kWard, 0.0, 1.0, 0.05, 0.05), Dir(theta, 0));
-    const double gmd = Albedo(Grey(BrdfModel::kWardGmd, 0.0, 1.0, 0.05, 0.05), Dir(theta, 0));
+    const double ward = Albedo(Grey(recon::BrdfModel::kWard, 0.0, 1.0, 0.05, 0.05), Dir(theta, 0));
+    const double gmd =
+        Albedo(Grey(recon::BrdfModel::kWardGmd, 0.0, 1.0, 0.05, 0.05), Dir(theta, 0));
     const double cos_o = std::cos(theta * kPi / 180.0);
     EXPECT_NEAR(ward, cos_o, 0.01 * cos_o) << theta;
     EXPECT_GT(gmd, 0.97) << theta;
@@ -492,22 +504,23 @@ struct SamplingCase {
 };
 
 std::vector<SamplingCase> SamplingCases() {
-  std::vector<BrdfParams> params = {Grey(BrdfModel::kLambert, 0.6, 0.0, 0.1, 0.1)};
-  for (BrdfModel model : {BrdfModel::kWard, BrdfModel::kWardGmd}) {
+  std::vector<BrdfParams> params = {Grey(recon::BrdfModel::kLambert, 0.6, 0.0, 0.1, 0.1)};
+  for (recon::BrdfModel model : {recon::BrdfModel::kWard, recon::BrdfModel::kWardGmd}) {
     params.push_back(Grey(model, 0.4, 0.3, 0.05, 0.05));
     params.push_back(Grey(model, 0.0, 0.5, 0.3, 0.3));
   }
-  for (BrdfModel model : {BrdfModel::kWardAniso, BrdfModel::kWardGmdAniso}) {
+  for (recon::BrdfModel model : {recon::BrdfModel::kWardAniso, recon::BrdfModel::kWardGmdAniso}) {
     params.push_back(Grey(model, 0.4, 0.3, 0.05, 0.25));
     params.push_back(Grey(model, 0.0, 0.5, 0.4, 0.1));
   }
   // The *_fresnel models draw as their plain models do; f (and so the weights) differ.
-  for (BrdfModel model : {BrdfModel::kWardFresnel, BrdfModel::kWardGmdFresnel}) {
+  for (recon::BrdfModel model :
+       {recon::BrdfModel::kWardFresnel, recon::BrdfModel::kWardGmdFresnel}) {
     params.push_back(Grey(model, 0.4, 0.3, 0.05, 0.05));
     params.back().ior = 1.4;
     params.push_back(Grey(model, 0.0, 0.5, 0.3, 0.3));
   }
-  params.push_back(Grey(BrdfModel::kWardGmdAnisoFresnel, 0.2, 0.3, 0.05, 0.25));
+  params.push_back(Grey(recon::BrdfModel::kWardGmdAnisoFresnel, 0.2, 0.3, 0.05, 0.25));
   std::vector<SamplingCase> cases;
   for (const BrdfParams& p : params) {
     for (double theta : {0.0, 35.0, 70.0}) cases.push_back({p, Dir(theta, 30)});
@@ -516,9 +529,9 @@ std::vector<SamplingCase> SamplingCases() {
 }
 
 std::string Describe(const SamplingCase& c) {
-  return std::string(BrdfModelName(c.params.model)) + " ax " + std::to_string(c.params.AlphaX()) +
-         " ay " + std::to_string(c.params.AlphaY()) + " rho_d " +
-         std::to_string(c.params.rho_d[0]) + " theta_o " +
+  return std::string(recon::BrdfModelName(c.params.model)) + " ax " +
+         std::to_string(c.params.AlphaX()) + " ay " + std::to_string(c.params.AlphaY()) +
+         " rho_d " + std::to_string(c.params.rho_d[0]) + " theta_o " +
          std::to_string(std::acos(c.wo.z()) * 180 / kPi);
 }
 
@@ -547,8 +560,8 @@ TEST(BrdfSamplingTest, SampledDirectionsFollowThePdf) {
 
 TEST(BrdfSamplingTest, ChiSquareDetectsAPdfTenPercentOffInAlpha) {
   // The power check: draws with α = 0.3 against the pdf of α = 0.33 must be rejected.
-  const SamplingCase c{Grey(BrdfModel::kWardGmd, 0.0, 0.5, 0.3, 0.3), Dir(35, 30)};
-  const BrdfParams wrong = Grey(BrdfModel::kWardGmd, 0.0, 0.5, 0.33, 0.33);
+  const SamplingCase c{Grey(recon::BrdfModel::kWardGmd, 0.0, 0.5, 0.3, 0.3), Dir(35, 30)};
+  const BrdfParams wrong = Grey(recon::BrdfModel::kWardGmd, 0.0, 0.5, 0.33, 0.33);
   const auto result =
       TestDirections([&](Pcg32& rng) { return Draw(c, rng); },
                      [&](const Eigen::Vector3d& wi) { return BrdfPdf(wrong, c.wo, wi); },
@@ -649,4 +662,4 @@ TEST(BrdfSamplingTest, WeightsEstimateTheAlbedoWithoutBias) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::render

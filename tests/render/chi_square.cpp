@@ -58,7 +58,7 @@ void GaussLegendre(int n, std::vector<double>* nodes, std::vector<double>* weigh
   weights->assign(n, 0.0);
   for (int i = 0; i < n; ++i) {
     // Newton's method on P_n from the Chebyshev-like first guess; P_n and P_n' by recurrence.
-    double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
+    double x = std::cos(render::kPi * (i + 0.75) / (n + 0.5));
     double derivative = 1.0;
     for (int iteration = 0; iteration < 100; ++iteration) {
       double p0 = 1.0;
@@ -126,9 +126,9 @@ int SphereHistogram::Bin(const std::optional<Eigen::Vector3d>& direction) const 
   const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
   if (theta >= theta_max) return other;
   double phi = std::atan2(d.y(), d.x());
-  if (phi < 0.0) phi += 2.0 * kPi;
+  if (phi < 0.0) phi += 2.0 * render::kPi;
   const int i = std::min(n_theta - 1, static_cast<int>(theta / theta_max * n_theta));
-  const int j = std::min(n_phi - 1, static_cast<int>(phi / (2.0 * kPi) * n_phi));
+  const int j = std::min(n_phi - 1, static_cast<int>(phi / (2.0 * render::kPi) * n_phi));
   return i * n_phi + j;
 }
 
@@ -139,7 +139,7 @@ std::vector<double> SphereHistogram::Probabilities(
   GaussLegendre(order, &nodes, &weights);
   std::vector<double> probabilities(NumBins(), 0.0);
   const double d_theta = theta_max / n_theta;
-  const double d_phi = 2.0 * kPi / n_phi;
+  const double d_phi = 2.0 * render::kPi / n_phi;
   double total = 0.0;
   for (int i = 0; i < n_theta; ++i) {
     for (int j = 0; j < n_phi; ++j) {
@@ -161,10 +161,11 @@ std::vector<double> SphereHistogram::Probabilities(
   return probabilities;
 }
 
-ChiSquareResult TestDirections(const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
-                               const std::function<double(const Eigen::Vector3d&)>& pdf,
-                               const SphereHistogram& histogram, int num_samples, uint64_t seed) {
-  Pcg32 rng(seed, 7);
+ChiSquareResult TestDirections(
+    const std::function<std::optional<Eigen::Vector3d>(render::Pcg32&)>& draw,
+    const std::function<double(const Eigen::Vector3d&)>& pdf, const SphereHistogram& histogram,
+    int num_samples, uint64_t seed) {
+  render::Pcg32 rng(seed, 7);
   std::vector<double> observed(histogram.NumBins(), 0.0);
   for (int s = 0; s < num_samples; ++s) observed[histogram.Bin(draw(rng))] += 1.0;
   std::vector<double> expected = histogram.Probabilities(pdf);
@@ -179,7 +180,7 @@ double SidakLevel(double overall, int num_tests) {
 double IntegrateSphere(const std::function<double(const Eigen::Vector3d&)>& fn, double theta_max,
                        int n_theta, int n_phi) {
   const double h_theta = theta_max / n_theta;
-  const double h_phi = 2.0 * kPi / n_phi;
+  const double h_phi = 2.0 * render::kPi / n_phi;
   double sum = 0.0;
   for (int a = 0; a <= n_theta; ++a) {
     const double theta = a * h_theta;

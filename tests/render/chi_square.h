@@ -33,7 +33,7 @@ ChiSquareResult ChiSquareTest(const std::vector<double>& observed,
 struct SphereHistogram {
   int n_theta = 20;
   int n_phi = 40;
-  double theta_max = kPi;
+  double theta_max = render::kPi;
 
   int NumBins() const { return n_theta * n_phi + 1; }
   int Bin(const std::optional<Eigen::Vector3d>& direction) const;
@@ -45,9 +45,10 @@ struct SphereHistogram {
 };
 
 // Draws `num_samples` directions (nullopt = failed draw) and tests them against `pdf`.
-ChiSquareResult TestDirections(const std::function<std::optional<Eigen::Vector3d>(Pcg32&)>& draw,
-                               const std::function<double(const Eigen::Vector3d&)>& pdf,
-                               const SphereHistogram& histogram, int num_samples, uint64_t seed);
+ChiSquareResult TestDirections(
+    const std::function<std::optional<Eigen::Vector3d>(render::Pcg32&)>& draw,
+    const std::function<double(const Eigen::Vector3d&)>& pdf, const SphereHistogram& histogram,
+    int num_samples, uint64_t seed);
 
 // Per-test significance level that keeps the family-wise level at `overall` over `num_tests`
 // independent tests (Šidák correction).

@@ -28,7 +28,7 @@
 #include "solver/render/render.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 namespace fs = std::filesystem;
@@ -58,14 +58,14 @@ double PixelNoiseVariance(const Image& im, int x, int y) {
 class RadianceRoomTest : public ::testing::TestWithParam<Case> {
  protected:
   static void SetUpTestSuite() {
-    SceneLoadOptions options;
+    recon::SceneLoadOptions options;
     options.require_complete_materials = true;
-    scene_ = new Scene(LoadScene(kRoom / "scene.json", options));
+    scene_ = new recon::Scene(recon::LoadScene(kRoom / "scene.json", options));
   }
   static void TearDownTestSuite() { delete scene_; }
-  static Scene* scene_;
+  static recon::Scene* scene_;
 };
-Scene* RadianceRoomTest::scene_ = nullptr;
+recon::Scene* RadianceRoomTest::scene_ = nullptr;
 
 TEST_P(RadianceRoomTest, MatchesRadianceImageAndBlockMeans) {
   const Case& c = GetParam();
@@ -141,4 +141,4 @@ INSTANTIATE_TEST_SUITE_P(Reference, RadianceRoomTest,
                          });
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::render

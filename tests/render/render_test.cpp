@@ -12,7 +12,7 @@
 #include "solver/render/ray_scene.h"
 #include "tests/solver/test_scenes.h"
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 using test::DownCamera;
@@ -45,13 +45,13 @@ Json FloorScene(const Json& light,
 }
 
 // Radiance from the floor's centre toward the camera above it, estimated with `spp` paths.
-Eigen::Vector3d CentreRadiance(const Scene& scene, int spp) {
+Eigen::Vector3d CentreRadiance(const recon::Scene& scene, int spp) {
   const Renderer renderer(scene, 0);
   return renderer.Radiance(scene.cameras[0].CenterInWorld(), Eigen::Vector3d(0, 0, -1), spp, 3);
 }
 
 // The centre pixel of the camera's image (a mean over the pixel's square).
-Eigen::Vector3d CentrePixel(const Scene& scene, int spp) {
+Eigen::Vector3d CentrePixel(const recon::Scene& scene, int spp) {
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = spp;
@@ -64,7 +64,7 @@ TEST(RenderTest, PointLightDirectIsExact) {
   const auto dir = TempSceneDir("point");
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
   // I = 10 W/sr at height 2: E = 10 / 4 = 2.5, L = 0.5 / pi * 2.5.
-  const Scene scene = LoadTestScene(
+  const recon::Scene scene = LoadTestScene(
       dir, FloorScene(ParseJson(R"({"type":"point","position":[0,0,2],"intensity":10})", "l")));
   const Eigen::Vector3d l = CentrePixel(scene, 16);
   // The centre pixel spans ±0.0025 m on the floor: E varies by < 1e-5 over it.
@@ -77,7 +77,7 @@ TEST(RenderTest, DirectionalLightAndSpotProfileAreExact) {
   // E = 3 W/m² perpendicular to the beam, arriving at 60° from the normal: 1.5 on the floor.
   const double s = std::sin(M_PI / 3);
   Json light{{"type", "directional"}, {"direction", {s, 0.0, -0.5}}, {"irradiance", 3}};
-  Scene scene = LoadTestScene(dir, FloorScene(light));
+  recon::Scene scene = LoadTestScene(dir, FloorScene(light));
   EXPECT_NEAR(CentrePixel(scene, 8).x(), 0.5 / M_PI * 1.5, 1e-6);
   // A cos^4 spot aimed 30° away from the floor's centre: relative intensity cos(30°)^4.
   Json spot{{"type", "spot"},
@@ -98,7 +98,7 @@ TEST(RenderTest, SphereLightIrradianceMatchesClosedForm) {
   // A sphere of radiance L and radius r at distance d, seen at angle theta from the normal
   // (wholly above the horizon): E = pi L (r/d)^2 cos(theta). Off the camera's line of sight.
   Json light{{"type", "sphere"}, {"center", {1, 0, 1}}, {"radius", 0.2}, {"radiance", 100}};
-  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  const recon::Scene scene = LoadTestScene(dir, FloorScene(light));
   const double expected = 0.5 / M_PI * M_PI * 100 * (0.04 / 2) * std::sqrt(0.5);
   // Cone sampling varies little over this sphere: 20000 paths give ~0.05 % noise. 0.3 %
   // catches a shadow ray clipping the light's own sphere (that bias was 1.3 %).
@@ -120,7 +120,7 @@ TEST(RenderTest, SphereLightRimHasNoFireflies) {
   const double r = 10 * eps, d = 40 * r, s = std::sqrt(0.5);
   light["center"] = {d * s, 0.0, d * s};
   light["radius"] = r;
-  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  const recon::Scene scene = LoadTestScene(dir, FloorScene(light));
   ASSERT_NEAR(std::make_unique<RayScene>(scene, 0)->ray_epsilon(), eps, 1e-12);
   const Renderer renderer(scene, 0);
   const Eigen::Vector3d origin = scene.cameras[0].CenterInWorld();
@@ -158,7 +158,7 @@ TEST(RenderTest, AreaLightIrradianceMatchesClosedForm) {
   // By superposition of rectangles with a corner above the point:
   const double form = 2 * (corner(2.0, 0.5) - corner(1.0, 0.5));
   Json light{{"type", "area"}, {"file", "panel.obj"}, {"radiance", 10}};
-  const Scene scene = LoadTestScene(dir, FloorScene(light));
+  const recon::Scene scene = LoadTestScene(dir, FloorScene(light));
   const double expected = 0.5 * form * 10;
   // Area sampling of this panel has ~50 % relative spread per sample: 200000 paths give 0.1 %.
   EXPECT_NEAR(CentreRadiance(scene, 200000).x(), expected, 0.005 * expected);
@@ -182,7 +182,7 @@ TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
              {"lights", {{"l", {{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", 1}}}}},
              {"lightings", {{"L", {"l"}}}},
              {"cameras", {{"in", DownCamera(0, 0, 0, 16, 16, 10)}}}};
-    const Scene scene = LoadTestScene(dir, doc);
+    const recon::Scene scene = LoadTestScene(dir, doc);
     const Renderer renderer(scene, 0);
     RenderOptions options;
     options.spp = 256;
@@ -194,7 +194,7 @@ TEST(RenderTest, FurnaceSphereConvergesToClosedForm) {
 }
 
 // The floor under a sphere light beside the camera's axis: soft, noisy renders (in `name`).
-Scene SphereLitFloor(const std::string& name) {
+recon::Scene SphereLitFloor(const std::string& name) {
   const auto dir = TempSceneDir(name);
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
   return LoadTestScene(
@@ -203,7 +203,7 @@ Scene SphereLitFloor(const std::string& name) {
 }
 
 TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
-  const Scene scene = SphereLitFloor("determinism");
+  const recon::Scene scene = SphereLitFloor("determinism");
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = 4;
@@ -220,7 +220,7 @@ TEST(RenderTest, SameSeedSameImageWhateverTheThreads) {
 // A pixel mask renders its pixels exactly as the whole render does (each pixel has its own random
 // streams) and leaves the others NaN; two complementary masks make up the whole image.
 TEST(RenderTest, PixelMaskRendersThePixelsOfTheWholeRender) {
-  const Scene scene = SphereLitFloor("mask");
+  const recon::Scene scene = SphereLitFloor("mask");
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = 3;
@@ -282,7 +282,7 @@ DerivativeCheck CheckDerivative(const std::filesystem::path& dir, const std::str
                                    {"cameras", {{"top", DownCamera(0, 0, 3, 9, 9, 400)}}}});
   };
   const Eigen::Vector3d dir_to = (target - origin).normalized();
-  const Scene scene = scene_with(1.0);
+  const recon::Scene scene = scene_with(1.0);
   std::vector<Eigen::Vector3d> d;
   Renderer(scene, 0).ReflectedRadiance(origin, dir_to, spp, 5, &d);
   int r = 0;
@@ -379,7 +379,7 @@ TEST(RenderTest, TextureIsSampledWithVUp) {
   // Rows 1 and 7 see y in ±[1.25, 1.75] m: v in [0.81, 0.94] and [0.06, 0.19], texel centres
   // clamp there, so each row sees one texel value exactly.
   doc["cameras"]["top"] = DownCamera(0, 0, 3, 9, 9, 6);
-  const Scene scene = LoadTestScene(dir, doc);
+  const recon::Scene scene = LoadTestScene(dir, doc);
   const Renderer renderer(scene, 0);
   RenderOptions options;
   options.spp = 4;
@@ -395,7 +395,7 @@ TEST(RenderTest, LightingWithoutLightIsBadInput) {
   WriteText(dir / "floor.obj", SquareObj("floor", 2.0));
   Json doc = FloorScene(ParseJson(R"({"type":"point","position":[0,0,2],"intensity":1})", "l"));
   doc["lightings"]["dark"] = Json::array();
-  const Scene scene = LoadTestScene(dir, doc);
+  const recon::Scene scene = LoadTestScene(dir, doc);
   try {
     Renderer renderer(scene, scene.FindLighting("dark"));
     FAIL();
@@ -408,4 +408,4 @@ TEST(RenderTest, LightingWithoutLightIsBadInput) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::render

@@ -9,7 +9,7 @@
 
 #include "chi_square.h"
 
-namespace igi {
+namespace igi::render {
 namespace {
 
 using test::ChiSquareTest;
@@ -371,7 +371,7 @@ TEST(MisTest, HeuristicsWeighStrategies) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::render
 
 // The solver's fit samples are drawn with InHashedSubset: the kept share must be right and even
 // over any pattern in the keys (the regular stride it replaced kept one phase of a period-14
@@ -382,8 +382,8 @@ TEST(HashedSubsetTest, KeepsTheShareEvenlyOverAPeriodicPattern) {
   std::array<int, kPeriod> per_phase{};
   int kept = 0;
   for (int i = 0; i < kKeys; ++i) {
-    const bool in = igi::InHashedSubset(uint64_t(i), p);
-    EXPECT_EQ(in, igi::InHashedSubset(uint64_t(i), p));  // reproducible
+    const bool in = igi::render::InHashedSubset(uint64_t(i), p);
+    EXPECT_EQ(in, igi::render::InHashedSubset(uint64_t(i), p));  // reproducible
     if (in) ++kept, ++per_phase[i % kPeriod];
   }
   EXPECT_NEAR(kept, 4000, 4 * std::sqrt(4000.0));
@@ -391,6 +391,6 @@ TEST(HashedSubsetTest, KeepsTheShareEvenlyOverAPeriodicPattern) {
   for (int phase = 0; phase < kPeriod; ++phase) {
     EXPECT_NEAR(per_phase[phase], expected, 5 * std::sqrt(expected)) << "phase " << phase;
   }
-  EXPECT_TRUE(igi::InHashedSubset(7, 1.0));
-  EXPECT_FALSE(igi::InHashedSubset(7, 0.0));
+  EXPECT_TRUE(igi::render::InHashedSubset(7, 1.0));
+  EXPECT_FALSE(igi::render::InHashedSubset(7, 0.0));
 }

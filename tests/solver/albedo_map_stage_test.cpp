@@ -14,7 +14,7 @@
 #include "solver/inverse/solve_internal.h"
 #include "tests/solver/stage_fixture.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 constexpr double kIrradiance = 3.0;
@@ -32,7 +32,7 @@ struct StageFixture : test::SquareStage {
                      u01 = std::uniform_real_distribution<double>(0.0, 1.0)](
                         double u, double v, std::mt19937& rng) mutable {
                       const double noise = 1 + gauss(rng) + (u01(rng) < 0.03 ? 8.0 : 0.0);
-                      return albedo(u, v) * kIrradiance / kPi * noise;
+                      return albedo(u, v) * kIrradiance / render::kPi * noise;
                     }) {}
 
   MapStageData Data() const {
@@ -162,18 +162,18 @@ TEST(AlbedoMapStage, TheSpecularTermIsTheOwnDirectLobeAndTheNeighboursIndirectLi
   // highlight's flanks and lower its core; the maps subtract each observation's own direct lobe
   // and the neighbours' mean of the indirect part.
   StageFixture f([](double, double) { return 0.5; }, 4, 3);
-  BrdfParams& p = f.materials[0].params;
-  p.model = BrdfModel::kWard;
+  render::BrdfParams& p = f.materials[0].params;
+  p.model = recon::BrdfModel::kWard;
   p.rho_s = Eigen::Vector3d::Constant(0.05);
   p.alpha = 0.1;
   for (int k = 0; k < 2; ++k) {
-    Photo photo;
+    recon::Photo photo;
     photo.lighting = 0;
     f.scene.photos.push_back(photo);
   }
   GatherSet& gather = f.light.lightings[0].gather;
   const Eigen::Vector3d view(0, 0, 1);
-  const Frame frame = f.materials.LocalFrame(0, view);
+  const render::Frame frame = f.materials.LocalFrame(0, view);
   std::vector<bool> in_highlight(f.obs.size());
   std::vector<Eigen::Vector3d> direct_lobe(f.obs.size());
   for (size_t i = 0; i < f.obs.size(); ++i) {
@@ -229,4 +229,4 @@ TEST(AlbedoMapStage, TheWrittenMapIsScaledAndClippedOnlyInAChannelHeldAtOne) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -15,14 +15,14 @@
 #include "solver/render/ray_scene.h"
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 constexpr float kQuadW = 1.0f, kQuadH = 0.5f;
 
 // A 1 × 0.5 m rectangle in z = 0 with UVs [0,1]² (u = x / 1 m, v = y / 0.5 m), region "floor".
-TriangleMesh Quad() {
-  TriangleMesh mesh;
+recon::TriangleMesh Quad() {
+  recon::TriangleMesh mesh;
   mesh.positions = {{0, 0, 0}, {kQuadW, 0, 0}, {kQuadW, kQuadH, 0}, {0, kQuadH, 0}};
   mesh.normals.assign(4, Eigen::Vector3f::UnitZ());
   mesh.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -33,8 +33,8 @@ TriangleMesh Quad() {
 }
 
 // A 1 × 0.6 × 0.4 m box without UVs (generated charts), 12 triangles, one region.
-TriangleMesh Box() {
-  TriangleMesh mesh;
+recon::TriangleMesh Box() {
+  recon::TriangleMesh mesh;
   for (int i = 0; i < 8; ++i) {
     mesh.positions.emplace_back((i & 1) ? 1.0f : 0, (i & 2) ? 0.6f : 0, (i & 4) ? 0.4f : 0);
   }
@@ -52,7 +52,7 @@ TriangleMesh Box() {
 // The renderer's own lookup (solver/render/ray_scene.h SampleTexture): the map must match what it
 // reads.
 Eigen::Vector3d Lookup(const Image& tex, const Eigen::Vector2d& uv) {
-  return SampleTexture(tex, uv);
+  return render::SampleTexture(tex, uv);
 }
 
 // A smooth albedo over the quad, different in every channel and asymmetric in x and y (so a
@@ -68,7 +68,8 @@ struct Sample {
   Eigen::Vector3d position;
 };
 
-Sample RandomPoint(const TriangleMesh& mesh, const std::vector<int>& tris, std::mt19937& rng) {
+Sample RandomPoint(const recon::TriangleMesh& mesh, const std::vector<int>& tris,
+                   std::mt19937& rng) {
   std::uniform_real_distribution<double> u01(0, 1);
   Sample s;
   s.triangle = tris[std::uniform_int_distribution<size_t>(0, tris.size() - 1)(rng)];
@@ -85,8 +86,8 @@ Sample RandomPoint(const TriangleMesh& mesh, const std::vector<int>& tris, std::
 // Adds `n` samples of albedo `f` with random irradiance E in [0.2, 2] and weights in [0.5, 1.5]
 // at random points of `tris` for which `keep(position)` holds.
 template <typename F, typename Keep>
-void AddSamples(const TriangleMesh& mesh, const std::vector<int>& tris, int n, F f, Keep keep,
-                AlbedoMapBuilder* builder, std::mt19937& rng) {
+void AddSamples(const recon::TriangleMesh& mesh, const std::vector<int>& tris, int n, F f,
+                Keep keep, AlbedoMapBuilder* builder, std::mt19937& rng) {
   std::uniform_real_distribution<double> e_dist(0.2, 2.0), w_dist(0.5, 1.5);
   for (int i = 0; i < n;) {
     const Sample s = RandomPoint(mesh, tris, rng);
@@ -99,7 +100,7 @@ void AddSamples(const TriangleMesh& mesh, const std::vector<int>& tris, int n, F
 }
 
 TEST(AlbedoMap, SmoothAlbedoOnQuadIsRecoveredWhereTheRendererLooksItUp) {
-  const TriangleMesh mesh = Quad();
+  const recon::TriangleMesh mesh = Quad();
   AtlasOptions options;
   options.texel_size_m = 0.01;
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
@@ -179,7 +180,7 @@ TEST(AlbedoMap, TexelCentresTakeTheValueAtTheirSurfacePoint) {
   // The box's generated charts: every texel centre on the surface gets Albedo() of its own
   // world point, exactly (the barycentrics of the centre, not of a sample near it); the gutters
   // and the space between charts are filled.
-  const TriangleMesh mesh = Box();
+  const recon::TriangleMesh mesh = Box();
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
   ASSERT_TRUE(atlas.generated);
   AlbedoMapBuilder builder(atlas);
@@ -211,7 +212,7 @@ TEST(AlbedoMap, TexelCentresTakeTheValueAtTheirSurfacePoint) {
 }
 
 TEST(AlbedoMap, ConstantAlbedoFillsEveryTexelIncludingGutters) {
-  const TriangleMesh mesh = Box();
+  const recon::TriangleMesh mesh = Box();
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
   ASSERT_TRUE(atlas.generated);
   AlbedoMapBuilder builder(atlas);
@@ -236,7 +237,7 @@ TEST(AlbedoMap, ConstantAlbedoFillsEveryTexelIncludingGutters) {
 }
 
 TEST(AlbedoMap, HolesGetValuesFromTheirNeighbourhood) {
-  const TriangleMesh mesh = Quad();
+  const recon::TriangleMesh mesh = Quad();
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
   AlbedoMapBuilder builder(atlas);
   std::mt19937 rng(5);
@@ -288,7 +289,7 @@ TEST(AlbedoMap, ChannelWithoutIrradianceFallsBack) {
 }
 
 TEST(AlbedoMap, MergeEqualsOneBuilder) {
-  const TriangleMesh mesh = Box();
+  const recon::TriangleMesh mesh = Box();
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
   AlbedoMapBuilder all(atlas), even(atlas), odd(atlas);
   std::mt19937 rng(11);
@@ -338,7 +339,7 @@ TEST(AlbedoPsnr, KnownImages) {
 // The seen mask marks exactly the texels estimated directly: samples only on the left half of
 // the quad leave the right half unseen (0) while Finish() fills it.
 TEST(AlbedoMap, DirectMaskMarksTheTexelsTheSamplesReach) {
-  const TriangleMesh mesh = Quad();
+  const recon::TriangleMesh mesh = Quad();
   AtlasOptions options;
   options.texel_size_m = 0.02;
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
@@ -474,4 +475,4 @@ TEST(SharedTexelDetail, IsNaNOnFewTexelsOrADarkChannel) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

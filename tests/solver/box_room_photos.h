@@ -17,12 +17,12 @@ namespace igi::test::box_room {
 // dir/photos/<camera>.exr at `spp` paths per pixel.
 inline void RenderTruthPhotos(const std::filesystem::path& dir,
                               const std::vector<std::string>& cameras, int spp, uint64_t seed) {
-  SceneLoadOptions lo;
+  recon::SceneLoadOptions lo;
   lo.require_complete_materials = true;
   lo.check_images = false;
-  const Scene truth = LoadScene(dir / "truth.json", lo);
-  const Renderer renderer(truth, truth.FindLighting("L0"));
-  RenderOptions ro;
+  const recon::Scene truth = recon::LoadScene(dir / "truth.json", lo);
+  const render::Renderer renderer(truth, truth.FindLighting("L0"));
+  render::RenderOptions ro;
   ro.spp = spp;
   ro.seed = seed;
   ro.num_threads = 2;

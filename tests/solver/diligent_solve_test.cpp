@@ -24,7 +24,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 namespace fs = std::filesystem;
@@ -39,8 +39,8 @@ struct BallFit {
   double seconds = 0;
 };
 
-std::vector<Photo> Select(const std::vector<Photo>& all, int first, int step) {
-  std::vector<Photo> out;
+std::vector<recon::Photo> Select(const std::vector<recon::Photo>& all, int first, int step) {
+  std::vector<recon::Photo> out;
   for (size_t i = first; i < all.size(); i += step) out.push_back(all[i]);
   return out;
 }
@@ -48,13 +48,14 @@ std::vector<Photo> Select(const std::vector<Photo>& all, int first, int step) {
 // Relative RMS sqrt(Σ(pred − photo)² / Σ photo²) of `solved` rendered at the pixels of `photos`
 // that are inside the mask eroded by one pixel (the silhouette of the mesh and the mask differ
 // by a few boundary pixels) and not clipped, every `stride`-th pixel, all channels.
-double HeldOutResidual(const Scene& solved, const std::vector<Photo>& photos, int stride) {
+double HeldOutResidual(const recon::Scene& solved, const std::vector<recon::Photo>& photos,
+                       int stride) {
   double num = 0, den = 0;
-  for (const Photo& p : photos) {
+  for (const recon::Photo& p : photos) {
     const Image photo = ReadImage(p.file, 3);
     const Image mask = ReadImage(*p.mask, 1);
-    const Camera& cam = solved.cameras[p.camera];
-    const Renderer renderer(solved, p.lighting);
+    const recon::Camera& cam = solved.cameras[p.camera];
+    const render::Renderer renderer(solved, p.lighting);
     const Eigen::Vector3d origin = cam.CenterInWorld();
     auto inside = [&](int x, int y) { return mask.at(x, y) > 0.5f; };
     for (int y = 1; y + 1 < photo.height; y += stride) {
@@ -77,12 +78,12 @@ double HeldOutResidual(const Scene& solved, const std::vector<Photo>& photos, in
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
-BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) {
-  Scene scene = LoadScene(kBall / "scene.json", SceneLoadOptions{});
+BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) {
+  recon::Scene scene = recon::LoadScene(kBall / "scene.json", recon::SceneLoadOptions{});
   EXPECT_EQ(scene.photos.size(), 48u);
-  const std::vector<Photo> used = Select(scene.photos, 0, 4);  // 12 photos
-  const std::vector<Photo> held_out = Select(used, 0, 2);      // 6
-  scene.photos = Select(used, 1, 2);                           // 6 fitted
+  const std::vector<recon::Photo> used = Select(scene.photos, 0, 4);  // 12 photos
+  const std::vector<recon::Photo> held_out = Select(used, 0, 2);      // 6
+  scene.photos = Select(used, 1, 2);                                  // 6 fitted
   scene.materials[0].brdf = brdf;
   scene.document["materials"]["ball"]["brdf"] = brdf_name;
 
@@ -109,10 +110,10 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
   fit.fit_residual = summary.stage2_render_residual;
   fit.region_rms = fit.region.stage2.relative_rms;
 
-  Scene solved = scene;
-  Material& m = solved.materials[0];
+  recon::Scene solved = scene;
+  recon::Material& m = solved.materials[0];
   m.rho_d = fit.region.final_params.rho_d;
-  if (brdf != BrdfModel::kLambert) {
+  if (brdf != recon::BrdfModel::kLambert) {
     m.rho_s = fit.region.final_params.rho_s;
     m.alpha = fit.region.final_params.alpha;
   }
@@ -138,8 +139,8 @@ BallFit FitBall(BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) 
 // 0.154 / 0.210 / 0.141.)
 TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   const fs::path out = test::UniqueTempDir("igi_diligent_solve");
-  const BallFit ward = FitBall(BrdfModel::kWard, "ward", out);
-  const BallFit lambert = FitBall(BrdfModel::kLambert, "lambert", out);
+  const BallFit ward = FitBall(recon::BrdfModel::kWard, "ward", out);
+  const BallFit lambert = FitBall(recon::BrdfModel::kLambert, "lambert", out);
   fs::remove_all(out);
 
   EXPECT_EQ(ward.region.status, RegionStatus::kSolved);
@@ -158,4 +159,4 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

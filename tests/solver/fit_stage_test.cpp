@@ -11,7 +11,7 @@
 #include "solver/inverse/paper_stage.h"
 #include "tests/solver/stage_fixture.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 constexpr double kIrradiance = 3.0;
@@ -26,7 +26,7 @@ struct FitFixture : test::SquareStage {
       : SquareStage("fit_stage", n, kIrradiance, seed,
                     [albedo, gauss = std::normal_distribution<double>(0.0, 0.05)](
                         double, double, std::mt19937& rng) mutable {
-                      return albedo * kIrradiance / kPi * (1 + gauss(rng));
+                      return albedo * kIrradiance / render::kPi * (1 + gauss(rng));
                     }) {}
 
   StageData Data() const { return StageData{scene, options, obs, patches, 1.0, 0.1, 0.02}; }
@@ -69,7 +69,7 @@ TEST(FitStage, TheJointUpdateIsTheFixedPointOfTheLinearisedLight) {
   const double sum_e = kIrradiance * 400;
   for (double g : {0.0, 0.5, 2.0}) {
     f.light.joint_sums.Resize(1);
-    const size_t entry = size_t(Renderer::kLnRhoD);  // region 0's row, region 0's ln ρd
+    const size_t entry = size_t(render::Renderer::kLnRhoD);  // region 0's row, region 0's ln ρd
     f.light.joint_sums.d_e[entry] = Eigen::Vector3d(g, g, 0.5 * g) * sum_e;
     const JointUpdate ju = JointParams(f.Data(), f.materials, f.light, {0}, {fit});
     ASSERT_EQ(ju.rho_d.size(), 1u);
@@ -95,4 +95,4 @@ TEST(PaperStage, WithoutADrawOrAdaptiveSmoothingEveryRadiusIsTheScenesOver96) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

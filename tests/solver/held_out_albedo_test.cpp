@@ -6,12 +6,12 @@
 
 #include <cmath>
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // A 1 × 1 m square in z = 0 with UVs [0,1]², two triangles, region 0.
-TriangleMesh Square() {
-  TriangleMesh mesh;
+recon::TriangleMesh Square() {
+  recon::TriangleMesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   mesh.normals.assign(4, Eigen::Vector3f::UnitZ());
   mesh.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -28,7 +28,7 @@ struct Point {
 Point At(double x, double y) { return {x - y, y}; }
 
 TEST(HeldOutAlbedo, EachPhotoReadsTheOtherPhotosOnly) {
-  const TriangleMesh mesh = Square();
+  const recon::TriangleMesh mesh = Square();
   AtlasOptions options;
   options.texel_size_m = 0.1;  // 10 × 10 texels
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
@@ -60,4 +60,4 @@ TEST(HeldOutAlbedo, EachPhotoReadsTheOtherPhotosOnly) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -13,7 +13,7 @@
 #include "solver/synth/camera_placement.h"
 #include "tests/solver/test_scenes.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 using Eigen::Vector3d;
@@ -26,7 +26,7 @@ const Vector3d kLightPosition(-1, 0, 2);
 // off to the side: "matte" (lambert), "known" (ward, all known), "half" (ward, α unknown),
 // "aniso" (anisotropic ward, α_x α_y known, ρs unknown). With `blocker`, a lambert square of
 // half-size 0.4 at z = 1 centred on (-0.5, 0) shadows the glossy square's centre.
-Scene MakeScene(const std::filesystem::path& dir, const Json& light, bool blocker = false) {
+recon::Scene MakeScene(const std::filesystem::path& dir, const Json& light, bool blocker = false) {
   WriteText(dir / "glossy.obj", SquareObj("glossy", 0.5));
   WriteText(dir / "matte.obj", SquareObj("matte", 0.5, 0, false, 3));
   WriteText(dir / "known.obj", SquareObj("known", 0.5, 0, false, -3));
@@ -51,7 +51,7 @@ Scene MakeScene(const std::filesystem::path& dir, const Json& light, bool blocke
                  {"geometry", geometry},        {"materials", materials},
                  {"lights", {{"lamp", light}}}, {"lightings", {{"L0", {"lamp"}}}}};
   WriteJsonFile(dir / "scene.json", doc);
-  return LoadScene(dir / "scene.json", SceneLoadOptions{.check_images = false});
+  return recon::LoadScene(dir / "scene.json", recon::SceneLoadOptions{.check_images = false});
 }
 
 Json PointLight() { return Json{{"type", "point"}, {"position", {-1, 0, 2}}, {"intensity", 10}}; }
@@ -60,10 +60,10 @@ Json SphereLight() {
 }
 
 // Adds a 64x48 camera at `eye` looking at `target` and its photo under lighting 0.
-int AddPhoto(Scene* scene, const Vector3d& eye, const Vector3d& target) {
+int AddPhoto(recon::Scene* scene, const Vector3d& eye, const Vector3d& target) {
   const int n = static_cast<int>(scene->photos.size());
-  scene->cameras.push_back(LookAtCamera("c" + std::to_string(n), eye, target, 64, 48, 40));
-  Photo photo;
+  scene->cameras.push_back(synth::LookAtCamera("c" + std::to_string(n), eye, target, 64, 48, 40));
+  recon::Photo photo;
   photo.file = scene->dir / ("p" + std::to_string(n) + ".exr");
   photo.camera = static_cast<int>(scene->cameras.size()) - 1;
   photo.lighting = 0;
@@ -72,14 +72,15 @@ int AddPhoto(Scene* scene, const Vector3d& eye, const Vector3d& target) {
 }
 
 // One observation per pixel centre that hits the scene mesh (flat faces: normal = face normal).
-std::vector<Observation> Observe(const Scene& scene, const RayScene& impl, int photo) {
-  const Camera& cam = scene.cameras[scene.photos[photo].camera];
+std::vector<Observation> Observe(const recon::Scene& scene, const render::RayScene& impl,
+                                 int photo) {
+  const recon::Camera& cam = scene.cameras[scene.photos[photo].camera];
   const Vector3d c = cam.CenterInWorld();
   std::vector<Observation> out;
   for (int y = 0; y < cam.height; ++y) {
     for (int x = 0; x < cam.width; ++x) {
       const Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
-      const std::optional<RayHit> hit = impl.Intersect(c, dir);
+      const std::optional<render::RayHit> hit = impl.Intersect(c, dir);
       if (!hit || hit->triangle < 0) continue;
       Observation o;
       o.photo = photo;
@@ -116,15 +117,15 @@ int LobeCount(const std::vector<Observation>& obs, int region, double limit, dou
 }
 
 struct Fixture {
-  Scene scene;
-  std::vector<std::unique_ptr<RayScene>> scenes;
+  recon::Scene scene;
+  std::vector<std::unique_ptr<render::RayScene>> scenes;
   std::vector<Observation> observations;
 };
 
 Fixture Make(const std::string& name, const Json& light, bool blocker = false) {
   Fixture f;
   f.scene = MakeScene(test::UniqueTempDir("igi_cover_" + name), light, blocker);
-  f.scenes.push_back(std::make_unique<RayScene>(f.scene, 0));
+  f.scenes.push_back(std::make_unique<render::RayScene>(f.scene, 0));
   return f;
 }
 
@@ -280,4 +281,4 @@ TEST(HighlightCoverageTest, JsonAndValidation) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 std::vector<Eigen::Vector3d> BruteForce(const std::vector<NeighbourPoint>& pts,
@@ -121,4 +121,4 @@ TEST(NeighbourMeanTest, AnIsolatedPointKeepsItsValue) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

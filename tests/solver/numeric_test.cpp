@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 TEST(ExpNonPositive, MatchesStdExpOverTheLobesRange) {
@@ -69,4 +69,4 @@ TEST(BrentMinimum, FindsKnownMinimaInFewEvaluations) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

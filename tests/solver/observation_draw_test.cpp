@@ -30,7 +30,7 @@
 #include "tools/common/error.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 namespace room = test::box_room;
@@ -174,7 +174,7 @@ fs::path* ObservationDrawRoom::dir_ = nullptr;
 using Pixel = std::tuple<int, int, int>;  // photo, x, y
 
 TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSamePixels) {
-  const Scene scene = LoadScene(*dir_ / "scene.json");
+  const recon::Scene scene = recon::LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();
   o.max_fit_samples = 200;      // the regions' needs (their highlight candidates and 200 others)
                                 // well inside the budget below
@@ -190,7 +190,7 @@ TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSame
 
   const int floor = scene.FindMaterial("floor");
   auto near = [&](const SolverState& s, const Observation& ob) {
-    const RayScene& g = *s.lighting_scenes[scene.photos[ob.photo].lighting];
+    const render::RayScene& g = *s.lighting_scenes[scene.photos[ob.photo].lighting];
     return NearHighlight(g, ob.position.cast<double>(), ob.view.cast<double>(),
                          ob.normal.cast<double>());
   };
@@ -233,7 +233,7 @@ TEST_F(ObservationDrawRoom, AThinnedCollectionKeepsHighlightsAndASubsetOfTheSame
 }
 
 TEST_F(ObservationDrawRoom, DrawnBlocksAreTheMeansOfTheirPixelsOnOneSurface) {
-  const Scene scene = LoadScene(*dir_ / "scene.json");
+  const recon::Scene scene = recon::LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();
   o.max_fit_samples = 200;
   o.max_observations = 1000;
@@ -258,7 +258,7 @@ TEST_F(ObservationDrawRoom, DrawnBlocksAreTheMeansOfTheirPixelsOnOneSurface) {
     const Eigen::Vector3d mean = sum / double(ob.size * ob.size);
     EXPECT_LT((mean - ob.radiance.cast<double>()).norm(), 1e-5 * (1 + mean.norm()));
     // Its point is where the block's centre ray meets the surface.
-    const Camera& cam = scene.cameras[scene.photos[ob.photo].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[ob.photo].camera];
     const std::optional<Eigen::Vector2d> centre = cam.ImgFromWorld(ob.position.cast<double>());
     ASSERT_TRUE(centre);
     EXPECT_NEAR(centre->x(), ob.x + 0.5 * ob.size, 1e-3);
@@ -270,7 +270,7 @@ TEST_F(ObservationDrawRoom, DrawnBlocksAreTheMeansOfTheirPixelsOnOneSurface) {
 }
 
 TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
-  const Scene scene = LoadScene(*dir_ / "scene.json");
+  const recon::Scene scene = recon::LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();
   o.max_fit_samples = 200;
   o.indirect_rays = 8;
@@ -311,7 +311,7 @@ TEST_F(ObservationDrawRoom, TheSmoothingRadiusWidensToHoldTheDrawnNeighbours) {
 }
 
 TEST_F(ObservationDrawRoom, ABudgetThatCannotHoldAPhotoIsRefusedBeforeAnyWork) {
-  const Scene scene = LoadScene(*dir_ / "scene.json");
+  const recon::Scene scene = recon::LoadScene(*dir_ / "scene.json");
   SolveOptions o = Options();
   o.memory_budget = 0.01;  // 10 MiB: less than the process itself
   SolverState s(scene, o);
@@ -327,4 +327,4 @@ TEST_F(ObservationDrawRoom, ABudgetThatCannotHoldAPhotoIsRefusedBeforeAnyWork) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

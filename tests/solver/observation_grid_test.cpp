@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // The nearest observation of `region` with group(o) == g to p, normal within the test; -1 if none.
@@ -28,9 +28,9 @@ int BruteForceNearest(const ObservationSet& obs, int g, int region, const Eigen:
 }
 
 TEST(ObservationGrid, TheNearestIsTheNearestOfItsLightingOrOfItsPhoto) {
-  Scene scene;
+  recon::Scene scene;
   for (int k = 0; k < 4; ++k) {
-    Photo photo;
+    recon::Photo photo;
     photo.lighting = k % 2;
     scene.photos.push_back(photo);
   }
@@ -81,4 +81,4 @@ TEST(ObservationGrid, TheNearestIsTheNearestOfItsLightingOrOfItsPhoto) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -11,7 +11,7 @@
 
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 constexpr double kTrueScale = 0.8;
@@ -24,7 +24,7 @@ constexpr double kE = 3.0, kG = 2.0;  // direct and gathered irradiance, the sam
 // missed), now and then far too dark (a dot hit under a mostly light pixel). Three channels
 // per observation, `per_patch` observations per patch.
 std::vector<PhotoScaleSample> TexturedReference(int patches, int per_patch, uint64_t seed) {
-  Pcg32 rng(seed, 1);
+  render::Pcg32 rng(seed, 1);
   std::vector<PhotoScaleSample> out;
   for (int g = 0; g < patches; ++g) {
     for (int i = 0; i < per_patch; ++i) {
@@ -105,4 +105,4 @@ TEST(PhotoScaleTest, SmallPatchesAreNotJudged) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -12,7 +12,7 @@
 
 #include "tests/solver/test_scenes.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // Closed boxes [x0, x0 + l] × [0, w] × [0, h], one after another along x (rooms of a building
@@ -66,7 +66,7 @@ Json CubeCameras(const Eigen::Vector3d& eye, const std::string& prefix, Json cam
   return cameras;
 }
 
-Scene BoxScene(const std::string& name, const std::string& obj, const Json& cameras) {
+recon::Scene BoxScene(const std::string& name, const std::string& obj, const Json& cameras) {
   const auto dir = test::TempSceneDir(name);
   test::WriteText(dir / "room.obj", obj);
   return test::LoadTestScene(
@@ -81,12 +81,12 @@ Scene BoxScene(const std::string& name, const std::string& obj, const Json& came
                 {"photos", Json::array()}});
 }
 
-SceneScale Measure(const Scene& scene) { return MeasureSceneScale(scene); }
+SceneScale Measure(const recon::Scene& scene) { return MeasureSceneScale(scene); }
 
 TEST(SceneScale, TheFreePathOfAConvexRoomSeenAllRoundIsItsMeanChord) {
   const double l = 4, w = 3, h = 2.5;
-  const Scene scene = BoxScene("scale_box", BoxesObj(1, l, w, h),
-                               CubeCameras({1.3, 1.1, 1.4}, "c", Json::object()));
+  const recon::Scene scene = BoxScene("scale_box", BoxesObj(1, l, w, h),
+                                      CubeCameras({1.3, 1.1, 1.4}, "c", Json::object()));
   const SceneScale s = Measure(scene);
   const double chord = 4 * l * w * h / (2 * (l * w + l * h + w * h));  // 2.03 m
   std::printf("free path %.3f m (4V/S %.3f m), diagonal %.3f m, rays hit %.3f\n", s.free_path_m,
@@ -104,7 +104,7 @@ TEST(SceneScale, ABuildingsRoomsSetItsScaleNotItsBoundingBox) {
   Json cameras = Json::object();
   for (int k = 0; k < 8; ++k)
     cameras = CubeCameras({4.0 * k + 1.3, 1.1, 1.4}, "r" + std::to_string(k) + "_", cameras);
-  const Scene scene = BoxScene("scale_building", BoxesObj(8, 4, 3, 2.5), cameras);
+  const recon::Scene scene = BoxScene("scale_building", BoxesObj(8, 4, 3, 2.5), cameras);
   const SceneScale s = Measure(scene);
   std::printf("free path %.3f m, diagonal %.3f m, scale %.3f m\n", s.free_path_m, s.diagonal_m,
               s.scale_m);
@@ -116,8 +116,8 @@ TEST(SceneScale, ABuildingsRoomsSetItsScaleNotItsBoundingBox) {
 
 TEST(SceneScale, AnOpenSceneKeepsItsDiagonal) {
   // A floor seen from above: every ray from it escapes.
-  const Scene scene = BoxScene("scale_open", test::SquareObj("room", 2.0),
-                               Json{{"cam", test::DownCamera(0, 0, 3, 64, 48, 40)}});
+  const recon::Scene scene = BoxScene("scale_open", test::SquareObj("room", 2.0),
+                                      Json{{"cam", test::DownCamera(0, 0, 3, 64, 48, 40)}});
   const SceneScale s = Measure(scene);
   EXPECT_TRUE(std::isnan(s.free_path_m));
   EXPECT_EQ(s.hit_fraction, 0.0);
@@ -125,4 +125,4 @@ TEST(SceneScale, AnOpenSceneKeepsItsDiagonal) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

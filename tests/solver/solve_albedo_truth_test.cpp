@@ -19,7 +19,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 
@@ -47,14 +47,14 @@ double RelErr(double a, double b) { return std::abs(a - b) / std::abs(b); }
 // those two texels inside them held above the bars.
 void CheckMapOfAResolvedTexture(int spp, double seen_bar_db, double interior_bar_db) {
   const fs::path tmp = test::UniqueTempDir("solve_albedo_truth");
-  SynthOptions so;
+  synth::SynthOptions so;
   so.out = tmp / "capture";
   so.spp = spp;
-  so.lamp = LampShape::kPoint;
-  so.floor_texture = FloorTexture::kSmooth;
+  so.lamp = synth::LampShape::kPoint;
+  so.floor_texture = synth::FloorTexture::kSmooth;
   so.validation_lightings = {};
-  Synthesize(so);
-  const Scene scene = LoadScene(so.out / "scene.json");
+  synth::Synthesize(so);
+  const recon::Scene scene = recon::LoadScene(so.out / "scene.json");
   SolveOptions o;
   o.pixel_stride = 1;       // every pixel: the map averages the photos' Monte Carlo noise
   o.texel_size_m = 0.0462;  // twice the median pixel footprint (87 × 87 texels on the floor)
@@ -151,17 +151,17 @@ TEST(SolveAlbedoTruth, MapOfATextureThePhotosResolveNoiseFree) {
 // by the paper's method alone (no refinement round).
 struct SolvedRoom {
   fs::path capture;
-  Scene scene;
+  recon::Scene scene;
   SolveOptions options;
   SolveSummary summary;
 };
-SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
+SolvedRoom SolveRoom(const fs::path& tmp, synth::SynthOptions so) {
   SolvedRoom room;
   so.out = room.capture = tmp / "capture";
-  so.lamp = LampShape::kPoint;
+  so.lamp = synth::LampShape::kPoint;
   so.validation_lightings = {};
-  Synthesize(so);
-  room.scene = LoadScene(so.out / "scene.json");
+  synth::Synthesize(so);
+  room.scene = recon::LoadScene(so.out / "scene.json");
   room.options.refine_iterations = 0;
   room.options.show_progress = false;
   room.summary = Solve(room.scene, room.options, tmp / "out");
@@ -190,14 +190,14 @@ SolvedRoom SolveRoom(const fs::path& tmp, SynthOptions so) {
 //    over fewer neighbours, and its noise enters every texel), its ρd no farther from the truth.
 TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
   const fs::path tmp = test::UniqueTempDir("solve_albedo_thinned");
-  SynthOptions so;
+  synth::SynthOptions so;
   so.out = tmp / "capture";
   so.spp = 64;
-  so.lamp = LampShape::kPoint;
-  so.floor_texture = FloorTexture::kSmooth;
+  so.lamp = synth::LampShape::kPoint;
+  so.floor_texture = synth::FloorTexture::kSmooth;
   so.validation_lightings = {};
-  Synthesize(so);
-  const Scene scene = LoadScene(so.out / "scene.json");
+  synth::Synthesize(so);
+  const recon::Scene scene = recon::LoadScene(so.out / "scene.json");
   const Json truth = ReadJsonFile(so.out / "truth.json")["materials"];
   const Image want = ReadImage(so.out / truth["floor"]["rho_d_map"].get<std::string>(), 3);
   double peak = 0;
@@ -256,14 +256,14 @@ TEST(SolveAlbedoTruth, AThinnedSolvesMapIsAtThePhotosResolution) {
 }
 
 TEST(SolveAlbedoTruth, AGlossyRegionsFineTextureGetsAMap) {
-  SynthOptions so;
+  synth::SynthOptions so;
   so.textured_walls = true;
   // The ceiling photographed (an unseen ceiling's placeholder albedo biases every region's
   // bounced light by several per cent, which would hide what this test looks at).
   so.cameras = 10;
   so.ceiling_cameras = 2;
   const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_fine_texture"), so);
-  const Scene& scene = room.scene;
+  const recon::Scene& scene = room.scene;
   const SolveSummary& s = room.summary;
   const Json truth = ReadJsonFile(room.capture / "truth.json")["materials"];
   const Json report = SolveReportJson(s, room.options);
@@ -309,7 +309,8 @@ TEST(SolveAlbedoTruth, AGlossyRegionsFineTextureGetsAMap) {
 // below the bar (their albedo constant, the photos' noise and the smooth errors of the gathered
 // irradiance left out by the split halves and the local means), and they get no map.
 TEST(SolveAlbedoTruth, ConstantGlossyRegionsGetNoMap) {
-  const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_no_fine_texture"), SynthOptions{});
+  const SolvedRoom room =
+      SolveRoom(test::UniqueTempDir("solve_no_fine_texture"), synth::SynthOptions{});
   for (const char* name : {"glossy_box", "glossy_sphere"}) {
     const RegionSolution& r = room.summary.regions[room.scene.FindMaterial(name)];
     std::printf("%s: texel variation %.1f %% (z %.1f)\n", name, 100 * r.texel_variation,
@@ -330,19 +331,19 @@ TEST(SolveAlbedoTruth, ConstantGlossyRegionsGetNoMap) {
 // alike, so the measure is the channels' summed detail variance over their summed mean²: 5.1 %.
 TEST(SolveAlbedoTruth, AWrongLobeShapeIsNoTexture) {
   const fs::path tmp = test::UniqueTempDir("solve_lobe_no_texture");
-  SynthOptions so;
+  synth::SynthOptions so;
   so.out = tmp / "capture";
   so.cameras = 4;
   so.seed = 11;
-  so.lamp = LampShape::kPoint;
+  so.lamp = synth::LampShape::kPoint;
   so.lamp_position = Eigen::Vector3d(2, 2, 0.6);
   so.grazing_cameras = 1;
   so.validation_lightings = {};
-  so.effects.push_back(ParseEffectSpec("specular_lobe_shape"));
-  Synthesize(so);
-  Scene scene = LoadScene(so.out / "scene.json");
+  so.effects.push_back(synth::ParseEffectSpec("specular_lobe_shape"));
+  synth::Synthesize(so);
+  recon::Scene scene = recon::LoadScene(so.out / "scene.json");
   const Json truth = ReadJsonFile(so.out / "truth.json")["materials"];
-  Material& ceiling = scene.materials[scene.FindMaterial("ceiling")];
+  recon::Material& ceiling = scene.materials[scene.FindMaterial("ceiling")];
   ASSERT_FALSE(ceiling.rho_d.has_value());
   const std::vector<double> rho = truth["ceiling"]["rho_d"].get<std::vector<double>>();
   ceiling.rho_d = Eigen::Vector3d(rho[0], rho[1], rho[2]);
@@ -362,7 +363,7 @@ TEST(SolveAlbedoTruth, AWrongLobeShapeIsNoTexture) {
 // it kept a placeholder (the seen regions' mean albedo, 0.495 against the true 0.8), and the walls'
 // albedos absorbed the missing light.
 TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
-  SynthOptions so;
+  synth::SynthOptions so;
   so.lamp_position = Eigen::Vector3d(2, 2, 0.6);
   const SolvedRoom room = SolveRoom(test::UniqueTempDir("solve_unseen_ceiling"), so);
   const Json truth = ReadJsonFile(room.capture / "truth.json")["materials"];
@@ -395,4 +396,4 @@ TEST(SolveAlbedoTruth, AnUnseenCeilingsAlbedoFromTheLightItBounces) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

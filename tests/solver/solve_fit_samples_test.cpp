@@ -26,7 +26,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 namespace room = test::box_room;
@@ -39,7 +39,7 @@ struct Draw {
 };
 
 Draw Prepare(const fs::path& scene_path) {
-  const Scene scene = LoadScene(scene_path);
+  const recon::Scene scene = recon::LoadScene(scene_path);
   SolveOptions o;
   o.pixel_stride = 1;
   o.max_fit_samples = 300;
@@ -78,8 +78,8 @@ TEST(SolveFitSamples, APhotosDrawDoesNotMoveWithAnotherPhotosPixels) {
   const Draw before = Prepare(dir / "scene.json");
 
   // cam0's floor pixels made invalid: the pixels whose centre ray meets the floor (z = 0).
-  const Scene scene = LoadScene(dir / "scene.json");
-  const Camera& cam0 = scene.cameras[scene.FindCamera("cam0")];
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json");
+  const recon::Camera& cam0 = scene.cameras[scene.FindCamera("cam0")];
   Image photo = ReadImage(dir / "photos" / "cam0.exr");
   const Eigen::Vector3d c = cam0.CenterInWorld();
   int cleared = 0;
@@ -112,4 +112,4 @@ TEST(SolveFitSamples, APhotosDrawDoesNotMoveWithAnotherPhotosPixels) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -26,7 +26,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 namespace room = test::box_room;
@@ -53,7 +53,7 @@ class SolveGather : public ::testing::Test {
 
   // The solved ceiling albedo's relative error (paper stage only).
   double CeilingError(bool specular_bounces) const {
-    const Scene scene = LoadScene(dir_ / "scene.json");
+    const recon::Scene scene = recon::LoadScene(dir_ / "scene.json");
     SolveOptions o;
     o.refine_iterations = 0;
     o.specular_bounces = specular_bounces;
@@ -66,12 +66,12 @@ class SolveGather : public ::testing::Test {
   }
 
   // `doc` written as dir_/name and loaded complete (no photos read).
-  Scene WriteAndLoad(const Json& doc, const std::string& name) const {
+  recon::Scene WriteAndLoad(const Json& doc, const std::string& name) const {
     WriteJsonFile(dir_ / name, doc);
-    SceneLoadOptions lo;
+    recon::SceneLoadOptions lo;
     lo.require_complete_materials = true;
     lo.check_images = false;
-    return LoadScene(dir_ / name, lo);
+    return recon::LoadScene(dir_ / name, lo);
   }
 
   fs::path dir_;
@@ -98,8 +98,8 @@ TEST_F(SolveGather, AmbientLightGivesExactlyPiLOfIrradiance) {
   Json doc = ReadJsonFile(dir_ / "truth.json");
   doc["lights"]["amb"] = {{"type", "ambient"}, {"radiance", {0.3, 0.2, 0.1}}};
   doc["lightings"]["L0"] = Json::array({"amb"});
-  const Scene scene = WriteAndLoad(doc, "ambient.json");
-  const auto rs = std::make_unique<RayScene>(scene, scene.FindLighting("L0"));
+  const recon::Scene scene = WriteAndLoad(doc, "ambient.json");
+  const auto rs = std::make_unique<render::RayScene>(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   std::vector<GatherQuery> queries(3);
   queries[0].position = {1, 1, 0};        // mid-floor, facing up
@@ -135,8 +135,8 @@ TEST_F(SolveGather, DirectLightIsTheMeanOverThePixelsFootprint) {
   doc["lights"]["lamp"] = {{"type", "point"},
                            {"position", {1.0, 1.0, h}},
                            {"intensity", {intensity, intensity, intensity}}};
-  const Scene scene = WriteAndLoad(doc, "near_lamp.json");
-  const auto rs = std::make_unique<RayScene>(scene, scene.FindLighting("L0"));
+  const recon::Scene scene = WriteAndLoad(doc, "near_lamp.json");
+  const auto rs = std::make_unique<render::RayScene>(scene, scene.FindLighting("L0"));
   const PatchSet patches = BuildPatches(scene.mesh, 0.2);
   // A camera at (1, 1, 1.9) looking straight down; its pixel's corner rays at unit depth.
   const Eigen::Vector3d eye(1, 1, 1.9), corner(1 - side / 2, 1 - side / 2, 0);
@@ -183,4 +183,4 @@ TEST_F(SolveGather, DirectLightIsTheMeanOverThePixelsFootprint) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

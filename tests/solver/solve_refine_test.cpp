@@ -28,7 +28,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 namespace room = test::box_room;
@@ -80,7 +80,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
   std::pair<double, double> OneRound(const std::string& update, double start_scale,
                                      double rho_s_scale = 1, double* rho_s_after = nullptr,
                                      int threads = 2) const {
-    const Scene scene = LoadScene(dir_ / "scene.json");
+    const recon::Scene scene = recon::LoadScene(dir_ / "scene.json");
     SolveOptions o;
     o.pixel_stride = 1;
     o.refine_rays = 64;
@@ -102,7 +102,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
     auto worst = [&]() {
       double w = 0;
       for (size_t r = 0; r < s.materials.size(); ++r) {
-        if (s.materials[r].params.model != BrdfModel::kLambert) continue;
+        if (s.materials[r].params.model != recon::BrdfModel::kLambert) continue;
         for (int c = 0; c < 3; ++c) {
           const double want = truth.at(scene.materials[r].name).at("rho_d")[c].get<double>();
           const double e = s.materials[r].params.rho_d[c] / want - 1;
@@ -115,7 +115,7 @@ class SolveRefine : public ::testing::TestWithParam<bool> {
     s.RefineRound(1, dir_ / ("maps_" + update));
     const double after = worst();
     for (size_t r = 0; r < s.materials.size(); ++r) {
-      const BrdfParams& v = s.materials[r].params;
+      const render::BrdfParams& v = s.materials[r].params;
       std::printf("  %s %-8s rho_d %.4f %.4f %.4f", update.c_str(), scene.materials[r].name.c_str(),
                   v.rho_d[0], v.rho_d[1], v.rho_d[2]);
       if (s.materials[r].unknown_rho_s) {
@@ -183,4 +183,4 @@ TEST_P(SolveRefineGlossy, JointRoundFollowsTheGlossyFloorsReflectedLight) {
 INSTANTIATE_TEST_SUITE_P(Room, SolveRefineGlossy, ::testing::Values(true));
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -16,7 +16,7 @@
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 Observation At(int photo, int x, int y, int region, const Eigen::Vector3f& position) {
@@ -28,20 +28,20 @@ Observation At(int photo, int x, int y, int region, const Eigen::Vector3f& posit
   return o;
 }
 
-Material Named(const std::string& name, BrdfModel brdf) {
-  Material m;
+recon::Material Named(const std::string& name, recon::BrdfModel brdf) {
+  recon::Material m;
   m.name = name;
   m.brdf = brdf;
   return m;
 }
 
 TEST(MaterialEstimateTest, FromSceneMarksTheUnknownsAndGroupsThePatchesByRegion) {
-  Scene scene;
-  Material walls = Named("walls", BrdfModel::kLambert);
+  recon::Scene scene;
+  recon::Material walls = Named("walls", recon::BrdfModel::kLambert);
   walls.rho_d = Eigen::Vector3d(0.3, 0.4, 0.5);
-  Material floor = Named("floor", BrdfModel::kWard);
+  recon::Material floor = Named("floor", recon::BrdfModel::kWard);
   floor.alpha = 0.2;  // ρd and ρs unknown
-  scene.materials = {walls, floor, Named("lamp", BrdfModel::kEmitter)};
+  scene.materials = {walls, floor, Named("lamp", recon::BrdfModel::kEmitter)};
   PatchSet patches;
   patches.patch_triangle = {0, 1, 2, 3};
   patches.patch_region = {1, 0, 1, 1};
@@ -69,8 +69,8 @@ TEST(MaterialEstimateTest, FromSceneMarksTheUnknownsAndGroupsThePatchesByRegion)
 TEST(SpecularTermsTest, SumTheWidenedLobeOverTheIncidentSamplesAndAreZeroOffLobes) {
   MaterialEstimate m;
   m.regions.resize(2);
-  m[0].params.model = BrdfModel::kLambert;
-  m[1].params.model = BrdfModel::kWard;
+  m[0].params.model = recon::BrdfModel::kLambert;
+  m[1].params.model = recon::BrdfModel::kWard;
   m[1].params.alpha = m[1].params.alpha_x = m[1].params.alpha_y = 0.2;
   ObservationSet obs;
   obs.items = {At(0, 0, 0, 0, Eigen::Vector3f::Zero()), At(0, 1, 0, 1, Eigen::Vector3f::Zero())};
@@ -88,8 +88,8 @@ TEST(SpecularTermsTest, SumTheWidenedLobeOverTheIncidentSamplesAndAreZeroOffLobe
   const double a = std::sqrt(0.04 + double(obs[1].lobe_blur2));
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
   for (const IncidentLocal& s : samples) {
-    expected += SpecularWeight(BrdfModel::kWard, a, a, m[1].params.ior, Eigen::Vector3d::UnitZ(),
-                               s.Wi().cast<double>()) *
+    expected += SpecularWeight(recon::BrdfModel::kWard, a, a, m[1].params.ior,
+                               Eigen::Vector3d::UnitZ(), s.Wi().cast<double>()) *
                 s.Value().cast<double>();
   }
   ASSERT_GT(expected.minCoeff(), 0);
@@ -131,8 +131,8 @@ TEST(SmoothIrradianceTest, AveragesTheIndirectOverTheSameRegionsNeighboursAndKee
 // observation, patch 1 unseen and lit directly (E 4); patch 0's gather point has one indirect
 // sample toward patch 1, the observation's point two (toward patch 0 and patch 1).
 TEST(IrradianceFromPatchesTest, SeenPatchesSendThePhotosRadianceUnseenOnesTheirAlbedoTimesE) {
-  Scene scene;
-  Material walls = Named("walls", BrdfModel::kLambert);
+  recon::Scene scene;
+  recon::Material walls = Named("walls", recon::BrdfModel::kLambert);
   walls.rho_d = Eigen::Vector3d::Constant(0.5);
   scene.materials = {walls};
   PatchSet patches;
@@ -186,9 +186,9 @@ TEST(IrradianceFromPatchesTest, SeenPatchesSendThePhotosRadianceUnseenOnesTheirA
 // Two regions: walls (ρd unknown) and a box whose ρd is given (not fitted); the walls' two
 // observations, one a fit sample.
 TEST(FitInputsTest, OneInputPerFittedRegionWithASamplePerFitObservation) {
-  Scene scene;
-  Material walls = Named("walls", BrdfModel::kLambert);
-  Material box = Named("box", BrdfModel::kLambert);
+  recon::Scene scene;
+  recon::Material walls = Named("walls", recon::BrdfModel::kLambert);
+  recon::Material box = Named("box", recon::BrdfModel::kLambert);
   box.rho_d = Eigen::Vector3d::Constant(0.4);
   scene.materials = {walls, box};
   PatchSet patches;
@@ -275,4 +275,4 @@ TEST(SelectFitSamplesTest, DrawsToTheCapsByPixelAndKeepsEveryObservationUnderThe
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

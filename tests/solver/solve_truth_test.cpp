@@ -20,7 +20,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 namespace fs = std::filesystem;
 
@@ -49,7 +49,7 @@ Eigen::Vector3d SeenMean(const Image& truth, const Image& seen) {
   for (int y = 0; y < truth.height; ++y) {
     for (int x = 0; x < truth.width; ++x) {
       const Eigen::Vector2d uv((x + 0.5) / truth.width, 1.0 - (y + 0.5) / truth.height);
-      if (SampleTexture(seen, uv)[0] < 1.0) continue;
+      if (render::SampleTexture(seen, uv)[0] < 1.0) continue;
       for (int c = 0; c < 3; ++c) sum[c] += truth.at(x, y, c);
       ++n;
     }
@@ -59,7 +59,7 @@ Eigen::Vector3d SeenMean(const Image& truth, const Image& seen) {
 
 TEST(SolveTruth, RadianceRoomMatchesTheIndependentRenderersValues) {
   const fs::path tmp = test::UniqueTempDir("solve_radiance");
-  const Scene scene = LoadScene(StrippedScene(kRoom / "scene.json", tmp));
+  const recon::Scene scene = recon::LoadScene(StrippedScene(kRoom / "scene.json", tmp));
   SolveOptions o;
   o.albedo_maps = AlbedoMaps::kNone;
   o.refine_iterations = 1;
@@ -118,22 +118,22 @@ class SolveWritten : public ::testing::TestWithParam<WrittenCase> {};
 
 TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
   const fs::path tmp = test::UniqueTempDir("solve_written");
-  SynthOptions so;
+  synth::SynthOptions so;
   so.out = tmp / "capture";
   so.cameras = 4;
   so.spp = 64;
   so.textured_walls = GetParam().textured_walls;
-  Synthesize(so);
-  const Scene scene = LoadScene(so.out / "scene.json");
+  synth::Synthesize(so);
+  const recon::Scene scene = recon::LoadScene(so.out / "scene.json");
   SolveOptions o;
   o.albedo_maps = GetParam().albedo_maps;
   o.refine_iterations = 0;
   const SolveSummary s = Solve(scene, o, tmp / "out");
   WriteSolveOutputs(s, o, tmp / "out");
-  const Scene written = LoadScene(tmp / "out" / "scene.json");
+  const recon::Scene written = recon::LoadScene(tmp / "out" / "scene.json");
   int mapped = 0;
   for (size_t r = 0; r < written.materials.size(); ++r) {
-    const Material& m = written.materials[r];
+    const recon::Material& m = written.materials[r];
     if (o.albedo_maps == AlbedoMaps::kNone) EXPECT_FALSE(m.rho_d_map) << m.name;
     if (m.rho_d_map && s.regions[r].stage1.albedo_model == AlbedoModel::kConstant) ++mapped;
   }
@@ -141,9 +141,9 @@ TEST_P(SolveWritten, ReportedRenderResidualIsOfTheWrittenModel) {
   if (o.albedo_maps != AlbedoMaps::kNone) EXPECT_GE(mapped, 2);
   double num = 0, den = 0;
   for (size_t k = 0; k < written.photos.size(); ++k) {
-    const Photo& ph = written.photos[k];
-    const Renderer renderer(written, ph.lighting);
-    RenderOptions ro;
+    const recon::Photo& ph = written.photos[k];
+    const render::Renderer renderer(written, ph.lighting);
+    render::RenderOptions ro;
     ro.spp = 128;
     ro.show_progress = false;
     ro.seed = 2 * k + 1;
@@ -192,12 +192,12 @@ class SolveSynth : public ::testing::TestWithParam<SynthCase> {};
 
 TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   const fs::path tmp = test::UniqueTempDir("solve_synth");
-  SynthOptions so;
+  synth::SynthOptions so;
   so.out = tmp / "capture";
   so.spp = GetParam().spp;
-  if (GetParam().noise) so.noise = NoiseModel::kRealistic;
-  Synthesize(so);
-  const Scene scene = LoadScene(so.out / "scene.json");
+  if (GetParam().noise) so.noise = synth::NoiseModel::kRealistic;
+  synth::Synthesize(so);
+  const recon::Scene scene = recon::LoadScene(so.out / "scene.json");
   SolveOptions o;  // igi-solve's defaults: two refinement rounds
   const SolveSummary s = Solve(scene, o, tmp / "out");
   WriteSolveOutputs(s, o, tmp / "out");
@@ -339,7 +339,7 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
     double peak = 0;
     for (int y = 0; y < want.height; ++y) {
       for (int x = 0; x < want.width; ++x) {
-        const Eigen::Vector3d v = SampleTexture(
+        const Eigen::Vector3d v = render::SampleTexture(
             mine, Eigen::Vector2d((x + 0.5) / want.width, 1.0 - (y + 0.5) / want.height));
         for (int c = 0; c < 3; ++c) {
           resampled.at(x, y, c) = float(v[c]);
@@ -359,12 +359,12 @@ TEST_P(SolveSynth, RecoversTheRoomsMaterialsAndRelightsIt) {
   // Relighting: the solved scene under L1 (no photo used it) against the true scene's clean
   // render of the same view, compared with the true scene rendered again with another seed
   // (the Monte Carlo noise floor of the two 64-spp renders against the 256-spp validation).
-  const Scene solved = LoadScene(tmp / "out" / "scene.json");
-  const Scene true_scene = LoadScene(so.out / "truth" / "scene.json");
+  const recon::Scene solved = recon::LoadScene(tmp / "out" / "scene.json");
+  const recon::Scene true_scene = recon::LoadScene(so.out / "truth" / "scene.json");
   const int l1 = solved.FindLighting("L1");
   ASSERT_GE(l1, 0);
-  Renderer model(solved, l1), reference(true_scene, true_scene.FindLighting("L1"));
-  RenderOptions ro;
+  render::Renderer model(solved, l1), reference(true_scene, true_scene.FindLighting("L1"));
+  render::RenderOptions ro;
   ro.spp = 64;
   ro.show_progress = false;
   const Image validation = ReadImage(so.out / "validation" / "cam0_L1.exr", 3);
@@ -415,4 +415,4 @@ INSTANTIATE_TEST_SUITE_P(Rooms, SolveSynth,
                          [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

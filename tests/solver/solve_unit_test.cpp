@@ -19,11 +19,11 @@
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
-TriangleMesh OneTriangle() {
-  TriangleMesh m;
+recon::TriangleMesh OneTriangle() {
+  recon::TriangleMesh m;
   m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   m.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
   m.triangles = {{0, 1, 2}};
@@ -36,9 +36,9 @@ TriangleMesh OneTriangle() {
 std::string SphereObj(double r, int rings, int segments) {
   std::string s = "usemtl ball\n";
   for (int i = 0; i <= rings; ++i) {
-    const double th = kPi * i / rings;
+    const double th = render::kPi * i / rings;
     for (int j = 0; j < segments; ++j) {
-      const double ph = 2 * kPi * j / segments;
+      const double ph = 2 * render::kPi * j / segments;
       const Eigen::Vector3d n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph),
                               std::cos(th));
       s += "v " + std::to_string(r * n.x()) + " " + std::to_string(r * n.y()) + " " +
@@ -80,8 +80,8 @@ TEST(Observations, APixelsSpreadOfNormalsFollowsTheSurfacesCurvature) {
       {"photos", {{{"file", "top.exr"}, {"camera", "top"}, {"lighting", "L"}}}}};
   const Image radiance(81, 81, 3, 0.5f);
   WriteImage(dir / "top.exr", radiance);
-  const Scene scene = test::LoadTestScene(dir, doc);
-  const auto impl = std::make_unique<RayScene>(scene, 0);
+  const recon::Scene scene = test::LoadTestScene(dir, doc);
+  const auto impl = std::make_unique<render::RayScene>(scene, 0);
   const PatchSet patches = BuildPatches(scene.mesh, 0.1);
   ObservationOptions oo;
   oo.pixel_stride = 1;
@@ -205,7 +205,7 @@ TEST(SolveOptions, SetChoicesParsesTheFlagsAndNamesABadTextInItsPlace) {
 }
 
 TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
-  const TriangleMesh mesh = OneTriangle();
+  const recon::TriangleMesh mesh = OneTriangle();
   const PatchSet set = BuildPatches(mesh, 0.3);  // longest edge √2 → k = 5
   ASSERT_EQ(set.triangle_k[0], 5);
   ASSERT_EQ(set.size(), 25);
@@ -217,7 +217,7 @@ TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
   }
   EXPECT_NEAR(area, 0.5, 1e-6);
   // Random points: the patch found contains the point (its centre is within one cell).
-  Pcg32 rng(3, 4);
+  render::Pcg32 rng(3, 4);
   std::vector<int> hits(25, 0);
   for (int i = 0; i < 20000; ++i) {
     double b1 = rng.UniformDouble(), b2 = rng.UniformDouble();
@@ -235,7 +235,7 @@ TEST(Patches, SplitTrianglesIntoCongruentCellsThatPartitionThem) {
 
 // Samples of one region: each sees a small light near the mirror direction of some views, plus
 // a few random incident directions, with L generated from the model.
-RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& slot_rho_d,
+RegionFitInput MakeSamples(recon::BrdfModel model, const std::vector<Eigen::Vector3d>& slot_rho_d,
                            double rho_s, double alpha, double noise, uint64_t seed,
                            double alpha_y = 0, double max_blur2 = 0) {
   if (alpha_y <= 0) alpha_y = alpha;
@@ -244,11 +244,11 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
   in.model = model;
   in.num_slots = static_cast<int>(slot_rho_d.size());
   in.slot_area.assign(in.num_slots, 1.0);
-  BrdfParams truth;
+  render::BrdfParams truth;
   truth.model = model;
   truth.rho_s.setConstant(rho_s);
   truth.alpha = alpha;
-  Pcg32 rng(seed, 7);
+  render::Pcg32 rng(seed, 7);
   const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.1, 1).normalized();
   std::vector<size_t> begins;  // each sample's first entry in in.incident
   for (int i = 0; i < 3000; ++i) {
@@ -256,7 +256,7 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
     s.slot = i % in.num_slots;
     // Views spread so that some fall inside the lobe around the light's mirror direction.
     const Eigen::Vector3d mirror(-light.x(), -light.y(), light.z());
-    const Eigen::Vector3d jitter = (0.6 * SampleUniformHemisphere(rng.Uniform2D())).eval();
+    const Eigen::Vector3d jitter = (0.6 * render::SampleUniformHemisphere(rng.Uniform2D())).eval();
     Eigen::Vector3d wo = (mirror + Eigen::Vector3d(jitter.x(), jitter.y(), 0)).normalized();
     if (wo.z() < 0.05) wo = Eigen::Vector3d(wo.x(), wo.y(), 0.05).normalized();
     s.wo = wo.cast<float>();
@@ -277,14 +277,14 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
       add(wi, Eigen::Vector3d(2.0, 1.8, 1.6) * wi.z());
     }
     for (int k = 0; k < 8; ++k) {  // dim light from the rest of the hemisphere
-      const Eigen::Vector3d wi = SampleCosineHemisphere(rng.Uniform2D());
+      const Eigen::Vector3d wi = render::SampleCosineHemisphere(rng.Uniform2D());
       add(wi, Eigen::Vector3d(0.1, 0.1, 0.12));
     }
     s.incident_count = int64_t(in.incident.size() - begin);
     begins.push_back(begin);
     s.irradiance = e;
     const Eigen::Vector3d l =
-        slot_rho_d[s.slot].cwiseProduct(e) / kPi + truth.rho_s.cwiseProduct(spec);
+        slot_rho_d[s.slot].cwiseProduct(e) / render::kPi + truth.rho_s.cwiseProduct(spec);
     // Shot-like noise: standard deviation noise·√(L·0.3), i.e. `noise` relative at L = 0.3.
     for (int c = 0; c < 3; ++c) {
       s.observed[c] =
@@ -298,13 +298,13 @@ RegionFitInput MakeSamples(BrdfModel model, const std::vector<Eigen::Vector3d>& 
 }
 
 TEST(IncidentLocal, KeepsItsDirectionWithinATenThousandthOfARadianAndItsValueExactly) {
-  Pcg32 rng(7, 3);
+  render::Pcg32 rng(7, 3);
   double worst = 0;
   for (int k = 0; k < 20000; ++k) {
     const Eigen::Vector2d u = rng.Uniform2D();
     const double z = 2 * u.x() - 1, r = std::sqrt(std::max(0.0, 1 - z * z));
-    const Eigen::Vector3f wi(float(r * std::cos(2 * kPi * u.y())),
-                             float(r * std::sin(2 * kPi * u.y())), float(z));
+    const Eigen::Vector3f wi(float(r * std::cos(2 * render::kPi * u.y())),
+                             float(r * std::sin(2 * render::kPi * u.y())), float(z));
     const Eigen::Vector3f v(0.1f * k, 1e-6f, 3e4f);
     const IncidentLocal inc(wi, v);
     EXPECT_EQ(inc.Value(), v);
@@ -323,7 +323,7 @@ TEST(IncidentLocal, KeepsItsDirectionWithinATenThousandthOfARadianAndItsValueExa
 }
 
 TEST(RegionFit, RecoversWardParametersExactlyFromNoiseFreeSamples) {
-  for (BrdfModel model : {BrdfModel::kWard, BrdfModel::kWardGmd}) {
+  for (recon::BrdfModel model : {recon::BrdfModel::kWard, recon::BrdfModel::kWardGmd}) {
     const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
     const RegionFitInput in = MakeSamples(model, {rho_d}, 0.06, 0.08, 0.0, 1);
     const RegionFitResult r = FitRegion(in, {});
@@ -342,7 +342,7 @@ TEST(RegionFit, RecoversWardParametersExactlyFromNoiseFreeSamples) {
 // lobe widened by its spread; taken as sharp samples (spread ignored), the lobe comes out wider.
 TEST(RegionFit, APixelsSpreadOfNormalsWidensItsLobeNotTheSurfaces) {
   const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
-  RegionFitInput in = MakeSamples(BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.0, 1, 0, 0.008);
+  RegionFitInput in = MakeSamples(recon::BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.0, 1, 0, 0.008);
   const RegionFitResult r = FitRegion(in, {});
   ASSERT_TRUE(r.fitted);
   EXPECT_NEAR(r.alpha, 0.08, 1e-4 * 0.08);
@@ -360,7 +360,7 @@ TEST(RegionFit, APixelsSpreadOfNormalsWidensItsLobeNotTheSurfaces) {
 // floor's α 2.0, and igi-diagnose refused its own baseline).
 TEST(RegionFit, RoughnessStaysInTheScenesRange) {
   const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
-  for (BrdfModel model : {BrdfModel::kWard, BrdfModel::kWardAniso}) {
+  for (recon::BrdfModel model : {recon::BrdfModel::kWard, recon::BrdfModel::kWardAniso}) {
     const RegionFitInput in = MakeSamples(model, {rho_d}, 0.5, 1.8, 0.0, 3);
     const RegionFitResult r = FitRegion(in, {});
     ASSERT_TRUE(r.fitted);
@@ -374,7 +374,8 @@ TEST(RegionFit, RoughnessStaysInTheScenesRange) {
 TEST(RegionFit, RecoversAnisotropicRoughnessAlongTheTangentAndAcrossIt) {
   // ward_aniso with its tangent known (the local frame's x): αx and αy both recovered.
   const Eigen::Vector3d rho_d(0.3, 0.3, 0.3);
-  const RegionFitInput in = MakeSamples(BrdfModel::kWardAniso, {rho_d}, 0.08, 0.05, 0.0, 6, 0.2);
+  const RegionFitInput in =
+      MakeSamples(recon::BrdfModel::kWardAniso, {rho_d}, 0.08, 0.05, 0.0, 6, 0.2);
   const RegionFitResult r = FitRegion(in, {});
   EXPECT_NEAR(r.alpha_x, 0.05, 0.01 * 0.05);
   EXPECT_NEAR(r.alpha_y, 0.2, 0.01 * 0.2);
@@ -385,7 +386,7 @@ TEST(RegionFit, NoisySamplesStayWithinTheirStatedUncertainty) {
   // Shot-like noise (2 % at L = 0.3): the estimates must fall within 4 sigma of the truth,
   // and sigma must be small enough to be useful (under 5 % of the value).
   const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
-  const RegionFitInput in = MakeSamples(BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.02, 2);
+  const RegionFitInput in = MakeSamples(recon::BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.02, 2);
   const RegionFitResult r = FitRegion(in, {});
   ASSERT_TRUE(std::isfinite(r.sigma_rho_s));
   ASSERT_TRUE(std::isfinite(r.sigma_alpha));
@@ -402,7 +403,7 @@ TEST(RegionFit, VaryingAlbedoIsFittedPerPatchAndKeepsTheLobe) {
   // per-patch model must be chosen, and ρs and α must still come out right (noise-free: 1 %).
   std::vector<Eigen::Vector3d> slots;
   for (int k = 0; k < 12; ++k) slots.push_back(Eigen::Vector3d(0.3, 0.4, 0.2) * (0.6 + 0.07 * k));
-  const RegionFitInput in = MakeSamples(BrdfModel::kWard, slots, 0.05, 0.12, 0.0, 3);
+  const RegionFitInput in = MakeSamples(recon::BrdfModel::kWard, slots, 0.05, 0.12, 0.0, 3);
   const RegionFitResult r = FitRegion(in, {});
   EXPECT_EQ(r.albedo_model, AlbedoModel::kPerPatch);
   EXPECT_TRUE(r.albedo_varies);
@@ -415,23 +416,23 @@ TEST(RegionFit, VaryingAlbedoIsFittedPerPatchAndKeepsTheLobe) {
 
 TEST(RegionFit, LambertRegionsGetTheirAlbedoAndKnownValuesAreHeld) {
   RegionFitInput in =
-      MakeSamples(BrdfModel::kLambert, {Eigen::Vector3d(0.7, 0.6, 0.5)}, 0, 0.1, 0, 4);
+      MakeSamples(recon::BrdfModel::kLambert, {Eigen::Vector3d(0.7, 0.6, 0.5)}, 0, 0.1, 0, 4);
   RegionFitResult r = FitRegion(in, {});
   EXPECT_NEAR(r.rho_d[0], 0.7, 1e-6);
   EXPECT_NEAR(r.rho_d[2], 0.5, 1e-6);
   // Ward with ρs known: only α and ρd are fitted, ρs stays.
-  in = MakeSamples(BrdfModel::kWard, {Eigen::Vector3d(0.2, 0.2, 0.2)}, 0.04, 0.1, 0, 5);
+  in = MakeSamples(recon::BrdfModel::kWard, {Eigen::Vector3d(0.2, 0.2, 0.2)}, 0.04, 0.1, 0, 5);
   in.rho_s_grey = 0.04;
   r = FitRegion(in, {});
   EXPECT_DOUBLE_EQ(r.rho_s.mean(), 0.04);
   EXPECT_NEAR(r.alpha, 0.1, 1e-3);
   // No sample: nothing fitted, and it says so.
   RegionFitInput empty;
-  empty.model = BrdfModel::kWard;
+  empty.model = recon::BrdfModel::kWard;
   r = FitRegion(empty, {});
   EXPECT_FALSE(r.fitted);
   EXPECT_FALSE(r.message.empty());
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

@@ -17,12 +17,12 @@
 namespace igi::test {
 
 struct SquareStage {
-  Scene scene;
-  SolveOptions options;
-  PatchSet patches;  // of 0.1 m
-  MaterialEstimate materials;
-  ObservationSet obs;
-  LightModel light;
+  recon::Scene scene;
+  solver::SolveOptions options;
+  solver::PatchSet patches;  // of 0.1 m
+  solver::MaterialEstimate materials;
+  solver::ObservationSet obs;
+  solver::LightModel light;
 
   // `n` observations at points drawn uniformly over the square (seeded by `seed`), each with the
   // radiance radiance(u, v, rng) in every channel (u, v in [0, 1] across the square), every one a
@@ -41,9 +41,9 @@ struct SquareStage {
              {"lightings", {{"L", {"l"}}}},
              {"cameras", Json::object()},
              {"photos", Json::array()}});
-    scene = LoadScene(dir / "scene.json");
-    patches = BuildPatches(scene.mesh, 0.1);
-    materials = MaterialEstimate::FromScene(scene, patches);
+    scene = recon::LoadScene(dir / "scene.json");
+    patches = solver::BuildPatches(scene.mesh, 0.1);
+    materials = solver::MaterialEstimate::FromScene(scene, patches);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     light.lightings.resize(1);
@@ -57,7 +57,7 @@ struct SquareStage {
       const Eigen::Vector3f p0 = scene.mesh.positions[t[0]], p1 = scene.mesh.positions[t[1]],
                             p2 = scene.mesh.positions[t[2]];
       const Eigen::Vector3f p = p0 + float(b1) * (p1 - p0) + float(b2) * (p2 - p0);
-      Observation o;
+      solver::Observation o;
       o.photo = i % 2;
       o.triangle = tri;
       o.b1 = float(b1);

@@ -43,11 +43,11 @@ inline Json DownCamera(double cx, double cy, double cz, int w, int h, double f) 
               {"tvec", {-cx, cy, cz}}};
 }
 
-inline Scene LoadTestScene(const std::filesystem::path& dir, const Json& doc) {
+inline recon::Scene LoadTestScene(const std::filesystem::path& dir, const Json& doc) {
   WriteJsonFile(dir / "scene.json", doc);
-  SceneLoadOptions options;
+  recon::SceneLoadOptions options;
   options.require_complete_materials = true;
-  return LoadScene(dir / "scene.json", options);
+  return recon::LoadScene(dir / "scene.json", options);
 }
 
 }  // namespace igi::test

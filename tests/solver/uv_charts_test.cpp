@@ -10,12 +10,12 @@
 
 #include "tests/temp_dir.h"
 
-namespace igi {
+namespace igi::solver {
 namespace {
 
 // A w×h rectangle in z = 0 facing +z, UVs [0,1]² (u along x, v along y), region "floor".
-TriangleMesh Quad(float w, float h, bool with_uvs) {
-  TriangleMesh mesh;
+recon::TriangleMesh Quad(float w, float h, bool with_uvs) {
+  recon::TriangleMesh mesh;
   mesh.positions = {{0, 0, 0}, {w, 0, 0}, {w, h, 0}, {0, h, 0}};
   mesh.normals.assign(4, Eigen::Vector3f::UnitZ());
   if (with_uvs) mesh.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -27,8 +27,8 @@ TriangleMesh Quad(float w, float h, bool with_uvs) {
 
 // A 1 × 0.6 × 0.4 m box, 8 shared vertices, 12 outward triangles; the +z face is region "lid",
 // the other five "box". No UVs.
-TriangleMesh Box() {
-  TriangleMesh mesh;
+recon::TriangleMesh Box() {
+  recon::TriangleMesh mesh;
   const Eigen::Vector3f size(1.0f, 0.6f, 0.4f);
   for (int i = 0; i < 8; ++i) {
     const Eigen::Vector3f corner((i & 1) ? size.x() : 0, (i & 2) ? size.y() : 0,
@@ -50,8 +50,8 @@ TriangleMesh Box() {
 }
 
 // Unshared vertices, one per corner (as LoadMesh makes a file without normals).
-TriangleMesh Unshared(const TriangleMesh& mesh) {
-  TriangleMesh out = mesh;
+recon::TriangleMesh Unshared(const recon::TriangleMesh& mesh) {
+  recon::TriangleMesh out = mesh;
   out.positions.clear();
   out.normals.clear();
   for (size_t t = 0; t < mesh.num_triangles(); ++t) {
@@ -65,7 +65,7 @@ TriangleMesh Unshared(const TriangleMesh& mesh) {
 }
 
 // An icosahedron subdivided `levels` times onto a sphere of `radius`, region "ball".
-TriangleMesh Icosphere(int levels, float radius) {
+recon::TriangleMesh Icosphere(int levels, float radius) {
   const float g = (1 + std::sqrt(5.0f)) / 2;
   std::vector<Eigen::Vector3f> p = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
                                     {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
@@ -90,7 +90,7 @@ TriangleMesh Icosphere(int levels, float radius) {
     }
     tris = next;
   }
-  TriangleMesh mesh;
+  recon::TriangleMesh mesh;
   for (const Eigen::Vector3f& v : p) {
     mesh.positions.push_back(v * radius);
     mesh.normals.push_back(v);
@@ -111,7 +111,7 @@ struct AtlasCheck {
 
 // Checks a generated atlas: UVs in [0,1]², scale, disjoint chart footprints (each chart's
 // bilinear footprint bounding box, so gutters included) and rasterised overlap.
-AtlasCheck CheckAtlas(const TriangleMesh& mesh, const RegionAtlas& atlas) {
+AtlasCheck CheckAtlas(const recon::TriangleMesh& mesh, const RegionAtlas& atlas) {
   AtlasCheck check;
   const int w = atlas.width, h = atlas.height;
   std::vector<int> footprint(size_t(w) * h, -1), raster(size_t(w) * h, -1);
@@ -216,14 +216,14 @@ TEST(AtlasOptions, ValidateRejectsBadValues) {
 }
 
 TEST(BuildRegionAtlas, RejectsMissingAndEmptyRegions) {
-  TriangleMesh mesh = Quad(1, 1, true);
+  recon::TriangleMesh mesh = Quad(1, 1, true);
   EXPECT_THROW(BuildRegionAtlas(mesh, 1, {}), Error);
   mesh.region_names.push_back("empty");
   EXPECT_THROW(BuildRegionAtlas(mesh, 1, {}), InputError);
 }
 
 TEST(BuildRegionAtlas, UsesMeshUvsWithSizeFromTexelSize) {
-  const TriangleMesh mesh = Quad(1.0f, 0.5f, true);
+  const recon::TriangleMesh mesh = Quad(1.0f, 0.5f, true);
   AtlasOptions options;
   options.texel_size_m = 0.01;
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
@@ -251,7 +251,7 @@ TEST(BuildRegionAtlas, UsesMeshUvsWithSizeFromTexelSize) {
 }
 
 TEST(BuildRegionAtlas, DegenerateMeshUvsAreReplacedByCharts) {
-  TriangleMesh mesh = Quad(1.0f, 0.5f, true);
+  recon::TriangleMesh mesh = Quad(1.0f, 0.5f, true);
   mesh.uvs.assign(4, Eigen::Vector2f::Zero());  // as TriangleMesh::Append pads a mesh without UVs
   const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, {});
   EXPECT_TRUE(atlas.generated);
@@ -263,7 +263,7 @@ TEST(BuildRegionAtlas, DegenerateMeshUvsAreReplacedByCharts) {
 
 TEST(BuildRegionAtlas, BoxGetsOneChartPerFace) {
   for (bool unshared : {false, true}) {
-    const TriangleMesh mesh = unshared ? Unshared(Box()) : Box();
+    const recon::TriangleMesh mesh = unshared ? Unshared(Box()) : Box();
     AtlasOptions options;
     options.texel_size_m = 0.01;
     const RegionAtlas atlas = BuildRegionAtlas(mesh, 0, options);
@@ -287,7 +287,7 @@ TEST(BuildRegionAtlas, BoxGetsOneChartPerFace) {
 }
 
 TEST(BuildRegionAtlas, GrowsTexelToFitMaxSize) {
-  const TriangleMesh mesh = Box();
+  const recon::TriangleMesh mesh = Box();
   AtlasOptions options;
   options.texel_size_m = 0.01;
   options.max_size = 64;
@@ -302,7 +302,7 @@ TEST(BuildRegionAtlas, GrowsTexelToFitMaxSize) {
 }
 
 TEST(BuildRegionAtlas, SphereChartsAreDisjointAndNearlyIsometric) {
-  const TriangleMesh mesh = Icosphere(3, 0.5f);  // 1280 triangles
+  const recon::TriangleMesh mesh = Icosphere(3, 0.5f);  // 1280 triangles
   AtlasOptions options;
   options.texel_size_m = 0.01;
   options.chart_angle_deg = 15;
@@ -336,7 +336,7 @@ TEST(BuildRegionAtlas, SphereChartsAreDisjointAndNearlyIsometric) {
 }
 
 // Emission order of WriteObjWithAtlases: by region, then mesh order.
-std::vector<int> ObjOrder(const TriangleMesh& mesh) {
+std::vector<int> ObjOrder(const recon::TriangleMesh& mesh) {
   std::vector<int> order;
   for (size_t r = 0; r < mesh.region_names.size(); ++r) {
     for (size_t t = 0; t < mesh.num_triangles(); ++t) {
@@ -349,7 +349,7 @@ std::vector<int> ObjOrder(const TriangleMesh& mesh) {
 TEST(WriteObjWithAtlases, RoundTripsThroughLoadMesh) {
   // floor (mesh UVs, no atlas), box + lid (generated atlases), ball (no atlas: mesh UVs, which
   // Append padded with (0, 0)).
-  TriangleMesh mesh = Quad(1.0f, 0.5f, true);
+  recon::TriangleMesh mesh = Quad(1.0f, 0.5f, true);
   mesh.Append(Box());
   mesh.Append(Icosphere(1, 0.3f));
   ASSERT_EQ(mesh.region_names, (std::vector<std::string>{"floor", "box", "lid", "ball"}));
@@ -358,8 +358,8 @@ TEST(WriteObjWithAtlases, RoundTripsThroughLoadMesh) {
   const auto dir = test::UniqueTempDir("igi_uv_charts");
   WriteObjWithAtlases(mesh, atlases, dir / "mesh.obj");
   ProblemList problems;
-  MeshLoadSummary summary;
-  const TriangleMesh loaded = LoadMesh(dir / "mesh.obj", &problems, &summary);
+  recon::MeshLoadSummary summary;
+  const recon::TriangleMesh loaded = recon::LoadMesh(dir / "mesh.obj", &problems, &summary);
   ASSERT_TRUE(problems.empty()) << problems.problems().front();
   EXPECT_TRUE(summary.has_uvs);
   EXPECT_TRUE(summary.has_normals);
@@ -389,4 +389,4 @@ TEST(WriteObjWithAtlases, RoundTripsThroughLoadMesh) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::solver

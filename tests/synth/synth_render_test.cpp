@@ -19,7 +19,7 @@
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 namespace fs = std::filesystem;
@@ -61,7 +61,7 @@ Image Photo(const fs::path& dir, const std::string& name) {
 
 TEST(SynthRender, DeclaredSceneLoadsAndTruthHasEveryValueItLeavesOut) {
   const fs::path& dir = Plain();
-  const Scene scene = LoadScene(dir / "scene.json");
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json");
   EXPECT_EQ(scene.cameras.size(), 4u);
   EXPECT_EQ(scene.photos.size(), 4u);
   EXPECT_EQ(scene.lightings.size(), 2u);
@@ -86,9 +86,9 @@ TEST(SynthRender, DeclaredSceneLoadsAndTruthHasEveryValueItLeavesOut) {
     EXPECT_TRUE(fs::exists(dir / v["file"].get<std::string>()));
   }
   // The true scene is complete and renderable.
-  SceneLoadOptions complete;
+  recon::SceneLoadOptions complete;
   complete.require_complete_materials = true;
-  EXPECT_NO_THROW(LoadScene(dir / truth["scene"].get<std::string>(), complete));
+  EXPECT_NO_THROW(recon::LoadScene(dir / truth["scene"].get<std::string>(), complete));
 }
 
 // Each highlight camera's photo is much brighter at its highlight than the same scene without
@@ -101,14 +101,14 @@ TEST(SynthRender, EachGlossyRegionShowsAHighlight) {
     if (m.contains("rho_s")) m["rho_s"] = 0.0;
   }
   WriteJsonFile(dir / "truth/diffuse_scene.json", diffuse);
-  SceneLoadOptions complete;
+  recon::SceneLoadOptions complete;
   complete.require_complete_materials = true;
-  const Scene scene = LoadScene(dir / "truth/diffuse_scene.json", complete);
-  const Renderer renderer(scene, scene.FindLighting("L0"));
+  const recon::Scene scene = recon::LoadScene(dir / "truth/diffuse_scene.json", complete);
+  const render::Renderer renderer(scene, scene.FindLighting("L0"));
   std::set<std::string> seen;
   for (const auto& [cam, info] : truth["cameras"].items()) {
     if (info["target"] != "highlight") continue;
-    RenderOptions ro;
+    render::RenderOptions ro;
     ro.spp = 64;
     const Image lambert = renderer.Render(scene.cameras[scene.FindCamera(cam)], ro);
     const Image photo = Photo(dir, cam + "_L0.exr");
@@ -132,9 +132,9 @@ TEST(SynthRender, NoUnknownsGivesACompleteScene) {
   o.unknowns = {};
   o.validation_lightings = {};
   const fs::path& dir = Synth("complete", o);
-  SceneLoadOptions complete;
+  recon::SceneLoadOptions complete;
   complete.require_complete_materials = true;
-  const Scene scene = LoadScene(dir / "scene.json", complete);
+  const recon::Scene scene = recon::LoadScene(dir / "scene.json", complete);
   EXPECT_TRUE(scene.materials[scene.FindMaterial("floor")].rho_d_map.has_value());
   EXPECT_TRUE(fs::exists(dir / "textures/floor_albedo.exr"));
 }
@@ -201,14 +201,15 @@ TEST(SynthRender, SceneEffectsChangeTheTrueSceneAndAreListed) {
   for (size_t i = 0; i < all.effects.size(); ++i) {
     EXPECT_EQ(truth["effects"][i]["effect"], all.effects[i].name);
   }
-  const Scene declared = LoadScene(many / "scene.json");
+  const recon::Scene declared = recon::LoadScene(many / "scene.json");
   EXPECT_EQ(declared.FindLight("ambient"), -1);
   EXPECT_EQ(declared.geometry_files.size(), 1u);
   EXPECT_NE(Photo(many, "cam0_L0.exr").pixels, Photo(Plain(), "cam0_L0.exr").pixels);
 }
 
 // The first hit of a ray on `mesh` (brute force, Möller–Trumbore): triangle index or -1.
-int FirstHit(const TriangleMesh& mesh, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) {
+int FirstHit(const recon::TriangleMesh& mesh, const Eigen::Vector3d& origin,
+             const Eigen::Vector3d& dir) {
   int best = -1;
   double best_t = 1e30;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -247,19 +248,20 @@ TEST(SynthRender, FresnelRaisesGrazingReflectionsMoreThanNearNormalOnes) {
   EXPECT_EQ(truth["effects"][0]["effect"], "fresnel");
   EXPECT_EQ(truth["effects"][0]["params"]["ior"], 1.5);
   EXPECT_NEAR(truth["effects"][0]["params"]["f0"].get<double>(), 0.04, 1e-15);
-  const Scene declared = LoadScene(dir / "scene.json");
+  const recon::Scene declared = recon::LoadScene(dir / "scene.json");
   const Json true_scene = ReadJsonFile(dir / truth["scene"].get<std::string>());
   const std::set<std::string> glossy = {"floor", "wall_y4", "glossy_box", "glossy_sphere"};
   for (const std::string& region : glossy) {
     EXPECT_EQ(true_scene["materials"][region]["brdf"], "ward_fresnel") << region;
     EXPECT_EQ(truth["effects"][0]["params"]["regions"][region]["true_brdf"], "ward_fresnel");
-    EXPECT_EQ(declared.materials[declared.FindMaterial(region)].brdf, BrdfModel::kWard) << region;
+    EXPECT_EQ(declared.materials[declared.FindMaterial(region)].brdf, recon::BrdfModel::kWard)
+        << region;
   }
   double sum[2] = {0, 0};  // mean photo ratio: [0] near normal (cosθo > 0.8), [1] grazing (< 0.3)
   int count[2] = {0, 0};
   double lowest = 1e9;
   for (const std::string cam : {"cam4", "cam5"}) {
-    const Camera& camera = declared.cameras[declared.FindCamera(cam)];
+    const recon::Camera& camera = declared.cameras[declared.FindCamera(cam)];
     const Image with = Photo(dir, cam + "_L0.exr"), without = Photo(plain, cam + "_L0.exr");
     for (int y = 0; y < with.height; ++y) {
       for (int x = 0; x < with.width; ++x) {
@@ -339,4 +341,4 @@ TEST(SynthCli, BadFlagsExitTwoWithOneLine) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::synth

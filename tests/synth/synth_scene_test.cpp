@@ -21,7 +21,7 @@
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 namespace fs = std::filesystem;
@@ -83,7 +83,7 @@ TEST(SynthOptions, ChoicesRoundTripAndBadTextsAreNamed) {
   flags.floor_texture = "smooth";
   flags.bracket_format = "tif";
   o.SetChoices(flags);
-  EXPECT_EQ(o.glossy_brdf, BrdfModel::kWardGmd);
+  EXPECT_EQ(o.glossy_brdf, recon::BrdfModel::kWardGmd);
   EXPECT_EQ(o.lamp, LampShape::kPoint);
   EXPECT_EQ(o.floor_texture, FloorTexture::kSmooth);
   EXPECT_EQ(o.brackets.format, BracketFormat::kTif);
@@ -106,7 +106,7 @@ TEST(SynthOptions, ChoicesRoundTripAndBadTextsAreNamed) {
   }
   SynthOptions lambert;
   lambert.out = "x";
-  lambert.glossy_brdf = BrdfModel::kLambert;
+  lambert.glossy_brdf = recon::BrdfModel::kLambert;
   EXPECT_THROW(lambert.Validate(), InputError);
 }
 
@@ -117,8 +117,8 @@ TEST(SynthRoom, ObjLoadsWithRegionsUvsAndNormals) {
   const fs::path path = fs::temp_directory_path() / "igi_synth_room_test.obj";
   WriteFileAtomic(path, room.mesh.ToObj("test"));
   ProblemList problems;
-  MeshLoadSummary summary;
-  const TriangleMesh mesh = LoadMesh(path, &problems, &summary);
+  recon::MeshLoadSummary summary;
+  const recon::TriangleMesh mesh = recon::LoadMesh(path, &problems, &summary);
   fs::remove(path);
   ASSERT_TRUE(problems.empty());
   EXPECT_TRUE(summary.has_uvs);
@@ -219,7 +219,7 @@ TEST(SynthCameras, HighlightCamerasMirrorTheLamp) {
 }
 
 // Share of a camera's pixels (a coarse grid of rays) whose first hit is `region`.
-double RegionShare(const SynthRoom& room, const Camera& camera, const std::string& region) {
+double RegionShare(const SynthRoom& room, const recon::Camera& camera, const std::string& region) {
   int hits = 0, total = 0;
   for (int y = 4; y < camera.height; y += 8) {
     for (int x = 4; x < camera.width; x += 8) {
@@ -284,7 +284,7 @@ TEST(SynthCameras, GrazingCamerasSeeTheFloorsHighlightAtGrazingIncidence) {
     const Vector3d l = (room.lamps[0].position - p).normalized();
     const Vector3d v = (eye - p).normalized();
     EXPECT_NEAR((2 * n.dot(l) * n - l).dot(v), 1.0, 1e-9);
-    const double incidence = std::acos(n.dot(l)) * 180 / kPi;
+    const double incidence = std::acos(n.dot(l)) * 180 / render::kPi;
     EXPECT_GT(incidence, 60.0) << "cam" << i;
     EXPECT_LT(incidence, 80.0) << "cam" << i;
   }
@@ -295,7 +295,7 @@ TEST(SynthCameras, GrazingCamerasSeeTheFloorsHighlightAtGrazingIncidence) {
 }
 
 TEST(SynthCameras, LookAtFollowsColmapAxes) {
-  const Camera cam = LookAtCamera("c", {2, 0.3, 1.5}, {2, 3, 1.5}, 160, 120, 60);
+  const recon::Camera cam = LookAtCamera("c", {2, 0.3, 1.5}, {2, 3, 1.5}, 160, 120, 60);
   // Looking along +y with z up: camera x = world +x, camera y = world -z.
   const Eigen::Matrix3d r = cam.cam_from_world.rotation.toRotationMatrix();
   EXPECT_TRUE(r.row(0).isApprox(Eigen::RowVector3d(1, 0, 0)));
@@ -318,7 +318,8 @@ struct Fixture {
                  {"lightings", room.LightingsJson()},
                  {"geometry", Json::array({Json{{"file", "geometry/room.obj"}}})},
                  {"cameras", Json::object()}};
-    for (const PlacedCamera& c : cameras) base["cameras"][c.camera.name] = CameraJson(c.camera);
+    for (const PlacedCamera& c : cameras)
+      base["cameras"][c.camera.name] = recon::CameraJson(c.camera);
     scenes.true_scene = base;
     scenes.declared_scene = base;
   }
@@ -332,7 +333,7 @@ TEST(SynthEffects, VignettingDarkensCornersByTheStatedFactor) {
   const Json list = f.Apply("vignetting:k1=-0.2,k2=-0.1");
   EXPECT_EQ(list[0]["effect"], "vignetting");
   EXPECT_NEAR(list[0]["params"]["corner_factor"].get<double>(), 0.7, 1e-12);
-  const Camera& cam = f.cameras[0].camera;
+  const recon::Camera& cam = f.cameras[0].camera;
   Image img(cam.width, cam.height, 3, 1.0f);
   f.post.ApplyBeforeSensor("photos/cam0_L0.exr", cam, &img);
   // The corner pixel's centre is half a pixel in from the corner.
@@ -451,9 +452,9 @@ TEST(SynthEffects, BadParametersAreInputErrors) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::synth
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 namespace fs = std::filesystem;
@@ -478,14 +479,14 @@ TEST(SynthFrom, HidesThePhotoEffectsInAnotherRenderersCapture) {
                ParseEffectSpec("pose_error:camera=cam2,rotation_deg=1,translation_m=0.02")};
   const SynthSummary s = Synthesize(o);
   ASSERT_EQ(s.photos.size(), 4u);
-  const Scene source = LoadScene(RadianceRoom());
-  const Scene declared = LoadScene(o.out / "scene.json");
-  const Scene truth = LoadScene(o.out / "truth" / "scene.json");
+  const recon::Scene source = recon::LoadScene(RadianceRoom());
+  const recon::Scene declared = recon::LoadScene(o.out / "scene.json");
+  const recon::Scene truth = recon::LoadScene(o.out / "truth" / "scene.json");
   ASSERT_EQ(declared.photos.size(), 4u);
   for (size_t i = 0; i < 4; ++i) {
     const Image src = ReadImage(source.photos[i].file, 3);
     const Image got = ReadImage(declared.photos[i].file, 3);
-    const Camera& cam = source.cameras[source.photos[i].camera];
+    const recon::Camera& cam = source.cameras[source.photos[i].camera];
     const double scale = declared.photos[i].file.filename() == "cam1_L0.exr" ? 1.25 : 1.0;
     ASSERT_EQ(got.width, src.width);
     for (const auto& [x, y] : {std::pair{0, 0}, {cam.width / 2, cam.height / 2}, {17, 200}}) {
@@ -500,7 +501,7 @@ TEST(SynthFrom, HidesThePhotoEffectsInAnotherRenderersCapture) {
   const Eigen::Quaterniond qd = declared.cameras[2].cam_from_world.rotation,
                            qs = source.cameras[2].cam_from_world.rotation,
                            qt = truth.cameras[2].cam_from_world.rotation;
-  EXPECT_NEAR(qd.angularDistance(qs) * 180 / kPi, 1.0, 1e-6);
+  EXPECT_NEAR(qd.angularDistance(qs) * 180 / render::kPi, 1.0, 1e-6);
   EXPECT_NEAR(qt.angularDistance(qs), 0, 1e-9);
   EXPECT_NEAR(declared.cameras[0].cam_from_world.rotation.angularDistance(
                   source.cameras[0].cam_from_world.rotation),
@@ -532,4 +533,4 @@ TEST(SynthFrom, AnEffectThatNeedsARenderIsAnInputError) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::synth

@@ -7,7 +7,7 @@
 #include "solver/synth/sensor.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::synth {
 namespace {
 
 Image Flat(int w, int h, float value) { return Image(w, h, 3, value); }
@@ -146,4 +146,4 @@ TEST(SynthBrackets, BracketsFollowTheResponseCurve) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::synth

@@ -11,13 +11,14 @@
 
 #include "recon/mesh_closest_point.h"
 #include "recon/scene.h"
+#include "tools/common/enum_names.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 #include "tools/common/json.h"
 #include "tools/pipeline/stage_marker.h"
 #include "tools/pipeline/subprocess.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
@@ -36,7 +37,8 @@ double Mean(const std::vector<double>& v) {
 
 // Whether the segment from `eye` to `p` (a point on the mesh) is blocked by a triangle before
 // it reaches p (p's own triangle is not hit before 1 - kEnd).
-bool Occluded(const MeshClosestPoint& bvh, const Eigen::Vector3d& eye, const Eigen::Vector3d& p) {
+bool Occluded(const recon::MeshClosestPoint& bvh, const Eigen::Vector3d& eye,
+              const Eigen::Vector3d& p) {
   constexpr double kEnd = 1e-4;
   return bvh.Intersect(eye, p - eye, kEnd, 1 - kEnd).has_value();
 }
@@ -45,7 +47,7 @@ bool Occluded(const MeshClosestPoint& bvh, const Eigen::Vector3d& eye, const Eig
 // kUpperWallM below the ceiling, at known 3D positions (a user sticks them and measures them
 // with a tape or a total station), so that cameras looking up see enough control points to be
 // posed from them (PnP needs >= 4; COLMAP does not match such views with the downward ones).
-std::vector<Eigen::Vector3d> SurveyedTargets(const TriangleMesh& mesh) {
+std::vector<Eigen::Vector3d> SurveyedTargets(const recon::TriangleMesh& mesh) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
   for (const auto& p : mesh.positions) {
     lo = lo.cwiseMin(p.cast<double>());
@@ -80,7 +82,7 @@ std::vector<Eigen::Vector3d> SurveyedTargets(const TriangleMesh& mesh) {
 // noise of `noise_px` (as a user or a target detector would mark them): the mesh's vertices outside
 // the sphere (room and box corners; every photo whose frame holds them, as before) and the surveyed
 // targets (SurveyedTargets; only where the camera sees them unoccluded).
-Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_names,
+Json MarkersOfTruth(const recon::Scene& truth, const std::vector<std::string>& photo_names,
                     double noise_px) {
   std::mt19937_64 rng(2026);
   std::normal_distribution<double> click(0.0, 1.0);
@@ -99,7 +101,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
   }
   const size_t num_corners = corners.size();
   for (const Eigen::Vector3d& t : SurveyedTargets(truth.mesh)) corners.push_back(t);
-  const MeshClosestPoint bvh(truth.mesh);
+  const recon::MeshClosestPoint bvh(truth.mesh);
   for (size_t i = 0; i < corners.size(); ++i) {
     const bool target = i >= num_corners;
     const std::string name =
@@ -109,7 +111,7 @@ Json MarkersOfTruth(const Scene& truth, const std::vector<std::string>& photo_na
       const std::string cam_name = photo.substr(0, photo.rfind('_'));
       const int c = truth.FindCamera(cam_name);
       if (c < 0) continue;
-      const Camera& camera = truth.cameras[c];
+      const recon::Camera& camera = truth.cameras[c];
       const auto px = camera.ImgFromWorld(corners[i]);
       if (!px || px->x() < 0 || px->y() < 0 || px->x() > camera.width || px->y() > camera.height) {
         continue;
@@ -187,15 +189,15 @@ fs::path Capture(const DemoOptions& o, const fs::path& bin, bool* kept) {
     throw Error("stage 00-capture failed: igi-synth exited " + std::to_string(r.exit_code) + ": " +
                 r.last_error + " (log: " + (dir / "log.txt").string() + ")");
   }
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.check_images = false;
-  const Scene truth = LoadScene(synth / "truth" / "scene.json", load);
+  const recon::Scene truth = recon::LoadScene(synth / "truth" / "scene.json", load);
   std::vector<std::string> photos;
   for (const auto& e : fs::directory_iterator(synth / "brackets")) {
     if (e.is_directory()) photos.push_back(e.path().filename().string());
   }
   std::sort(photos.begin(), photos.end());  // the markers' noise does not depend on the listing
-  const Camera& c0 = truth.cameras.at(0);
+  const recon::Camera& c0 = truth.cameras.at(0);
   WriteJsonFile(synth / "brackets" / "camera.json", Json{{"format", "igi-camera"},
                                                          {"version", 1},
                                                          {"model", "PINHOLE"},
@@ -238,17 +240,17 @@ double MeasureRadianceScale(const fs::path& hdr_dir, const fs::path& synth_dir) 
 }
 
 Json ComparePoses(const fs::path& registered_scene, const fs::path& truth_scene) {
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.check_images = false;
   load.load_geometry = false;
-  const Scene truth = LoadScene(truth_scene, load);
-  const Scene solved = LoadScene(registered_scene, load);
+  const recon::Scene truth = recon::LoadScene(truth_scene, load);
+  const recon::Scene solved = recon::LoadScene(registered_scene, load);
   Json cameras = Json::array();
   double max_rotation_deg = 0, max_position_m = 0;
-  for (const Camera& got : solved.cameras) {
+  for (const recon::Camera& got : solved.cameras) {
     const int c = truth.FindCamera(got.name.substr(0, got.name.rfind('_')));
     if (c < 0) continue;
-    const Camera& want = truth.cameras[c];
+    const recon::Camera& want = truth.cameras[c];
     const double rotation_deg =
         want.cam_from_world.rotation.angularDistance(got.cam_from_world.rotation) * 180 /
         std::numbers::pi;
@@ -295,24 +297,16 @@ ProblemList DemoProblems(const DemoOptions& o, const DemoChoiceFlags* typed) {
 
 }  // namespace
 
-std::string_view DemoCalibrationName(DemoCalibration calibration) {
-  switch (calibration) {
-    case DemoCalibration::kReference:
-      return "reference";
-    case DemoCalibration::kMeasured:
-      return "measured";
-    case DemoCalibration::kNone:
-      return "none";
-  }
-  return "?";
-}
+constexpr EnumNames<DemoCalibration, 3> kDemoCalibrationNames{
+    {{DemoCalibration::kReference, "reference"},
+     {DemoCalibration::kMeasured, "measured"},
+     {DemoCalibration::kNone, "none"}}};
 
+std::string_view DemoCalibrationName(DemoCalibration calibration) {
+  return kDemoCalibrationNames.Name(calibration);
+}
 std::optional<DemoCalibration> DemoCalibrationFromName(std::string_view name) {
-  for (DemoCalibration c :
-       {DemoCalibration::kReference, DemoCalibration::kMeasured, DemoCalibration::kNone}) {
-    if (DemoCalibrationName(c) == name) return c;
-  }
-  return std::nullopt;
+  return kDemoCalibrationNames.FromName(name);
 }
 
 void DemoOptions::Validate() const { DemoProblems(*this, nullptr).ThrowIfAny(); }
@@ -346,9 +340,9 @@ Eigen::Vector3d TextureAt(const Image& texture, const Eigen::Vector2f& uv) {
 
 std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scene, int samples,
                                                       uint64_t seed) {
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.check_images = false;
-  const Scene truth = LoadScene(truth_scene, load);
+  const recon::Scene truth = recon::LoadScene(truth_scene, load);
   std::map<std::string, Eigen::Vector3d> out;
   if (!truth.mesh.has_uvs()) return out;
   std::vector<std::optional<Image>> textures(truth.materials.size());
@@ -362,7 +356,7 @@ std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scen
     cdf.push_back(total += r >= 0 && textures[r] ? truth.mesh.TriangleArea(t) : 0.0);
   }
   if (!(total > 0)) return out;
-  const MeshClosestPoint bvh(truth.mesh);
+  const recon::MeshClosestPoint bvh(truth.mesh);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Eigen::Vector3d> sum(truth.materials.size(), Eigen::Vector3d::Zero());
@@ -377,11 +371,12 @@ std::map<std::string, Eigen::Vector3d> SeenTrueAlbedo(const fs::path& truth_scen
     const Eigen::Vector3d p = (1 - b1 - b2) * truth.mesh.positions[tri[0]].cast<double>() +
                               b1 * truth.mesh.positions[tri[1]].cast<double>() +
                               b2 * truth.mesh.positions[tri[2]].cast<double>();
-    const bool seen = std::any_of(truth.cameras.begin(), truth.cameras.end(), [&](const Camera& c) {
-      const auto px = c.ImgFromWorld(p);
-      return px && px->x() >= 0 && px->y() >= 0 && px->x() < c.width && px->y() < c.height &&
-             !Occluded(bvh, c.CenterInWorld(), p);
-    });
+    const bool seen =
+        std::any_of(truth.cameras.begin(), truth.cameras.end(), [&](const recon::Camera& c) {
+          const auto px = c.ImgFromWorld(p);
+          return px && px->x() >= 0 && px->y() >= 0 && px->x() < c.width && px->y() < c.height &&
+                 !Occluded(bvh, c.CenterInWorld(), p);
+        });
     if (!seen) continue;
     const Eigen::Vector2f uv = float(1 - b1 - b2) * truth.mesh.uvs[tri[0]] +
                                float(b1) * truth.mesh.uvs[tri[1]] +
@@ -615,4 +610,4 @@ DemoSummary RunDemo(const DemoOptions& o) {
   return d;
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -23,7 +23,7 @@
 #include "tools/common/json.h"
 #include "tools/pipeline/pipeline.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 // How the demo gives the HDR maps their absolute scale (DemoOptions::calibration): kReference,
 // kMeasured or kNone.
@@ -154,4 +154,4 @@ Json CompareWithTruth(const std::filesystem::path& solved_scene,
 Json ComparePoses(const std::filesystem::path& registered_scene,
                   const std::filesystem::path& truth_scene);
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -7,7 +7,7 @@
 #include "tools/common/error.h"
 #include "tools/common/strings.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
@@ -171,4 +171,4 @@ PhotoLayout ScanPhotosDir(const fs::path& dir, const std::vector<std::string>& l
   return layout;
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-namespace igi {
+namespace igi::pipeline {
 
 enum class PhotoSourceKind { kBracket, kRaw, kRadiance, kCapture };
 
@@ -50,4 +50,4 @@ PhotoLayout ScanPhotosDir(const std::filesystem::path& dir,
 
 const char* KindName(PhotoSourceKind kind);
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -11,12 +11,12 @@
 #include "tools/pipeline/pipeline_internal.h"
 #include "tools/pipeline/subprocess.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
-using pipeline_internal::Context;
-using pipeline_internal::StageRun;
+using internal::Context;
+using internal::StageRun;
 
-namespace pipeline_internal {
+namespace internal {
 
 fs::path Context::SolveInput() const {
   return options.hdr_photos ? options.scene : Dir("03-register") / "scene.json";
@@ -46,7 +46,7 @@ std::vector<std::string> ThreadArgs(const Context& ctx) {
   return {"--threads", std::to_string(ctx.options.num_threads)};
 }
 
-}  // namespace pipeline_internal
+}  // namespace internal
 
 namespace {
 
@@ -57,9 +57,9 @@ struct Stage {
   std::function<void(const Context&, StageRun*)> body;
 };
 
-std::vector<std::string> Lightings(const Scene& scene) {
+std::vector<std::string> Lightings(const recon::Scene& scene) {
   std::vector<std::string> names;
-  for (const Lighting& l : scene.lightings) names.push_back(l.name);
+  for (const recon::Lighting& l : scene.lightings) names.push_back(l.name);
   return names;
 }
 
@@ -69,9 +69,9 @@ Context Validate(const RunOptions& o) {
   Context ctx;
   ctx.options = o;
   ctx.bin = o.bin_dir.empty() ? ExecutableDir() : o.bin_dir;
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.check_images = o.hdr_photos;
-  ctx.scene = LoadScene(o.scene, load);
+  ctx.scene = recon::LoadScene(o.scene, load);
   ctx.scene_json = ReadJsonFile(o.scene);
   if (o.hdr_photos) {
     if (ctx.scene.photos.empty()) {
@@ -97,18 +97,18 @@ Context Validate(const RunOptions& o) {
 void AddSceneFiles(const Context& ctx, Fingerprint* fp, bool photos) {
   fp->AddFile(ctx.options.scene);
   for (const fs::path& g : ctx.scene.geometry_files) fp->AddFile(g);
-  for (const Material& m : ctx.scene.materials) {
+  for (const recon::Material& m : ctx.scene.materials) {
     if (m.rho_d_map) fp->AddFile(ctx.scene.dir / *m.rho_d_map);
   }
   if (!photos) return;
-  for (const Photo& p : ctx.scene.photos) {
+  for (const recon::Photo& p : ctx.scene.photos) {
     fp->AddFile(ctx.scene.dir / p.file);
     if (p.mask) fp->AddFile(ctx.scene.dir / *p.mask);
   }
 }
 
 std::vector<Stage> Stages(const Context& ctx) {
-  using namespace pipeline_internal;
+  using namespace internal;
   const RunOptions& o = ctx.options;
   const bool ldr = !o.hdr_photos && ctx.layout.ResponseSource() >= 0;
   return {
@@ -225,4 +225,4 @@ RunSummary RunPipeline(const RunOptions& options) {
   return summary;
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -19,7 +19,7 @@
 
 #include "tools/pipeline/run_options.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 struct StageOutcome {
   std::string stage;   // "04-solve"
@@ -49,4 +49,4 @@ const std::vector<std::string>& StageNames();
 // the stages. A failing stage throws igi::Error naming it (exit 1); finished stages are kept.
 RunSummary RunPipeline(const RunOptions& options);
 
-}  // namespace igi
+}  // namespace igi::pipeline

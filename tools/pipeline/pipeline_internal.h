@@ -11,13 +11,13 @@
 #include "tools/pipeline/pipeline.h"
 #include "tools/pipeline/stage_marker.h"
 
-namespace igi::pipeline_internal {
+namespace igi::pipeline::internal {
 
 struct Context {
   RunOptions options;
   std::filesystem::path bin;
   PhotoLayout layout;  // empty with hdr_photos
-  Scene scene;         // the input scene (geometry loaded)
+  recon::Scene scene;  // the input scene (geometry loaded)
   Json scene_json;
   std::filesystem::path Dir(const std::string& stage) const { return options.out / stage; }
   std::filesystem::path SolveInput() const;  // the scene.json given to igi-solve
@@ -53,4 +53,4 @@ void ReportStage(const Context& ctx, StageRun* run);
 
 std::vector<std::string> ThreadArgs(const Context& ctx);
 
-}  // namespace igi::pipeline_internal
+}  // namespace igi::pipeline::internal

@@ -11,7 +11,7 @@
 #include "tools/pipeline/pipeline_internal.h"
 #include "tools/pipeline/scene_assembly.h"
 
-namespace igi::pipeline_internal {
+namespace igi::pipeline::internal {
 namespace fs = std::filesystem;
 
 namespace {
@@ -105,7 +105,7 @@ fs::path SolveScene(const Context& ctx, const fs::path& stage_dir) {
   const fs::path input = ctx.SolveInput();
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  SceneDocument scene(ReadJsonFile(input));
+  recon::SceneDocument scene(ReadJsonFile(input));
   scene.RebasePaths(input.parent_path(), dir);
   for (size_t i = 0; i < scene.NumPhotos(); ++i) {
     scene.SetPhotoExposure(i, scene.PhotoExposure(i).value_or(1.0) * ctx.options.radiance_scale);
@@ -130,10 +130,10 @@ void SolveStage(const Context& ctx, StageRun* run) {
 // itself would make its refits hold every albedo fixed and let the held-out pixels into the fit.
 fs::path DiagnoseScene(const Context& ctx, const fs::path& stage_dir) {
   const fs::path input = ctx.SolveInput();
-  const SceneDocument solved(ReadJsonFile(ctx.Dir("04-solve") / "scene.json"));
+  const recon::SceneDocument solved(ReadJsonFile(ctx.Dir("04-solve") / "scene.json"));
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  SceneDocument scene(ReadJsonFile(input));
+  recon::SceneDocument scene(ReadJsonFile(input));
   scene.RebasePaths(input.parent_path(), dir);
   if (scene.NumPhotos() != solved.NumPhotos()) {
     throw Error("stage 05-diagnose: " + (ctx.Dir("04-solve") / "scene.json").string() + " has " +
@@ -160,4 +160,4 @@ void DiagnoseStage(const Context& ctx, StageRun* run) {
   run->Tool("igi-diagnose", args, /*partial_ok=*/true);
 }
 
-}  // namespace igi::pipeline_internal
+}  // namespace igi::pipeline::internal

@@ -9,7 +9,7 @@
 
 #include "tools/common/error.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 void RunOptions::Validate() const {
   ProblemList problems;
@@ -44,4 +44,4 @@ void RunOptions::Validate() const {
   problems.ThrowIfAny();
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

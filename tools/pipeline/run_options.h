@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace igi {
+namespace igi::pipeline {
 
 struct RunOptions {
   std::filesystem::path photos_dir;  // PHOTOS_DIR (layout: tools/pipeline/photo_layout.h); may be
@@ -40,4 +40,4 @@ struct RunOptions {
   void Validate() const;  // InputError naming the flag
 };
 
-}  // namespace igi
+}  // namespace igi::pipeline

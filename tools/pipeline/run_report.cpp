@@ -11,7 +11,7 @@
 #include "tools/common/json.h"
 #include "tools/pipeline/pipeline_internal.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
@@ -118,11 +118,11 @@ void CamerasSection(const fs::path& out, HtmlReport* page) {
         fmt::format("{:.2f} px ({} points)", r["reprojection_rms_px"].get<double>(),
                     r["observations"].get<int>());
   }
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.load_geometry = load.check_images = false;
-  const Scene scene = LoadScene(scene_file, load);
+  const recon::Scene scene = recon::LoadScene(scene_file, load);
   std::vector<std::vector<std::string>> rows;
-  for (const Camera& c : scene.cameras) {
+  for (const recon::Camera& c : scene.cameras) {
     const Eigen::Vector3d centre = c.CenterInWorld();
     const Eigen::Vector3d forward =
         c.cam_from_world.rotation.conjugate() * Eigen::Vector3d(0, 0, 1);
@@ -173,12 +173,12 @@ void ParametersSection(const fs::path& out, HtmlReport* page) {
 // the solved model as photo K records it).
 void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
   page->Heading("Photos, re-renders of the solved model, residuals");
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.load_geometry = load.check_images = false;
-  const Scene scene = LoadScene(out / "04-solve" / "scene.json", load);
+  const recon::Scene scene = recon::LoadScene(out / "04-solve" / "scene.json", load);
   const int n = std::min<int>(max_photos, int(scene.photos.size()));
   for (int k = 0; k < n; ++k) {
-    const Photo& p = scene.photos[k];
+    const recon::Photo& p = scene.photos[k];
     const fs::path render_file = out / "06-report" / "renders" / fmt::format("photo_{}.exr", k);
     if (!fs::exists(render_file)) continue;
     // The render is at the photo's size or reduced by an integer factor (report_megapixels):
@@ -305,18 +305,18 @@ void WriteRunReport(const RunReportInputs& in) {
   page.Write(in.out / "report.html");
 }
 
-namespace pipeline_internal {
+namespace internal {
 
 // Renders the solved scene: the first photos (their camera and lighting), and the first photo's
 // camera under every lighting; then the page.
 void ReportStage(const Context& ctx, StageRun* run) {
   const fs::path solved = ctx.Dir("04-solve") / "scene.json";
-  SceneLoadOptions load;
+  recon::SceneLoadOptions load;
   load.load_geometry = load.check_images = false;
-  const Scene scene = LoadScene(solved, load);
+  const recon::Scene scene = recon::LoadScene(solved, load);
   const fs::path renders = run->dir() / "renders";
   fs::create_directories(renders);
-  auto render = [&](const Camera& cam, const Lighting& l, const fs::path& file) {
+  auto render = [&](const recon::Camera& cam, const recon::Lighting& l, const fs::path& file) {
     const int f = ReductionFactor(cam.width, cam.height, ctx.options.report_megapixels);
     std::vector<std::string> args = {solved.string(),
                                      "--camera",
@@ -337,7 +337,7 @@ void ReportStage(const Context& ctx, StageRun* run) {
   };
   const int n = std::min<int>(ctx.options.report_photos, int(scene.photos.size()));
   for (int k = 0; k < n; ++k) {
-    const Photo& p = scene.photos[k];
+    const recon::Photo& p = scene.photos[k];
     const fs::path file = renders / fmt::format("photo_{}.exr", k);
     render(scene.cameras[p.camera], scene.lightings[p.lighting], file);
     // The model as the photo records it (v = R(s · L), the render carrying the vignetting), so
@@ -349,7 +349,7 @@ void ReportStage(const Context& ctx, StageRun* run) {
     }
   }
   if (!scene.photos.empty()) {
-    const Camera& cam = scene.cameras[scene.photos[0].camera];
+    const recon::Camera& cam = scene.cameras[scene.photos[0].camera];
     const int m = std::min<int>(ctx.options.report_lightings, int(scene.lightings.size()));
     for (int l = 0; l < m; ++l) {
       render(cam, scene.lightings[l], renders / ("relit_" + scene.lightings[l].name + ".exr"));
@@ -372,5 +372,5 @@ void ReportStage(const Context& ctx, StageRun* run) {
   WriteRunReport({ctx.options.out, ctx.options.report_photos, exports});
 }
 
-}  // namespace pipeline_internal
-}  // namespace igi
+}  // namespace internal
+}  // namespace igi::pipeline

@@ -7,7 +7,7 @@
 
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 struct RunReportInputs {
   std::filesystem::path out;  // the run's DIR (stage folders under it)
@@ -20,4 +20,4 @@ struct RunReportInputs {
 // Builds DIR/report.html from what the stages left (absent parts are named, not fatal).
 void WriteRunReport(const RunReportInputs& in);
 
-}  // namespace igi
+}  // namespace igi::pipeline

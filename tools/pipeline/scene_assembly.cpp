@@ -10,7 +10,7 @@
 #include "tools/common/error.h"
 #include "tools/common/image.h"
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 void TonemapForRegistration(const fs::path& radiance, const fs::path& png) {
@@ -58,7 +58,7 @@ std::string RelativeTo(const fs::path& target, const fs::path& base) {
 }  // namespace
 
 Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unregistered) {
-  SceneDocument scene(in.input_scene);
+  recon::SceneDocument scene(in.input_scene);
   scene.RebasePaths(in.input_dir, in.out_dir);
   const Json& registered =
       in.registered_scene.contains("cameras") ? in.registered_scene["cameras"] : Json::object();
@@ -66,15 +66,15 @@ Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unre
     throw Error("igi-register's scene.json has no camera list (\"cameras\" is not an object)");
   }
   Json cameras = Json::object();
-  std::vector<ScenePhotoEntry> photos;
+  std::vector<recon::ScenePhotoEntry> photos;
   for (const PhotoSource& p : in.photos) {
     if (!registered.contains(p.name)) {
       unregistered->push_back(p.name);
       continue;
     }
     cameras[p.name] = registered[p.name];
-    ScenePhotoEntry photo{RelativeTo(in.hdr_dir / (p.name + ".exr"), in.out_dir), p.name,
-                          p.lighting, std::nullopt};
+    recon::ScenePhotoEntry photo{RelativeTo(in.hdr_dir / (p.name + ".exr"), in.out_dir), p.name,
+                                 p.lighting, std::nullopt};
     const fs::path mask = in.hdr_dir / (p.name + "_mask.png");
     if (fs::exists(mask)) photo.mask = RelativeTo(mask, in.out_dir);
     photos.push_back(std::move(photo));
@@ -84,4 +84,4 @@ Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unre
   return std::move(scene).json();
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

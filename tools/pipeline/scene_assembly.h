@@ -9,7 +9,7 @@
 #include "tools/common/json.h"
 #include "tools/pipeline/photo_layout.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 // An 8-bit PNG of a radiance map for feature matching: scaled so the 99th percentile maps to
 // 0.9, gamma 2.2, then a 3x3 median (takes out render/sensor speckle, moves no edge).
@@ -30,4 +30,4 @@ struct SolvableSceneInputs {
 // `unregistered` receives the photos without a camera.
 Json SolvableScene(const SolvableSceneInputs& in, std::vector<std::string>* unregistered);
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -6,7 +6,7 @@
 #include <ctime>
 #include <fstream>
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 void Fingerprint::AddBytes(const char* data, size_t size) {
@@ -86,4 +86,4 @@ std::string UtcNow() {
   return text;
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

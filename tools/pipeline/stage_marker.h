@@ -11,7 +11,7 @@
 
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::pipeline {
 
 // FNV-1a (64 bit) over strings and file contents, order-sensitive.
 class Fingerprint {
@@ -43,4 +43,4 @@ std::optional<StageMarker> ReadStageMarker(const std::filesystem::path& stage_di
 void WriteStageMarker(const std::filesystem::path& stage_dir, const StageMarker& marker);
 std::string UtcNow();
 
-}  // namespace igi
+}  // namespace igi::pipeline

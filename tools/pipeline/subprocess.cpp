@@ -14,7 +14,7 @@
 
 extern char** environ;
 
-namespace igi {
+namespace igi::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
@@ -82,4 +82,4 @@ std::string CommandLine(const fs::path& executable, const std::vector<std::strin
   return line;
 }
 
-}  // namespace igi
+}  // namespace igi::pipeline

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace igi {
+namespace igi::pipeline {
 
 struct ProcessResult {
   int exit_code = -1;      // the child's exit status; -1 when it was killed by a signal
@@ -26,4 +26,4 @@ std::filesystem::path ExecutableDir();
 std::string CommandLine(const std::filesystem::path& executable,
                         const std::vector<std::string>& args);
 
-}  // namespace igi
+}  // namespace igi::pipeline

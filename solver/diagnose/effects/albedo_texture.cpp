@@ -20,7 +20,7 @@
 #include "solver/diagnose/effects/effects.h"
 #include "solver/diagnose/texture_evidence.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // The albedo_texture step for the solved regions whose records show a texture
@@ -100,7 +100,7 @@ class AlbedoTextureEffect final : public Effect {
 
   // The refit's maps: the named regions', or every region's where the albedo varies.
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
-    MapMode maps{AlbedoMaps::kAuto, {}};
+    MapMode maps{solver::AlbedoMaps::kAuto, {}};
     if (c->params.contains("regions")) {
       maps.only = c->params["regions"].get<std::vector<std::string>>();
     }
@@ -108,10 +108,10 @@ class AlbedoTextureEffect final : public Effect {
   }
 
   // A last-resort step names the regions the refit gave maps.
-  void DescribeKept(CandidateResult* c, const Scene& refit) const override {
+  void DescribeKept(CandidateResult* c, const recon::Scene& refit) const override {
     if (c->params.contains("regions")) return;
     Json regions = Json::array();
-    for (const Material& m : refit.materials) {
+    for (const recon::Material& m : refit.materials) {
       if (m.rho_d_map) regions.push_back(m.name);
     }
     c->params = {{"regions", regions}};
@@ -121,7 +121,7 @@ class AlbedoTextureEffect final : public Effect {
   }
 
   // Nothing: the maps are the refit's (PlanTrial), written by the solver into its scene.
-  void Write(const CandidateResult&, SceneDocument*) const override {}
+  void Write(const CandidateResult&, recon::SceneDocument*) const override {}
 
  private:
   bool judged_ = false;  // the texture test has named textured regions
@@ -131,4 +131,4 @@ class AlbedoTextureEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeAlbedoTexture() { return std::make_unique<AlbedoTextureEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -16,7 +16,7 @@
 #include "solver/render/sampling.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -27,24 +27,24 @@ using Eigen::Vector3d;
 // rendered with the model's materials and no other light; emitters made black), times the photo's
 // exposure scale and the camera's vignetting. 16 paths per record: the first vertex is exact for
 // the diffuse term (the renderer evaluates ambient light exactly), the bounces are averaged.
-std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
+std::vector<Eigen::Vector3f> UnitAmbientResponse(const recon::Scene& model,
                                                  const std::vector<PixelRecord>& records) {
-  Scene unit = model;
-  Light ambient;
+  recon::Scene unit = model;
+  recon::Light ambient;
   ambient.name = "unit_ambient";
-  ambient.type = LightType::kAmbient;
+  ambient.type = recon::LightType::kAmbient;
   ambient.radiance = Eigen::Vector3d::Ones();
   unit.lights = {ambient};
-  unit.lightings = {Lighting{"unit_ambient", {0}}};
-  for (Material& m : unit.materials) {
-    if (m.brdf == BrdfModel::kEmitter) m.brdf = BrdfModel::kBlack;
+  unit.lightings = {recon::Lighting{"unit_ambient", {0}}};
+  for (recon::Material& m : unit.materials) {
+    if (m.brdf == recon::BrdfModel::kEmitter) m.brdf = recon::BrdfModel::kBlack;
   }
-  const Renderer renderer(unit, 0);
+  const render::Renderer renderer(unit, 0);
   std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
   ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
     const PixelRecord& r = records[i];
-    const Photo& photo = model.photos[r.photo];
-    const Camera& camera = model.cameras[photo.camera];
+    const recon::Photo& photo = model.photos[r.photo];
+    const recon::Camera& camera = model.cameras[photo.camera];
     const Eigen::Vector3d center = camera.CenterInWorld();
     const Eigen::Vector3d dir = r.position.cast<double>() - center;
     if (!(dir.norm() > 0)) return;
@@ -60,36 +60,37 @@ std::vector<Eigen::Vector3f> UnitAmbientResponse(const Scene& model,
 // the point's BRDF (the record's ρd, its region's lobe) toward the camera, ∫ f cos θi dωi over the
 // hemisphere (the ambient light is never occluded), times the photo's exposure scale and the
 // camera's vignetting. 64 stratified BRDF samples (exact for the diffuse term).
-std::vector<Eigen::Vector3f> UnitAmbientFirstReflection(const Scene& model,
+std::vector<Eigen::Vector3f> UnitAmbientFirstReflection(const recon::Scene& model,
                                                         const std::vector<PixelRecord>& records) {
   constexpr int kSide = 8;
-  std::vector<ShadingMaterial> materials;
-  for (const Material& m : model.materials) materials.push_back(MakeShadingMaterial(m));
+  std::vector<render::ShadingMaterial> materials;
+  for (const recon::Material& m : model.materials)
+    materials.push_back(render::MakeShadingMaterial(m));
   std::vector<Eigen::Vector3f> out(records.size(), Eigen::Vector3f::Zero());
   ParallelFor(0, int64_t(records.size()), [&](int64_t i) {
     const PixelRecord& r = records[i];
     if (r.region < 0 || r.region >= int(materials.size())) return;
-    const ShadingMaterial& sm = materials[r.region];
-    if (!IsReflective(sm.model)) return;
-    BrdfParams params = sm.params;
+    const render::ShadingMaterial& sm = materials[r.region];
+    if (!recon::IsReflective(sm.model)) return;
+    render::BrdfParams params = sm.params;
     params.rho_d = r.albedo.cast<double>();
     const Vector3d n = r.normal.cast<double>();
-    const Frame frame = IsAnisotropic(params.model) && sm.tangent
-                            ? Frame::FromNormalTangent(n, *sm.tangent)
-                            : Frame::FromNormal(n);
+    const render::Frame frame = recon::IsAnisotropic(params.model) && sm.tangent
+                                    ? render::Frame::FromNormalTangent(n, *sm.tangent)
+                                    : render::Frame::FromNormal(n);
     const Vector3d wo = frame.ToLocal(r.view.cast<double>());
-    Pcg32 rng(uint64_t(i) + 1, 17);
+    render::Pcg32 rng(uint64_t(i) + 1, 17);
     Vector3d sum = Vector3d::Zero();
     for (int a = 0; a < kSide; ++a) {
       for (int b = 0; b < kSide; ++b) {
         const Eigen::Vector2d u((a + rng.UniformDouble()) / kSide,
                                 (b + rng.UniformDouble()) / kSide);
-        const BrdfSample smp = SampleBrdf(params, wo, rng.UniformDouble(), u);
+        const render::BrdfSample smp = render::SampleBrdf(params, wo, rng.UniformDouble(), u);
         if (smp.Valid()) sum += smp.weight;
       }
     }
-    const Photo& photo = model.photos[r.photo];
-    const Camera& camera = model.cameras[photo.camera];
+    const recon::Photo& photo = model.photos[r.photo];
+    const recon::Camera& camera = model.cameras[photo.camera];
     const double k =
         photo.exposure_scale * camera.VignettingFactor(Eigen::Vector2d(r.x + 0.5, r.y + 0.5));
     out[i] = (sum * (k / (kSide * kSide))).cast<float>();
@@ -156,7 +157,7 @@ class AmbientLightEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return AmbientLight(cx, f); }});
   }
   // A new "ambient" light (a name no light has) of the fitted radiance, in every lighting.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     doc->AddLightToEveryLighting("ambient",
                                  {{"type", "ambient"}, {"radiance", c.params.at("radiance")}});
   }
@@ -166,4 +167,4 @@ class AmbientLightEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeAmbientLight() { return std::make_unique<AmbientLightEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

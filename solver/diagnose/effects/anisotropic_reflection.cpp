@@ -16,7 +16,7 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -24,49 +24,50 @@ using Eigen::Vector3d;
 
 Json Vec(const Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
-BrdfModel AnisotropicOf(BrdfModel m) {
+recon::BrdfModel AnisotropicOf(recon::BrdfModel m) {
   switch (m) {
-    case BrdfModel::kWard:
-      return BrdfModel::kWardAniso;
-    case BrdfModel::kWardGmd:
-      return BrdfModel::kWardGmdAniso;
-    case BrdfModel::kWardFresnel:
-      return BrdfModel::kWardAnisoFresnel;
-    case BrdfModel::kWardGmdFresnel:
-      return BrdfModel::kWardGmdAnisoFresnel;
+    case recon::BrdfModel::kWard:
+      return recon::BrdfModel::kWardAniso;
+    case recon::BrdfModel::kWardGmd:
+      return recon::BrdfModel::kWardGmdAniso;
+    case recon::BrdfModel::kWardFresnel:
+      return recon::BrdfModel::kWardAnisoFresnel;
+    case recon::BrdfModel::kWardGmdFresnel:
+      return recon::BrdfModel::kWardGmdAnisoFresnel;
     default:
       return m;
   }
 }
 
 // The colourless specular factor of `model` (with its Fresnel weight) in `frame`.
-double Specular(BrdfModel model, double ax, double ay, double ior, const Frame& frame,
-                const Vector3d& wo, const Vector3d& wi) {
+double Specular(recon::BrdfModel model, double ax, double ay, double ior,
+                const render::Frame& frame, const Vector3d& wo, const Vector3d& wi) {
   const Vector3d lo = frame.ToLocal(wo), li = frame.ToLocal(wi);
-  double s = SpecularFactor<double>(model, ax, ay, lo, li);
-  if (s > 0 && HasFresnel(model)) s *= FresnelWeight<double>(ior, lo, li);
+  double s = render::SpecularFactor<double>(model, ax, ay, lo, li);
+  if (s > 0 && recon::HasFresnel(model)) s *= render::FresnelWeight<double>(ior, lo, li);
   return s;
 }
 
 // The lobe of one region at its records, for a lobe model and parameters.
 class RegionLobe {
  public:
-  RegionLobe(const std::vector<PixelRecord>& records, int region, const Material& m)
+  RegionLobe(const std::vector<PixelRecord>& records, int region, const recon::Material& m)
       : records_(records),
         region_(region),
         rho_s_(m.rho_s.value_or(Vector3d::Zero())),
-        ior_(m.ior.value_or(Material::kDefaultIor)) {}
+        ior_(m.ior.value_or(recon::Material::kDefaultIor)) {}
 
   // ρs_c Σ S(wo, wi)·E_c per record (zero off the region); tangent only for anisotropic models.
-  std::vector<Eigen::Vector3f> Term(BrdfModel model, double ax, double ay,
+  std::vector<Eigen::Vector3f> Term(recon::BrdfModel model, double ax, double ay,
                                     const Vector3d& tangent) const {
     std::vector<Eigen::Vector3f> out(records_.size(), Eigen::Vector3f::Zero());
     for (size_t i = 0; i < records_.size(); ++i) {
       const PixelRecord& r = records_[i];
       if (r.region != region_) continue;
       const Vector3d n = r.normal.cast<double>(), wo = r.view.cast<double>();
-      const Frame frame =
-          IsAnisotropic(model) ? Frame::FromNormalTangent(n, tangent) : Frame::FromNormal(n);
+      const render::Frame frame = recon::IsAnisotropic(model)
+                                      ? render::Frame::FromNormalTangent(n, tangent)
+                                      : render::Frame::FromNormal(n);
       Vector3d sum = Vector3d::Zero();
       for (const RecordLightSample& ls : r.lights) {
         const double s = Specular(model, ax, ay, ior_, frame, wo, ls.wi.cast<double>());
@@ -96,7 +97,7 @@ std::array<Vector3d, 3> HighlightPlane(const std::vector<PixelRecord>& records, 
   }
   if (!(n.norm() > 1e-9)) n = plain;
   if (!(n.norm() > 1e-9)) n = Vector3d::UnitZ();
-  const Frame f = Frame::FromNormal(n.normalized());
+  const render::Frame f = render::Frame::FromNormal(n.normalized());
   return {f.n, f.t, f.b};
 }
 
@@ -107,7 +108,7 @@ struct LobeParams {
 // The region's current lobe and an anisotropic one on one fitter's records.
 class LobeFit {
  public:
-  LobeFit(const ResidualFitter& f, int region, const Material& m)
+  LobeFit(const ResidualFitter& f, int region, const recon::Material& m)
       : f_(f), lobe_(f.records(), region, m), to_(AnisotropicOf(m.brdf)) {
     const double alpha = *m.alpha;
     current_ = lobe_.Term(m.brdf, alpha, alpha, Vector3d::UnitX());
@@ -124,7 +125,7 @@ class LobeFit {
  private:
   const ResidualFitter& f_;
   RegionLobe lobe_;
-  BrdfModel to_;
+  recon::BrdfModel to_;
   std::vector<Eigen::Vector3f> current_;
   Change ch_;
 };
@@ -135,10 +136,10 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
                                const ResidualFitter& search, int region) {
   CandidateResult out;
   out.effect = "anisotropic_reflection";
-  const Material& m = cx.model.materials[region];
+  const recon::Material& m = cx.model.materials[region];
   LobeFit lobe(search, region, m);
   const std::array<Vector3d, 3> plane = HighlightPlane(search.records(), region, lobe.current());
-  const BrdfModel to = AnisotropicOf(m.brdf);
+  const recon::BrdfModel to = AnisotropicOf(m.brdf);
   auto tangent_of = [&](double phi) {
     return (std::cos(phi) * plane[1] + std::sin(phi) * plane[2]).normalized();
   };
@@ -164,7 +165,8 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
   const std::vector<double> grid = {0.02, 0.03, 0.045, 0.065, 0.095, 0.14, 0.2, 0.3};
   for (int k = 0; k < 12; ++k) {
     for (size_t i = 0; i < grid.size(); ++i) {
-      for (size_t j = i + 1; j < grid.size(); ++j) consider({k * kPi / 12, grid[i], grid[j]});
+      for (size_t j = i + 1; j < grid.size(); ++j)
+        consider({k * render::kPi / 12, grid[i], grid[j]});
     }
   }
   if (best.coef.size() == 0) {
@@ -175,7 +177,7 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
     for (int round = 0; round < 8; ++round) {
       bool moved = false;
       for (double s : {-1.0, 1.0}) {
-        moved |= consider({bp.phi + s * step * kPi / 24, bp.ax, bp.ay});
+        moved |= consider({bp.phi + s * step * render::kPi / 24, bp.ax, bp.ay});
         moved |= consider({bp.phi, bp.ax * std::pow(1.2, s * step), bp.ay});
         moved |= consider({bp.phi, bp.ax, bp.ay * std::pow(1.2, s * step)});
       }
@@ -213,8 +215,8 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
   }
   FillScores(best, &out);
   const double k = best.coef[0];
-  const std::string to_name(BrdfModelName(to));
-  out.params = {{"region", m.name}, {"from", BrdfModelName(m.brdf)},
+  const std::string to_name(recon::BrdfModelName(to));
+  out.params = {{"region", m.name}, {"from", recon::BrdfModelName(m.brdf)},
                 {"to", to_name},    {"tangent", Vec(tangent)},
                 {"alpha_x", bp.ax}, {"alpha_y", bp.ay},
                 {"rho_s_factor", k}};
@@ -234,9 +236,10 @@ CandidateResult AnisotropicFit(const CandidateContext& cx, const ResidualFitter&
 
 CandidateResult AnisotropicReflection(const CandidateContext& cx, const ResidualFitter& f,
                                       int region) {
-  const Material& m = cx.model.materials[region];
-  const bool plain = m.brdf == BrdfModel::kWard || m.brdf == BrdfModel::kWardGmd ||
-                     m.brdf == BrdfModel::kWardFresnel || m.brdf == BrdfModel::kWardGmdFresnel;
+  const recon::Material& m = cx.model.materials[region];
+  const bool plain = m.brdf == recon::BrdfModel::kWard || m.brdf == recon::BrdfModel::kWardGmd ||
+                     m.brdf == recon::BrdfModel::kWardFresnel ||
+                     m.brdf == recon::BrdfModel::kWardGmdFresnel;
   if (!plain || !m.rho_s || !m.alpha || !(m.rho_s->mean() > 0)) {
     CandidateResult out;
     out.effect = "anisotropic_reflection";
@@ -277,9 +280,10 @@ class AnisotropicReflectionEffect final : public Effect {
   }
   // The region's model becomes its *_aniso form with the fitted tangent; where the declared
   // region has α and ρs, they become the fitted α_x, α_y and the scaled ρs.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const std::string region = c.params.at("region").get<std::string>();
-    doc->SetMaterialBrdf(region, BrdfModelFromName(c.params.at("to").get<std::string>()).value());
+    doc->SetMaterialBrdf(region,
+                         recon::BrdfModelFromName(c.params.at("to").get<std::string>()).value());
     doc->SetMaterialValue(region, "tangent", c.params.at("tangent"));
     const bool known_alpha = doc->Material(region).contains("alpha");
     doc->EraseMaterialValue(region, "alpha");
@@ -297,4 +301,4 @@ std::unique_ptr<Effect> MakeAnisotropicReflection() {
   return std::make_unique<AnisotropicReflectionEffect>();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -17,7 +17,7 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 CandidateResult Response(const CandidateContext& cx, const ResidualFitter& f) {
   CandidateResult out;
@@ -141,7 +141,7 @@ class CameraResponseEffect final : public Effect {
   // and κ is in [0.1, 1] (a fit that absorbs nothing, or overshoots, is left as it was); the
   // held-out test judges the last refit as any other.
   std::optional<Refinement> Refine(const CandidateResult& c, const Json& document,
-                                   const Scene& refit, const Simulation& refit_sim,
+                                   const recon::Scene& refit, const Simulation& refit_sim,
                                    const DiagnosisModel& m) const override {
     if (!m.materials_solved) return std::nullopt;
     const double e1 = c.params.value("exponent", 1.0);
@@ -165,7 +165,7 @@ class CameraResponseEffect final : public Effect {
     const double reference = again.params.value("reference", c.params.value("reference", 1.0));
     // The document's exponents carry the first step's: it is taken back and the fixed point
     // written in its place.
-    SceneDocument doc(document);
+    recon::SceneDocument doc(document);
     for (size_t i = 0; i < doc.NumPhotos(); ++i) {
       const std::optional<double> exponent = doc.PhotoResponseExponent(i);
       doc.SetPhotoResponse(i, (exponent ? *exponent / e1 : 1.0) * e, reference);
@@ -184,7 +184,7 @@ class CameraResponseEffect final : public Effect {
 
   // Every photo's response is composed with the fitted power: exponents multiply, the reference
   // is the fitted one.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const double e = c.params.at("exponent").get<double>();
     const double reference = c.params.at("reference").get<double>();
     for (size_t i = 0; i < doc->NumPhotos(); ++i) {
@@ -197,4 +197,4 @@ class CameraResponseEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeCameraResponse() { return std::make_unique<CameraResponseEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

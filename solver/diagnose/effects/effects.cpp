@@ -1,6 +1,6 @@
 #include "solver/diagnose/effects/effects.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 // The order is the driver's: the effects tried alone first come first (an object the geometry
 // lacks before any albedo map), and a round's fits come out in this order.
@@ -23,4 +23,4 @@ std::vector<std::unique_ptr<Effect>> MakeEffects() {
   return effects;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

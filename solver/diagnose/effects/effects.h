@@ -16,7 +16,7 @@
 #include "solver/diagnose/effect.h"
 #include "solver/diagnose/residual_fit.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 // ---------------------------------------------------------------- the effects (MakeEffects)
 std::unique_ptr<Effect> MakeMissingGeometry();        // missing_geometry.cpp
@@ -75,7 +75,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
 
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
 // (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
-double IsotropicLobe(BrdfModel model, double alpha, const Eigen::Vector3f& n,
+double IsotropicLobe(recon::BrdfModel model, double alpha, const Eigen::Vector3f& n,
                      const Eigen::Vector3f& wo, const Eigen::Vector3f& wi);
 
 // anisotropic_reflection of region `region` (a ward / ward_gmd model, with or without _fresnel,
@@ -116,4 +116,4 @@ std::vector<bool> WhereLightSizeShows(const CandidateContext& cx,
 // lighting.
 CandidateResult AmbientLight(const CandidateContext& cx, const ResidualFitter& f);
 
-}  // namespace igi
+}  // namespace igi::diagnose

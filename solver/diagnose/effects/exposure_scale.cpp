@@ -17,14 +17,14 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
 // Whether `light` is the only light of every photographed lighting: then everything the photos
 // record comes from it (bounces too), and a scale common to all photos is its intensity.
-bool AloneInEveryPhoto(const Scene& model, int light) {
-  for (const Photo& p : model.photos) {
+bool AloneInEveryPhoto(const recon::Scene& model, int light) {
+  for (const recon::Photo& p : model.photos) {
     if (p.lighting < 0 || p.lighting >= int(model.lightings.size())) return false;
     const std::vector<int>& lights = model.lightings[p.lighting].lights;
     if (lights.size() != 1 || lights[0] != light) return false;
@@ -33,7 +33,7 @@ bool AloneInEveryPhoto(const Scene& model, int light) {
 }
 
 // The light that is alone in every photographed lighting, or -1.
-int LoneLight(const Scene& model) {
+int LoneLight(const recon::Scene& model) {
   for (int l = 0; l < int(model.lights.size()); ++l) {
     if (AloneInEveryPhoto(model, l)) return l;
   }
@@ -165,7 +165,7 @@ class ExposureScaleEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return ExposureScale(cx, f); }});
   }
   // Each photo's exposure_scale is multiplied by its fitted scale.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const Json& scales = c.params.at("scale");
     for (size_t i = 0; i < doc->NumPhotos(); ++i) {
       const std::string file = std::filesystem::path(doc->PhotoFile(i)).filename().string();
@@ -179,4 +179,4 @@ class ExposureScaleEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeExposureScale() { return std::make_unique<ExposureScaleEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

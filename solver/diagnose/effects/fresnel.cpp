@@ -7,7 +7,7 @@
 
 #include "solver/diagnose/effects/effects.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 class FresnelEffect final : public Effect {
@@ -25,9 +25,10 @@ class FresnelEffect final : public Effect {
     return RegionScope(c, m);
   }
   // The region's model becomes its *_fresnel form with the fitted index.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const std::string region = c.params.at("region").get<std::string>();
-    doc->SetMaterialBrdf(region, BrdfModelFromName(c.params.at("to").get<std::string>()).value());
+    doc->SetMaterialBrdf(region,
+                         recon::BrdfModelFromName(c.params.at("to").get<std::string>()).value());
     doc->SetMaterialValue(region, "ior", c.params.at("ior"));
   }
 };
@@ -36,4 +37,4 @@ class FresnelEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeFresnel() { return std::make_unique<FresnelEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -18,12 +18,12 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
 // Whether photo `photo`'s lighting has light `light`.
-bool LitBy(const Scene& model, int photo, int light) {
+bool LitBy(const recon::Scene& model, int photo, int light) {
   if (photo < 0 || photo >= int(model.photos.size())) return false;
   const int g = model.photos[photo].lighting;
   if (g < 0 || g >= int(model.lightings.size())) return false;
@@ -32,8 +32,8 @@ bool LitBy(const Scene& model, int photo, int light) {
 }
 
 // Whether `l` is a spot with a cos^n profile (an emission profile kept in an earlier step).
-bool CosProfiled(const Light& l) {
-  return l.type == LightType::kSpot && l.profile.kind == SpotProfile::Kind::kCosPower;
+bool CosProfiled(const recon::Light& l) {
+  return l.type == recon::LightType::kSpot && l.profile.kind == recon::SpotProfile::Kind::kCosPower;
 }
 
 // The direct light of one light at a record toward the camera, Σ f(wi, view)·irradiance with the
@@ -45,24 +45,24 @@ struct LightTerm {
   bool lit = false;
 };
 
-LightTerm TermOf(const Scene& model, const PixelRecord& r, int light) {
+LightTerm TermOf(const recon::Scene& model, const PixelRecord& r, int light) {
   LightTerm t;
-  BrdfParams p;
+  render::BrdfParams p;
   if (r.region >= 0 && r.region < int(model.materials.size())) {
-    const Material& m = model.materials[r.region];
-    if (IsReflective(m.brdf) && !IsAnisotropic(m.brdf) && m.rho_s && m.alpha) {
+    const recon::Material& m = model.materials[r.region];
+    if (recon::IsReflective(m.brdf) && !recon::IsAnisotropic(m.brdf) && m.rho_s && m.alpha) {
       p.model = m.brdf;
       p.rho_s = *m.rho_s;
       p.alpha = *m.alpha;
-      p.ior = m.ior.value_or(Material::kDefaultIor);
+      p.ior = m.ior.value_or(recon::Material::kDefaultIor);
     }
   }
   p.rho_d = r.albedo.cast<double>();
-  const Frame frame = Frame::FromNormal(r.normal.cast<double>());
+  const render::Frame frame = render::Frame::FromNormal(r.normal.cast<double>());
   const Eigen::Vector3d wo = frame.ToLocal(r.view.cast<double>());
   for (const RecordLightSample& s : r.lights) {
     if (s.light != light) continue;
-    const Eigen::Vector3d f = EvalBrdf(p, wo, frame.ToLocal(s.wi.cast<double>()));
+    const Eigen::Vector3d f = render::EvalBrdf(p, wo, frame.ToLocal(s.wi.cast<double>()));
     t.direct += f.cast<float>().cwiseProduct(s.irradiance);
     t.from_light -= s.wi;
     t.lit = true;
@@ -73,7 +73,7 @@ LightTerm TermOf(const Scene& model, const PixelRecord& r, int light) {
 
 std::vector<Eigen::Vector3d> SphereDirections(int n) {
   std::vector<Eigen::Vector3d> d;
-  const double golden = kPi * (3 - std::sqrt(5.0));
+  const double golden = render::kPi * (3 - std::sqrt(5.0));
   for (int i = 0; i < n; ++i) {
     const double z = 1 - 2 * (i + 0.5) / n, rr = std::sqrt(1 - z * z);
     d.emplace_back(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
@@ -105,7 +105,7 @@ class ProfileFit {
     const std::vector<PixelRecord>& recs = f.records();
     // A spot with a cos^n profile already (a profile kept earlier, refitted): its direct term
     // carries the current profile, which the new one replaces.
-    const Light& l = cx.model.lights[light];
+    const recon::Light& l = cx.model.lights[light];
     const bool profiled = CosProfiled(l);
     const Eigen::Vector3f axis0 = l.direction.normalized().cast<float>();
     for (size_t i = 0; i < terms_.size(); ++i) {
@@ -237,7 +237,7 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
                                 const RecordSubset* search) {
   CandidateResult out;
   out.effect = "light_emission_profile";
-  const Light& l = cx.model.lights[light];
+  const recon::Light& l = cx.model.lights[light];
   const ProfileFit all(cx, f, light);
   if (all.lit() < 100) return out;
   // The axis and power are searched with a camera response beside the profile as a nuisance: a
@@ -327,9 +327,9 @@ CandidateResult EmissionProfile(const CandidateContext& cx, const ResidualFitter
   }
   FillScores(best, &out);
   const double n = best_n;
-  const Eigen::Vector3d position = l.type == LightType::kSphere ? l.center : l.position;
+  const Eigen::Vector3d position = l.type == recon::LightType::kSphere ? l.center : l.position;
   const Eigen::Vector3d intensity =
-      peak * (l.type == LightType::kSphere
+      peak * (l.type == recon::LightType::kSphere
                   ? Eigen::Vector3d(l.radiance * (std::numbers::pi * l.radius * l.radius))
                   : l.intensity);
   out.params = {{"light", l.name},
@@ -371,10 +371,11 @@ class LightEmissionProfileEffect final : public Effect {
   void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
                std::vector<CandidateTask>* tasks) const override {
     for (int l = 0; l < int(cx.model.lights.size()); ++l) {
-      const Light& light = cx.model.lights[l];
-      const bool point_like =
-          light.type == LightType::kPoint || light.type == LightType::kSphere ||
-          (light.type == LightType::kSpot && light.profile.kind == SpotProfile::Kind::kNone);
+      const recon::Light& light = cx.model.lights[l];
+      const bool point_like = light.type == recon::LightType::kPoint ||
+                              light.type == recon::LightType::kSphere ||
+                              (light.type == recon::LightType::kSpot &&
+                               light.profile.kind == recon::SpotProfile::Kind::kNone);
       const std::string key = Name() + ":" + light.name;
       if ((point_like && allowed(key)) || (CosProfiled(light) && allowed(key + ":refit"))) {
         tasks->push_back(
@@ -383,7 +384,7 @@ class LightEmissionProfileEffect final : public Effect {
     }
   }
   // The light becomes a spot at its position, with its intensity, the fitted axis and cos^n.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     doc->SetLight(c.params.at("light").get<std::string>(),
                   {{"type", "spot"},
                    {"position", c.params.at("position")},
@@ -399,4 +400,4 @@ std::unique_ptr<Effect> MakeLightEmissionProfile() {
   return std::make_unique<LightEmissionProfileEffect>();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -15,12 +15,12 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter& f, int light) {
   CandidateResult out;
   out.effect = "light_intensity";
-  const Light& l = cx.model.lights[light];
+  const recon::Light& l = cx.model.lights[light];
   const std::vector<PixelRecord>& recs = f.records();
   std::vector<float> share(recs.size(), 0.0f);
   bool any = false;
@@ -108,13 +108,13 @@ class LightIntensityEffect final : public Effect {
   void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
                std::vector<CandidateTask>* tasks) const override {
     for (int l = 0; l < int(cx.model.lights.size()); ++l) {
-      const Light& light = cx.model.lights[l];
-      if (light.type == LightType::kAmbient || !allowed(Name() + ":" + light.name)) continue;
+      const recon::Light& light = cx.model.lights[l];
+      if (light.type == recon::LightType::kAmbient || !allowed(Name() + ":" + light.name)) continue;
       tasks->push_back({[&cx, &f = in.fitter, l] { return LightIntensity(cx, f, l); }});
     }
   }
   // The light's intensity (or radiance, or irradiance) is multiplied by the fitted factor.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     doc->ScaleLightEmission(c.params.at("light").get<std::string>(),
                             c.params.at("factor").get<double>());
   }
@@ -124,4 +124,4 @@ class LightIntensityEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeLightIntensity() { return std::make_unique<LightIntensityEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -21,7 +21,7 @@
 #include "solver/render/sampling.h"
 #include "tools/common/parallel.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -55,16 +55,16 @@ struct FootprintPoint {
 // The direct radiance a sphere source of radius `radius` (0: a point) sends toward the camera
 // from footprint point `q` (BRDF of its region with the record's albedo, shadow rays through the
 // model's geometry), from the cone samples `u`; adds the unoccluded share to `lit`/`above`.
-Vector3d DirectAt(const RayScene& impl, int target, const SphereSource& s, const FootprintPoint& q,
-                  const Eigen::Vector3f& albedo, double radius, const Eigen::Vector2d* u, int* lit,
-                  int* above) {
-  const ShadingMaterial& sm = impl.material(q.region);
-  BrdfParams params = sm.params;
+Vector3d DirectAt(const render::RayScene& impl, int target, const SphereSource& s,
+                  const FootprintPoint& q, const Eigen::Vector3f& albedo, double radius,
+                  const Eigen::Vector2d* u, int* lit, int* above) {
+  const render::ShadingMaterial& sm = impl.material(q.region);
+  render::BrdfParams params = sm.params;
   params.rho_d = albedo.cast<double>();
   const Vector3d p = q.position.cast<double>(), n = q.normal.cast<double>();
-  const Frame frame = IsAnisotropic(params.model) && sm.tangent
-                          ? Frame::FromNormalTangent(n, *sm.tangent)
-                          : Frame::FromNormal(n);
+  const render::Frame frame = recon::IsAnisotropic(params.model) && sm.tangent
+                                  ? render::Frame::FromNormalTangent(n, *sm.tangent)
+                                  : render::Frame::FromNormal(n);
   const Vector3d lo = frame.ToLocal(q.view.cast<double>());
   const Vector3d origin = p + n * (4 * impl.ray_epsilon());
   const Vector3d to = s.center - p;
@@ -77,18 +77,18 @@ Vector3d DirectAt(const RayScene& impl, int target, const SphereSource& s, const
     ++*above;
     if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon(), target)) return Vector3d::Zero();
     ++*lit;
-    return EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) *
+    return render::EvalBrdf(params, lo, frame.ToLocal(w)).cwiseProduct(s.intensity) *
            (cos_center / (d * d));
   }
   const double sin2 = radius * radius / (d * d);
   const double one_minus = OneMinusCosMax(sin2);
-  const Frame cone = Frame::FromNormal(w);
-  const Vector3d radiance = s.intensity / (kPi * radius * radius);
-  const Vector3d rho_pi = params.rho_d * kInvPi;
+  const render::Frame cone = render::Frame::FromNormal(w);
+  const Vector3d radiance = s.intensity / (render::kPi * radius * radius);
+  const Vector3d rho_pi = params.rho_d * render::kInvPi;
   Vector3d sum = Vector3d::Zero(), diffuse = Vector3d::Zero();
   for (int k = 0; k < kConeSamples; ++k) {
     const double ct = 1 - u[k].x() * one_minus, st = std::sqrt(std::max(0.0, 1 - ct * ct));
-    const double ph = 2 * kPi * u[k].y();
+    const double ph = 2 * render::kPi * u[k].y();
     const Vector3d dir = cone.ToWorld({st * std::cos(ph), st * std::sin(ph), ct});
     const double cs = dir.dot(n);
     if (!(cs > 0)) continue;
@@ -97,10 +97,10 @@ Vector3d DirectAt(const RayScene& impl, int target, const SphereSource& s, const
     const double t = d * ct - std::sqrt(std::max(0.0, radius * radius - d * d * st * st));
     if (impl.Occluded(origin, dir, t - 4 * impl.ray_epsilon(), target)) continue;
     ++*lit;
-    sum += EvalBrdf(params, lo, frame.ToLocal(dir)).cwiseProduct(radiance) * cs;
+    sum += render::EvalBrdf(params, lo, frame.ToLocal(dir)).cwiseProduct(radiance) * cs;
   }
   // pdf = 1 / (2π (1 − cos θmax)) per sample.
-  const double weight = 2 * kPi * one_minus / kConeSamples;
+  const double weight = 2 * render::kPi * one_minus / kConeSamples;
   // Control variate: a sphere wholly above the horizon gives exactly the irradiance of a point
   // of the same intensity at its centre, I·cos/d²; the samples' estimate of that unoccluded
   // diffuse term is swapped for the exact value, so a fully lit diffuse point shows no change.
@@ -153,20 +153,20 @@ class ExtentModel {
         points_(records.size()),
         hidden_(records.size(), Eigen::Vector3f::Zero()),
         hidden_distance_(records.size(), 0.0f) {
-    const Light& l = cx.model.lights[light];
-    source_.center = l.type == LightType::kSphere ? l.center : l.position;
-    source_.intensity = l.type == LightType::kSphere
-                            ? Vector3d(l.radiance * (kPi * l.radius * l.radius))
+    const recon::Light& l = cx.model.lights[light];
+    source_.center = l.type == recon::LightType::kSphere ? l.center : l.position;
+    source_.intensity = l.type == recon::LightType::kSphere
+                            ? Vector3d(l.radiance * (render::kPi * l.radius * l.radius))
                             : l.intensity;
-    declared_radius_ = l.type == LightType::kSphere ? l.radius : 0.0;
+    declared_radius_ = l.type == recon::LightType::kSphere ? l.radius : 0.0;
     for (size_t g = 0; g < cx.model.lightings.size(); ++g) {
       const std::vector<int>& ids = cx.model.lightings[g].lights;
       const auto it = std::find(ids.begin(), ids.end(), light);
       if (it != ids.end()) target_[g] = int(it - ids.begin());
     }
-    for (const Photo& p : cx.model.photos) {
+    for (const recon::Photo& p : cx.model.photos) {
       if (target_[p.lighting] >= 0 && !impls_[p.lighting]) {
-        impls_[p.lighting] = std::make_unique<RayScene>(cx.model, p.lighting);
+        impls_[p.lighting] = std::make_unique<render::RayScene>(cx.model, p.lighting);
       }
     }
     ParallelFor(0, int64_t(records.size()), [&](int64_t i) { Prepare(size_t(i), hidden); });
@@ -182,9 +182,9 @@ class ExtentModel {
     if (visible) visible->assign(records_.size(), 0.0f);
     ParallelFor(0, int64_t(records_.size()), [&](int64_t i) {
       const PixelRecord& r = records_[i];
-      const Photo& photo = cx_.model.photos[r.photo];
+      const recon::Photo& photo = cx_.model.photos[r.photo];
       if (target_[photo.lighting] < 0 || points_[i].empty()) return;
-      const RayScene& impl = *impls_[photo.lighting];
+      const render::RayScene& impl = *impls_[photo.lighting];
       Vector3d sum = Vector3d::Zero();
       int lit = 0, above = 0;
       for (size_t k = 0; k < points_[i].size(); ++k) {
@@ -214,7 +214,7 @@ class ExtentModel {
     auto solid_angle = [](double r, double d) {
       if (!(r > 0) || !(d > 0)) return 0.0;
       const double sin2 = std::min(0.95, r * r / (d * d));
-      return 2 * kPi * OneMinusCosMax(sin2);
+      return 2 * render::kPi * OneMinusCosMax(sin2);
     };
     for (size_t i = 0; i < records_.size(); ++i) {
       const double d = hidden_distance_[i];
@@ -228,7 +228,7 @@ class ExtentModel {
  private:
   // The photo's exposure scale and its camera's vignetting at the record's pixel.
   double Scale(const PixelRecord& r) const {
-    const Photo& photo = cx_.model.photos[r.photo];
+    const recon::Photo& photo = cx_.model.photos[r.photo];
     double scale = photo.exposure_scale;
     if (photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size())) {
       scale *=
@@ -240,8 +240,8 @@ class ExtentModel {
   // The radiance per steradian the light's sphere hides from the record's point (Hidden).
   void PrepareHidden(size_t i) {
     const PixelRecord& r = records_[i];
-    const Photo& photo = cx_.model.photos[r.photo];
-    const RayScene& impl = *impls_[photo.lighting];
+    const recon::Photo& photo = cx_.model.photos[r.photo];
+    const render::RayScene& impl = *impls_[photo.lighting];
     const Vector3d p = r.position.cast<double>(), n = r.normal.cast<double>();
     const Vector3d to = source_.center - p;
     const double d = to.norm();
@@ -252,35 +252,38 @@ class ExtentModel {
     const Vector3d origin = p + n * (4 * impl.ray_epsilon());
     if (impl.Occluded(origin, w, d - 4 * impl.ray_epsilon(), target_[photo.lighting])) return;
     // The surface behind the light, seen from the point through its centre.
-    const std::optional<SurfaceHit> hit =
+    const std::optional<render::SurfaceHit> hit =
         impl.TraceSurface(source_.center + w * (declared_radius_ + 4 * impl.ray_epsilon()), w);
     if (!hit || hit->region < 0 || hit->region >= int(cx_.model.materials.size())) return;
-    const Material& m = cx_.model.materials[hit->region];
+    const recon::Material& m = cx_.model.materials[hit->region];
     const double t = (hit->position - source_.center).norm();
     const double cos_h = -hit->n_s.dot(w);
     if (!m.rho_d || !(t > 0) || !(cos_h > 0)) return;
-    const Vector3d behind = m.rho_d->cwiseProduct(source_.intensity) * (kInvPi * cos_h / (t * t));
+    const Vector3d behind =
+        m.rho_d->cwiseProduct(source_.intensity) * (render::kInvPi * cos_h / (t * t));
     hidden_[i] =
-        (r.albedo.cast<double>().cwiseProduct(behind) * (kInvPi * cos_p * Scale(r))).cast<float>();
+        (r.albedo.cast<double>().cwiseProduct(behind) * (render::kInvPi * cos_p * Scale(r)))
+            .cast<float>();
     hidden_distance_[i] = float(d);
   }
 
   // The record's footprint points and cone samples.
   void Prepare(size_t i, bool hidden) {
     const PixelRecord& r = records_[i];
-    const Photo& photo = cx_.model.photos[r.photo];
+    const recon::Photo& photo = cx_.model.photos[r.photo];
     if (target_[photo.lighting] < 0 || r.region < 0) return;
     if (hidden) PrepareHidden(i);
-    Pcg32 rng = PixelSampleRng(0x5eed, i, 0);
+    render::Pcg32 rng = render::PixelSampleRng(0x5eed, i, 0);
     const bool camera = photo.camera >= 0 && photo.camera < int(cx_.model.cameras.size());
     for (int k = 0; k < kFootprint; ++k) {  // without a camera: the centre kFootprint times
       FootprintPoint q{r.position, r.normal, r.view, r.region};
       if (camera) {
-        const Camera& cam = cx_.model.cameras[photo.camera];
+        const recon::Camera& cam = cx_.model.cameras[photo.camera];
         const double sx = (k % 4 + rng.UniformDouble()) / 4, sy = (k / 4 + rng.UniformDouble()) / 4;
         const Vector3d eye = cam.CenterInWorld();
         const Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(r.x + sx, r.y + sy));
-        const std::optional<SurfaceHit> hit = impls_[photo.lighting]->TraceSurface(eye, dir);
+        const std::optional<render::SurfaceHit> hit =
+            impls_[photo.lighting]->TraceSurface(eye, dir);
         if (!hit || hit->region != r.region) continue;  // off the record's surface
         q = {hit->position.cast<float>(), hit->n_s.cast<float>(), (-dir).cast<float>(),
              hit->region};
@@ -299,7 +302,7 @@ class ExtentModel {
 
   const CandidateContext& cx_;
   const std::vector<PixelRecord>& records_;
-  std::vector<std::unique_ptr<RayScene>> impls_;
+  std::vector<std::unique_ptr<render::RayScene>> impls_;
   std::vector<int> target_;  // per lighting: the light's index among its emitters, or -1
   std::vector<std::vector<Eigen::Vector2d>> u_;
   std::vector<std::vector<FootprintPoint>> points_;
@@ -357,10 +360,10 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
                           const ResidualFitter& search, int stride, int light) {
   CandidateResult out;
   out.effect = "light_source_extent";
-  const Light& l = cx.model.lights[light];
+  const recon::Light& l = cx.model.lights[light];
   const std::vector<PixelRecord>& recs = f.records();
   bool photographed = false;
-  for (const Photo& p : cx.model.photos) {
+  for (const recon::Photo& p : cx.model.photos) {
     const std::vector<int>& ids = cx.model.lightings[p.lighting].lights;
     photographed |= std::find(ids.begin(), ids.end(), light) != ids.end();
   }
@@ -466,8 +469,8 @@ CandidateResult ExtentFit(const CandidateContext& cx, const ResidualFitter& f,
 
 CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitter& f, int light,
                                   const RecordSubset* search) {
-  const Light& l = cx.model.lights[light];
-  if (l.type != LightType::kPoint && l.type != LightType::kSphere) {
+  const recon::Light& l = cx.model.lights[light];
+  if (l.type != recon::LightType::kPoint && l.type != recon::LightType::kSphere) {
     CandidateResult out;
     out.effect = "light_source_extent";
     return out;
@@ -522,8 +525,8 @@ CandidateResult LightSourceExtent(const CandidateContext& cx, const ResidualFitt
 std::vector<bool> WhereLightSizeShows(const CandidateContext& cx,
                                       const std::vector<PixelRecord>& records, int light) {
   std::vector<bool> out(records.size(), false);
-  const Light& l = cx.model.lights[light];
-  if (l.type != LightType::kPoint && l.type != LightType::kSphere) return out;
+  const recon::Light& l = cx.model.lights[light];
+  if (l.type != recon::LightType::kPoint && l.type != recon::LightType::kSphere) return out;
   if (records.empty()) return out;
   const ExtentModel model(cx, records, light);
   if (!(kLargestRadius > model.declared_radius())) return out;
@@ -543,8 +546,8 @@ class LightSourceExtentEffect final : public Effect {
   void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
                std::vector<CandidateTask>* tasks) const override {
     for (int l = 0; l < int(cx.model.lights.size()); ++l) {
-      const Light& light = cx.model.lights[l];
-      if ((light.type != LightType::kPoint && light.type != LightType::kSphere) ||
+      const recon::Light& light = cx.model.lights[l];
+      if ((light.type != recon::LightType::kPoint && light.type != recon::LightType::kSphere) ||
           !allowed(Name() + ":" + light.name)) {
         continue;
       }
@@ -553,11 +556,12 @@ class LightSourceExtentEffect final : public Effect {
     }
   }
   // The light becomes a sphere of the fitted radius at its position, with its intensity.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const double radius = c.params.at("radius").get<double>();
     const Json& intensity = c.params.at("intensity");
     Json radiance = Json::array();
-    for (const Json& v : intensity) radiance.push_back(v.get<double>() / (kPi * radius * radius));
+    for (const Json& v : intensity)
+      radiance.push_back(v.get<double>() / (render::kPi * radius * radius));
     doc->SetLight(c.params.at("light").get<std::string>(), {{"type", "sphere"},
                                                             {"center", c.params.at("center")},
                                                             {"radius", radius},
@@ -571,4 +575,4 @@ std::unique_ptr<Effect> MakeLightSourceExtent() {
   return std::make_unique<LightSourceExtentEffect>();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

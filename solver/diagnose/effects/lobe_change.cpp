@@ -17,7 +17,7 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -27,35 +27,35 @@ constexpr double kFresnelIors[] = {1.05, 1.1, 1.2, 1.33, 1.5, 2.0};
 
 }  // namespace
 
-double IsotropicLobe(BrdfModel model, double alpha, const Eigen::Vector3f& n,
+double IsotropicLobe(recon::BrdfModel model, double alpha, const Eigen::Vector3f& n,
                      const Eigen::Vector3f& wo, const Eigen::Vector3f& wi) {
-  const Frame frame = Frame::FromNormal(n.cast<double>());
-  return SpecularFactor<double>(model, alpha, alpha, frame.ToLocal(wo.cast<double>()),
-                                frame.ToLocal(wi.cast<double>()));
+  const render::Frame frame = render::Frame::FromNormal(n.cast<double>());
+  return render::SpecularFactor<double>(model, alpha, alpha, frame.ToLocal(wo.cast<double>()),
+                                        frame.ToLocal(wi.cast<double>()));
 }
 
 CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
                            bool fresnel) {
   CandidateResult out;
   out.effect = fresnel ? "fresnel" : "specular_lobe_shape";
-  const Material& m = cx.model.materials[region];
-  const bool gmd = m.brdf == BrdfModel::kWardGmd;
-  if (!(m.brdf == BrdfModel::kWard || gmd) || !m.rho_s || !m.alpha) return out;
+  const recon::Material& m = cx.model.materials[region];
+  const bool gmd = m.brdf == recon::BrdfModel::kWardGmd;
+  if (!(m.brdf == recon::BrdfModel::kWard || gmd) || !m.rho_s || !m.alpha) return out;
   const double rho_s = m.rho_s->mean(), alpha = *m.alpha;
   if (!(rho_s > 0)) return out;
   // The lobe term ρs·Σ lobe·E at a record, of the current model or the alternative at (ior, a).
   auto lobe_term = [&](const PixelRecord& r, int c, bool alternative, double ior, double a0) {
     // The pixel sees the lobe widened by its spread of normals.
-    const double a = WidenedAlpha(a0, r.lobe_blur2);
+    const double a = solver::WidenedAlpha(a0, r.lobe_blur2);
     double d = 0;
     auto add = [&](const RecordLightSample& ls) {
       const double plain = IsotropicLobe(m.brdf, a, r.normal, r.view, ls.wi);
       double v = plain;
       if (alternative) {
-        v = fresnel
-                ? plain * FresnelWeight<double>(ior, r.view.cast<double>(), ls.wi.cast<double>())
-                : IsotropicLobe(gmd ? BrdfModel::kWard : BrdfModel::kWardGmd, a, r.normal, r.view,
-                                ls.wi);
+        v = fresnel ? plain * render::FresnelWeight<double>(ior, r.view.cast<double>(),
+                                                            ls.wi.cast<double>())
+                    : IsotropicLobe(gmd ? recon::BrdfModel::kWard : recon::BrdfModel::kWardGmd, a,
+                                    r.normal, r.view, ls.wi);
       }
       d += rho_s * v * ls.irradiance[c];
     };
@@ -106,7 +106,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   // fresnel: the index whose weight explains the most (with materials given, at amplitude near
   // 1: the weight is a fixed function of the angles once the index is chosen).
   ResidualFit fit;
-  double ior = m.ior.value_or(Material::kDefaultIor);
+  double ior = m.ior.value_or(recon::Material::kDefaultIor);
   double fitted_amplitude = 0;
   if (fresnel && !refit) {
     // Materials given: the change, plain lobe × (1/F0 − 1)(1 − c)⁵, has the same shape at every
@@ -179,7 +179,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
         out.note = fmt::format(
             "region {}: the {} lobe explains no more than the {} lobe with its rho_s and alpha "
             "re-fitted (alpha {:.3f})",
-            m.name, fresnel ? "Fresnel-weighted" : "alternative", BrdfModelName(m.brdf), a);
+            m.name, fresnel ? "Fresnel-weighted" : "alternative", recon::BrdfModelName(m.brdf), a);
         return out;
       }
       fit.held_after = fit.held_before - beyond;
@@ -187,10 +187,12 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
     }
   }
   FillScores(fit, &out);
-  const std::string to =
-      fresnel ? std::string(BrdfModelName(m.brdf)) + "_fresnel" : (gmd ? "ward" : "ward_gmd");
-  out.params = {
-      {"region", m.name}, {"from", BrdfModelName(m.brdf)}, {"to", to}, {"amplitude", fit.coef[0]}};
+  const std::string to = fresnel ? std::string(recon::BrdfModelName(m.brdf)) + "_fresnel"
+                                 : (gmd ? "ward" : "ward_gmd");
+  out.params = {{"region", m.name},
+                {"from", recon::BrdfModelName(m.brdf)},
+                {"to", to},
+                {"amplitude", fit.coef[0]}};
   if (refit) out.params["alpha_refit"] = alpha_refit;
   if (fresnel) out.params["ior"] = ior;
   out.where = {{"regions", {m.name}}, {"frame", fresnel ? "grazing angle" : "half-vector angle"}};
@@ -200,13 +202,13 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
                     "region '{}': the photos' highlights grow toward grazing angles faster than "
                     "the {} lobe; Schlick's Fresnel weight at index {:.2f} explains it "
                     "(amplitude {:.2f})",
-                    m.name, BrdfModelName(m.brdf), ior, fit.coef[0])
+                    m.name, recon::BrdfModelName(m.brdf), ior, fit.coef[0])
               : fmt::format(
                     "region '{}': the highlight's fall-off away from its peak follows {} rather "
                     "than {} (amplitude {:.2f} of the difference)",
-                    m.name, to, BrdfModelName(m.brdf), fit.coef[0]);
+                    m.name, to, recon::BrdfModelName(m.brdf), fit.coef[0]);
   out.valid = true;
   return out;
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

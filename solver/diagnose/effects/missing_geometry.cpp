@@ -12,7 +12,7 @@
 
 #include "solver/diagnose/effects/effects.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 class MissingGeometryEffect final : public Effect {
@@ -43,7 +43,7 @@ class MissingGeometryEffect final : public Effect {
 
   // The refit and its comparison use the pixels outside the located object's masks.
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
-    SceneDocument doc(m.declared);
+    recon::SceneDocument doc(m.declared);
     Write(*c, &doc);
     return {std::move(doc).json(), m.maps, MaskedPhotoSet(m.photos, located_.excluded)};
   }
@@ -68,7 +68,7 @@ class MissingGeometryEffect final : public Effect {
   }
 
   // Each photo with pixels of the object gets the mask that excludes them.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     for (const Json& m : c.params.at("mask_files")) {
       doc->SetPhotoMask(m.at("photo").get<size_t>(),
                         std::filesystem::path(m.at("file").get<std::string>()));
@@ -83,4 +83,4 @@ class MissingGeometryEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeMissingGeometry() { return std::make_unique<MissingGeometryEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

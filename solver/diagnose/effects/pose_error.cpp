@@ -21,7 +21,7 @@
 #include "solver/render/render.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
@@ -34,7 +34,7 @@ namespace {
 // independent from pixel to pixel, and a pose fitted to noise gains nothing on held-out pixels —
 // in Wilcoxon's signed-rank z.
 template <class Basis>
-double EdgeBlockZ(const std::vector<PixelRecord>& records, int camera, const Scene& model,
+double EdgeBlockZ(const std::vector<PixelRecord>& records, int camera, const recon::Scene& model,
                   int block_px, const Basis& basis, const Eigen::VectorXd& coef) {
   std::map<std::tuple<int, int, int>, double> energy;
   std::vector<std::pair<std::tuple<int, int, int>, double>> gains;
@@ -111,7 +111,7 @@ Vec6 DampedPoseStep(const CandidateContext& cx, const ResidualFitter& f, const F
 }  // namespace
 
 void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
-                     const Eigen::Vector3d& delta, SceneDocument* doc) {
+                     const Eigen::Vector3d& delta, recon::SceneDocument* doc) {
   const Rigid3d pose = doc->CameraPose(camera);
   const double a = omega.norm();
   const Eigen::Quaterniond dr(a > 0 ? Eigen::AngleAxisd(a, omega / a)
@@ -120,7 +120,7 @@ void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
                      Rigid3d((dr * pose.rotation).normalized(), dr * pose.translation + delta));
 }
 
-double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, int camera) {
+double MedianDepth(const std::vector<PixelRecord>& records, const recon::Scene& model, int camera) {
   std::vector<float> z;
   for (const PixelRecord& r : records) {
     if (model.photos[r.photo].camera == camera && r.point_cam.z() > 0) z.push_back(r.point_cam.z());
@@ -205,7 +205,7 @@ constexpr int kAlignIterations = 5;
 std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
                                       const std::vector<PixelRecord>& records, int camera,
                                       double depth, std::vector<cv::Mat>* fine) {
-  const Camera& cam = cx.model.cameras[camera];
+  const recon::Camera& cam = cx.model.cameras[camera];
   const double fx = cam.focal_x_px(), fy = cam.focal_y_px();
   const std::vector<Image>& photos = cx.photos->recorded;
   const std::vector<Image>& sims = *cx.sims;
@@ -250,7 +250,7 @@ std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
       const Vec6 step = damped.ldlt().solve(g);
       if (!step.allFinite()) return std::nullopt;
       x += step;
-      if (x.head<3>().norm() * 180 / kPi > kMaxPoseErrorDeg) return std::nullopt;
+      if (x.head<3>().norm() * 180 / render::kPi > kMaxPoseErrorDeg) return std::nullopt;
       if (step.norm() < 1e-6) break;
     }
   }
@@ -266,7 +266,7 @@ std::optional<Vec6> AlignCoarseToFine(const CandidateContext& cx,
 CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f, int camera) {
   CandidateResult out;
   out.effect = "pose_error";
-  const Camera& cam = cx.model.cameras[camera];
+  const recon::Camera& cam = cx.model.cameras[camera];
   if (!cx.declared.contains("cameras") || cx.declared["cameras"].contains("colmap")) return out;
   const double fx = cam.focal_x_px(), fy = cam.focal_y_px();
   const double depth = MedianDepth(f.records(), cx.model, camera);
@@ -321,7 +321,7 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
     x = fit.coef[0] * direction;
   }
   const Eigen::Vector3d omega = x.head<3>(), delta = depth * x.tail<3>();
-  const double angle_deg = omega.norm() * 180 / kPi;
+  const double angle_deg = omega.norm() * 180 / render::kPi;
   // "Small" in the scene's own units: a shift below a tenth of the distance to what the camera
   // sees (a room seen from 3 m: 0.3 m; DiLiGenT's radius-1 ball seen from 50 units: 5 units).
   if (!(angle_deg < kMaxPoseErrorDeg) || !(delta.norm() < kMaxPoseShiftOfDepth * depth)) {
@@ -343,7 +343,7 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
                 {"rotation_vector", {omega.x(), omega.y(), omega.z()}},
                 {"translation_m", {delta.x(), delta.y(), delta.z()}}};
   Json photos = Json::array();
-  for (const Photo& p : cx.model.photos) {
+  for (const recon::Photo& p : cx.model.photos) {
     if (p.camera == camera) photos.push_back(p.file.filename().string());
   }
   out.where = {{"photos", photos}, {"frame", "image position (edges)"}};
@@ -356,33 +356,34 @@ CandidateResult FitPoseError(const CandidateContext& cx, const ResidualFitter& f
   return out;
 }
 
-PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
+PoseRefinement RefinePose(const recon::Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& o,
                           bool materials_solved, double cell_m, int max_iterations,
-                          SceneDocument* doc) {
+                          recon::SceneDocument* doc) {
   PoseRefinement out;
-  Scene m = model;
+  recon::Scene m = model;
   const std::string name = m.cameras[camera].name;
   const Rigid3d start = model.cameras[camera].cam_from_world;
   std::vector<Image> current = sims;
-  std::vector<std::unique_ptr<Renderer>> renderers(m.lightings.size());
+  std::vector<std::unique_ptr<render::Renderer>> renderers(m.lightings.size());
   double last_train = std::numeric_limits<double>::infinity();
-  SceneDocument last_doc = *doc;
+  recon::SceneDocument last_doc = *doc;
   Eigen::Vector3d last_omega = Eigen::Vector3d::Zero(), last_delta = Eigen::Vector3d::Zero();
   int halvings = 0;
   for (int it = 0; it < max_iterations; ++it) {
     m.cameras[camera].cam_from_world = doc->CameraPose(name);
     for (size_t i = 0; i < m.photos.size(); ++i) {
-      const Photo& p = m.photos[i];
+      const recon::Photo& p = m.photos[i];
       if (p.camera != camera) continue;
-      if (!renderers[p.lighting]) renderers[p.lighting] = std::make_unique<Renderer>(m, p.lighting);
-      RenderOptions ro;  // as SimulatePhotos
+      if (!renderers[p.lighting])
+        renderers[p.lighting] = std::make_unique<render::Renderer>(m, p.lighting);
+      render::RenderOptions ro;  // as SimulatePhotos
       ro.spp = o.spp;
       ro.seed = o.seed + 7919 * i;
       ro.num_threads = o.num_threads;
       ro.show_progress = false;
       current[i] = renderers[p.lighting]->Render(m.cameras[camera], ro);
-      ApplyExposureAndResponse(p, &current[i]);
+      solver::ApplyExposureAndResponse(p, &current[i]);
     }
     std::vector<PixelRecord> records = BuildRecords(m, photos, current, o);
     // The camera's residual tail is the pose error's own signal on sharp edges (the outlier flag
@@ -409,7 +410,7 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
       }
       last_omega *= 0.5, last_delta *= 0.5;
       ComposePoseStep(name, last_omega, last_delta, doc);
-      out.last_step_deg = last_omega.norm() * 180 / kPi;
+      out.last_step_deg = last_omega.norm() * 180 / render::kPi;
       out.last_step_m = last_delta.norm();
       spdlog::info("igi-diagnose: pose of {}: the last step raised the residual; halved", name);
       continue;
@@ -442,7 +443,8 @@ PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos
     if (out.last_step_deg < 0.005 && out.last_step_m < 3e-5 * depth) break;
   }
   const Rigid3d end = doc->CameraPose(name);
-  out.rotation_deg = Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / kPi;
+  out.rotation_deg =
+      Eigen::AngleAxisd(end.rotation * start.rotation.inverse()).angle() * 180 / render::kPi;
   const Eigen::Vector3d c0 = -(start.rotation.inverse() * start.translation);
   const Eigen::Vector3d c1 = -(end.rotation.inverse() * end.translation);
   out.translation_m = (c1 - c0).norm();
@@ -454,8 +456,8 @@ namespace {
 // The held-out blocks of `camera`'s photos whose model image's gradient energy is at least
 // kEdgeFactor times the median block's: where a pose error shows (its gain sits on edges; flat
 // blocks only add their noise).
-BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>& sims,
-                       const PixelHoldout& h) {
+BlockFilter EdgeBlocks(const recon::Scene& model, int camera, const std::vector<Image>& sims,
+                       const solver::PixelHoldout& h) {
   auto energies = std::make_shared<std::map<std::tuple<size_t, int, int>, double>>();
   for (size_t i = 0; i < sims.size(); ++i) {
     if (model.photos[i].camera != camera) continue;
@@ -487,7 +489,7 @@ BlockFilter EdgeBlocks(const Scene& model, int camera, const std::vector<Image>&
 }
 
 // The index of the candidate's camera (params "camera") in `model`, or -1.
-int CameraOf(const CandidateResult& c, const Scene& model) {
+int CameraOf(const CandidateResult& c, const recon::Scene& model) {
   const std::string name = c.params.value("camera", "");
   for (int k = 0; k < int(model.cameras.size()); ++k) {
     if (model.cameras[k].name == name) return k;
@@ -523,7 +525,7 @@ class PoseErrorEffect final : public Effect {
   TrialPlan PlanTrial(CandidateResult* c, const DiagnosisModel& m) override {
     const int camera = CameraOf(*c, m.model);
     if (camera < 0) return {m.declared, m.maps, std::nullopt};
-    SceneDocument doc(m.declared);
+    recon::SceneDocument doc(m.declared);
     const PoseRefinement pr = RefinePose(m.model, camera, m.photos, m.sims, m.options,
                                          m.materials_solved, m.cell_m, 8, &doc);
     Json& p = c->params;
@@ -556,7 +558,7 @@ class PoseErrorEffect final : public Effect {
   }
 
   // The camera's pose: the one found (qvec, tvec), or the fitted step composed with the pose.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const std::string camera = c.params.at("camera").get<std::string>();
     if (c.params.contains("qvec") && c.params.contains("tvec")) {
       const std::vector<double> q = c.params["qvec"].get<std::vector<double>>();
@@ -576,4 +578,4 @@ class PoseErrorEffect final : public Effect {
 
 std::unique_ptr<Effect> MakePoseError() { return std::make_unique<PoseErrorEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

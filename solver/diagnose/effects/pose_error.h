@@ -23,7 +23,7 @@
 #include "tools/common/geometry.h"
 #include "tools/common/json.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 // The pose correction of `camera`: the coarse-to-fine alignment when `context` has the photos
 // and renders (scored as the change of the render it warps), otherwise one damped Gauss–Newton
@@ -53,10 +53,10 @@ constexpr double kPoseMinStepGain = 0.002;
 // Composes a small rotation ω (camera frame, radians) and shift δ (scene units) with the pose of
 // camera entry `camera` in *doc: R ← exp(ω) R, t ← exp(ω) t + δ.
 void ComposePoseStep(const std::string& camera, const Eigen::Vector3d& omega,
-                     const Eigen::Vector3d& delta, SceneDocument* doc);
+                     const Eigen::Vector3d& delta, recon::SceneDocument* doc);
 
 // The median depth (camera z, scene units) of `camera`'s records; 0 when it has none.
-double MedianDepth(const std::vector<PixelRecord>& records, const Scene& model, int camera);
+double MedianDepth(const std::vector<PixelRecord>& records, const recon::Scene& model, int camera);
 
 // Blocks whose model-image gradient energy reaches this many times the median block's are the
 // edges where a pose error is scored.
@@ -75,9 +75,9 @@ struct PoseRefinement {
 // median depth (0.1 mm at 3 m), a step cuts the fitted residual² by less than kPoseMinStepGain
 // of it, a step raises it even at a quarter of its length (taken back), or max_iterations
 // (halvings included) were made.
-PoseRefinement RefinePose(const Scene& model, int camera, const PhotoSet& photos,
+PoseRefinement RefinePose(const recon::Scene& model, int camera, const PhotoSet& photos,
                           const std::vector<Image>& sims, const DiagnoseOptions& options,
                           bool materials_solved, double cell_m, int max_iterations,
-                          SceneDocument* doc);
+                          recon::SceneDocument* doc);
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -8,7 +8,7 @@
 
 #include "solver/diagnose/effects/effects.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 class SpecularLobeShapeEffect final : public Effect {
@@ -26,9 +26,9 @@ class SpecularLobeShapeEffect final : public Effect {
     return RegionScope(c, m);
   }
   // The region's model becomes the other lobe; its rho_s and alpha stay (or are solved).
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     doc->SetMaterialBrdf(c.params.at("region").get<std::string>(),
-                         BrdfModelFromName(c.params.at("to").get<std::string>()).value());
+                         recon::BrdfModelFromName(c.params.at("to").get<std::string>()).value());
   }
 };
 
@@ -38,4 +38,4 @@ std::unique_ptr<Effect> MakeSpecularLobeShape() {
   return std::make_unique<SpecularLobeShapeEffect>();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -15,7 +15,7 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -44,9 +44,9 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
     const ResidualFit fit = f.Fit(k, [&](const PixelRecord& r, int c, double* b) {
       if (r.region != region) return;
       double s = 0;
-      const double a = WidenedAlpha(alpha, r.lobe_blur2);
+      const double a = solver::WidenedAlpha(alpha, r.lobe_blur2);
       for (const RecordLightSample& ls : r.lights) {
-        s += IsotropicLobe(BrdfModel::kWard, a, r.normal, r.view, ls.wi) * ls.irradiance[c];
+        s += IsotropicLobe(recon::BrdfModel::kWard, a, r.normal, r.view, ls.wi) * ls.irradiance[c];
       }
       b[0] = s;
       if (k == 2) b[1] = r.sim[c];
@@ -91,8 +91,8 @@ class SpecularReflectionEffect final : public Effect {
   void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
                std::vector<CandidateTask>* tasks) const override {
     for (int g = 0; g < int(cx.model.materials.size()); ++g) {
-      const Material& m = cx.model.materials[g];
-      if (m.brdf != BrdfModel::kLambert || !allowed(Name() + ":" + m.name)) continue;
+      const recon::Material& m = cx.model.materials[g];
+      if (m.brdf != recon::BrdfModel::kLambert || !allowed(Name() + ":" + m.name)) continue;
       tasks->push_back({[&cx, &f = in.fitter, g] { return SpecularReflection(cx, f, g); }});
     }
   }
@@ -101,7 +101,7 @@ class SpecularReflectionEffect final : public Effect {
   }
   // The region becomes "ward". Where its albedo is declared (materials given, nothing is
   // solved), the lobe gets the fitted values; otherwise igi-solve fits them with the albedo.
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const std::string region = c.params.at("region").get<std::string>();
     const Json& m = doc->Material(region);
     Json fresh = {{"brdf", "ward"}};
@@ -121,4 +121,4 @@ std::unique_ptr<Effect> MakeSpecularReflection() {
   return std::make_unique<SpecularReflectionEffect>();
 }
 
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -13,7 +13,7 @@
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 
-namespace igi {
+namespace igi::diagnose {
 
 namespace {
 
@@ -61,7 +61,7 @@ class VignettingEffect final : public Effect {
     if (allowed(Name())) tasks->push_back({[&cx, &f = in.fitter] { return Vignetting(cx, f); }});
   }
   // Every camera's fall-off becomes the product of its declared one and the fitted one (to r⁴).
-  void Write(const CandidateResult& c, SceneDocument* doc) const override {
+  void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const double k1 = c.params.at("k1").get<double>(), k2 = c.params.at("k2").get<double>();
     for (const std::string& name : doc->CameraNames()) {
       const Eigen::Vector2d old = doc->CameraVignetting(name);
@@ -74,4 +74,4 @@ class VignettingEffect final : public Effect {
 
 std::unique_ptr<Effect> MakeVignetting() { return std::make_unique<VignettingEffect>(); }
 
-}  // namespace igi
+}  // namespace igi::diagnose

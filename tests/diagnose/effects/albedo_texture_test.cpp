@@ -17,12 +17,12 @@
 #include "solver/diagnose/effects/effects.h"
 #include "tests/diagnose/one_light_record.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // A diagnosis's model with regions floor, wall and box, no photos, the albedo maps `maps`.
 struct Model {
-  Scene scene;
+  recon::Scene scene;
   Json declared = {{"materials",
                     {{"floor", {{"brdf", "lambert"}}},
                      {"wall", {{"brdf", "lambert"}}},
@@ -30,13 +30,13 @@ struct Model {
   PhotoSet photos;
   std::vector<Image> sims;
   std::vector<PixelRecord> records;
-  PixelHoldout holdout;
+  solver::PixelHoldout holdout;
   DiagnoseOptions options;
   MapMode maps;
 
   explicit Model(MapMode m) : maps(std::move(m)) {
     for (const char* name : {"floor", "wall", "box"}) {
-      Material mat;
+      recon::Material mat;
       mat.name = name;
       scene.materials.push_back(mat);
     }
@@ -51,17 +51,17 @@ struct Model {
 // (num_params −1) that names no regions, so that its trial maps every region. With maps for
 // every region already ("auto" for all), it offers nothing.
 TEST(AlbedoTextureTest, TryLastOnlyWhileTheMapsAreNotEveryRegions) {
-  for (const MapMode& maps : {MapMode{}, MapMode{AlbedoMaps::kAuto, {"floor"}}}) {
+  for (const MapMode& maps : {MapMode{}, MapMode{solver::AlbedoMaps::kAuto, {"floor"}}}) {
     const Model m(maps);
     const std::unique_ptr<Effect> e = MakeAlbedoTexture();
     const std::optional<CandidateResult> c = e->TryLast(m.View());
-    ASSERT_TRUE(c.has_value()) << AlbedoMapsName(maps.maps) << " " << maps.only.size();
+    ASSERT_TRUE(c.has_value()) << solver::AlbedoMapsName(maps.maps) << " " << maps.only.size();
     EXPECT_EQ(c->effect, "albedo_texture");
     EXPECT_TRUE(c->valid);
     EXPECT_EQ(c->num_params, -1);
     EXPECT_FALSE(c->params.contains("regions"));
   }
-  const Model full(MapMode{AlbedoMaps::kAuto, {}});
+  const Model full(MapMode{solver::AlbedoMaps::kAuto, {}});
   EXPECT_FALSE(MakeAlbedoTexture()->TryLast(full.View()).has_value());
 }
 
@@ -75,7 +75,7 @@ TEST(AlbedoTextureTest, PlanTrialMapsTheNamedRegionsOrEvery) {
   named.effect = "albedo_texture";
   named.params = {{"regions", {"floor", "box"}}};
   const TrialPlan some = e->PlanTrial(&named, m.View());
-  EXPECT_EQ(some.maps.maps, AlbedoMaps::kAuto);
+  EXPECT_EQ(some.maps.maps, solver::AlbedoMaps::kAuto);
   EXPECT_EQ(some.maps.only, (std::vector<std::string>{"floor", "box"}));
   EXPECT_FALSE(some.maps.Full());
   EXPECT_EQ(some.document, m.declared);
@@ -83,7 +83,7 @@ TEST(AlbedoTextureTest, PlanTrialMapsTheNamedRegionsOrEvery) {
   CandidateResult last;
   last.effect = "albedo_texture";
   const TrialPlan every = e->PlanTrial(&last, m.View());
-  EXPECT_EQ(every.maps.maps, AlbedoMaps::kAuto);
+  EXPECT_EQ(every.maps.maps, solver::AlbedoMaps::kAuto);
   EXPECT_TRUE(every.maps.only.empty());
   EXPECT_TRUE(every.maps.Full());
   EXPECT_EQ(every.document, m.declared);
@@ -94,9 +94,9 @@ TEST(AlbedoTextureTest, PlanTrialMapsTheNamedRegionsOrEvery) {
 // albedo map (Material::rho_d_map set), in the refit's order; a step that named its regions is
 // left as it was.
 TEST(AlbedoTextureTest, DescribeKeptNamesTheRegionsTheRefitGaveMaps) {
-  Scene refit;
+  recon::Scene refit;
   for (const char* name : {"floor", "wall", "box"}) {
-    Material mat;
+    recon::Material mat;
     mat.name = name;
     mat.rho_d = Eigen::Vector3d::Constant(0.5);
     if (std::string(name) != "wall") {
@@ -138,4 +138,4 @@ TEST(AlbedoTextureTest, WriteLeavesTheDocumentUnchanged) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

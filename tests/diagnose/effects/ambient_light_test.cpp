@@ -12,7 +12,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/shadow_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3f;
@@ -24,8 +24,8 @@ using namespace test::shadow;
 // in the lamp's light and in the blocker's shadow give L back, whatever albedo scale the
 // nuisance takes.
 TEST(AmbientLightTest, WithSolvedMaterialsTheFirstReflectionGivesTheRadianceBack) {
-  Scene model = ShadowScene(0);
-  Camera camera;
+  recon::Scene model = ShadowScene(0);
+  recon::Camera camera;
   camera.name = "cam";
   camera.width = camera.height = 120;
   camera.params = {100, 100, 60, 60};
@@ -83,4 +83,4 @@ TEST(AmbientLightTest, WriteAddsALightToEveryLightingUnderAFreshName) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

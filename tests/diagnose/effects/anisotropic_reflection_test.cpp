@@ -16,13 +16,13 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/ward_plate.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using namespace test::ward_plate;
 
 TEST(AnisotropicReflectionTest, RecoversTheTangentAndRoughnesses) {
-  const Scene model = PlateScene();
+  const recon::Scene model = PlateScene();
   const Json declared = PlateDocument();
   const std::vector<PixelRecord> records = PlateRecords(true, 1);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
@@ -35,7 +35,7 @@ TEST(AnisotropicReflectionTest, RecoversTheTangentAndRoughnesses) {
   const std::vector<double> t = c.params["tangent"].get<std::vector<double>>();
   double ax = c.params["alpha_x"], ay = c.params["alpha_y"];
   // The narrow direction's angle in the plate's plane, modulo 180°.
-  double angle = std::atan2(t[1], t[0]) * 180 / kPi;
+  double angle = std::atan2(t[1], t[0]) * 180 / render::kPi;
   if (ax > ay) std::swap(ax, ay), angle += 90;
   angle = std::fmod(angle + 360, 180);
   // 6000 records at 1 % noise pin the lobe well; the grid refinement stops at 1.25° and at
@@ -55,7 +55,7 @@ TEST(AnisotropicReflectionTest, RecoversTheTangentAndRoughnesses) {
 // The same for anisotropic_reflection: a lobe stretched to α 0.8 across its tangent (the grid
 // goes to 0.3) is refused, where 0.03 / 0.15 is found (RecoversTheTangentAndRoughnesses).
 TEST(AnisotropicReflectionTest, ALobeReachingTheWidestAlphaIsRefused) {
-  const Scene model = PlateScene();
+  const recon::Scene model = PlateScene();
   const Json declared = PlateDocument();
   const std::vector<PixelRecord> records = PlateRecords(true, 5, 0.03, 0.8);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
@@ -65,7 +65,7 @@ TEST(AnisotropicReflectionTest, ALobeReachingTheWidestAlphaIsRefused) {
 }
 
 TEST(AnisotropicReflectionTest, AWiderIsotropicLobeIsNotNamedAnisotropic) {
-  const Scene model = PlateScene();
+  const recon::Scene model = PlateScene();
   const Json declared = PlateDocument();
   const std::vector<PixelRecord> records = PlateRecords(false, 2);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
@@ -76,8 +76,8 @@ TEST(AnisotropicReflectionTest, AWiderIsotropicLobeIsNotNamedAnisotropic) {
 }
 
 TEST(AnisotropicReflectionTest, KeepsTheFresnelSuffix) {
-  Scene model = PlateScene();
-  model.materials[0].brdf = BrdfModel::kWardGmdFresnel;
+  recon::Scene model = PlateScene();
+  model.materials[0].brdf = recon::BrdfModel::kWardGmdFresnel;
   Json declared = PlateDocument();
   declared["materials"]["plate"]["brdf"] = "ward_gmd_fresnel";
   // Records of the plain ward model still differ from this model's lobe by a stretch; what
@@ -134,4 +134,4 @@ TEST(AnisotropicReflectionTest, WriteLeavesUnknownRoughnessesToTheSolver) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

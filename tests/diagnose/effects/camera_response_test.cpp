@@ -16,7 +16,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3f;
@@ -29,7 +29,7 @@ using namespace test::room;
 // `render_noise` relative Monte Carlo noise, its variance known to the records when
 // `variance_known` (as SimulatePhotos estimates it). The camera_response candidate.
 CandidateResult ResponseWithNoisyRenders(double render_noise, bool variance_known) {
-  const Scene model = RoomModelWithPhotos();
+  const recon::Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::mt19937_64 rng(11);
   std::normal_distribution<double> g(0, 1);
@@ -38,7 +38,7 @@ CandidateResult ResponseWithNoisyRenders(double render_noise, bool variance_know
   for (int i = 0; i < 16000; ++i) {
     RoomPoint q;
     PixelRecord r = RoomRecordAt(i, rng, &q);
-    const double truth = kRho / kPi * q.e + kBounce;
+    const double truth = kRho / render::kPi * q.e + kBounce;
     const double recorded = ref * std::pow(truth * (r.region == 1 ? 1.1 : 1.0) / ref, 0.8);
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(truth);
@@ -93,7 +93,7 @@ TEST(ResponseTest, TheRendersNoiseDoesNotBendTheCurve) {
 // exponent trade off; the power written (its exponent and reference) must still be the one the
 // photos follow: it reproduces them to the photo noise.
 TEST(ResponseTest, WithTheMaterialsGivenThePowerWrittenReproducesThePhotos) {
-  const Scene model = RoomModelWithPhotos();
+  const recon::Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g(0, 1);
@@ -102,7 +102,7 @@ TEST(ResponseTest, WithTheMaterialsGivenThePowerWrittenReproducesThePhotos) {
   for (int i = 0; i < 16000; ++i) {
     RoomPoint q;
     PixelRecord r = RoomRecordAt(i, rng, &q);
-    const double v = kRho / kPi * q.e + kBounce;
+    const double v = kRho / render::kPi * q.e + kBounce;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(v);
       r.recorded[c] = float(truth_curve(v) * (1 + 0.01 * g(rng)));
@@ -149,4 +149,4 @@ TEST(ResponseTest, WriteMultipliesTheDeclaredExponents) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

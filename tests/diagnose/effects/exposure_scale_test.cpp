@@ -14,7 +14,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3d;
@@ -26,7 +26,7 @@ using namespace test::room;
 // model (lamp2 is dimmer than declared: a scale common to its lighting, another effect's), and
 // photo `off` (under lamp2; -1: none) records a further `off_scale`.
 CandidateResult ExposureWithTwoLightings(int off, double off_scale, bool solved = true) {
-  const Scene model = TwoLightingRoomModel();
+  const recon::Scene model = TwoLightingRoomModel();
   const Json declared = {
       {"lights", {{"lamp", {{"type", "point"}}}, {"lamp2", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = TwoLightingRoomRecords(
@@ -128,4 +128,4 @@ TEST(ExposureScaleTest, WriteMultipliesEachPhotosScaleMatchedByFileName) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

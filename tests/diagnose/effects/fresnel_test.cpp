@@ -14,7 +14,7 @@
 #include "tests/diagnose/lobe_plate.h"
 #include "tests/diagnose/one_light_record.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using namespace test::lobe_plate;
@@ -84,4 +84,4 @@ TEST(FresnelTest, WriteSetsTheBrdfAndTheIndex) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -19,7 +19,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3d;
@@ -30,7 +30,7 @@ using namespace test::room;
 // power searched on every `stride`-th record (1: on all of them).
 CandidateResult FitProfile(double power, double exponent, uint64_t seed, int stride = 1,
                            double peak = 1.0) {
-  const Scene model = RoomModelWithPhotos();
+  const recon::Scene model = RoomModelWithPhotos();
   const Json declared = {{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = RoomRecords(power, exponent, seed, peak);
   std::vector<int> cells(records.size());
@@ -43,7 +43,7 @@ CandidateResult FitProfile(double power, double exponent, uint64_t seed, int str
 
 // The emission-profile candidate of light 0 fitted to `records` (one cell per region; the albedo
 // nuisance on when `solved`), and the angle of its axis from −z in degrees.
-CandidateResult ProfileOn(const Scene& model, const Json& declared,
+CandidateResult ProfileOn(const recon::Scene& model, const Json& declared,
                           const std::vector<PixelRecord>& records, bool solved) {
   std::vector<int> cells(records.size());
   for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
@@ -52,7 +52,7 @@ CandidateResult ProfileOn(const Scene& model, const Json& declared,
 }
 double DegreesFromDown(const CandidateResult& c) {
   const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
-  return std::acos(std::min(1.0, -axis[2])) * 180 / kPi;
+  return std::acos(std::min(1.0, -axis[2])) * 180 / render::kPi;
 }
 
 // Measured (seed 1): axis 0.3° from −z, power 2.12. Searched without the response nuisance the
@@ -62,7 +62,7 @@ TEST(EmissionProfileTest, AHiddenResponseDoesNotBendTheProfile) {
   const CandidateResult c = FitProfile(2.0, 0.8, 1);
   ASSERT_TRUE(c.valid) << c.note;
   const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
-  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_GT(-axis[2], std::cos(3 * render::kPi / 180)) << c.params.dump();
   EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
   EXPECT_GT(c.Gain(), 0.5);
 }
@@ -88,7 +88,7 @@ TEST(EmissionProfileTest, ThePeakIntensityIsFittedWithTheMaterialsGiven) {
 // almost nothing (with the region scales over every photo it predicted 69 % on the RADIANCE
 // room's Cycles capture and was tried first).
 TEST(EmissionProfileTest, AnotherLightingsScaleIsNotThisLightsProfile) {
-  const Scene model = TwoLightingRoomModel();
+  const recon::Scene model = TwoLightingRoomModel();
   const std::vector<PixelRecord> records =
       TwoLightingRoomRecords(7, [](int photo) { return photo < 4 ? 0.6 : 1.0; });
   std::vector<int> cells(records.size());
@@ -113,7 +113,7 @@ TEST(EmissionProfileTest, AnotherLightingsScaleIsNotThisLightsProfile) {
 // with a free scale of the bounced light per region, the prediction was that of a better fit
 // than the spot renders.
 TEST(EmissionProfileTest, ThePredictedResidualIsTheOneTheProfileRenders) {
-  const Scene model = RoomModelWithPhotos();
+  const recon::Scene model = RoomModelWithPhotos();
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g(0, 1);
   std::vector<PixelRecord> records;
@@ -121,7 +121,7 @@ TEST(EmissionProfileTest, ThePredictedResidualIsTheOneTheProfileRenders) {
   for (int i = 0; i < 8000; ++i) {
     RoomPoint q;
     PixelRecord r = RoomRecordAt(i, rng, &q);
-    const double d = kRho / kPi * q.e;
+    const double d = kRho / render::kPi * q.e;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(d + kBounce);
       r.recorded[c] = float((1.3 * d + kBounce) * (1 + 0.01 * g(rng)));
@@ -156,7 +156,7 @@ TEST(EmissionProfileTest, FindsTheProfileAlone) {
   const CandidateResult c = FitProfile(2.0, 1.0, 2);
   ASSERT_TRUE(c.valid) << c.note;
   const std::vector<double> axis = c.params["direction"].get<std::vector<double>>();
-  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << c.params.dump();
+  EXPECT_GT(-axis[2], std::cos(3 * render::kPi / 180)) << c.params.dump();
   EXPECT_NEAR(c.params["cos_power"].get<double>(), 2.0, 0.3) << c.params.dump();
   EXPECT_GT(c.Gain(), 0.9);
 }
@@ -170,7 +170,7 @@ TEST(EmissionProfileTest, SearchOnASubsampleScoresOnEveryRecord) {
   ASSERT_TRUE(all.valid) << all.note;
   ASSERT_TRUE(sub.valid) << sub.note;
   const std::vector<double> axis = sub.params["direction"].get<std::vector<double>>();
-  EXPECT_GT(-axis[2], std::cos(3 * kPi / 180)) << sub.params.dump();
+  EXPECT_GT(-axis[2], std::cos(3 * render::kPi / 180)) << sub.params.dump();
   EXPECT_NEAR(sub.params["cos_power"].get<double>(), 2.0, 0.3) << sub.params.dump();
   EXPECT_DOUBLE_EQ(sub.held_before, all.held_before);
   EXPECT_DOUBLE_EQ(sub.train_before, all.train_before);
@@ -188,15 +188,15 @@ TEST(EmissionProfileTest, SearchOnASubsampleScoresOnEveryRecord) {
 // the suite's seed-107 capture, where the search on every record gave cos^14 about an axis
 // pointing up, and on the lamp's photos alone cos^1.43 about one 6.8° from the true one.)
 TEST(EmissionProfileTest, SearchedOnItsOwnPhotosWhenAnotherLightingSharesTheAlbedos) {
-  Scene model = RoomModel();
-  Light lamp2 = model.lights[0];
+  recon::Scene model = RoomModel();
+  recon::Light lamp2 = model.lights[0];
   lamp2.name = "lamp2";
   const Vector3d at2(-1, 1, 2.2);
   lamp2.position = at2;
   model.lights.push_back(lamp2);
-  model.lightings.push_back(Lighting{"L1", {1}});
+  model.lightings.push_back(recon::Lighting{"L1", {1}});
   for (int j = 0; j < 8; ++j) {
-    Photo ph;
+    recon::Photo ph;
     ph.lighting = j < 4 ? 0 : 1;
     model.photos.push_back(ph);
   }
@@ -213,7 +213,7 @@ TEST(EmissionProfileTest, SearchedOnItsOwnPhotosWhenAnotherLightingSharesTheAlbe
     const RoomPoint q = DrawRoomPoint(rng, wall, lighting == 0 ? kLamp : at2);
     const Vector3d &p = q.p, &n = q.n, &wi = q.wi;
     const double d = q.d, e = q.e;
-    const double direct = kRho / kPi * e;
+    const double direct = kRho / render::kPi * e;
     const int photo = 4 * lighting + (i / 4) % 4;
     PixelRecord r = test::OneLightRecord(photo, (i / 16) % 160, (i / 2560) % 120, wall ? 1 : 0, p,
                                          n, n, Vector3f::Constant(float(kRho)), wi, e, d);
@@ -241,12 +241,12 @@ TEST(EmissionProfileTest, SearchedOnItsOwnPhotosWhenAnotherLightingSharesTheAlbe
 // capture: cos^1.43, 6.8° off); the photos show cos² straight down. The records' light carries
 // the model's profile, which the new one replaces. Materials given. Allowed: 1° and 0.15.
 TEST(EmissionProfileTest, AKeptProfileIsRefittedFromTheModelsOne) {
-  Scene model = RoomModel();
-  Light& lamp = model.lights[0];
-  lamp.type = LightType::kSpot;
-  const double tilt = 6 * kPi / 180;
+  recon::Scene model = RoomModel();
+  recon::Light& lamp = model.lights[0];
+  lamp.type = recon::LightType::kSpot;
+  const double tilt = 6 * render::kPi / 180;
   lamp.direction = Vector3d(std::sin(tilt), 0, -std::cos(tilt));
-  lamp.profile.kind = SpotProfile::Kind::kCosPower;
+  lamp.profile.kind = recon::SpotProfile::Kind::kCosPower;
   lamp.profile.cos_power = 1.4;
   const Json declared = {{"lights", {{"lamp", {{"type", "spot"}}}}}};
   std::mt19937_64 rng(7);
@@ -261,9 +261,9 @@ TEST(EmissionProfileTest, AKeptProfileIsRefittedFromTheModelsOne) {
     const double now = std::pow(std::max(0.0, (-wi).dot(lamp.direction)), 1.4);
     PixelRecord r = test::OneLightRecord(i % 4, (i / 4) % 160, (i / 640) % 120, wall ? 1 : 0, p, n,
                                          n, Vector3f::Constant(float(kRho)), wi, e * now, d);
-    const double truth = kRho / kPi * e * std::pow(std::max(0.0, wi.z()), 2.0) + kBounce;
+    const double truth = kRho / render::kPi * e * std::pow(std::max(0.0, wi.z()), 2.0) + kBounce;
     for (int c = 0; c < 3; ++c) {
-      r.sim[c] = float(kRho / kPi * e * now + kBounce);
+      r.sim[c] = float(kRho / render::kPi * e * now + kBounce);
       r.recorded[c] = float(truth * (1 + 0.01 * g(rng)));
     }
     records.push_back(r);
@@ -310,4 +310,4 @@ TEST(EmissionProfileTest, WriteMakesTheLightASpotWithTheFittedProfile) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

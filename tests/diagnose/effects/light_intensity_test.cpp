@@ -16,7 +16,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/shadow_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3f;
@@ -29,7 +29,7 @@ using namespace test::shadow;
 // 0.25 m with the same intensity, kept before the extent itself). light_intensity fits away from
 // where the light's size shows (WhereLightSizeShows) and finds the intensity unchanged.
 TEST(LightIntensityTest, ASoftShadowIsNotAWeakerLight) {
-  const Scene model = ShadowScene(0);
+  const recon::Scene model = ShadowScene(0);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::vector<PixelRecord> records = ShadowRecords(model, 0.3);
   for (PixelRecord& r : records) {  // every record lit by the lamp alone (the photo's lighting)
@@ -104,4 +104,4 @@ TEST(LightIntensityTest, WriteScalesTheLightsValueWhateverItsType) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -19,7 +19,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/shadow_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3d;
@@ -27,7 +27,7 @@ using Eigen::Vector3f;
 using namespace test::shadow;
 
 TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
-  const Scene model = ShadowScene(0);
+  const recon::Scene model = ShadowScene(0);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = ShadowRecords(model, 0.2);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
@@ -45,7 +45,8 @@ TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
   EXPECT_EQ(l["type"], "sphere");
   EXPECT_NEAR(l["radius"].get<double>(), c.params["radius"].get<double>(), 1e-12);
   const double r = l["radius"];
-  EXPECT_NEAR(l["radiance"][0].get<double>() * kPi * r * r, kIntensity, 1e-9);  // same intensity
+  EXPECT_NEAR(l["radiance"][0].get<double>() * render::kPi * r * r, kIntensity,
+              1e-9);  // same intensity
   EXPECT_NEAR(l["center"][0].get<double>(), kLamp.x(), 1e-12);
   // Its support: held-out blocks at the penumbrae, a small part of all the held-out blocks (the
   // step's significance counts these; igi-diagnose's refit test).
@@ -75,7 +76,7 @@ TEST(LightSourceExtentTest, RecoversTheRadiusFromSoftShadows) {
 // tail is the extent's own signal. The candidate takes back the flagged records whose direct
 // term a larger sphere changes, and still finds the radius.
 TEST(LightSourceExtentTest, TakesBackTheTailAtItsShadowEdges) {
-  const Scene model = ShadowScene(0);
+  const recon::Scene model = ShadowScene(0);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
   std::vector<PixelRecord> records = ShadowRecords(model, 0.2);
   FlagOutliers(&records);
@@ -104,7 +105,7 @@ TEST(LightSourceExtentTest, TakesBackTheTailAtItsShadowEdges) {
 }
 
 TEST(LightSourceExtentTest, APointLightEarnsNothing) {
-  const Scene model = ShadowScene(0);
+  const recon::Scene model = ShadowScene(0);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records = ShadowRecords(model, 0);
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
@@ -120,9 +121,9 @@ TEST(LightSourceExtentTest, APointLightEarnsNothing) {
 // shadow edge or highlight shows the size: only that smooth loss does. Records on a floor under a
 // ceiling, the photo path-traced with a sphere of 0.25 m and the same intensity, the model with
 // the point lamp (path-traced too). The candidate finds the sphere from the light it hides.
-Scene CeilingScene(double radius) {
-  Scene s = ShadowScene(radius);
-  s.mesh = TriangleMesh{};
+recon::Scene CeilingScene(double radius) {
+  recon::Scene s = ShadowScene(radius);
+  s.mesh = recon::TriangleMesh{};
   AddQuad(&s.mesh, {Vector3f(-2, -2, 0), Vector3f(2, -2, 0), Vector3f(2, 2, 0), Vector3f(-2, 2, 0)},
           0);
   AddQuad(
@@ -131,14 +132,14 @@ Scene CeilingScene(double radius) {
       1);
   s.mesh.region_names = {"floor", "ceiling"};
   s.materials[1].name = "ceiling";
-  s.materials[1].brdf = BrdfModel::kLambert;
+  s.materials[1].brdf = recon::BrdfModel::kLambert;
   s.materials[1].rho_d = Vector3d::Constant(0.8);
   return s;
 }
 
 TEST(LightSourceExtentTest, FindsTheSphereFromTheLightItHides) {
-  const Scene model = CeilingScene(0);
-  const Scene truth = CeilingScene(0.25);
+  const recon::Scene model = CeilingScene(0);
+  const recon::Scene truth = CeilingScene(0.25);
   const Json declared = Json{{"lights", {{"lamp", {{"type", "point"}}}}}};
   const std::vector<PixelRecord> records =
       FloorGridRecords(model, truth, Vector3d(0, -1.9, 2.3), 40, 256, 256);
@@ -172,7 +173,7 @@ TEST(LightSourceExtentTest, WriteMakesASphereOfTheSameIntensity) {
         {"sun", {{"type", "directional"}, {"direction", {0, 0, -1}}, {"irradiance", {1, 1, 1}}}}}},
       {"lightings", {{"L0", {"lamp", "sun"}}}}};
   Json expected = doc;
-  const double area = kPi * radius * radius;
+  const double area = render::kPi * radius * radius;
   expected["lights"]["lamp"] = {{"type", "sphere"},
                                 {"center", {0.3, 0.2, 2.0}},
                                 {"radius", radius},
@@ -187,4 +188,4 @@ TEST(LightSourceExtentTest, WriteMakesASphereOfTheSameIntensity) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -10,7 +10,7 @@
 #include "solver/diagnose/effects/effects.h"
 #include "tests/diagnose/one_light_record.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // A located object's candidate whose masks hold `gain` of the held-out residual², above the
@@ -75,4 +75,4 @@ TEST(MissingGeometryEffectTest, WriteSetsEachListedPhotosMask) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -13,7 +13,7 @@
 #include "solver/render/sampling.h"
 #include "tests/diagnose/one_light_record.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 // Two cameras of a scene document, cam0 and cam1, with their poses and intrinsics.
@@ -62,23 +62,23 @@ TEST(PoseErrorTest, WriteComposesTheFittedStepWithTheDeclaredPose) {
   CandidateResult c;
   c.effect = "pose_error";
   c.params = {{"camera", "cam0"},
-              {"rotation_deg", omega.norm() * 180 / kPi},
+              {"rotation_deg", omega.norm() * 180 / render::kPi},
               {"rotation_vector", {omega.x(), omega.y(), omega.z()}},
               {"translation_m", {delta.x(), delta.y(), delta.z()}}};
   const Json declared = TwoCameras();
   Json doc = declared;
   test::WriteCandidate(c, &doc);
-  SceneDocument expected(declared);
+  recon::SceneDocument expected(declared);
   ComposePoseStep("cam0", omega, delta, &expected);
   EXPECT_EQ(doc, expected.json()) << doc.dump();
   EXPECT_NE(doc["cameras"]["cam0"], declared["cameras"]["cam0"]);
   EXPECT_EQ(doc["cameras"]["cam1"], declared["cameras"]["cam1"]);
-  const Rigid3d before = SceneDocument(declared).CameraPose("cam0");
-  const Rigid3d after = SceneDocument(doc).CameraPose("cam0");
+  const Rigid3d before = recon::SceneDocument(declared).CameraPose("cam0");
+  const Rigid3d after = recon::SceneDocument(doc).CameraPose("cam0");
   const Eigen::Quaterniond step(Eigen::AngleAxisd(omega.norm(), omega.normalized()));
   EXPECT_LT(after.rotation.angularDistance(step * before.rotation), 1e-12);
   EXPECT_LT((after.translation - (step * before.translation + delta)).norm(), 1e-12);
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

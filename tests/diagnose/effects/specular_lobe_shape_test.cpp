@@ -15,7 +15,7 @@
 #include "tests/diagnose/lobe_plate.h"
 #include "tests/diagnose/one_light_record.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3d;
@@ -38,23 +38,25 @@ TEST(LobeChangeTest, TheRoomsReflectionCounts) {
   auto room = [](const Vector3d& wi) { return wi.x() > 0.3 ? 4.0 : 0.2; };
   std::vector<PixelRecord> records;
   for (int i = 0; i < 6000; ++i) {
-    const double el = (30 + 55 * u(rng)) * kPi / 180, az = 2 * kPi * u(rng);
+    const double el = (30 + 55 * u(rng)) * render::kPi / 180, az = 2 * render::kPi * u(rng);
     const Vector3d wo(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     const Vector3d p(2 * u(rng) - 1, 2 * u(rng) - 1, 0);
     const Vector3d lamp_dir = Vector3d(-0.9, 0, 0.2).normalized();  // off every highlight
     PixelRecord r = test::OneLightRecord(i % 4, int(160 * u(rng)), int(120 * u(rng)), 0, p, n, wo,
                                          Vector3f::Constant(float(rho_d)), lamp_dir, 0.01, 3);
-    double ward = 0, gmd = 0, diffuse = 0.01 * rho_d / kPi;
+    double ward = 0, gmd = 0, diffuse = 0.01 * rho_d / render::kPi;
     for (int k = 0; k < 64; ++k) {
-      const Vector3d wi = SampleUniformHemisphere(Eigen::Vector2d(u(rng), u(rng)));
-      const double e = room(wi) * wi.z() * 2 * kPi / 64;  // L·cos/(pdf·n), pdf = 1/2π
+      const Vector3d wi = render::SampleUniformHemisphere(Eigen::Vector2d(u(rng), u(rng)));
+      const double e = room(wi) * wi.z() * 2 * render::kPi / 64;  // L·cos/(pdf·n), pdf = 1/2π
       RecordLightSample ls;
       ls.wi = wi.cast<float>();
       ls.irradiance = Vector3f::Constant(float(e));
       r.room.push_back(ls);
-      ward += rho_s * SpecularFactor<double>(BrdfModel::kWard, alpha, alpha, wo, wi) * e;
-      gmd += rho_s * SpecularFactor<double>(BrdfModel::kWardGmd, alpha, alpha, wo, wi) * e;
-      diffuse += rho_d / kPi * e;
+      ward +=
+          rho_s * render::SpecularFactor<double>(recon::BrdfModel::kWard, alpha, alpha, wo, wi) * e;
+      gmd += rho_s *
+             render::SpecularFactor<double>(recon::BrdfModel::kWardGmd, alpha, alpha, wo, wi) * e;
+      diffuse += rho_d / render::kPi * e;
     }
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(diffuse + ward);
@@ -92,4 +94,4 @@ TEST(SpecularLobeShapeTest, WriteChangesOnlyTheBrdf) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -14,7 +14,7 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/ward_plate.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using namespace test::ward_plate;
@@ -24,13 +24,14 @@ using namespace test::ward_plate;
 // (materials given: without them the refit could not load the scene), left to igi-solve
 // otherwise.
 TEST(SpecularReflectionTest, ADeclaredAlbedoGetsTheFittedLobe) {
-  Scene model = PlateScene();
-  model.materials[0].brdf = BrdfModel::kLambert;
+  recon::Scene model = PlateScene();
+  model.materials[0].brdf = recon::BrdfModel::kLambert;
   model.materials[0].rho_s.reset();
   model.materials[0].alpha.reset();
   std::vector<PixelRecord> records = PlateRecords(false, 3);
   for (PixelRecord& r : records) {
-    for (int c = 0; c < 3; ++c) r.sim[c] = float(kRhoD[c] / kPi * r.lights[0].irradiance[c]);
+    for (int c = 0; c < 3; ++c)
+      r.sim[c] = float(kRhoD[c] / render::kPi * r.lights[0].irradiance[c]);
   }
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
   const Json given = {
@@ -57,13 +58,14 @@ TEST(SpecularReflectionTest, ADeclaredAlbedoGetsTheFittedLobe) {
 // candidate refuses it (in the light_emission_profile concealed capture such a "lobe" on wall_y0,
 // α 0.35, absorbed what the profile's fitted power left).
 TEST(SpecularReflectionTest, ALobeAtTheWidestAlphaSearchedIsRefused) {
-  Scene model = PlateScene();
-  model.materials[0].brdf = BrdfModel::kLambert;
+  recon::Scene model = PlateScene();
+  model.materials[0].brdf = recon::BrdfModel::kLambert;
   model.materials[0].rho_s.reset();
   model.materials[0].alpha.reset();
   std::vector<PixelRecord> records = PlateRecords(false, 4, 0.8);
   for (PixelRecord& r : records) {
-    for (int c = 0; c < 3; ++c) r.sim[c] = float(kRhoD[c] / kPi * r.lights[0].irradiance[c]);
+    for (int c = 0; c < 3; ++c)
+      r.sim[c] = float(kRhoD[c] / render::kPi * r.lights[0].irradiance[c]);
   }
   const ResidualFitter f(records, std::vector<int>(records.size(), 0), 1, false, 8);
   const Json given = {
@@ -95,4 +97,4 @@ TEST(SpecularReflectionTest, WriteKeepsTheAlbedoMapAndGivesTheFittedLobe) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -16,17 +16,17 @@
 #include "tests/diagnose/one_light_record.h"
 #include "tests/diagnose/room_records.h"
 
-namespace igi {
+namespace igi::diagnose {
 namespace {
 
 using Eigen::Vector3f;
 using namespace test::room;
 
 // The room with 4 photos of one camera under the lamp.
-Scene VignettedRoom() {
-  Scene model = RoomModel();
+recon::Scene VignettedRoom() {
+  recon::Scene model = RoomModel();
   for (int j = 0; j < 4; ++j) {
-    Photo ph;
+    recon::Photo ph;
     ph.file = "cam" + std::to_string(j) + "_L0.exr";
     ph.camera = 0;
     ph.lighting = 0;
@@ -51,7 +51,7 @@ std::vector<PixelRecord> VignettedRecords(double k1, double k2, uint64_t seed) {
                                          Vector3f::Constant(float(kRho)), q.wi, q.e, q.d);
     const double dx = x + 0.5 - 80, dy = y + 0.5 - 60;
     r.r2 = float((dx * dx + dy * dy) / (100.0 * 100.0));
-    const double sim = kRho / kPi * q.e + kBounce;
+    const double sim = kRho / render::kPi * q.e + kBounce;
     const double fall = 1 + k1 * r.r2 + k2 * r.r2 * r.r2;
     for (int c = 0; c < 3; ++c) {
       r.sim[c] = float(sim);
@@ -66,7 +66,7 @@ std::vector<PixelRecord> VignettedRecords(double k1, double k2, uint64_t seed) {
 // `solved`), the cameras declared as `declared`.
 CandidateResult VignettingOn(const Json& declared, const std::vector<PixelRecord>& records,
                              bool solved) {
-  const Scene model = VignettedRoom();
+  const recon::Scene model = VignettedRoom();
   std::vector<int> cells(records.size());
   for (size_t i = 0; i < records.size(); ++i) cells[i] = records[i].region;
   const ResidualFitter f(records, cells, 2, solved, 8);
@@ -136,4 +136,4 @@ TEST(VignettingTest, WriteComposesWithTheDeclaredFallOff) {
 }
 
 }  // namespace
-}  // namespace igi
+}  // namespace igi::diagnose

@@ -8,9 +8,9 @@
 int main(int argc, char** argv) {
   if (argc != 2) return 2;
   try {
-    igi::SceneLoadOptions options;
+    igi::recon::SceneLoadOptions options;
     options.check_images = false;
-    const igi::Scene scene = igi::LoadScene(argv[1], options);
+    const igi::recon::Scene scene = igi::recon::LoadScene(argv[1], options);
     std::printf("materials %zu lights %zu cameras %zu triangles %zu\n", scene.materials.size(),
                 scene.lights.size(), scene.cameras.size(), scene.mesh.num_triangles());
     return 0;
