@@ -61,8 +61,8 @@ SceneScale MeasureSceneScale(const recon::Scene& scene, const render::RayScene* 
 
 SceneScale MeasureSceneScale(const recon::Scene& scene) {
   if (scene.lightings.empty()) return MeasureSceneScale(scene, nullptr);
-  const std::unique_ptr<render::RayScene> geometry = std::make_unique<render::RayScene>(scene, 0);
-  return MeasureSceneScale(scene, geometry.get());
+  const render::RayScene geometry(scene, 0);
+  return MeasureSceneScale(scene, &geometry);
 }
 
 }  // namespace igi::solver
