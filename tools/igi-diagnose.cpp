@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--spp", o.spp, "paths per pixel of the re-renders")->capture_default_str();
   app.add_option("--spp-max", o.spp_max,
                  "when above --spp: the paths per pixel are chosen within [--spp, this] from the "
-                 "photos' noise (0 = fixed at --spp)")
+                 "photos' noise; -1 = up to the paths --analysis-megapixels of photos take at "
+                 "--spp, spread over the pixels analysed; 0 = fixed at --spp")
       ->capture_default_str();
   app.add_option("--render-noise-share", o.render_noise_share,
                  "the renders' variance the chosen paths allow, as a share of the photos' noise")

@@ -31,15 +31,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool HasUnknowns(const recon::Scene& scene) {
+// Whether any material lacks a value for rendering (`key` empty) or lacks `key`.
+bool HasUnknowns(const recon::Scene& scene, const std::string& key = "") {
   for (const recon::Material& m : scene.materials) {
-    if (!m.MissingForRendering().empty()) return true;
+    const std::vector<std::string> missing = m.MissingForRendering();
+    if (key.empty() ? !missing.empty()
+                    : std::find(missing.begin(), missing.end(), key) != missing.end()) {
+      return true;
+    }
   }
   return false;
 }
 
 struct ModelState {
   fs::path dir;
+  fs::path model_file;  // the model's scene.json: the solved one, or the document as declared
+  std::vector<std::string> solved_materials;  // the materials the document left without a value
   recon::Scene model;
   // The photos re-rendered (complete, except a trial's, rendered only where its held-out test
   // reads until it is applied: CompleteModel).
@@ -48,10 +55,23 @@ struct ModelState {
   ResidualSums train, held;
 };
 
-// Fits (solves, when materials are unknown) the declared document into `dir` and simulates it
-// (only the pixels `only` marks, when given); with `with_records`, also builds its residual
-// samples (only the kept model's are ever used; they need the complete simulation).
-ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const fs::path& dir,
+// With the materials given, the values a step's refit solved (a found lobe's ρs and α, left to
+// the solver by the step) are given from then on: each material the document left without a
+// value takes the solved model's entry, so that later trials render it instead of solving it
+// again.
+void GiveSolvedValues(const ModelState& st, Json* declared) {
+  const Json solved = recon::AbsoluteScenePaths(ReadJsonFile(st.model_file), st.dir);
+  for (const std::string& name : st.solved_materials) {
+    (*declared)["materials"][name] = solved["materials"][name];
+  }
+}
+
+// Fits the declared document into `dir` (solves it when a material value is unknown: the
+// materials the diagnosis solves, or a step's model left to the solver, such as a lobe found on a
+// region whose albedo is given) and simulates it (only the pixels `only` marks, when given); with
+// `with_records`, also builds its residual samples (only the kept model's are ever used; they
+// need the complete simulation).
+ModelState FitModel(const Json& declared, const MapMode& maps, const fs::path& dir,
                     const DiagnoseOptions& o, const PhotoSet& photos, bool with_records,
                     const PixelMasks* only = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -59,9 +79,13 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
   st.dir = dir;
   fs::create_directories(dir);
   WriteJsonFile(dir / "declared.json", declared, 1);
-  fs::path model_path = dir / "declared.json";
+  st.model_file = dir / "declared.json";
+  const recon::Scene declared_scene = recon::LoadScene(st.model_file);
+  for (const recon::Material& m : declared_scene.materials) {
+    if (!m.MissingForRendering().empty()) st.solved_materials.push_back(m.name);
+  }
+  const bool solve = !st.solved_materials.empty();
   if (solve) {
-    const recon::Scene declared_scene = recon::LoadScene(dir / "declared.json");
     solver::SolveOptions so = o.solve;
     so.holdout_fraction = o.holdout_fraction;
     so.holdout_block_px = o.holdout_block_px;
@@ -69,13 +93,18 @@ ModelState FitModel(const Json& declared, bool solve, const MapMode& maps, const
     so.show_progress = false;
     so.albedo_maps = maps.maps;
     so.albedo_map_regions = maps.only;
+    // Every pixel is an observation for the albedo maps' sake (DiagnoseOptions::solve); with
+    // every albedo given (a lobe left to the solver) igi-solve's own stride does.
+    if (!HasUnknowns(declared_scene, "rho_d")) {
+      so.pixel_stride = std::max(so.pixel_stride, solver::SolveOptions{}.pixel_stride);
+    }
     const solver::SolveSummary summary = solver::Solve(declared_scene, so, dir);
     solver::WriteSolveOutputs(summary, so, dir);
-    model_path = dir / "scene.json";
+    st.model_file = dir / "scene.json";
   }
   recon::SceneLoadOptions lo;
   lo.require_complete_materials = true;
-  st.model = recon::LoadScene(model_path, lo);
+  st.model = recon::LoadScene(st.model_file, lo);
   const auto t1 = std::chrono::steady_clock::now();
   SimulatePhotos(st.model, o, o.seed, &st.sim, only);
   const auto t2 = std::chrono::steady_clock::now();
@@ -334,12 +363,12 @@ DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
   // it is found; an effect's step (albedo_texture) adds them.
   MapMode maps{solve ? solver::AlbedoMaps::kNone : solver::AlbedoMaps::kAuto, {}};
   spdlog::info("igi-diagnose: fitting the baseline model{}", solve ? " (solving materials)" : "");
-  ModelState st =
-      FitModel(declared, solve, maps, out_dir / "steps" / "00-baseline", o, photos, true);
-  if (o.spp_max > o.spp) {
+  ModelState st = FitModel(declared, maps, out_dir / "steps" / "00-baseline", o, photos, true);
+  const int spp_max = MaxSpp(o, photos);
+  if (spp_max > o.spp) {
     // The paths the tests can afford: the baseline rendered again at the paths chosen from the
     // photos' noise, and every later render at them.
-    const RenderNoise noise = ChooseSpp(photos, st.sim, o.spp, o.spp_max, o.render_noise_share);
+    const RenderNoise noise = ChooseSpp(photos, st.sim, o.spp, spp_max, o.render_noise_share);
     sum.render_noise = RenderNoiseJson(noise, o.render_noise_share);
     spdlog::info(
         "igi-diagnose: photo noise {:.3f}, render noise {:.3f} at {} paths per pixel: rendering "
@@ -391,7 +420,7 @@ DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
     ds.model_dir = out_dir / "steps" / fmt::format("{:02d}-{}", ++attempt, c.effect);
     const PhotoSet& ph = t.photos ? *t.photos : photos;
     try {
-      t.state = FitModel(t.next, solve, t.maps, ds.model_dir, o, ph, false, &test_masks);
+      t.state = FitModel(t.next, t.maps, ds.model_dir, o, ph, false, &test_masks);
     } catch (const Error& e) {
       ds.verdict = std::string("the refit failed: ") + e.what();
       ds.candidate = std::move(c);
@@ -399,8 +428,8 @@ DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
     }
     if (std::optional<Refinement> r = effect->Refine(c, t.next, t.state.model, t.state.sim, m)) {
       try {
-        ModelState refined = FitModel(r->document, solve, t.maps, ds.model_dir / "refined", o, ph,
-                                      false, &test_masks);
+        ModelState refined =
+            FitModel(r->document, t.maps, ds.model_dir / "refined", o, ph, false, &test_masks);
         c = std::move(r->candidate);
         t.next = std::move(r->document);
         t.state = std::move(refined);
@@ -480,6 +509,7 @@ DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
       if (trials[best].photos) photos = std::move(*trials[best].photos);
       declared = std::move(trials[best].next);
       st = std::move(trials[best].state);
+      if (!solve) GiveSolvedValues(st, &declared);
       st.records = BuildRecords(st.model, photos, st.sim.sims, o, &st.sim.variance);
       maps = trials[best].maps;
     }
@@ -543,9 +573,8 @@ DiagnosisSummary DiagnoseCapture(const recon::Scene& scene, DiagnoseOptions o,
   sum.noise_floor = NoiseFloor(photos, st.sim.sims);
   sum.unexplained = Unexplained(st, sum.noise_floor);
   sum.final_model_dir = st.dir;
-  const fs::path model_file = st.dir / (solve ? "scene.json" : "declared.json");
   sum.final_scene = recon::RelativeScenePaths(
-      recon::AbsoluteScenePaths(ReadJsonFile(model_file), st.dir), out_dir);
+      recon::AbsoluteScenePaths(ReadJsonFile(st.model_file), st.dir), out_dir);
   if (!scene.photos.empty()) {
     Image render = st.sim.sims[0];
     sum.final_images = {{photos.recorded[0], "photo " + scene.photos[0].file.filename().string()},

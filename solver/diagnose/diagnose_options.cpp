@@ -12,8 +12,9 @@ void DiagnoseOptions::Validate() const {
     if (!ok) problems.Add(DescribeProblem("", flag, value, rule));
   };
   check(spp >= 1 && spp <= 65536, "--spp", std::to_string(spp), "must be in [1, 65536]");
-  check(spp_max == 0 || (spp_max >= spp && spp_max <= 65536), "--spp-max", std::to_string(spp_max),
-        "must be 0 (the paths fixed at --spp) or in [--spp, 65536]");
+  check(spp_max == -1 || spp_max == 0 || (spp_max >= spp && spp_max <= 65536), "--spp-max",
+        std::to_string(spp_max),
+        "must be -1 (auto), 0 (the paths fixed at --spp) or in [--spp, 65536]");
   check(render_noise_share > 0 && render_noise_share <= 4, "--render-noise-share",
         fmt::format("{}", render_noise_share), "must be in (0, 4]");
   check(pixel_stride >= 1 && pixel_stride <= 64, "--pixel-stride", std::to_string(pixel_stride),

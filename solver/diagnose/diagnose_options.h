@@ -11,8 +11,10 @@ struct DiagnoseOptions {
   int spp = 32;  // paths per pixel of the re-renders
   // When above spp: the re-renders' paths per pixel are chosen, within [spp, spp_max], so that
   // their Monte Carlo variance is at most render_noise_share of the photos' own noise, measured
-  // on the baseline (render_noise.h).
-  int spp_max = 0;
+  // on the baseline (render_noise.h). 0: fixed at spp. −1 (auto): up to the paths a capture of
+  // analysis_megapixels takes at spp, spread over the pixels analysed (a smaller capture affords
+  // more paths per pixel at the same cost; a capture analysed at that size keeps spp).
+  int spp_max = -1;
   double render_noise_share = 0.25;
   int pixel_stride = 2;  // every Nth pixel of each photo is a residual sample
   int max_steps = 4;     // effects modelled at most

@@ -41,6 +41,15 @@ RenderNoise ChooseSpp(const PhotoSet& photos, const Simulation& sim, int spp, in
   return n;
 }
 
+int MaxSpp(const DiagnoseOptions& o, const PhotoSet& photos) {
+  if (o.spp_max >= 0) return o.spp_max;
+  double pixels = 0;
+  for (const Image& p : photos.recorded) pixels += double(p.width) * p.height;
+  if (!(o.analysis_megapixels > 0) || !(pixels > 0)) return o.spp;
+  return int(
+      std::clamp(std::floor(o.spp * o.analysis_megapixels * 1e6 / pixels), double(o.spp), 65536.0));
+}
+
 Json RenderNoiseJson(const RenderNoise& n, double share) {
   return {{"white_residual", std::sqrt(n.white)},
           {"photo_noise", std::sqrt(n.photo)},

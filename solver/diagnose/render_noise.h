@@ -8,6 +8,7 @@
 
 #include <vector>
 
+#include "solver/diagnose/diagnose_options.h"
 #include "solver/diagnose/pixel_records.h"
 #include "tools/common/json.h"
 
@@ -29,6 +30,11 @@ struct RenderNoise {
 // (variance falls as 1/spp), within [spp, spp_max].
 RenderNoise ChooseSpp(const PhotoSet& photos, const Simulation& sim, int spp, int spp_max,
                       double share);
+
+// The most paths per pixel the re-renders may take (DiagnoseOptions::spp_max): with −1, the
+// paths a capture of analysis_megapixels takes at spp, spread over the pixels of `photos` (the
+// capture as analysed), at least spp.
+int MaxSpp(const DiagnoseOptions& o, const PhotoSet& photos);
 
 Json RenderNoiseJson(const RenderNoise& n, double share);
 

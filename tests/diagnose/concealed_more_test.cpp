@@ -12,8 +12,8 @@
 //   intensity: exposure_scale is fitted relative to the median photo (before, it took the common
 //   scale with 4 parameters and was kept first).
 // - specular_reflection (wall_y4 declared lambert; truly ward ρs 0.05, α 0.07): specular_reflection
-//   first, ρs 0.053, α 0.12, held-out residual² −18.5 %, 3.8 standard errors over the held-out
-//   blocks that see wall_y4; final 0.1548 against 0.1446 (1.07×; baseline 0.1876).
+//   first, its ρs and α solved by the refit; final 0.1451 against the true model's 0.1451 (1.00×;
+//   baseline 0.1884). With the candidate's own ρs 0.053 and grid α 0.12 written instead: 1.07×.
 // - vignetting + exposure_scale: exposure_scale first (cam1 1.148× the median photo; truth
 //   1.3, the rest absorbed by the vignetting's different mean in each photo), then vignetting
 //   (k1 0.113, k2 −0.419; truth −0.25, −0.05), which had passed the first round too but explained
@@ -77,11 +77,11 @@ TEST_P(ConcealedMoreTest, FirstStepNamesItAndTheResidualReachesTheFloor) {
   ExpectReachesTheFloor(o);
 }
 
-INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest,
-                         testing::Values("specular_reflection", "ambient_light:kind=uniform"));
-// Labelled slow: CI names a light's intensity in another renderer's photos
-// (concealed_cycles_test.cpp).
-INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedMoreTest, testing::Values("light_intensity"));
+INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest, testing::Values("ambient_light:kind=uniform"));
+// Labelled slow: CI names a light's intensity and a floor's hidden lobe (its ρs and α solved by
+// the refit) in another renderer's photos (concealed_cycles_test.cpp).
+INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedMoreTest,
+                         testing::Values("light_intensity", "specular_reflection"));
 
 INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest,
                          testing::Values("light_emission_profile+camera_response"));

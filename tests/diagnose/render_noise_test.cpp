@@ -78,5 +78,25 @@ TEST(ChooseSpp, OnlyValidPixelsCount) {
   EXPECT_NEAR(std::sqrt(half.photo), std::sqrt(all.photo), 0.1 * std::sqrt(all.photo));
 }
 
+// The cap of the chosen paths: given (0 or N) as it is; by default the paths a capture of
+// analysis_megapixels takes at spp, spread over the pixels analysed.
+TEST(MaxSppTest, ASmallCaptureAffordsMorePathsPerPixel) {
+  PhotoSet four;
+  four.recorded.assign(4, Image(256, 192, 3));
+  DiagnoseOptions o;               // spp 32, spp_max -1, analysis_megapixels 0.5
+  EXPECT_EQ(MaxSpp(o, four), 81);  // 32 · 500 000 / 196 608
+  o.spp_max = 0;
+  EXPECT_EQ(MaxSpp(o, four), 0);
+  o.spp_max = 300;
+  EXPECT_EQ(MaxSpp(o, four), 300);
+  // A capture analysed at the analysis size or more keeps spp, as does analysis at full size.
+  o.spp_max = -1;
+  PhotoSet thirty;
+  thirty.recorded.assign(30, Image(816, 612, 3));
+  EXPECT_EQ(MaxSpp(o, thirty), 32);
+  o.analysis_megapixels = 0;
+  EXPECT_EQ(MaxSpp(o, four), 32);
+}
+
 }  // namespace
 }  // namespace igi::diagnose

@@ -64,7 +64,7 @@ TEST(RunChainE2eTest, DiagnosisGetsTheSolvesInputWithTheSolvedPhotoScale) {
                      " --report-megapixels 0.001"
                      " --solve-arg=--photo-scale=solve --solve-arg=--indirect-rays=32"
                      " --solve-arg=--refine-iterations=0 --diagnose-arg=--max-steps=1"
-                     " --diagnose-arg=--spp=8 --diagnose-arg=--refine-iterations=0"
+                     " --diagnose-arg=--spp=8 --diagnose-arg=--spp-max=0 --diagnose-arg=--refine-iterations=0"
                      "");
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
 

@@ -90,11 +90,11 @@ struct DemoOptions {
   // third pixel (fewer observations than igi-solve's default stride 2, a shorter solve).
   std::vector<std::string> solve_args = {"--refine-iterations", "0", "--pixel-stride", "3"};
   // Passed to igi-diagnose, the slowest stage (igi-run --diagnose-arg replaces them): residuals
-  // at every fourth pixel, 16 paths per pixel, its solves from every fourth pixel without
-  // refinement, at most two steps.
-  std::vector<std::string> diagnose_args = {"--pixel-stride", "4",  "--max-steps",         "2",
-                                            "--spp",          "16", "--refine-iterations", "0",
-                                            "--solve-stride", "4"};
+  // at every fourth pixel, 16 paths per pixel (fixed), its solves from every fourth pixel
+  // without refinement, at most two steps.
+  std::vector<std::string> diagnose_args = {
+      "--pixel-stride", "4", "--max-steps",         "2", "--spp",          "16",
+      "--spp-max",      "0", "--refine-iterations", "0", "--solve-stride", "4"};
   // Samples per pixel of the report's renders (RunOptions::report_spp), >= 1.
   int report_spp = 16;
   // Throws InputError naming the flag and the rule (a choice outside its enum: by its number).

@@ -99,19 +99,29 @@ class SpecularReflectionEffect final : public Effect {
   HeldOutScope Scope(const CandidateResult& c, const DiagnosisModel& m) const override {
     return RegionScope(c, m);
   }
-  // The region becomes "ward". Where its albedo is declared (materials given, nothing is
-  // solved), the lobe gets the fitted values; otherwise igi-solve fits them with the albedo.
+  // The region becomes "ward" with its albedo as declared (a value, a map or unknown) and its
+  // lobe's ρs and α left to igi-solve, which the refit runs on a document with unknown values:
+  // the candidate's grid and its free scale of the region's light only locate the lobe (with
+  // the albedos given, that scale takes the room the lobe reflects, and a lobe that is not
+  // Ward's, such as another renderer's microfacet lobe, is fitted at a wrong height), while the
+  // solver fits ρs and α to every observation with the light the lobe really reflects.
   void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
     const std::string region = c.params.at("region").get<std::string>();
     const Json& m = doc->Material(region);
     Json fresh = {{"brdf", "ward"}};
     if (m.contains("rho_d")) fresh["rho_d"] = m["rho_d"];
     if (m.contains("rho_d_map")) fresh["rho_d_map"] = m["rho_d_map"];
-    if (fresh.contains("rho_d") || fresh.contains("rho_d_map")) {
-      fresh["rho_s"] = c.params.at("rho_s");
-      fresh["alpha"] = c.params.at("alpha");
-    }
     doc->SetMaterial(region, std::move(fresh));
+  }
+  // The kept step's description with the lobe the refit solved.
+  void DescribeKept(CandidateResult* c, const recon::Scene& refit) const override {
+    const std::string region = c->params.at("region").get<std::string>();
+    for (const recon::Material& m : refit.materials) {
+      if (m.name != region || !m.rho_s || !m.alpha) continue;
+      c->params["rho_s_solved"] = m.rho_s->mean();
+      c->params["alpha_solved"] = *m.alpha;
+      c->evidence += fmt::format("; solved: rho_s {:.3f}, alpha {:.3f}", m.rho_s->mean(), *m.alpha);
+    }
   }
 };
 
