@@ -18,6 +18,12 @@
 #                                             peak intensity the declared one)
 #   missing_geometry:center=X/Y/Z,size=X/Y/Z,rho=R
 #                                             a grey box the geometry lacks
+#   specular_reflection:region=NAME,rho_s=S,alpha=A[,distribution=beckmann|ggx]
+#                                             the region's diffuse albedo plus a microfacet lobe
+#                                             (Cycles' Glossy BSDF, alpha = roughness^2)
+#   anisotropic_reflection:region=NAME,rho_s=S,alpha_x=AX,alpha_y=AY[,tangent=X/Y/Z]
+#                                             the same with Cycles' Anisotropic BSDF, alpha_x
+#                                             along the tangent (default the world's x axis)
 import json
 import math
 import os
@@ -27,7 +33,8 @@ import bpy
 from mathutils import Vector
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "render"))
-from cycles_scene import add_camera, add_geometry, configure, diffuse_material  # noqa: E402
+from cycles_scene import (add_camera, add_geometry, configure, diffuse_material,  # noqa: E402
+                          glossy_material)
 
 
 def parse_args():
@@ -116,11 +123,29 @@ def add_box(params):
     obj.data.materials.append(diffuse_material("missing_box", [rho] * 3))
 
 
+def lobe_of(effect, params):
+    """make_material for add_geometry: the effect's region with its hidden lobe."""
+    if effect not in ("specular_reflection", "anisotropic_reflection"):
+        return None
+
+    def make(name, rho_d):
+        if name != params["region"]:
+            return None
+        dist = params.get("distribution", "beckmann").upper()
+        if effect == "specular_reflection":
+            return glossy_material(name, rho_d, float(params["rho_s"]), float(params["alpha"]),
+                                   distribution=dist)
+        return glossy_material(name, rho_d, float(params["rho_s"]), float(params["alpha_x"]),
+                               float(params["alpha_y"]), tuple(vec(params.get("tangent", "1/0/0"))),
+                               distribution=dist)
+    return make
+
+
 def render_photo(doc, scene_dir, photo, effect, params, args):
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj, do_unlink=True)
     scene = bpy.context.scene
-    add_geometry(scene_dir, doc)
+    add_geometry(scene_dir, doc, lobe_of(effect, params))
     add_lights(doc, photo["lighting"], effect, params)
     if effect == "missing_geometry":
         add_box(params)
@@ -140,7 +165,7 @@ def main():
         doc = json.load(f)
     effect, params = parse_effect(args["effect"])
     known = ("none", "light_intensity", "light_source_extent", "light_emission_profile",
-             "missing_geometry")
+             "missing_geometry", "specular_reflection", "anisotropic_reflection")
     if effect not in known:
         sys.exit(f"cycles_capture.py: --effect {effect}: not one of {', '.join(known)}")
     scene_dir = os.path.dirname(os.path.abspath(args["scene"]))

@@ -1,6 +1,7 @@
 # Blender (Cycles) scenes built from an igi scene.json, without a .blend file: the OBJ geometry as
 # given (z up, metres), every material a Diffuse BSDF (roughness 0 = Lambertian) with rho_d as
-# colour (a material with a specular lobe gets rho_d only), sphere lights as emissive ico-spheres
+# colour (a material with a specular lobe gets rho_d only, unless the caller gives it a lobe:
+# glossy_material, Cycles' Beckmann or GGX microfacet lobes), sphere lights as emissive ico-spheres
 # (emission strength = radiance: Cycles' emission of strength 1 is radiance 1) or Cycles' own
 # sphere lights, the COLMAP pinhole camera, and the render settings of an unbiased comparison.
 # Used by cycles_room.py (the time-to-noise benchmark) and bench/diagnose/cycles_capture.py
@@ -45,6 +46,45 @@ def diffuse_material(name, rgb):
     return mat
 
 
+def glossy_material(name, rho_d, rho_s, alpha_x, alpha_y=None, tangent=(1, 0, 0),
+                    distribution="BECKMANN"):
+    """A Diffuse BSDF of colour rho_d plus a microfacet lobe of colour rho_s (Cycles' Glossy
+    BSDF, or its Anisotropic BSDF when alpha_y differs from alpha_x, the lobe's x axis along
+    `tangent` projected into the surface). Cycles' roughness r is the distribution's
+    alpha = r^2; its anisotropy a in [0, 1) gives alpha_x = r^2 (1 - a), alpha_y = r^2 / (1 - a)."""
+    alpha_y = alpha_x if alpha_y is None else alpha_y
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (rho_d[0], rho_d[1], rho_d[2], 1.0)
+    diffuse.inputs["Roughness"].default_value = 0.0
+    rho_s = [rho_s] * 3 if isinstance(rho_s, (int, float)) else rho_s
+    alpha0 = math.sqrt(alpha_x * alpha_y)
+    if abs(alpha_x - alpha_y) <= 1e-9 * alpha0:
+        lobe = nodes.new("ShaderNodeBsdfGlossy")
+    else:
+        lobe = nodes.new("ShaderNodeBsdfAnisotropic")
+        # a >= 0 draws the lobe out along y: alpha_x <= alpha_y; otherwise along x.
+        if alpha_x <= alpha_y:
+            lobe.inputs["Anisotropy"].default_value = 1 - math.sqrt(alpha_x / alpha_y)
+        else:
+            lobe.inputs["Anisotropy"].default_value = math.sqrt(alpha_y / alpha_x) - 1
+        t = nodes.new("ShaderNodeCombineXYZ")
+        t.inputs[0].default_value, t.inputs[1].default_value, t.inputs[2].default_value = tangent
+        links.new(t.outputs["Vector"], lobe.inputs["Tangent"])
+    lobe.distribution = distribution
+    lobe.inputs["Color"].default_value = (rho_s[0], rho_s[1], rho_s[2], 1.0)
+    lobe.inputs["Roughness"].default_value = math.sqrt(alpha0)
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(diffuse.outputs["BSDF"], add.inputs[0])
+    links.new(lobe.outputs["BSDF"], add.inputs[1])
+    out = nodes.new("ShaderNodeOutputMaterial")
+    links.new(add.outputs["Shader"], out.inputs["Surface"])
+    return mat
+
+
 def emission_material(name, radiance):
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
@@ -59,7 +99,9 @@ def emission_material(name, radiance):
     return mat
 
 
-def add_geometry(scene_dir, doc):
+def add_geometry(scene_dir, doc, make_material=None):
+    """The scene's meshes; each material from make_material(name, rho_d) when it returns one,
+    else a Diffuse BSDF of its rho_d."""
     for geo in doc["geometry"]:
         verts, faces = read_obj(os.path.join(scene_dir, geo["file"]))
         names = sorted({m for m, _ in faces})
@@ -68,7 +110,8 @@ def add_geometry(scene_dir, doc):
         for name in names:
             rho = doc["materials"][name].get("rho_d", [0.5, 0.5, 0.5])
             rho = [rho] * 3 if isinstance(rho, (int, float)) else rho
-            mesh.materials.append(diffuse_material(name, rho))
+            mat = make_material(name, rho) if make_material else None
+            mesh.materials.append(mat or diffuse_material(name, rho))
         for poly, (m, _) in zip(mesh.polygons, faces):
             poly.material_index = names.index(m)
             poly.use_smooth = False
