@@ -2,27 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace igi::recon {
 namespace {
 
-struct BrdfName {
-  BrdfModel model;
-  std::string_view name;
-};
-constexpr BrdfName kBrdfNames[] = {
-    {BrdfModel::kLambert, "lambert"},
-    {BrdfModel::kWard, "ward"},
-    {BrdfModel::kWardGmd, "ward_gmd"},
-    {BrdfModel::kWardAniso, "ward_aniso"},
-    {BrdfModel::kWardGmdAniso, "ward_gmd_aniso"},
-    {BrdfModel::kEmitter, "emitter"},
-    {BrdfModel::kBlack, "black"},
-    {BrdfModel::kWardFresnel, "ward_fresnel"},
-    {BrdfModel::kWardGmdFresnel, "ward_gmd_fresnel"},
-    {BrdfModel::kWardAnisoFresnel, "ward_aniso_fresnel"},
-    {BrdfModel::kWardGmdAnisoFresnel, "ward_gmd_aniso_fresnel"},
-};
 
 template <typename T>
 int FindByName(const std::vector<T>& items, std::string_view name) {
@@ -34,18 +18,22 @@ int FindByName(const std::vector<T>& items, std::string_view name) {
 
 }  // namespace
 
-std::string_view BrdfModelName(BrdfModel model) {
-  for (const BrdfName& b : kBrdfNames) {
-    if (b.model == model) return b.name;
-  }
-  return "unknown";
-}
+std::string_view BrdfModelName(BrdfModel model) { return Info(model).name; }
 
 std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
-  for (const BrdfName& b : kBrdfNames) {
+  for (const BrdfModelInfo& b : kBrdfModels) {
     if (b.name == name) return b.model;
   }
   return std::nullopt;
+}
+
+std::string_view BrdfModelNames() {
+  static const std::string names = [] {
+    std::string s;
+    for (const BrdfModelInfo& b : kBrdfModels) s += (s.empty() ? "" : ", ") + std::string(b.name);
+    return s;
+  }();
+  return names;
 }
 
 std::vector<std::string> Material::MissingForRendering() const {

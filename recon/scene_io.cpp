@@ -74,29 +74,21 @@ std::set<std::string> ReadGeometry(const SceneLoader& ld, const JsonCursor& root
 // dielectric; metals need a complex index, which this model does not take).
 const NumberRule kIorRule{1.0, 5.0, true, false};
 
-// Keys a material of each model may have.
+// Keys a material of each model may have: its albedo; a lobe's ρs and roughness (α, or αx, αy
+// and the tangent); the index of refraction of a lobe weighted by an ior's Fresnel factor.
 std::vector<std::string_view> MaterialKeys(BrdfModel model) {
-  switch (model) {
-    case BrdfModel::kLambert:
-      return {"brdf", "rho_d", "rho_d_map"};
-    case BrdfModel::kWard:
-    case BrdfModel::kWardGmd:
-      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha"};
-    case BrdfModel::kWardFresnel:
-    case BrdfModel::kWardGmdFresnel:
-      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha", "ior"};
-    case BrdfModel::kWardAniso:
-    case BrdfModel::kWardGmdAniso:
-      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha_x", "alpha_y", "tangent"};
-    case BrdfModel::kWardAnisoFresnel:
-    case BrdfModel::kWardGmdAnisoFresnel:
-      return {"brdf", "rho_d", "rho_d_map", "rho_s", "alpha_x", "alpha_y", "tangent", "ior"};
-    case BrdfModel::kEmitter:
-      return {"brdf", "radiance"};
-    case BrdfModel::kBlack:
-      return {"brdf"};
+  if (model == BrdfModel::kEmitter) return {"brdf", "radiance"};
+  if (model == BrdfModel::kBlack) return {"brdf"};
+  std::vector<std::string_view> keys = {"brdf", "rho_d", "rho_d_map"};
+  if (!HasSpecularLobe(model)) return keys;
+  keys.push_back("rho_s");
+  if (IsAnisotropic(model)) {
+    keys.insert(keys.end(), {"alpha_x", "alpha_y", "tangent"});
+  } else {
+    keys.push_back("alpha");
   }
-  return {"brdf"};
+  if (HasFresnel(model)) keys.push_back("ior");
+  return keys;
 }
 
 Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::string& name) {
@@ -109,9 +101,7 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
   auto brdf_name = c["brdf"].String();
   auto model = brdf_name ? BrdfModelFromName(*brdf_name) : std::nullopt;
   if (brdf_name && !model) {
-    c["brdf"].Problem(
-        "unknown brdf (known: lambert, ward, ward_gmd, ward_aniso, ward_gmd_aniso, emitter, black, "
-        "ward_fresnel, ward_gmd_fresnel, ward_aniso_fresnel, ward_gmd_aniso_fresnel)");
+    c["brdf"].Problem("unknown brdf (known: " + std::string(BrdfModelNames()) + ")");
   }
   if (!model) return m;
   m.brdf = *model;

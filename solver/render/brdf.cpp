@@ -1,5 +1,6 @@
 #include "solver/render/brdf.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -41,14 +42,26 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
     if (recon::HasFresnel(params.model) && !(std::isfinite(params.ior) && params.ior > 1.0)) {
       problems.push_back({"ior", params.ior, "must be finite and > 1"});
     }
+    if (recon::Info(params.model).fresnel == recon::LobeFresnel::kRhoS) {
+      for (int c = 0; c < 3; ++c) {
+        if (params.rho_s[c] > 1.0) {
+          problems.push_back({"rho_s[" + std::to_string(c) + "]", params.rho_s[c],
+                              "must be <= 1 (it is F0, the reflectance at normal incidence)"});
+        }
+      }
+    }
   }
   return problems;
 }
 
-double SpecularLobeProbability(const BrdfParams& params) {
+double SpecularLobeProbability(const BrdfParams& params, const Eigen::Vector3d& wo) {
   if (!recon::HasSpecularLobe(params.model)) return 0.0;
   const double diffuse = Mean(params.rho_d);
-  const double specular = Mean(params.rho_s);
+  double specular = Mean(params.rho_s);
+  if (recon::Info(params.model).fresnel == recon::LobeFresnel::kRhoS) {
+    const double m = std::pow(1.0 - std::clamp(wo.z(), 0.0, 1.0), 5);
+    specular = specular * (1.0 - m) + m;
+  }
   const double total = diffuse + specular;
   return total > 0.0 ? specular / total : 0.0;
 }
@@ -60,15 +73,24 @@ BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& w
   BrdfEval out;
   if (!(wo.z() > 0.0)) return out;
   const bool above = wi.z() > 0.0;
-  const double p_specular = SpecularLobeProbability(params);
+  const double p_specular = SpecularLobeProbability(params, wo);
   if (above) out.f = params.rho_d * kInvPi;
   out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
 
-  // Shared by f and pdf: the unnormalised half vector and the Gaussian of its slopes.
   const double ax = params.AlphaX();
   const double ay = params.AlphaY();
   const Eigen::Vector3d h = wo + wi;
   if (!(h.z() > 0.0)) return out;  // no half vector of the upper hemisphere maps here
+  if (recon::IsMicrofacet(params.model)) {
+    out.pdf += p_specular * microfacet::ReflectedPdf(recon::Lobe(params.model), ax, ay, wo, h);
+    if (above) {
+      const LobeWeights w = SpecularWeights<double>(params.model, ax, ay, params.ior, wo, wi);
+      out.f += params.rho_s * w.scale + Eigen::Vector3d::Constant(w.offset);
+    }
+    return out;
+  }
+  // Ward's lobes, sharing the unnormalised half vector and the Gaussian of its slopes between f
+  // and pdf.
   const double hz2 = h.z() * h.z();
   const double slope_x = h.x() / ax;
   const double slope_y = h.y() / ay;
@@ -91,16 +113,14 @@ BrdfSample SampleGlossyBrdf(const BrdfParams& params, const Eigen::Vector3d& wo,
                             const Eigen::Vector2d& u) {
   BrdfSample sample;
   if (!(wo.z() > 0.0)) return sample;
-  if (u_lobe < SpecularLobeProbability(params)) {
+  if (u_lobe < SpecularLobeProbability(params, wo)) {
     sample.lobe = BrdfLobe::kSpecular;
-    // Slopes (h.x/h.z, h.y/h.z) ~ Gaussian with deviations αx/√2, αy/√2 (Box-Muller radius);
-    // 1 - u.x() is in (0, 1], so the log is finite.
-    const double radius = std::sqrt(-std::log(1.0 - u.x()));
-    double sin_phi, cos_phi;
-    SinCos2Pi(u.y(), &sin_phi, &cos_phi);
+    // Ward's lobes draw as Beckmann's microfacets do (Gaussian slopes).
+    const recon::LobeShape shape = recon::Lobe(params.model) == recon::LobeShape::kGgx
+                                       ? recon::LobeShape::kGgx
+                                       : recon::LobeShape::kBeckmann;
     const Eigen::Vector3d h =
-        Eigen::Vector3d(params.AlphaX() * radius * cos_phi, params.AlphaY() * radius * sin_phi, 1.0)
-            .normalized();
+        microfacet::SampleHalfVector(shape, params.AlphaX(), params.AlphaY(), wo, u);
     const double wo_dot_h = wo.dot(h);
     if (!(wo_dot_h > 0.0)) return sample;  // wo would mirror to the back of h: a failed draw
     sample.wi = (2.0 * wo_dot_h * h - wo).normalized();

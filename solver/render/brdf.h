@@ -18,6 +18,11 @@
 //   ward_gmd_aniso  f = ρd/π + ρs (h·h) exp(-((h.x/αx)² + (h.y/αy)²)/h.z²) / (π αx αy h.z⁴)
 // i.e. f = ρd/π + ρs·S(wo, wi) with the colourless specular factor S of SpecularFactor().
 //
+// The microfacet models ggx, beckmann, ggx_aniso and beckmann_aniso (solver/render/microfacet.h)
+// have S = D·G2/(4 cosθo cosθi) and Schlick's Fresnel factor with F0 = ρs:
+//   f = ρd/π + S·(ρs·(1 − m) + m),   m = (1 − wo·ĥ)⁵,
+// affine in ρs. SpecularWeights() gives every model's lobe as ρs·scale + offset.
+//
 // The Fresnel-weighted models ward_fresnel, ward_gmd_fresnel, ward_aniso_fresnel and
 // ward_gmd_aniso_fresnel (igi's additions) multiply the specular term of the model without the
 // suffix by Schlick's Fresnel factor divided by its value at normal incidence:
@@ -30,11 +35,13 @@
 // η → ∞ (F0 → 1) W → 1 and the model becomes the plain one. W is symmetric in wi and wo, so the
 // models stay reciprocal. The diffuse term is not weighted.
 //
-// Sampling picks the diffuse lobe (cosine-weighted) or the specular lobe (Ward's half-vector
-// sampling: the slopes (h.x/h.z, h.y/h.z) are Gaussian with deviations αx/√2, αy/√2, and wi is wo
-// mirrored about h) with probabilities from the lobes' mean RGB albedos (ρs, without the
-// Fresnel weight: the *_fresnel models sample exactly as their plain models do). BrdfPdf() is the
-// exact combined density of that procedure over the whole sphere of wi, so it serves MIS directly.
+// Sampling picks the diffuse lobe (cosine-weighted) or the specular lobe with probabilities from
+// the lobes' mean RGB albedos (SpecularLobeProbability). Ward's lobes and Beckmann's draw the half
+// vector's slopes (h.x/h.z, h.y/h.z) from a Gaussian with deviations αx/√2, αy/√2 (Ward's
+// half-vector sampling, which is Beckmann's D·cosθh); GGX draws the visible normals (Heitz 2018);
+// wi is wo mirrored about ĥ. The *_fresnel models sample exactly as their plain models do.
+// BrdfPdf() is the exact combined density of that procedure over the whole sphere of wi, so it
+// serves MIS directly.
 //
 // EvalBrdf/SpecularFactor are templates so Ceres Jets flow through the parameters (and the
 // directions); their branches compare values only, which Jets support.
@@ -47,6 +54,7 @@
 #include <vector>
 
 #include "recon/brdf_model.h"
+#include "solver/render/microfacet.h"
 #include "solver/render/sampling.h"
 
 namespace igi::render {
@@ -88,13 +96,16 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params);
 
 // S(wo, wi) of the header comment for a model with specular lobe; 0 for lambert or when wo or
 // wi is at or below the surface. Isotropic models take alpha_x = alpha_y = alpha. For a
-// *_fresnel model it is S of the plain model (without the Fresnel weight W).
+// *_fresnel model it is S of the plain model (without the Fresnel weight W); for a microfacet
+// model D·G2/(4 cosθo cosθi), without its Fresnel factor.
 template <typename T>
 T SpecularFactor(recon::BrdfModel model, const T& alpha_x, const T& alpha_y,
                  const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
   using std::exp;
   using std::sqrt;
   if (!recon::HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return T(0.0);
+  if (recon::IsMicrofacet(model))
+    return microfacet::Factor<T>(recon::Lobe(model), alpha_x, alpha_y, wo, wi);
   const Eigen::Matrix<T, 3, 1> h = wo + wi;
   const T hz2 = h.z() * h.z();
   const T slope_x = h.x() / alpha_x;
@@ -104,12 +115,12 @@ T SpecularFactor(recon::BrdfModel model, const T& alpha_x, const T& alpha_y,
   return lobe / (T(4.0 * kPi) * alpha_x * alpha_y * sqrt(wo.z() * wi.z()));
 }
 
-// SpecularFactor split into the parts that do not depend on the roughness, for searches over α:
-// S = g·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y). False (parts unset) when S is 0 at every α (no lobe,
-// or wo or wi at or below the surface).
+// SpecularFactor of Ward's lobes split into the parts that do not depend on the roughness, for
+// searches over α: S = g·exp(−(q_x/α_x² + q_y/α_y²))/(α_x·α_y). False (parts unset) when the model
+// has no Ward lobe or S is 0 at every α (wo or wi at or below the surface).
 inline bool SpecularFactorParts(recon::BrdfModel model, const Eigen::Vector3d& wo,
                                 const Eigen::Vector3d& wi, double* q_x, double* q_y, double* g) {
-  if (!recon::HasSpecularLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return false;
+  if (!recon::IsWardLobe(model) || !(wo.z() > 0.0) || !(wi.z() > 0.0)) return false;
   const Eigen::Vector3d h = wo + wi;
   const double hz2 = h.z() * h.z();
   *q_x = h.x() * h.x() / hz2;
@@ -132,6 +143,42 @@ T FresnelWeight(const T& ior, const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Mat
   return T(1.0) + (T(1.0) / f0 - T(1.0)) * (m2 * m2 * m);
 }
 
+// A lobe's value per unit ρs and its part that ρs does not scale: the lobe is ρs_c·scale + offset
+// in each channel c. scale = S·W for Ward's models (W = 1 without Fresnel weight, offset 0);
+// S·(1 − m) and S·m for the microfacet models (Schlick's F = ρs + (1 − ρs)·m).
+template <typename T>
+struct LobeWeightsT {
+  T scale = T(0.0);
+  T offset = T(0.0);
+};
+using LobeWeights = LobeWeightsT<double>;
+
+// The lobe of `model` at (αx, αy) for wo, wi (local); zero when it has none or wo or wi is at or
+// below the surface. `ior` is read by the *_fresnel models only.
+template <typename T>
+LobeWeightsT<T> SpecularWeights(recon::BrdfModel model, const T& alpha_x, const T& alpha_y,
+                                const T& ior, const Eigen::Matrix<T, 3, 1>& wo,
+                                const Eigen::Matrix<T, 3, 1>& wi) {
+  LobeWeightsT<T> w;
+  const T s = SpecularFactor<T>(model, alpha_x, alpha_y, wo, wi);
+  if (!(s > 0.0)) return w;
+  switch (recon::Info(model).fresnel) {
+    case recon::LobeFresnel::kNone:
+      w.scale = s;
+      break;
+    case recon::LobeFresnel::kIorWeight:
+      w.scale = s * FresnelWeight<T>(ior, wo, wi);
+      break;
+    case recon::LobeFresnel::kRhoS: {
+      const T m = microfacet::SchlickWeight<T>(wo, wi);
+      w.scale = s * (T(1.0) - m);
+      w.offset = s * m;
+      break;
+    }
+  }
+  return w;
+}
+
 // f(wo, wi), RGB per steradian; zero when wo or wi is at or below the surface.
 template <typename T>
 Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,
@@ -139,9 +186,9 @@ Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matri
   if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) return Eigen::Matrix<T, 3, 1>::Zero();
   Eigen::Matrix<T, 3, 1> f = params.rho_d * T(kInvPi);
   if (recon::HasSpecularLobe(params.model)) {
-    T s = SpecularFactor<T>(params.model, params.AlphaX(), params.AlphaY(), wo, wi);
-    if (recon::HasFresnel(params.model)) s *= FresnelWeight<T>(params.ior, wo, wi);
-    f += params.rho_s * s;
+    const LobeWeightsT<T> w =
+        SpecularWeights<T>(params.model, params.AlphaX(), params.AlphaY(), params.ior, wo, wi);
+    f += params.rho_s * w.scale + Eigen::Matrix<T, 3, 1>::Constant(w.offset);
   }
   return f;
 }
@@ -168,9 +215,10 @@ struct BrdfSample {
   bool Valid() const { return pdf > 0.0 && wi.z() > 0.0; }
 };
 
-// Probability of drawing from the specular lobe: mean(ρs)/(mean(ρd) + mean(ρs)); 0 for lambert
-// and for an all-black material.
-double SpecularLobeProbability(const BrdfParams& params);
+// Probability of drawing from the specular lobe given wo (local): s/(mean(ρd) + s) with s the
+// lobe's mean reflectance estimate, mean(ρs) for Ward's lobes and Schlick's mean(ρs + (1 − ρs)·
+// (1 − cosθo)⁵) for the microfacet ones; 0 for lambert and for an all-black material.
+double SpecularLobeProbability(const BrdfParams& params, const Eigen::Vector3d& wo);
 
 // EvalBrdf and BrdfPdf in one call (shares the half vector): what light sampling with MIS needs.
 struct BrdfEval {

@@ -59,7 +59,7 @@ struct PathState {
 // depend on the parameters: they are the estimator's, not the integrand's).
 struct VertexShares {
   Eigen::Vector3d d = Eigen::Vector3d::Zero();  // (ρd/π)/f: linear in the albedo scale
-  Eigen::Vector3d s = Eigen::Vector3d::Zero();  // (f − ρd/π)/f: the lobe is linear in ρs
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();  // ρs·scale/f: the part of the lobe ρs scales
   Eigen::Vector3d a = Eigen::Vector3d::Zero();  // ∂ln f/∂ln α
 };
 
@@ -88,23 +88,35 @@ class PathDerivative {
 };
 
 // The shares of a BRDF value f = EvalBrdf(params, wo, wi) (local frame). The lobe's part
-// ρs·W·S has S = g·exp(−Q)/(αx·αy), Q = qx/αx² + qy/αy² (SpecularFactorParts), so scaling both
-// roughnesses by e^t gives ∂ln S/∂t = 2Q − 2 at t = 0.
+// ρs·scale + offset (SpecularWeights) is proportional to S at any α. For Ward's lobes
+// S = g·exp(−Q)/(αx·αy), Q = qx/αx² + qy/αy² (SpecularFactorParts), so scaling both roughnesses
+// by e^t gives ∂ln S/∂t = 2Q − 2 at t = 0; for the microfacet lobes it is a central difference
+// in t. ρs scales only the `scale` part (Schlick's F0 = ρs leaves F's grazing part).
 VertexShares BrdfShares(const BrdfParams& params, const Eigen::Vector3d& wo,
                         const Eigen::Vector3d& wi, const Eigen::Vector3d& f) {
   VertexShares out;
   double lobe_log_slope = 0;
   double qx = 0, qy = 0, g = 0;
+  const double ax = params.AlphaX(), ay = params.AlphaY();
   if (SpecularFactorParts(params.model, wo, wi, &qx, &qy, &g)) {
-    const double ax = params.AlphaX(), ay = params.AlphaY();
     lobe_log_slope = 2 * (qx / (ax * ax) + qy / (ay * ay)) - 2;
+  } else if (recon::IsMicrofacet(params.model)) {
+    constexpr double kStep = 1e-4;
+    const double up = std::exp(kStep), down = std::exp(-kStep);
+    const double s_up = SpecularFactor<double>(params.model, ax * up, ay * up, wo, wi);
+    const double s_down = SpecularFactor<double>(params.model, ax * down, ay * down, wo, wi);
+    if (s_up > 0 && s_down > 0) lobe_log_slope = std::log(s_up / s_down) / (2 * kStep);
   }
+  const LobeWeights w = recon::HasSpecularLobe(params.model)
+                            ? SpecularWeights<double>(params.model, ax, ay, params.ior, wo, wi)
+                            : LobeWeights{};
   for (int c = 0; c < 3; ++c) {
     if (!(f[c] > 0)) continue;
     const double diffuse = params.rho_d[c] * kInvPi;
+    const double lobe = std::clamp((f[c] - diffuse) / f[c], 0.0, 1.0);
     out.d[c] = std::min(1.0, diffuse / f[c]);
-    out.s[c] = std::clamp((f[c] - diffuse) / f[c], 0.0, 1.0);
-    out.a[c] = out.s[c] * lobe_log_slope;
+    out.s[c] = w.offset > 0 ? std::clamp(params.rho_s[c] * w.scale / f[c], 0.0, 1.0) : lobe;
+    out.a[c] = lobe * lobe_log_slope;
   }
   return out;
 }

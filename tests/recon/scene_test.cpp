@@ -181,6 +181,54 @@ TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
   fs::remove_all(dir);
 }
 
+// The microfacet models (docs/scene-format.md) take the keys of the Ward model of the same
+// anisotropy: no "ior" (their Fresnel factor's F0 is rho_s), rho_s in [0, 1], α in (0, 1].
+TEST(SceneTest, MicrofacetModelsReadTheKeysOfTheirWardForms) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("igi_scene_microfacet_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Json doc = ReadJsonFile(kMini);
+  const fs::path mini = kMini.parent_path();
+  for (auto& g : doc["geometry"]) g["file"] = (mini / g["file"].get<std::string>()).string();
+  doc["materials"]["floor"]["rho_d_map"] = (mini / "textures/floor.exr").string();
+  doc["lights"]["spot"]["profile"]["ies"] = (mini / "lights/spot.ies").string();
+  doc["lights"]["panel"]["file"] = (mini / "geometry/panel.obj").string();
+  for (auto& photo : doc["photos"]) {
+    photo["file"] = (mini / photo["file"].get<std::string>()).string();
+    if (photo.contains("mask") && photo["mask"].is_string()) {
+      photo["mask"] = (mini / photo["mask"].get<std::string>()).string();
+    }
+  }
+  doc["materials"]["floor"]["brdf"] = "ggx";
+  doc["materials"]["box"] = {{"brdf", "beckmann_aniso"}, {"tangent", {1, 0, 0}}};
+  WriteJsonFile(dir / "scene.json", doc);
+  const Scene scene = LoadScene(dir / "scene.json");
+  const Material& floor = scene.materials[scene.FindMaterial("floor")];
+  EXPECT_EQ(floor.brdf, BrdfModel::kGgx);
+  EXPECT_TRUE(floor.MissingForRendering().empty());
+  const Material& box = scene.materials[scene.FindMaterial("box")];
+  EXPECT_EQ(box.brdf, BrdfModel::kBeckmannAniso);
+  EXPECT_EQ(box.MissingForRendering(),
+            (std::vector<std::string>{"rho_d", "rho_s", "alpha_x", "alpha_y"}));
+
+  const std::pair<const char*, Json> bad[] = {
+      {"ior", 1.5}, {"rho_s", 1.2}, {"alpha", 0.0}, {"alpha", 1.5}, {"alpha_x", 0.2}};
+  for (const auto& [key, value] : bad) {
+    Json broken = doc;
+    broken["materials"]["floor"][key] = value;
+    WriteJsonFile(dir / "scene.json", broken);
+    try {
+      LoadScene(dir / "scene.json");
+      ADD_FAILURE() << key << " " << value;
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.problems().size(), 1u) << e.what();
+      EXPECT_NE(e.problems()[0].find(std::string("materials.floor.") + key), std::string::npos)
+          << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace igi::recon
 
