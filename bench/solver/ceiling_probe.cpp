@@ -219,8 +219,9 @@ int main(int argc, char** argv) {
               for (const solver::WeightedDirection& d2 :
                    solver::HemisphereDirections(hq, spec_rays, 0.2, r2)) {
                 const double sw =
-                    solver::SpecularWeight(hm.params.model, hm.params.AlphaX(), hm.params.AlphaY(),
-                                           hm.params.ior, wo, frame.ToLocal(d2.wi));
+                    solver::LobeWeight(hm.params.model, hm.params.AlphaX(), hm.params.AlphaY(),
+                                       hm.params.ior, wo, frame.ToLocal(d2.wi))
+                        .scale;
                 if (!(sw > 0)) continue;
                 l_spec_ind += sw * d2.weight *
                               ref.ReflectedRadiance(h->position + h->n_geo * eps, d2.wi, 1,

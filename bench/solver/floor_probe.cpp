@@ -70,8 +70,9 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d wo =
         s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     for (const solver::IncidentLocal& inc : s.light.incident[i]) {
-      const double w = solver::SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo,
-                                              inc.Wi().cast<double>());
+      const double w = solver::LobeWeight(m.params.model, a_true, a_true, m.params.ior, wo,
+                                          inc.Wi().cast<double>())
+                           .scale;
       if (w > 0) t_true[i] += w * inc.Value().cast<double>();
     }
   }
@@ -322,10 +323,12 @@ int main(int argc, char** argv) {
         s.materials.LocalFrame(floor, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     double tt = 0, tf = 0;
     for (const solver::IncidentLocal& inc : s.light.incident[i]) {
-      const double w1 = solver::SpecularWeight(m.params.model, a_true, a_true, m.params.ior, wo,
-                                               inc.Wi().cast<double>());
-      const double w2 = solver::SpecularWeight(m.params.model, m.params.alpha, m.params.alpha,
-                                               m.params.ior, wo, inc.Wi().cast<double>());
+      const double w1 = solver::LobeWeight(m.params.model, a_true, a_true, m.params.ior, wo,
+                                           inc.Wi().cast<double>())
+                            .scale;
+      const double w2 = solver::LobeWeight(m.params.model, m.params.alpha, m.params.alpha,
+                                           m.params.ior, wo, inc.Wi().cast<double>())
+                            .scale;
       if (w1 > 0) tt += w1 * inc.Value().cast<double>().mean();
       if (w2 > 0) tf += w2 * inc.Value().cast<double>().mean();
     }

@@ -12,15 +12,25 @@ MapLight MapLightOf(const MapStageData& d) {
   const LightModel& light = d.light;
   const double radius = o.smoothing_radius_m > 0 ? o.smoothing_radius_m : d.scene_scale_m / 96;
   MapLight out;
+  std::vector<Eigen::Vector3d> t0_direct;
   const std::vector<Eigen::Vector3d> t_direct =
-      DirectSpecularTerms(d.scene, d.obs, d.materials, light, o.num_threads);
-  std::vector<Eigen::Vector3d> t_indirect(d.obs.size());
-  for (size_t i = 0; i < d.obs.size(); ++i) t_indirect[i] = light.t[i] - t_direct[i];
+      DirectSpecularTerms(d.scene, d.obs, d.materials, light, o.num_threads, &t0_direct);
+  const bool offsets = light.t0.size() == d.obs.size();
+  std::vector<Eigen::Vector3d> t_indirect(d.obs.size()), t0_indirect(d.obs.size());
+  for (size_t i = 0; i < d.obs.size(); ++i) {
+    t_indirect[i] = light.t[i] - t_direct[i];
+    t0_indirect[i].setZero();
+    if (offsets) t0_indirect[i] = light.t0[i] - t0_direct[i];
+  }
   out.t_indirect =
       NeighbourMean(d.obs, light.lightings, t_indirect, d.scene_scale_m / 96, true, o.num_threads);
+  out.t0_indirect =
+      NeighbourMean(d.obs, light.lightings, t0_indirect, d.scene_scale_m / 96, true, o.num_threads);
   out.t.resize(d.obs.size());
+  out.t0.resize(d.obs.size());
   for (size_t i = 0; i < d.obs.size(); ++i) {
     out.t[i] = (t_direct[i] + out.t_indirect[i]).cwiseMax(0.0);
+    out.t0[i] = (t0_direct[i] + out.t0_indirect[i]).cwiseMax(0.0);
   }
   const bool have_stage1 = light.e_stage1.size() == d.obs.size() && d.stage2_iterations > 0;
   if (!have_stage1 || !IsJointUpdate(o.refine_update)) {
@@ -70,7 +80,7 @@ void AddObservations(const MapStageData& d, int r, const MapLight& light, int ph
     const Observation& o = d.obs[i];
     if (o.region != r) continue;
     if (photo_parity >= 0 && o.photo % 2 != photo_parity) continue;
-    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(light.t[i]);
+    const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(light.t[i]) + light.t0[i];
     const Eigen::Vector3d diffuse = o.radiance.cast<double>() - spec;
     // Highlights tell little about the albedo and much about any error in the fitted lobe:
     // weight each observation by its diffuse share, and leave out those under half diffuse.

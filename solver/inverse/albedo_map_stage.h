@@ -45,8 +45,11 @@ struct MapStageData {
 // reflected room, so the indirect part is noisy (the same view, nearly), while the direct part
 // from the light samples is not, and near a highlight it varies within a smoothing radius, where
 // a mean over neighbours would subtract the highlight's flanks from the albedo.
+// Per observation: the specular term per unit ρs (t, its indirect part t_indirect smoothed over
+// the neighbours), the lobe's part that ρs does not scale (t0, t0_indirect likewise) and the
+// irradiance e the maps use.
 struct MapLight {
-  std::vector<Eigen::Vector3d> t, t_indirect, e;
+  std::vector<Eigen::Vector3d> t, t_indirect, t0, t0_indirect, e;
 };
 MapLight MapLightOf(const MapStageData& d);
 

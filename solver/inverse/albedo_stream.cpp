@@ -111,18 +111,21 @@ std::vector<Image> SolverState::StreamAlbedoMaps(const std::vector<int>& regions
             const Eigen::Vector3d ratio =
                 (e_direct + e_indirect).cwiseQuotient((light.e[j]).cwiseMax(1e-300));
             const Eigen::Vector3d e = map_e[j].cwiseProduct(ratio);
-            Eigen::Vector3d t = Eigen::Vector3d::Zero();
-            if (recon::HasSpecularLobe(m.params.model) && m.params.rho_s.maxCoeff() > 0) {
+            Eigen::Vector3d t = Eigen::Vector3d::Zero(), t0 = t;
+            const bool offset = recon::Info(m.params.model).fresnel == recon::LobeFresnel::kRhoS;
+            if (recon::HasSpecularLobe(m.params.model) &&
+                (offset || m.params.rho_s.maxCoeff() > 0)) {
               // The pixel's own direct lobe, and the indirect part of T at the nearest
               // observation of the same photo (of any photo when it has none near).
               const double spread =
                   options.pixel_footprint ? PixelNormalSpread(*quarter, hit->n_s) : 0.0;
               const int jv = grid_in_photo.Nearest(int(i), hit->region, hit->position, hit->n_s);
               t = DirectSpecularTerm(m.params, spread, materials.LocalFrame(hit->region, hit->n_s),
-                                     -dir, direct.data(), int64_t(direct.size())) +
+                                     -dir, direct.data(), int64_t(direct.size()), &t0) +
                   map_light.t_indirect[jv >= 0 ? jv : j].cwiseMax(0.0);
+              t0 += map_light.t0_indirect[jv >= 0 ? jv : j].cwiseMax(0.0);
             }
-            const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t);
+            const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t) + t0;
             const Eigen::Vector3d diffuse = value.cast<double>() - spec;
             // As the maps from the observations (AlbedoMapOf): each weighted by its diffuse share.
             const int patch = patches.PatchOf(hit->triangle, hit->b1, hit->b2);

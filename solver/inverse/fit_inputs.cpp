@@ -5,8 +5,8 @@ namespace igi::solver {
 std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet& patches,
                                       const ObservationSet& obs, const LightModel& light,
                                       const MaterialEstimate& materials, int stage,
-                                      bool grey_specular, bool held_out_albedo,
-                                      std::vector<int>* regions) {
+                                      const SolveOptions& options, std::vector<int>* regions) {
+  const bool grey_specular = options.specular_colour == SpecularColour::kGrey;
   regions->clear();
   for (size_t r = 0; r < materials.size(); ++r) {
     if (materials[r].NeedsFit() && materials[r].observations > 0) regions->push_back(int(r));
@@ -33,7 +33,8 @@ std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet&
     in.ior = m.params.ior;
     if (m.last_fit.fitted && recon::HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
-    in.use_held_albedo = held_out_albedo;
+    if (options.uniform_albedo) in.albedo_varies = false;
+    in.use_held_albedo = options.held_out_albedo;
     in.num_slots = static_cast<int>(materials.region_patches[r].size());
     for (int q : materials.region_patches[r]) in.slot_area.push_back(patches.area[q]);
   }

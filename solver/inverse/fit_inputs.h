@@ -11,6 +11,7 @@
 #include "solver/inverse/observation_set.h"
 #include "solver/inverse/patches.h"
 #include "solver/inverse/region_fit.h"
+#include "solver/inverse/solve_options.h"
 
 namespace igi::solver {
 
@@ -19,12 +20,12 @@ namespace igi::solver {
 // radiance, its irradiance (light.e), the given albedo where ρd is known, its patch's slot, its
 // held-out albedo and lobe (materials.held_*, where HeldOutAlbedos filled them), its view in the
 // local frame and its incident samples, read in place (`light` must outlive the inputs). Stage 2
-// (`stage`) keeps stage 1's decision whether the albedo varies; a region fitted before starts its α
-// search there.
+// (`stage`) keeps stage 1's decision whether the albedo varies (with options.uniform_albedo it
+// never does); a region fitted before starts its α search there. The options' specular colour and
+// held-out albedo go to every input.
 std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet& patches,
                                       const ObservationSet& obs, const LightModel& light,
                                       const MaterialEstimate& materials, int stage,
-                                      bool grey_specular, bool held_out_albedo,
-                                      std::vector<int>* regions);
+                                      const SolveOptions& options, std::vector<int>* regions);
 
 }  // namespace igi::solver

@@ -157,11 +157,10 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
   const SolveOptions& options = d.options;
   MaterialEstimate& materials = *estimate;
   const auto start = std::chrono::steady_clock::now();
-  HeldOutAlbedos(obs, light.e, light.t, d.scene.mesh, d.texel_size_m, &materials);
+  HeldOutAlbedos(obs, light.e, light.t, light.t0, d.scene.mesh, d.texel_size_m, &materials);
   std::vector<int> regions;
-  std::vector<RegionFitInput> inputs = FitInputs(d.scene, d.patches, obs, light, materials, stage,
-                                                 options.specular_colour == SpecularColour::kGrey,
-                                                 options.held_out_albedo, &regions);
+  std::vector<RegionFitInput> inputs =
+      FitInputs(d.scene, d.patches, obs, light, materials, stage, options, &regions);
   std::vector<RegionFitResult> results(regions.size());
   for (size_t k = 0; k < regions.size(); ++k) {
     Eigen::Vector3d e = Eigen::Vector3d::Zero(), l = e;

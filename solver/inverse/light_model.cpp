@@ -40,8 +40,9 @@ void SmoothIrradiance(const ObservationSet& obs, int num_threads, LightModel* li
 std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
                                            const MaterialEstimate& materials,
                                            const std::vector<std::vector<IncidentLocal>>& incident,
-                                           int num_threads) {
+                                           int num_threads, std::vector<Eigen::Vector3d>* offsets) {
   std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
+  offsets->assign(obs.size(), Eigen::Vector3d::Zero());
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
@@ -52,13 +53,15 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
             materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
         const double ax = WidenedAlpha(m.params.AlphaX(), o.lobe_blur2);
         const double ay = WidenedAlpha(m.params.AlphaY(), o.lobe_blur2);
-        Eigen::Vector3d t = Eigen::Vector3d::Zero();
+        Eigen::Vector3d t = Eigen::Vector3d::Zero(), t0 = t;
         for (const IncidentLocal& inc : incident[i]) {
-          const double w =
-              SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, inc.Wi().cast<double>());
-          if (w > 0) t += w * inc.Value().cast<double>();
+          const render::LobeWeights w =
+              LobeWeight(m.params.model, ax, ay, m.params.ior, wo, inc.Wi().cast<double>());
+          if (w.scale > 0) t += w.scale * inc.Value().cast<double>();
+          if (w.offset > 0) t0 += w.offset * inc.Value().cast<double>();
         }
         out[i] = t;
+        (*offsets)[i] = t0;
       },
       num_threads);
   return out;
@@ -66,14 +69,16 @@ std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
 
 Eigen::Vector3d DirectSpecularTerm(const render::BrdfParams& p, double blur2,
                                    const render::Frame& frame, const Eigen::Vector3d& view,
-                                   const DirectSample* d, int64_t n) {
+                                   const DirectSample* d, int64_t n, Eigen::Vector3d* offset) {
   const double ax = WidenedAlpha(p.AlphaX(), blur2), ay = WidenedAlpha(p.AlphaY(), blur2);
   const Eigen::Vector3d wo = frame.ToLocal(view);
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  offset->setZero();
   for (int64_t k = 0; k < n; ++k) {
-    const double w =
-        SpecularWeight(p.model, ax, ay, p.ior, wo, frame.ToLocal(d[k].wi.cast<double>()));
-    if (w > 0) t += w * d[k].value.cast<double>();
+    const render::LobeWeights w =
+        LobeWeight(p.model, ax, ay, p.ior, wo, frame.ToLocal(d[k].wi.cast<double>()));
+    if (w.scale > 0) t += w.scale * d[k].value.cast<double>();
+    if (w.offset > 0) *offset += w.offset * d[k].value.cast<double>();
   }
   return t;
 }
@@ -81,8 +86,10 @@ Eigen::Vector3d DirectSpecularTerm(const render::BrdfParams& p, double blur2,
 std::vector<Eigen::Vector3d> DirectSpecularTerms(const recon::Scene& scene,
                                                  const ObservationSet& obs,
                                                  const MaterialEstimate& materials,
-                                                 const LightModel& light, int num_threads) {
+                                                 const LightModel& light, int num_threads,
+                                                 std::vector<Eigen::Vector3d>* offsets) {
   std::vector<Eigen::Vector3d> out(obs.size(), Eigen::Vector3d::Zero());
+  offsets->assign(obs.size(), Eigen::Vector3d::Zero());
   ParallelFor(
       0, int64_t(obs.size()),
       [&](int64_t i) {
@@ -94,7 +101,7 @@ std::vector<Eigen::Vector3d> DirectSpecularTerms(const recon::Scene& scene,
         out[i] = DirectSpecularTerm(
             p, o.lobe_blur2, materials.LocalFrame(o.region, o.normal.cast<double>()),
             o.view.cast<double>(), st.gather.direct.data() + gp.direct_begin,
-            gp.direct_end - gp.direct_begin);
+            gp.direct_end - gp.direct_begin, &(*offsets)[i]);
       },
       num_threads);
   return out;
@@ -153,20 +160,22 @@ Eigen::Vector3d PatchSpecular(const PatchSet& patches, const MaterialEstimate& m
                               const LightingState& st, int q, const Eigen::Vector3d& toward) {
   const int r = patches.patch_region[q];
   const MaterialState& m = materials[r];
-  if (st.lobe_begin[q] == st.lobe_begin[q + 1] || !(m.params.rho_s.maxCoeff() > 0)) {
+  const bool offset = recon::Info(m.params.model).fresnel == recon::LobeFresnel::kRhoS;
+  if (st.lobe_begin[q] == st.lobe_begin[q + 1] || !(offset || m.params.rho_s.maxCoeff() > 0)) {
     return Eigen::Vector3d::Zero();
   }
   const render::Frame frame = materials.LocalFrame(r, patches.normal[q].cast<double>());
   const Eigen::Vector3d wo = frame.ToLocal(toward);
   if (!(wo.z() > 0)) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d s = Eigen::Vector3d::Zero(), s0 = s;
   for (int k = st.lobe_begin[q]; k < st.lobe_begin[q + 1]; ++k) {
     const DirectSample& d = st.lobes[k];
-    const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
-                                    m.params.ior, wo, frame.ToLocal(d.wi.cast<double>()));
-    s += w * d.value.cast<double>();
+    const render::LobeWeights w = LobeWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                             m.params.ior, wo, frame.ToLocal(d.wi.cast<double>()));
+    s += w.scale * d.value.cast<double>();
+    s0 += w.offset * d.value.cast<double>();
   }
-  return s.cwiseProduct(m.params.rho_s);
+  return s.cwiseProduct(m.params.rho_s) + s0;
 }
 
 Eigen::Vector3d PatchRadiance(const PatchSet& patches, const MaterialEstimate& materials,
@@ -175,18 +184,21 @@ Eigen::Vector3d PatchRadiance(const PatchSet& patches, const MaterialEstimate& m
 }
 
 // The specular radiance an indirect sample's glossy hit reflects back along the sample from its
-// bounce (solver/inverse/gather.h): ρs·S·W(wo, wi)·weight times the diffuse radiance of the patch
-// the bounce meets (the specular part of that radiance is left out: second order in ρs).
+// bounce (solver/inverse/gather.h): the lobe (ρs·scale + offset)(wo, wi)·weight times the diffuse
+// radiance of the patch the bounce meets (the specular part of that radiance is left out: second
+// order in the lobe).
 Eigen::Vector3d BounceRadiance(const PatchSet& patches, const MaterialEstimate& materials,
                                const LightingState& st, const IndirectSample& s) {
   if (s.bounce < 0 || s.patch < 0) return Eigen::Vector3d::Zero();
   const SpecularBounce& b = st.gather.bounces[s.bounce];
   const MaterialState& m = materials[patches.patch_region[s.patch]];
-  if (b.patch < 0 || !(m.params.rho_s.maxCoeff() > 0)) return Eigen::Vector3d::Zero();
-  const double w = SpecularWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
-                                  m.params.ior, b.wo.cast<double>(), b.wi.cast<double>());
-  if (!(w > 0)) return Eigen::Vector3d::Zero();
-  return (w * b.weight) * m.params.rho_s.cwiseProduct(st.patch_d[b.patch].cast<double>());
+  const bool offset = recon::Info(m.params.model).fresnel == recon::LobeFresnel::kRhoS;
+  if (b.patch < 0 || !(offset || m.params.rho_s.maxCoeff() > 0)) return Eigen::Vector3d::Zero();
+  const render::LobeWeights w = LobeWeight(m.params.model, m.params.AlphaX(), m.params.AlphaY(),
+                                           m.params.ior, b.wo.cast<double>(), b.wi.cast<double>());
+  if (!(w.scale > 0) && !(w.offset > 0)) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d lobe = m.params.rho_s * w.scale + Eigen::Vector3d::Constant(w.offset);
+  return b.weight * lobe.cwiseProduct(st.patch_d[b.patch].cast<double>());
 }
 
 }  // namespace
@@ -202,12 +214,13 @@ Eigen::Vector3d IndirectRadiance(const PatchSet& patches, const MaterialEstimate
 // predicted specular part; patches no photo of the lighting sees get ρd·E/π.
 void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
                          const MaterialEstimate& materials, const std::vector<Eigen::Vector3d>& t,
-                         int num_threads, LightingState* st) {
+                         const std::vector<Eigen::Vector3d>& t0, int num_threads,
+                         LightingState* st) {
   std::vector<Eigen::Vector3d> sum(patches.size(), Eigen::Vector3d::Zero());
   std::vector<int> count(patches.size(), 0);
   for (int i : st->obs) {
     const Observation& o = obs[i];
-    const Eigen::Vector3d spec = materials[o.region].params.rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d spec = materials[o.region].params.rho_s.cwiseProduct(t[i]) + t0[i];
     sum[o.patch] += (o.radiance.cast<double>() - spec).cwiseMax(0.0);
     ++count[o.patch];
   }

@@ -70,7 +70,10 @@ struct LightModel {
   // (SmoothIrradiance): the irradiance the fits divide by; `e` at the end of stage 1.
   std::vector<Eigen::Vector3d> e_direct, e_indirect, e, e_stage1;
   std::vector<std::vector<IncidentLocal>> incident;  // in the local frame (glossy regions)
-  std::vector<Eigen::Vector3d> t;                    // T = Σ S·W·v at the current α
+  std::vector<Eigen::Vector3d> t;                    // T = Σ scale·v at the current α
+  // O = Σ offset·v at the current α: the lobe's part that ρs does not scale (the microfacet
+  // models' grazing Fresnel; zero for Ward's lobes), so that the lobe is ρs∘T + O.
+  std::vector<Eigen::Vector3d> t0;
   // Per observation: the radius its indirect irradiance is smoothed over (empty until the
   // solve first smooths).
   std::vector<float> smoothing_radius;
@@ -95,27 +98,28 @@ std::vector<Eigen::Vector3d> NeighbourMean(const ObservationSet& obs,
 // noisy.
 void SmoothIrradiance(const ObservationSet& obs, int num_threads, LightModel* light);
 
-// Per observation: its specular term T = Σ S·W·v over its incident samples (`incident`, in the
-// local frame) with its region's lobe at the current α widened by the pixel's spread of normals;
-// zero for regions without a lobe.
+// Per observation: its specular term T = Σ scale·v over its incident samples (`incident`, in the
+// local frame) with its region's lobe at the current α widened by the pixel's spread of normals
+// (render::SpecularWeights), and in `offsets` O = Σ offset·v; zero for regions without a lobe.
 std::vector<Eigen::Vector3d> SpecularTerms(const ObservationSet& obs,
                                            const MaterialEstimate& materials,
                                            const std::vector<std::vector<IncidentLocal>>& incident,
-                                           int num_threads);
+                                           int num_threads, std::vector<Eigen::Vector3d>* offsets);
 
-// The direct part of a point's specular term T: Σ S·W·v over its direct samples d[0..n) (world
+// The direct part of a point's specular term T: Σ scale·v over its direct samples d[0..n) (world
 // directions) with the lobe of `p` widened by the spread of normals `blur2` (as SpecularTerms),
-// in `frame`, seen from `view` (world, unit).
+// in `frame`, seen from `view` (world, unit); its O = Σ offset·v in `offset`.
 Eigen::Vector3d DirectSpecularTerm(const render::BrdfParams& p, double blur2,
                                    const render::Frame& frame, const Eigen::Vector3d& view,
-                                   const DirectSample* d, int64_t n);
+                                   const DirectSample* d, int64_t n, Eigen::Vector3d* offset);
 
-// Per observation: DirectSpecularTerm over its gather point's direct samples; zero for regions
-// without a lobe.
+// Per observation: DirectSpecularTerm over its gather point's direct samples (O in `offsets`);
+// zero for regions without a lobe.
 std::vector<Eigen::Vector3d> DirectSpecularTerms(const recon::Scene& scene,
                                                  const ObservationSet& obs,
                                                  const MaterialEstimate& materials,
-                                                 const LightModel& light, int num_threads);
+                                                 const LightModel& light, int num_threads,
+                                                 std::vector<Eigen::Vector3d>* offsets);
 
 // Each patch's direct samples (its gather point's) grouped into at most four representative
 // directions, for the specular part of the radiance it sends toward other points.
@@ -128,11 +132,12 @@ Eigen::Vector3d IndirectRadiance(const PatchSet& patches, const MaterialEstimate
                                  const LightingState& st, const IndirectSample& s);
 
 // D_q, st->patch_d: the diffuse radiance of each patch, the photos' mean over its observations
-// (of st->obs) less their predicted specular part ρs·t; patches no photo of the lighting sees
-// get ρd·E/π, their irradiance E (st->patch_e) from the patches' new radiance (two sweeps).
+// (of st->obs) less their predicted specular part ρs∘t + t0; patches no photo of the lighting
+// sees get ρd·E/π, their irradiance E (st->patch_e) from the patches' new radiance (two sweeps).
 void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
                          const MaterialEstimate& materials, const std::vector<Eigen::Vector3d>& t,
-                         int num_threads, LightingState* st);
+                         const std::vector<Eigen::Vector3d>& t0, int num_threads,
+                         LightingState* st);
 
 // Per observation of the active lightings: light->e_direct (its gather point's), light->
 // e_indirect (its indirect samples' radiance from the patches) and light->incident (both as

@@ -71,8 +71,9 @@ Eigen::Vector3d MaterialEstimate::KnownAlbedo(const recon::TriangleMesh& mesh,
 // ρs, πT/E (held_lobe): the albedo is their difference at the ρs being fitted, so that the fit
 // takes ρs from both (solver/inverse/region_fit.h) instead of from the previous iteration.
 void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d>& e,
-                    const std::vector<Eigen::Vector3d>& t, const recon::TriangleMesh& mesh,
-                    double texel_size_m, MaterialEstimate* estimate) {
+                    const std::vector<Eigen::Vector3d>& t, const std::vector<Eigen::Vector3d>& t0,
+                    const recon::TriangleMesh& mesh, double texel_size_m,
+                    MaterialEstimate* estimate) {
   estimate->held_rho_d.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   estimate->held_lobe.assign(obs.size(), Eigen::Vector3d::Constant(NAN));
   estimate->held_atlases.resize(estimate->size());
@@ -93,7 +94,7 @@ void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d
     for (size_t i = 0; i < obs.size(); ++i) {
       const Observation& o = obs[i];
       if (o.region != int(r)) continue;
-      const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t[i]);
+      const Eigen::Vector3d spec = m.params.rho_s.cwiseProduct(t[i]) + t0[i];
       // Off the highlight by the model, not by the observation: a test on the observed radiance
       // would let noise that brightens a pixel pass and bias the albedo. The model's diffuse part
       // takes the region's mean albedo, not the patch's: a patch's albedo follows its texels
@@ -103,7 +104,9 @@ void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d
       // several per cent, the region's mean by 0.2 %).
       const Eigen::Vector3d diffuse = m.params.rho_d.cwiseProduct(e[i]) / render::kPi;
       if ((spec.array() > 0.1 * (diffuse + spec).array()).any()) continue;
-      held.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * o.radiance.cast<double>(), e[i]);
+      // The lobe's part that ρs does not scale is known at the current α: taken off the radiance.
+      held.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * (o.radiance.cast<double>() - t0[i]),
+               e[i]);
       lobe.Add(o.photo, o.triangle, o.b1, o.b2, render::kPi * t[i], e[i]);
     }
     for (size_t i = 0; i < obs.size(); ++i) {

@@ -74,12 +74,14 @@ struct MaterialEstimate {
 };
 
 // For each glossy region with an unknown, varying albedo and a fitted lobe: every fit sample's
-// albedo as the other photos see it off their highlights (modelled specular part ρs·t under 10 %
-// of the modelled radiance in every channel), per texel of `texel_size_m`, into
-// estimate->held_rho_d and held_lobe (solver/inverse/held_out_albedo.h). `e` and `t`: per
-// observation, its irradiance and its specular term per unit ρs.
+// albedo as the other photos see it off their highlights (modelled specular part ρs∘t + t0
+// under 10 % of the modelled radiance in every channel), per texel of `texel_size_m`, into
+// estimate->held_rho_d (of the radiance less t0) and held_lobe (solver/inverse/
+// held_out_albedo.h). `e`, `t` and `t0`: per observation, its irradiance, its specular term per
+// unit ρs and the lobe's part that ρs does not scale (LightModel::t0).
 void HeldOutAlbedos(const ObservationSet& obs, const std::vector<Eigen::Vector3d>& e,
-                    const std::vector<Eigen::Vector3d>& t, const recon::TriangleMesh& mesh,
-                    double texel_size_m, MaterialEstimate* estimate);
+                    const std::vector<Eigen::Vector3d>& t, const std::vector<Eigen::Vector3d>& t0,
+                    const recon::TriangleMesh& mesh, double texel_size_m,
+                    MaterialEstimate* estimate);
 
 }  // namespace igi::solver

@@ -119,14 +119,15 @@ void SmoothStageIrradiance(const StageData& d, size_t num_regions, LightModel* l
 void UpdateIrradiance(const StageData& d, const MaterialEstimate& materials, LightModel* light) {
   const int threads = d.options.num_threads;
   for (LightingState& st : light->lightings) {
-    if (st.active) UpdatePatchRadiance(d.obs, d.patches, materials, light->t, threads, &st);
+    if (st.active)
+      UpdatePatchRadiance(d.obs, d.patches, materials, light->t, light->t0, threads, &st);
   }
   IncidentFromPatches(d.obs, d.patches, materials, threads, light);
   SmoothStageIrradiance(d, materials.size(), light);
 }
 
 void UpdateSpecularTerms(const StageData& d, const MaterialEstimate& materials, LightModel* light) {
-  light->t = SpecularTerms(d.obs, materials, light->incident, d.options.num_threads);
+  light->t = SpecularTerms(d.obs, materials, light->incident, d.options.num_threads, &light->t0);
 }
 
 // A region that no photo sees still lights the ones they show: its patches send ρd·E/π, and the
@@ -242,6 +243,7 @@ void RunPaperStage(const StageData& d, MaterialEstimate* estimate, LightModel* l
   MaterialEstimate& materials = *estimate;
   SolveSummary& summary = *out;
   light->t.assign(d.obs.size(), Eigen::Vector3d::Zero());
+  light->t0.assign(d.obs.size(), Eigen::Vector3d::Zero());
   summary.converged = false;
   for (int it = 1; it <= options.max_iterations; ++it) {
     UpdateIrradiance(d, materials, light);

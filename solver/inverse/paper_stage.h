@@ -34,7 +34,7 @@ void SmoothStageIrradiance(const StageData& d, size_t num_regions, LightModel* l
 // observations' indirect irradiance gathered from them, and its smoothing (light->e).
 void UpdateIrradiance(const StageData& d, const MaterialEstimate& materials, LightModel* light);
 
-// light->t at the current materials (SpecularTerms in solver/inverse/light_model.h).
+// light->t and light->t0 at the current materials (SpecularTerms in solver/inverse/light_model.h).
 void UpdateSpecularTerms(const StageData& d, const MaterialEstimate& materials, LightModel* light);
 
 // The ρd of the reflective regions of unknown ρd that no photo sees, from the light they bounce

@@ -94,11 +94,12 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
           const double eps = ray_epsilon[l];
           const bool summed = sums != nullptr && obs.in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
-          // The lobe's weight of an incident direction (ComputeSpecularTerms' T = Σ S·W·v).
+          // The lobe's weight per unit ρs of an incident direction (SpecularTerms' T = Σ scale·v;
+          // its part that ρs does not scale, O, is left to SpecularTerms after the round).
           const double ax = WidenedAlpha(m.params.AlphaX(), o.lobe_blur2);
           const double ay = WidenedAlpha(m.params.AlphaY(), o.lobe_blur2);
           auto lobe_weight = [&](const Eigen::Vector3d& wi_local) {
-            const double w = SpecularWeight(m.params.model, ax, ay, m.params.ior, wo, wi_local);
+            const double w = LobeWeight(m.params.model, ax, ay, m.params.ior, wo, wi_local).scale;
             return w > 0 ? w : 0.0;
           };
           Eigen::Vector3d t = Eigen::Vector3d::Zero();

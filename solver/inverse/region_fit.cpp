@@ -3,8 +3,10 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "solver/inverse/numeric.h"
 #include "solver/render/brdf.h"
@@ -12,11 +14,9 @@
 
 namespace igi::solver {
 
-double SpecularWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
-                      const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
-  double s = render::SpecularFactor<double>(model, alpha_x, alpha_y, wo, wi);
-  if (recon::HasFresnel(model) && s > 0) s *= render::FresnelWeight<double>(ior, wo, wi);
-  return s;
+render::LobeWeights LobeWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
+                               const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  return render::SpecularWeights<double>(model, alpha_x, alpha_y, ior, wo, wi);
 }
 
 namespace {
@@ -62,36 +62,55 @@ double ScalarPart(const ceres::Jet<J, N>& x) {
   return x.a;
 }
 
-// The specular term T_c(α) = Σ S·W·v of every sample from a per-incident-sample table of the
-// α-independent factors, computed once per region fit (the α search evaluates T at dozens of α):
-// S·W·v = exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy) (SpecularFactorParts, solver/render/brdf.h; Fresnel
-// folded into g).
-// Each sample's entries (a row) are sorted by qx + qy, so a sum stops at the first entry whose
-// exponent is beyond kMaxExponent (exp(−60): nothing). Used by the α search (double, vectorised)
-// and by Ceres' polish (Jets), so both see the same lobe.
+// The lobe of every sample at one α: ρs_c·t_c + o_c, with o the part that ρs does not scale (the
+// microfacet models' grazing Fresnel, LobeWeights in solver/render/brdf.h; zero for Ward's lobes).
+struct LobeTerms {
+  std::vector<Eigen::Vector3d> t, o;
+  Eigen::Vector3d Lobe(size_t i, const Eigen::Vector3d& rho_s) const {
+    return rho_s.cwiseProduct(t[i]) + o[i];
+  }
+};
+
+// The specular terms of every sample from a per-incident-sample table of the α-independent
+// factors, computed once per region fit (the α search evaluates them at dozens of α).
+// Ward's lobes: S·W·v = exp(−(qx/αx² + qy/αy²))·g·v / (αx·αy) (SpecularFactorParts,
+// solver/render/brdf.h; Fresnel folded into g). Each sample's entries (a row) are sorted by
+// qx + qy, so a sum stops at the first entry whose exponent is beyond kMaxExponent (exp(−60):
+// nothing).
+// The microfacet lobes (solver/render/microfacet.h): S = D·G2/(4 cosθo cosθi) with
+// D = d(Q)/(π αx αy cos⁴θh), Q = qx/αx² + qy/αy², d = 1/(1 + Q)² (GGX) or exp(−Q) (Beckmann), and
+// G2 = 1/(1 + Λ(wo) + Λ(wi)), Λ a function of a² = αx²·lx + αy²·ly with (lx, ly) the squared
+// tangents of the direction along x and y; the entry keeps qx, qy, wi's (lx, ly) and g·v split
+// into Schlick's (1 − m) part (t) and m part (o). Rows stop where d has fallen below 1e-9 of its
+// peak (GGX: Q > 3·10⁴, which leaves out 3·10⁻⁵ of its normals; Beckmann as Ward's).
+// Used by the α search (double) and by Ceres' polish (Jets), so both see the same lobe.
 class LobeTable {
  public:
   // Built once per region fit from all its samples; any subset of them (the held-albedo
   // variant's) finds its rows by incident range (Rows).
-  explicit LobeTable(const RegionFitInput& in) : model_(in.model) {
+  explicit LobeTable(const RegionFitInput& in)
+      : model_(in.model),
+        shape_(recon::Lobe(in.model)),
+        microfacet_(recon::IsMicrofacet(in.model)) {
     if (!recon::HasSpecularLobe(in.model)) return;
     std::vector<std::pair<const IncidentLocal*, int>> order;  // (incident, sample)
     order.reserve(in.samples.size());
-    int64_t entries = 0;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       order.emplace_back(in.samples[i].incident, int(i));
-      entries += in.samples[i].incident_count;
     }
     std::sort(order.begin(), order.end());
     starts_.reserve(order.size());
     begin_.reserve(order.size() + 1);
-    // At most one entry per incident sample: reserved once (grown by doubling, the six arrays
-    // held up to twice the region's incident light).
+    // At most one entry per incident sample: reserved once (grown by doubling, the arrays held
+    // up to twice the region's incident light).
     for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_})
       v->reserve(in.incident.size());
+    if (microfacet_) {
+      for (std::vector<float>* v : {&lx_, &ly_, &orr_, &og_, &ob_}) v->reserve(in.incident.size());
+    }
     struct Entry {
-      float qx, qy;
-      Eigen::Vector3f gv;
+      float qx, qy, lx, ly;
+      Eigen::Vector3f gv, ov;
     };
     std::vector<Entry> row;
     for (const auto& [start, i] : order) {
@@ -100,22 +119,48 @@ class LobeTable {
       begin_.push_back(static_cast<int>(qx_.size()));
       blur2_.push_back(std::max(0.0, s.lobe_blur2));
       const Eigen::Vector3d wo = s.wo.cast<double>();
+      if (microfacet_) {
+        const double z2 = std::max(wo.z() * wo.z(), 1e-300);
+        wo_l_.push_back({wo.x() * wo.x() / z2, wo.y() * wo.y() / z2});
+      }
       row.clear();
       for (int64_t k = 0; k < s.incident_count; ++k) {
         const IncidentLocal& inc = s.incident[k];
         const Eigen::Vector3d wi = inc.Wi().cast<double>();
-        double qx = 0, qy = 0, g = 0;
-        if (!render::SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
-        if (recon::HasFresnel(in.model)) g *= render::FresnelWeight<double>(in.ior, wo, wi);
-        const Eigen::Vector3d gv = g * inc.Value().cast<double>();
-        if (!(g > 0.0) || !gv.allFinite()) continue;
-        row.push_back({float(qx), float(qy), gv.cast<float>()});
+        const Eigen::Vector3d v = inc.Value().cast<double>();
+        Entry e{};
+        if (microfacet_) {
+          if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) continue;
+          const Eigen::Vector3d h = wo + wi;
+          const double hz2 = h.z() * h.z(), h2 = h.squaredNorm();
+          e.qx = float(h.x() * h.x() / hz2), e.qy = float(h.y() * h.y() / hz2);
+          e.lx = float(wi.x() * wi.x() / (wi.z() * wi.z()));
+          e.ly = float(wi.y() * wi.y() / (wi.z() * wi.z()));
+          // 1/(π cos⁴θh · 4 cosθo cosθi), cos⁴θh = hz⁴/|h|⁴.
+          const double g = h2 * h2 / (render::kPi * hz2 * hz2 * 4.0 * wo.z() * wi.z());
+          const double m = render::microfacet::SchlickWeight<double>(wo, wi);
+          e.gv = (g * (1.0 - m) * v).cast<float>();
+          e.ov = (g * m * v).cast<float>();
+          if (!(g > 0.0) || !e.gv.allFinite() || !e.ov.allFinite()) continue;
+        } else {
+          double qx = 0, qy = 0, g = 0;
+          if (!render::SpecularFactorParts(in.model, wo, wi, &qx, &qy, &g)) continue;
+          if (recon::HasFresnel(in.model)) g *= render::FresnelWeight<double>(in.ior, wo, wi);
+          const Eigen::Vector3d gv = g * v;
+          if (!(g > 0.0) || !gv.allFinite()) continue;
+          e.qx = float(qx), e.qy = float(qy), e.gv = gv.cast<float>();
+        }
+        row.push_back(e);
       }
       std::sort(row.begin(), row.end(),
                 [](const Entry& a, const Entry& b) { return a.qx + a.qy < b.qx + b.qy; });
       for (const Entry& e : row) {
         qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
         gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
+        if (microfacet_) {
+          lx_.push_back(e.lx), ly_.push_back(e.ly);
+          orr_.push_back(e.ov[0]), og_.push_back(e.ov[1]), ob_.push_back(e.ov[2]);
+        }
       }
     }
     begin_.push_back(static_cast<int>(qx_.size()));
@@ -133,15 +178,21 @@ class LobeTable {
     return rows;
   }
 
-  // One row's term at (αx, αy) (Ceres' polish: T a double or a Jet), without the held-out
-  // albedo's share (Terms adds it).
+  // One row's terms at (αx, αy) (Ceres' polish: T a double or a Jet): the part per unit ρs (t)
+  // and the part ρs does not scale (o, zero for Ward's lobes); without the held-out albedo's
+  // share (Terms adds it).
   template <typename T>
-  Eigen::Matrix<T, 3, 1> Term(int row, const T& ax, const T& ay) const {
+  std::pair<Eigen::Matrix<T, 3, 1>, Eigen::Matrix<T, 3, 1>> Term(int row, const T& ax,
+                                                                 const T& ay) const {
     using std::exp;
-    Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero();
-    if (row < 0) return sum;
     using std::sqrt;
+    Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero(), off = sum;
+    if (row < 0) return {sum, off};
     const T ax2 = ax * ax + T(blur2_[row]), ay2 = ay * ay + T(blur2_[row]);
+    if (microfacet_) {
+      MicrofacetRow<T>(row, ax2, ay2, &sum, &off);
+      return {sum, off};
+    }
     const T ix = T(1.0) / ax2, iy = T(1.0) / ay2;
     const double ix0 = ScalarPart(ix), iy0 = ScalarPart(iy), imin = std::min(ix0, iy0);
     for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
@@ -150,21 +201,27 @@ class LobeTable {
       const T f = exp(-(T(double(qx_[k])) * ix + T(double(qy_[k])) * iy));
       sum[0] += f * double(gr_[k]), sum[1] += f * double(gg_[k]), sum[2] += f * double(gb_[k]);
     }
-    return sum / sqrt(ax2 * ay2);
+    return {sum / sqrt(ax2 * ay2), off};
   }
 
-  // T_c(α) for every sample of `in` (its rows from Rows(in)), less the held-out albedo's own lobe
-  // where `in` fits with it (RegionFitInput::use_held_albedo). The α search's inner loop: the
-  // exponentials of a row up to its cut-off in one vectorised pass, then their weighted sums.
-  std::vector<Eigen::Vector3d> Terms(const RegionFitInput& in, const std::vector<int>& rows,
-                                     double ax, double ay) const {
-    std::vector<Eigen::Vector3d> t(in.samples.size(), Eigen::Vector3d::Zero());
-    if (!recon::HasSpecularLobe(model_)) return t;
+  // The terms for every sample of `in` (its rows from Rows(in)), t less the held-out albedo's
+  // own lobe where `in` fits with it (RegionFitInput::use_held_albedo). The α search's inner
+  // loop: for Ward's lobes the exponentials of a row up to its cut-off in one vectorised pass,
+  // then their weighted sums.
+  LobeTerms Terms(const RegionFitInput& in, const std::vector<int>& rows, double ax,
+                  double ay) const {
+    LobeTerms out;
+    out.t.assign(in.samples.size(), Eigen::Vector3d::Zero());
+    out.o.assign(in.samples.size(), Eigen::Vector3d::Zero());
+    if (!recon::HasSpecularLobe(model_)) return out;
     std::vector<float> f;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      if (rows[i] >= 0) {
+      if (rows[i] >= 0 && microfacet_) {
+        MicrofacetRow<double>(rows[i], ax * ax + blur2_[rows[i]], ay * ay + blur2_[rows[i]], &sum,
+                              &out.o[i]);
+      } else if (rows[i] >= 0) {
         // The row's lobe: α² widened by its pixel's spread of normals.
         const double ax2 = ax * ax + blur2_[rows[i]], ay2 = ay * ay + blur2_[rows[i]];
         const float ix = float(1.0 / ax2), iy = float(1.0 / ay2);
@@ -181,13 +238,57 @@ class LobeTable {
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
         sum -= s.held_lobe.cwiseProduct(s.irradiance) / render::kPi;
       }
-      t[i] = sum;
+      out.t[i] = sum;
     }
-    return t;
+    return out;
   }
 
  private:
   static constexpr double kMaxExponent = 60.0;
+  static constexpr double kMaxGgxQ = 3e4;  // (1 + Q)² = 1e9
+
+  // Smith's Λ from a² (solver/render/microfacet.h's, for the squared tangent a²).
+  template <typename T>
+  T Lambda(const T& a2) const {
+    using std::exp;
+    using std::sqrt;
+    if (shape_ == recon::LobeShape::kGgx) return (sqrt(T(1.0) + a2) - T(1.0)) * T(0.5);
+    if (!(a2 > 1.0 / 36.0)) return T(0.0);
+    using std::erfc;
+    const T nu = T(1.0) / sqrt(a2);
+    return (exp(-nu * nu) / (nu * T(std::sqrt(render::kPi))) - erfc(nu)) * T(0.5);
+  }
+
+  // A microfacet row's sums at the widened (αx², αy²): t and o of Term.
+  template <typename T>
+  void MicrofacetRow(int row, const T& ax2, const T& ay2, Eigen::Matrix<T, 3, 1>* t,
+                     Eigen::Matrix<T, 3, 1>* o) const {
+    using std::exp;
+    using std::sqrt;
+    const T ix = T(1.0) / ax2, iy = T(1.0) / ay2;
+    const double imin = std::min(ScalarPart(ix), ScalarPart(iy));
+    const bool ggx = shape_ == recon::LobeShape::kGgx;
+    const double cut = ggx ? kMaxGgxQ : kMaxExponent;
+    const T lambda_o = Lambda<T>(ax2 * wo_l_[row][0] + ay2 * wo_l_[row][1]);
+    const T norm = T(1.0) / sqrt(ax2 * ay2);
+    for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
+      if (imin * double(qs_[k]) >= cut) break;
+      const T q = T(double(qx_[k])) * ix + T(double(qy_[k])) * iy;
+      T d;
+      if (ggx) {
+        const T d1 = T(1.0) + q;
+        d = T(1.0) / (d1 * d1);
+      } else {
+        d = exp(-q);
+      }
+      const T g2 = T(1.0) / (T(1.0) + lambda_o +
+                             Lambda<T>(ax2 * T(double(lx_[k])) + ay2 * T(double(ly_[k]))));
+      const T w = d * g2 * norm;
+      (*t)[0] += w * double(gr_[k]), (*t)[1] += w * double(gg_[k]), (*t)[2] += w * double(gb_[k]);
+      (*o)[0] += w * double(orr_[k]), (*o)[1] += w * double(og_[k]), (*o)[2] += w * double(ob_[k]);
+    }
+  }
+
   static void Exponentials(const float* __restrict qx, const float* __restrict qy, int n, float ix,
                            float iy, float* __restrict f) {
     for (int k = 0; k < n; ++k) f[k] = ExpNonPositive(-(qx[k] * ix + qy[k] * iy));
@@ -208,11 +309,17 @@ class LobeTable {
     return sum;
   }
   recon::BrdfModel model_;
+  recon::LobeShape shape_;
+  bool microfacet_;
   std::vector<const IncidentLocal*> starts_;  // each row's incident list, ascending
   std::vector<int> begin_;                    // each row's first entry (+1: the end)
   std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
-  // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v.
+  std::vector<std::array<double, 2>> wo_l_;   // microfacet: each row's wo (lx, ly)
+  // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v (Ward: with the
+  // Fresnel weight; microfacet: Schlick's (1 − m) part).
   std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
+  // Microfacet entries: wi's (lx, ly) and g·v's Schlick m part.
+  std::vector<float> lx_, ly_, orr_, og_, ob_;
 };
 
 // The linear part for given specular terms: ρs and per-slot ρd by least squares.
@@ -223,8 +330,10 @@ struct LinearSolution {
   double sum_v2 = 0;  // Σ v² of the projected specular column (grey), for ρs's variance
 };
 
-LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
-                           const std::vector<Eigen::Vector3d>& t, bool per_patch) {
+// The lobe's part that ρs does not scale (LobeTerms::o) is taken off the observed radiance.
+LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr, const LobeTerms& lt,
+                           bool per_patch) {
+  const std::vector<Eigen::Vector3d>& t = lt.t;
   const int slots = per_patch ? in.num_slots : 1;
   std::vector<Eigen::Vector3d> A(slots, Eigen::Vector3d::Zero()), B = A, C = A;
   const size_t n = in.samples.size();
@@ -234,23 +343,24 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr,
       const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
       const int s = slot_of(i);
       A[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
-      B[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed);
+      B[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed - lt.o[i]);
       C[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(t[i]);
     }
   }
   std::vector<Eigen::Vector3d> u(n), v(n);
   for (size_t i = 0; i < n; ++i) {
     const FitSample& smp = in.samples[i];
+    const Eigen::Vector3d observed = smp.observed - lt.o[i];
     for (int c = 0; c < 3; ++c) {
       const double w = pr.w[i][c], a = pr.a[i][c];
       if (in.fit_rho_d) {
         const int s = slot_of(i);
         const double ratio_b = A[s][c] > 0 ? B[s][c] / A[s][c] : 0.0;
         const double ratio_c = A[s][c] > 0 ? C[s][c] / A[s][c] : 0.0;
-        u[i][c] = w * (smp.observed[c] - a * ratio_b);
+        u[i][c] = w * (observed[c] - a * ratio_b);
         v[i][c] = w * (t[i][c] - a * ratio_c);
       } else {
-        u[i][c] = w * (smp.observed[c] - smp.rho_d_known[c] * a);
+        u[i][c] = w * (observed[c] - smp.rho_d_known[c] * a);
         v[i][c] = w * t[i][c];
       }
     }
@@ -409,9 +519,9 @@ struct SampleResidual {
       ax = p[block_a][0];
       ay = recon::IsAnisotropic(in->model) ? p[block_a][1] : p[block_a][0];
     }
-    const V3 t = table->Term<T>(row, ax, ay);
+    const auto [t, o] = table->Term<T>(row, ax, ay);
     for (int c = 0; c < 3; ++c) {
-      residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] - s->observed[c]);
+      residual[c] = T(w[c]) * (rho_d[c] * a[c] + rho_s[c] * t[c] + o[c] - s->observed[c]);
     }
     return true;
   }
@@ -523,7 +633,7 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   return out;
 }
 
-double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>& t,
+double RelativeRms(const RegionFitInput& in, const LobeTerms& lt,
                    const std::vector<Eigen::Vector3d>& slot_rho_d, const Eigen::Vector3d& rho_s,
                    bool per_patch) {
   double num = 0, den = 0;
@@ -531,8 +641,7 @@ double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>&
     const FitSample& s = in.samples[i];
     Eigen::Vector3d rd = in.fit_rho_d ? slot_rho_d[per_patch ? s.slot : 0] : s.rho_d_known;
     if (!rd.allFinite()) continue;
-    const Eigen::Vector3d pred =
-        rd.cwiseProduct(s.irradiance) / render::kPi + rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d pred = rd.cwiseProduct(s.irradiance) / render::kPi + lt.Lobe(i, rho_s);
     num += (pred - s.observed).squaredNorm();
     den += s.observed.squaredNorm();
   }
@@ -542,13 +651,12 @@ double RelativeRms(const RegionFitInput& in, const std::vector<Eigen::Vector3d>&
 // Each slot's albedo from its samples whose specular part is under 10 % of the radiance (least
 // squares per channel); NaN for a slot without such a sample.
 std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const Prepared& pr,
-                                                const std::vector<Eigen::Vector3d>& t,
-                                                const Eigen::Vector3d& rho_s,
+                                                const LobeTerms& lt, const Eigen::Vector3d& rho_s,
                                                 const Eigen::Vector3d& rho_d_mean) {
   std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
   for (size_t i = 0; i < in.samples.size(); ++i) {
     const FitSample& s = in.samples[i];
-    const Eigen::Vector3d spec = rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d spec = lt.Lobe(i, rho_s);
     (void)rho_d_mean;
     if ((spec.array() > 0.1 * s.observed.array().max(0.0)).any()) continue;
     const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
@@ -567,7 +675,7 @@ std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const 
 // Whether the per-patch albedos vary beyond their noise: the area-weighted spread of the
 // slots' mean albedo must exceed 3 % of the mean and three times the spread noise alone gives.
 bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolution& b,
-                  const std::vector<Eigen::Vector3d>& t, std::vector<int>* counts) {
+                  const LobeTerms& lt, std::vector<int>* counts) {
   const int slots = in.num_slots;
   counts->assign(slots, 0);
   std::vector<double> info(slots, 0.0);
@@ -577,8 +685,7 @@ bool AlbedoVaries(const RegionFitInput& in, const Prepared& pr, const LinearSolu
     ++(*counts)[s.slot];
     for (int c = 0; c < 3; ++c) info[s.slot] += std::pow(pr.w[i][c] * pr.a[i][c], 2) / 3;
     if (!b.slot_rho_d[s.slot].allFinite()) continue;
-    const Eigen::Vector3d pred =
-        b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + b.rho_s.cwiseProduct(t[i]);
+    const Eigen::Vector3d pred = b.slot_rho_d[s.slot].cwiseProduct(pr.a[i]) + lt.Lobe(i, b.rho_s);
     if (pred.allFinite()) rss += (pr.w[i].cwiseProduct(pred - s.observed)).squaredNorm();
   }
   int used = 0;
@@ -657,7 +764,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.slot_count.assign(in.num_slots, 0);
   for (const FitSample& s : in.samples) ++r.slot_count[s.slot];
   const std::vector<int> rows = table.Rows(in);
-  std::vector<Eigen::Vector3d> t = table.Terms(in, rows, r.alpha_x, r.alpha_y);
+  LobeTerms t = table.Terms(in, rows, r.alpha_x, r.alpha_y);
   r.relative_rms = RelativeRms(in, t, {r.rho_d}, r.rho_s, false);
   if (!in.fit_rho_d || in.num_slots <= 1) return r;
   // Per-patch albedo from the observations off the highlights (specular part < 10 % of the
@@ -719,7 +826,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& smp = in.samples[i];
       const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
-      const Eigen::Vector3d diffuse = smp.observed - r.rho_s.cwiseProduct(t[i]);
+      const Eigen::Vector3d diffuse = smp.observed - t.Lobe(i, r.rho_s);
       num[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(diffuse);
       den[smp.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
     }

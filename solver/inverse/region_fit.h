@@ -5,10 +5,13 @@
 // is either constant over the region or free per patch, whichever the data support.
 //
 // The model of one observation o (radiance L toward its camera, channel c):
-//   L_c = ρd_c·E_c/π + ρs_c·T_c(α),   T_c(α) = Σ_k S(wo, wi_k; α)·W(wo, wi_k)·v_k,c
+//   L_c = ρd_c·E_c/π + ρs_c·T_c(α) + O_c(α),   T_c(α) = Σ_k scale(wo, wi_k; α)·v_k,c,
+//   O_c(α) = Σ_k offset(wo, wi_k; α)·v_k,c
 // with E the gathered irradiance and (wi_k, v_k) the incident samples (v = L_in·cosθ/pdf, so
-// Σ v = E), S the model's colourless specular factor and W its Fresnel weight
-// (solver/render/brdf.h). For a given α the model is linear in ρd and ρs: they are projected out
+// Σ v = E), and the lobe's scale and offset of render::SpecularWeights (solver/render/brdf.h):
+// S·W and 0 for Ward's lobes (S the colourless specular factor, W the Fresnel weight), S·(1 − m)
+// and S·m for the microfacet ones (Schlick's F = ρs + (1 − ρs)·m). For a given α the model is
+// linear in ρd and ρs: they are projected out
 // (variable projection) and α is found by a log-grid search refined by Brent's method; Ceres then
 // polishes all parameters jointly (autodiff through EvalBrdf's specular factor) and gives their
 // covariance. Residuals are weighted as for shot noise, 1/√((ρ̄E/π + 0.1·mean L)·mean L) per
@@ -25,6 +28,7 @@
 #include <vector>
 
 #include "recon/brdf_model.h"
+#include "solver/render/brdf.h"
 
 namespace igi::solver {
 
@@ -159,8 +163,9 @@ struct RegionFitOptions {
 
 RegionFitResult FitRegion(const RegionFitInput& input, const RegionFitOptions& options);
 
-// The colourless specular factor times the Fresnel weight, S·W, for one sample (double).
-double SpecularWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
-                      const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
+// The lobe of one direction pair (double): ρs_c·scale + offset (render::SpecularWeights; for
+// Ward's lobes scale = S·W and offset 0).
+render::LobeWeights LobeWeight(recon::BrdfModel model, double alpha_x, double alpha_y, double ior,
+                               const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
 
 }  // namespace igi::solver

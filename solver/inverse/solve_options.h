@@ -138,6 +138,10 @@ struct SolveOptions {
   // A textured glossy region's ρs and α are fitted with each sample's albedo as the other photos
   // see that texel off their highlights (false: its patch's off-highlight albedo).
   bool held_out_albedo = true;
+  // Every region's albedo is one value: the fits never take one per patch (an object of one paint,
+  // such as the DiLiGenT ball, whose diffuse falls off unlike Lambert's toward the terminator;
+  // per-patch albedos would take that fall-off as texture).
+  bool uniform_albedo = false;
   // Fit samples per region: up to this many of the observations near a highlight (tanθh < 0.6
   // toward a light), drawn evenly by a hash of their photo and pixel; they carry a lobe's ρs
   // and α (>= 1). More: a steadier ρs and α where a faint lobe lies on a texture, for a longer

@@ -188,7 +188,8 @@ TEST(AlbedoMapStage, TheSpecularTermIsTheOwnDirectLobeAndTheNeighboursIndirectLi
     gather.direct.push_back(sample);
     gather.points.push_back(point);
     f.light.point.push_back(int(i));
-    direct_lobe[i] = DirectSpecularTerm(p, 0.0, frame, view, &sample, 1);
+    Eigen::Vector3d offset;
+    direct_lobe[i] = DirectSpecularTerm(p, 0.0, frame, view, &sample, 1, &offset);
     f.light.t[i] = direct_lobe[i] + Eigen::Vector3d::Constant(0.02);
   }
   const MapStageData d{f.scene, f.options, f.obs, f.materials, f.patches, f.light, 0.02, 10.0};

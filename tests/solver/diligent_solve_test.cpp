@@ -78,7 +78,8 @@ double HeldOutResidual(const recon::Scene& solved, const std::vector<recon::Phot
   return den > 0 ? std::sqrt(num / den) : 0.0;
 }
 
-BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& out_dir) {
+BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& out_dir,
+                bool uniform_albedo = false) {
   recon::Scene scene = recon::LoadScene(kBall / "scene.json", recon::SceneLoadOptions{});
   EXPECT_EQ(scene.photos.size(), 48u);
   const std::vector<recon::Photo> used = Select(scene.photos, 0, 4);  // 12 photos
@@ -101,6 +102,7 @@ BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& ou
   options.max_fit_samples = 100000;
   options.num_threads = 2;
   options.show_progress = false;
+  options.uniform_albedo = uniform_albedo;
   const auto start = std::chrono::steady_clock::now();
   const SolveSummary summary = Solve(scene, options, out_dir);
   BallFit fit;
@@ -156,6 +158,34 @@ TEST(DiligentSolve, WardExplainsAndPredictsTheBallBetterThanLambert) {
   EXPECT_LT(ward.region_rms, 0.8 * lambert.region_rms);
   // Photos under lights neither fit saw (measured 0.68 of Lambert's).
   EXPECT_LE(ward.held_out, lambert.held_out);
+}
+
+// The microfacet lobes on the same photos, every fit with one albedo (the ball is one paint: a
+// per-patch albedo takes its diffuse fall-off toward the terminator, which is not Lambert's, as
+// texture; GGX's fit did so, region rms 0.064, and the mean of those albedos rendered the held-out
+// photos at 0.108). The ball's highlight has a sharper peak and broader shoulders than Ward's
+// Gaussian, which GGX's long tail follows. Measured (region rms, held-out residual / Lambert's):
+// ward 0.0947, 0.678; beckmann 0.0945, 0.676; ggx 0.0880, 0.657 (ρs 0.0125, α 0.021).
+TEST(DiligentSolve, MicrofacetLobesPredictTheBall) {
+  const fs::path out = test::UniqueTempDir("igi_diligent_microfacet");
+  const BallFit ward = FitBall(recon::BrdfModel::kWard, "ward", out, true);
+  const BallFit ggx = FitBall(recon::BrdfModel::kGgx, "ggx", out, true);
+  const BallFit beckmann = FitBall(recon::BrdfModel::kBeckmann, "beckmann", out, true);
+  const BallFit lambert = FitBall(recon::BrdfModel::kLambert, "lambert", out, true);
+  fs::remove_all(out);
+  std::printf("held-out residual / Lambert's: ward %.3f, beckmann %.3f, ggx %.3f\n",
+              ward.held_out / lambert.held_out, beckmann.held_out / lambert.held_out,
+              ggx.held_out / lambert.held_out);
+  for (const BallFit* f : {&ggx, &beckmann}) {
+    EXPECT_EQ(f->region.status, RegionStatus::kSolved);
+    EXPECT_EQ(f->region.stage2.albedo_model, AlbedoModel::kConstant);
+    EXPECT_GT(f->region.final_params.rho_s.minCoeff(), 0.0);
+    EXPECT_LE(f->region.final_params.rho_s.maxCoeff(), 1.0);
+    EXPECT_LT(f->region_rms, 0.8 * lambert.region_rms);
+    EXPECT_LT(f->held_out, 0.8 * lambert.held_out);
+  }
+  EXPECT_LT(ggx.region_rms, ward.region_rms);
+  EXPECT_LT(ggx.held_out, ward.held_out);
 }
 
 }  // namespace

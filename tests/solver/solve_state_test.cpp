@@ -81,15 +81,19 @@ TEST(SpecularTermsTest, SumTheWidenedLobeOverTheIncidentSamplesAndAreZeroOffLobe
       {Eigen::Vector3f(float(s30), 0, float(c30)), Eigen::Vector3f(0.5f, 0.5f, 0.5f)}};
   const std::vector<std::vector<IncidentLocal>> incident = {samples, samples};
 
-  const std::vector<Eigen::Vector3d> t = SpecularTerms(obs, m, incident, 1);
+  std::vector<Eigen::Vector3d> t0;
+  const std::vector<Eigen::Vector3d> t = SpecularTerms(obs, m, incident, 1, &t0);
+  ASSERT_EQ(t0.size(), 2u);
+  EXPECT_EQ(t0[1], Eigen::Vector3d::Zero());  // Ward's lobe: all of it scales with ρs
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[0], Eigen::Vector3d::Zero());
   // Ward at α widened by the pixel's spread of normals: √(0.2² + 0.01).
   const double a = std::sqrt(0.04 + double(obs[1].lobe_blur2));
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
   for (const IncidentLocal& s : samples) {
-    expected += SpecularWeight(recon::BrdfModel::kWard, a, a, m[1].params.ior,
-                               Eigen::Vector3d::UnitZ(), s.Wi().cast<double>()) *
+    expected += LobeWeight(recon::BrdfModel::kWard, a, a, m[1].params.ior, Eigen::Vector3d::UnitZ(),
+                           s.Wi().cast<double>())
+                    .scale *
                 s.Value().cast<double>();
   }
   ASSERT_GT(expected.minCoeff(), 0);
@@ -169,7 +173,8 @@ TEST(IrradianceFromPatchesTest, SeenPatchesSendThePhotosRadianceUnseenOnesTheirA
   st.patch_d.assign(2, Eigen::Vector3f::Zero());
   BuildPatchLobes(patches, materials, &st);  // Lambertian: none
 
-  UpdatePatchRadiance(obs, patches, materials, {Eigen::Vector3d::Zero()}, 1, &st);
+  UpdatePatchRadiance(obs, patches, materials, {Eigen::Vector3d::Zero()}, {Eigen::Vector3d::Zero()},
+                      1, &st);
   const double d1 = 0.5 * 4 / M_PI;
   EXPECT_NEAR(st.patch_d[0].x(), 0.3, 1e-6);  // the photo's
   EXPECT_NEAR(st.patch_d[1].x(), d1, 1e-6);   // ρd·E/π
@@ -209,8 +214,10 @@ TEST(FitInputsTest, OneInputPerFittedRegionWithASamplePerFitObservation) {
   light.incident.resize(3);
 
   std::vector<int> regions;
+  SolveOptions options;
+  options.specular_colour = SpecularColour::kRgb;
   const std::vector<RegionFitInput> in =
-      FitInputs(scene, patches, obs, light, materials, 1, false, true, &regions);
+      FitInputs(scene, patches, obs, light, materials, 1, options, &regions);
   ASSERT_EQ(regions, std::vector<int>{0});
   ASSERT_EQ(in.size(), 1u);
   EXPECT_EQ(in[0].name, "walls");

@@ -1,0 +1,84 @@
+// igi-solve on igi-synth rooms whose glossy regions are microfacet lobes (ggx, beckmann: Smith's
+// masking-shadowing and Schlick's Fresnel with F0 = ρs), every value unknown: the solver fits
+// them as it fits Ward's lobes (solver/inverse/region_fit.h), the part of the lobe that ρs does
+// not scale (Schlick's grazing rise) included.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "recon/scene.h"
+#include "solver/inverse/solve.h"
+#include "solver/synth/synthesize.h"
+#include "tests/temp_dir.h"
+#include "tools/common/json.h"
+
+namespace igi::solver {
+namespace {
+namespace fs = std::filesystem;
+
+double RelErr(double a, double b) { return std::abs(a - b) / std::abs(b); }
+
+class SolveMicrofacet : public ::testing::TestWithParam<recon::BrdfModel> {};
+
+// The room's glossy regions (truth: ρs 0.04-0.1 = F0 of dielectrics, α 0.05-0.15) from 256-path
+// photos, the paper's stage and one refinement round. The accuracy targets: ρs and α within 5 %
+// of the truth, ρd within 2 % (the textured floor: its lobe only, its albedo is a texture; the
+// glossy sphere 3 %, as the Ward room's sphere from 256-path photos: solve_truth_test). Measured
+// (ggx): ρs / α the floor −3.0 / −4.1 %, wall_y4 +0.4 / +1.7 %, the glossy box −0.4 / +0.1 %,
+// the sphere +3.5 / +4.3 %; ρd within 1.75 %, the sphere's −0.8 / −1.6 / −2.0 %.
+TEST_P(SolveMicrofacet, RecoversTheGlossyRegionsLobes) {
+  const std::string model(recon::BrdfModelName(GetParam()));
+  const fs::path tmp = test::UniqueTempDir("solve_" + model);
+  synth::SynthOptions so;
+  so.out = tmp / "capture";
+  so.spp = 256;
+  so.glossy_brdf = GetParam();
+  synth::Synthesize(so);
+  const recon::Scene scene = recon::LoadScene(so.out / "scene.json");
+  for (const recon::Material& m : scene.materials) {
+    if (m.name == "floor" || m.name == "glossy_box") {
+      EXPECT_EQ(m.brdf, GetParam()) << m.name;
+    }
+  }
+  SolveOptions o;
+  o.refine_iterations = 1;
+  const SolveSummary s = Solve(scene, o, tmp / "out");
+  const Json truth = ReadJsonFile(so.out / "truth.json")["materials"];
+  int lobes = 0;
+  for (const RegionSolution& r : s.regions) {
+    const Json& t = truth[r.name];
+    const RegionFitResult& f = r.stage2.fitted ? r.stage2 : r.stage1;
+    if (!t.contains("rho_s")) continue;
+    ++lobes;
+    std::printf("%s %s: rho_s %+.2f %%, alpha %+.2f %%", model.c_str(), r.name.c_str(),
+                100 * (f.rho_s.mean() / t["rho_s"].get<double>() - 1),
+                100 * (f.alpha / t["alpha"].get<double>() - 1));
+    if (t.contains("rho_d") && !t.contains("rho_d_map")) {
+      std::printf(", rho_d %+.2f %+.2f %+.2f %%",
+                  100 * (r.final_params.rho_d[0] / t["rho_d"][0].get<double>() - 1),
+                  100 * (r.final_params.rho_d[1] / t["rho_d"][1].get<double>() - 1),
+                  100 * (r.final_params.rho_d[2] / t["rho_d"][2].get<double>() - 1));
+      for (int c = 0; c < 3; ++c) {
+        const double bar = r.name == "glossy_sphere" ? 0.03 : 0.02;
+        EXPECT_LT(RelErr(r.final_params.rho_d[c], t["rho_d"][c].get<double>()), bar)
+            << r.name << " rho_d[" << c << "]";
+      }
+    }
+    std::printf("\n");
+    EXPECT_LT(RelErr(f.rho_s.mean(), t["rho_s"].get<double>()), 0.05) << r.name;
+    EXPECT_LT(RelErr(f.alpha, t["alpha"].get<double>()), 0.05) << r.name;
+  }
+  EXPECT_EQ(lobes, 4);  // the floor, wall_y4, the glossy box and sphere
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, SolveMicrofacet,
+                         ::testing::Values(recon::BrdfModel::kGgx, recon::BrdfModel::kBeckmann),
+                         [](const testing::TestParamInfo<recon::BrdfModel>& model) {
+                           return std::string(recon::BrdfModelName(model.param));
+                         });
+
+}  // namespace
+}  // namespace igi::solver
