@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--spp", o.spp, "Render samples per pixel");
   app.add_option("--seed", o.seed, "Random seed (same seed, same files)");
   app.add_option("--glossy-brdf", choices.glossy_brdf,
-                 "True model of the glossy regions: ward|ward_gmd");
+                 "True model of the glossy regions: ward|ward_gmd|ggx|beckmann");
   app.add_option("--lamp", choices.lamp, "Lamp type: sphere (r = 4 cm) or point");
   app.add_option("--lamp-position", lamp_position,
                  "Centre of the photographed lamp, x,y,z in metres (default 2.3,1.7,2.4)");

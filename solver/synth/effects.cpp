@@ -295,6 +295,7 @@ Json PoseError(Params& p, const std::vector<recon::Camera>& cameras, uint64_t se
 
 Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
   const auto regions = p.Names("regions", room.glossy_regions, room.glossy_regions);
+  const std::string to = p.Name("to", "", {"ward", "ward_gmd", "beckmann", "ggx"});
   p.Finish();
   Json changes = Json::object();
   for (const std::string& region : regions) {
@@ -305,7 +306,19 @@ Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
                                                              {"ward_aniso", "ward_gmd_aniso"},
                                                              {"ward_gmd_aniso", "ward_aniso"}};
     const auto [base, fresnel] = SplitFresnel(brdf);
-    m["brdf"] = kSwap.at(base) + fresnel;
+    if (to.empty()) {
+      m["brdf"] = kSwap.at(base) + fresnel;
+    } else {
+      // The named lobe, anisotropic where the region is; a microfacet lobe carries its own
+      // Fresnel factor (F0 = rho_s), so a *_fresnel region's ior goes with its weight.
+      recon::BrdfModel model = *recon::BrdfModelFromName(to);
+      if (recon::IsAnisotropic(*recon::BrdfModelFromName(base))) {
+        model = recon::AnisotropicForm(model);
+      }
+      if (!fresnel.empty() && recon::IsMicrofacet(model)) m.erase("ior");
+      m["brdf"] =
+          std::string(recon::BrdfModelName(model)) + (recon::IsMicrofacet(model) ? "" : fresnel);
+    }
     changes[region] = Json{{"true_brdf", m["brdf"]},
                            {"declared_brdf", s->declared_scene["materials"][region]["brdf"]}};
   }

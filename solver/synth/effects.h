@@ -23,7 +23,8 @@
 //   pose_error              a camera's declared pose is off by rotation_deg (1°) about a random
 //                           axis and translation_m (2 cm) in a random direction
 //   specular_lobe_shape     the glossy regions are truly ward_gmd when declared ward, or the
-//                           reverse (regions=a/b/c)
+//                           reverse (regions=a/b/c); to=ward|ward_gmd|beckmann|ggx: truly that
+//                           lobe instead (its anisotropic form on an anisotropic region)
 //   light_intensity         the lamp is truly `factor` (1.25) times brighter
 //   specular_reflection     a glossy region (region=wall_y4) is declared lambert
 //   fresnel                 the glossy regions (regions=a/b/c) are truly Fresnel-weighted

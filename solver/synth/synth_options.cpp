@@ -79,14 +79,16 @@ ProblemList SynthProblems(const SynthOptions& o, const SynthChoiceFlags* typed) 
     p.Add("--fov", "", Str(o.fov_deg), "must be in [10, 140]");
   }
   if (o.spp < 1 || o.spp > 1 << 20) p.Add("--spp", "", std::to_string(o.spp), "must be >= 1");
-  // Any BrdfModel has a name; only the two Ward models are the glossy regions' choices.
+  // Any BrdfModel has a name; only the isotropic lobes without an ior are the glossy regions'
+  // choices.
   const std::optional<recon::BrdfModel> glossy =
       typed ? recon::BrdfModelFromName(typed->glossy_brdf)
             : std::optional<recon::BrdfModel>(o.glossy_brdf);
-  if (glossy != recon::BrdfModel::kWard && glossy != recon::BrdfModel::kWardGmd) {
+  if (!glossy || !recon::HasSpecularLobe(*glossy) || recon::IsAnisotropic(*glossy) ||
+      recon::HasFresnel(*glossy)) {
     p.Add("--glossy-brdf", "",
           ChoiceText(o.glossy_brdf, recon::BrdfModelName, typed ? &typed->glossy_brdf : nullptr),
-          "must be ward or ward_gmd");
+          "must be ward, ward_gmd, ggx or beckmann");
   }
   if (typed ? !LampShapeFromName(typed->lamp) : !LampShapeFromName(LampShapeName(o.lamp))) {
     p.Add("--lamp", "", ChoiceText(o.lamp, LampShapeName, typed ? &typed->lamp : nullptr),

@@ -105,7 +105,7 @@ struct SynthOptions {
   double fov_deg = 60;  // horizontal field of view
   int spp = 64;         // render samples per pixel
   uint64_t seed = 1;    // same seed, same options -> same files
-  // The glossy regions' true model: BrdfModel::kWard (default) or kWardGmd.
+  // The glossy regions' true model: BrdfModel::kWard (default), kWardGmd, kGgx or kBeckmann.
   recon::BrdfModel glossy_brdf = recon::BrdfModel::kWard;
   LampShape lamp = LampShape::kSphere;  // kSphere (default; r = 4 cm) or kPoint
   // The photographed lamp's centre (default (2.3, 1.7, 2.4), below the ceiling; inside the room).

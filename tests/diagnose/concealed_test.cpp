@@ -56,6 +56,18 @@ TEST(ConcealedFresnelTest, GrazingViewOfTheFloorNamesFresnelFirst) {
   test::ExpectReachesTheFloor(o);
 }
 
+// A microfacet lobe in photos of regions declared Ward: the glossy regions are truly GGX (their
+// ρs as F0 and α kept), and specular_lobe_shape, which tries each of the other lobes, names GGX
+// first.
+TEST(ConcealedLobeFamilyTest, AGgxLobeDeclaredWardIsNamedGgx) {
+  const ConcealedOutcome o = DiagnoseConcealed("specular_lobe_shape:to=ggx", 11);
+  const Json& d = o.diagnosis;
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["effect"], "specular_lobe_shape") << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["params"]["to"], "ggx") << d.dump(1);
+  test::ExpectReachesTheFloor(o);
+}
+
 // light_emission_profile, anisotropic_reflection and light_source_extent:
 // concealed_brdf_light_test.cpp; missing_geometry and pose_error: concealed_geometry_test.cpp.
 INSTANTIATE_TEST_SUITE_P(Effects, ConcealedEffectTest, testing::Values("specular_lobe_shape"));

@@ -100,7 +100,8 @@ TEST(SynthOptions, ChoicesRoundTripAndBadTextsAreNamed) {
     FAIL() << "no InputError";
   } catch (const InputError& e) {
     const std::vector<std::string> want = {
-        "--cameras: 0: must be 1..64", "--glossy-brdf: lambert: must be ward or ward_gmd",
+        "--cameras: 0: must be 1..64",
+        "--glossy-brdf: lambert: must be ward, ward_gmd, ggx or beckmann",
         "--lamp: spot: must be sphere or point", "--bracket-format: jpg: must be png or tif"};
     EXPECT_EQ(e.problems(), want);
   }

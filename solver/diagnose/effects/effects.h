@@ -64,12 +64,13 @@ CandidateResult LightIntensity(const CandidateContext& cx, const ResidualFitter&
 // declared (nothing is solved then), without them otherwise (igi-solve fits them).
 CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFitter& f, int region);
 
-// specular_lobe_shape (ward <-> ward_gmd) and fresnel (plain -> *_fresnel) on glossy region
-// `region`: the change of its specular term. With the materials given (the refit keeps ρs and α)
-// the alternative lobe less the current one at the same values, with an amplitude that must stay
-// near 1; with them solved (the refit re-solves ρs and α) the current lobe is replaced by the
-// alternative at a searched α' with a free ρs scale, and credited only with what it explains
-// beyond the current model re-fitted the same way. fresnel also searches the index.
+// specular_lobe_shape (the region's isotropic lobe for another of kLobeShapes: ward, ward_gmd,
+// beckmann, ggx; the one that explains most) and fresnel (a Ward lobe -> *_fresnel) on glossy
+// region `region`: the change of its specular term. With the materials given (the refit keeps
+// ρs and α) the alternative lobe less the current one at the same values, with an amplitude that
+// must stay near 1; with them solved (the refit re-solves ρs and α) the current lobe is replaced
+// by the alternative at a searched α' with a free ρs scale, and credited only with what it
+// explains beyond the current model re-fitted the same way. fresnel also searches the index.
 CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
                            bool fresnel);
 

@@ -21,6 +21,23 @@ namespace igi::diagnose {
 
 namespace {
 
+// The isotropic lobes specular_lobe_shape moves a region between (the *_fresnel models are the
+// fresnel effect's; the microfacet models carry their own Fresnel factor).
+constexpr recon::BrdfModel kLobeShapes[] = {recon::BrdfModel::kWard, recon::BrdfModel::kWardGmd,
+                                            recon::BrdfModel::kBeckmann, recon::BrdfModel::kGgx};
+
+// The lobe of `model` with reflectance ρs at roughness `alpha` (ρs·scale + offset: the
+// microfacet models' Schlick factor has a part ρs does not scale), for a record's world-frame
+// normal, view and light directions.
+double LobeValue(recon::BrdfModel model, double rho_s, double alpha, const Eigen::Vector3f& n,
+                 const Eigen::Vector3f& wo, const Eigen::Vector3f& wi) {
+  const render::Frame frame = render::Frame::FromNormal(n.cast<double>());
+  const render::LobeWeights w = render::SpecularWeights<double>(
+      model, alpha, alpha, recon::Material::kDefaultIor, frame.ToLocal(wo.cast<double>()),
+      frame.ToLocal(wi.cast<double>()));
+  return rho_s * w.scale + w.offset;
+}
+
 // The indices of refraction the fresnel candidate tries when the materials are solved (F0 from
 // 0.0006 to 0.11): the weight's growth toward grazing angles is steeper the lower the index.
 constexpr double kFresnelIors[] = {1.05, 1.1, 1.2, 1.33, 1.5, 2.0};
@@ -39,25 +56,28 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   CandidateResult out;
   out.effect = fresnel ? "fresnel" : "specular_lobe_shape";
   const recon::Material& m = cx.model.materials[region];
-  const bool gmd = m.brdf == recon::BrdfModel::kWardGmd;
-  if (!(m.brdf == recon::BrdfModel::kWard || gmd) || !m.rho_s || !m.alpha) return out;
+  const bool ward = m.brdf == recon::BrdfModel::kWard || m.brdf == recon::BrdfModel::kWardGmd;
+  const bool shape =
+      std::find(std::begin(kLobeShapes), std::end(kLobeShapes), m.brdf) != std::end(kLobeShapes);
+  if (!(fresnel ? ward : shape) || !m.rho_s || !m.alpha) return out;
   const double rho_s = m.rho_s->mean(), alpha = *m.alpha;
   if (!(rho_s > 0)) return out;
-  // The lobe term ρs·Σ lobe·E at a record, of the current model or the alternative at (ior, a).
+  // The alternative lobe the fits below try (specular_lobe_shape: each of kLobeShapes in turn).
+  recon::BrdfModel other = m.brdf;
+  // The lobe term Σ lobe·E at a record, of the current model or the alternative at (ior, a).
   auto lobe_term = [&](const PixelRecord& r, int c, bool alternative, double ior, double a0) {
     // The pixel sees the lobe widened by its spread of normals.
     const double a = solver::WidenedAlpha(a0, r.lobe_blur2);
     double d = 0;
     auto add = [&](const RecordLightSample& ls) {
-      const double plain = IsotropicLobe(m.brdf, a, r.normal, r.view, ls.wi);
-      double v = plain;
-      if (alternative) {
-        v = fresnel ? plain * render::FresnelWeight<double>(ior, r.view.cast<double>(),
-                                                            ls.wi.cast<double>())
-                    : IsotropicLobe(gmd ? recon::BrdfModel::kWard : recon::BrdfModel::kWardGmd, a,
-                                    r.normal, r.view, ls.wi);
+      double v = 0;
+      if (alternative && fresnel) {
+        v = rho_s * IsotropicLobe(m.brdf, a, r.normal, r.view, ls.wi) *
+            render::FresnelWeight<double>(ior, r.view.cast<double>(), ls.wi.cast<double>());
+      } else {
+        v = LobeValue(alternative ? other : m.brdf, rho_s, a, r.normal, r.view, ls.wi);
       }
-      d += rho_s * v * ls.irradiance[c];
+      d += v * ls.irradiance[c];
     };
     // The lights' reflection, and the room's (on a curved glossy object it is most of the lobe's
     // change: the sphere's Ward-GMD lobe was predicted 1-2 % from the lights alone and its refit
@@ -139,8 +159,21 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
       if (better(at, fit)) fit = at, ior = candidate_ior, alpha_refit = a;
     }
   } else {
-    fit = refit ? fit_best_alpha(ior, &alpha_refit) : fit_at(ior);
-    if (fit.coef.size()) fitted_amplitude = fit.coef[0];
+    // The alternative lobe that explains most.
+    recon::BrdfModel best = m.brdf;
+    for (recon::BrdfModel candidate : kLobeShapes) {
+      if (candidate == m.brdf) continue;
+      other = candidate;
+      double a = alpha;
+      const ResidualFit at = refit ? fit_best_alpha(ior, &a) : fit_at(ior);
+      spdlog::debug("igi-diagnose: specular_lobe_shape on {}: {} amplitude {:.3f}, train {:.5g}",
+                    m.name, recon::BrdfModelName(candidate), at.coef.size() ? at.coef[0] : 0.0,
+                    at.train_after);
+      if (at.coef.size() && best == m.brdf) fitted_amplitude = at.coef[0];
+      if (better(at, fit))
+        fit = at, best = candidate, alpha_refit = a, fitted_amplitude = at.coef[0];
+    }
+    other = best;
   }
   if (fit.coef.size() == 0 || !(fit.coef[0] > lo) || !(fit.coef[0] < hi)) {
     out.note = fmt::format("the alternative lobe does not fit region {} (amplitude {:.2f})", m.name,
@@ -188,7 +221,7 @@ CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, 
   }
   FillScores(fit, &out);
   const std::string to = fresnel ? std::string(recon::BrdfModelName(m.brdf)) + "_fresnel"
-                                 : (gmd ? "ward" : "ward_gmd");
+                                 : std::string(recon::BrdfModelName(other));
   out.params = {{"region", m.name},
                 {"from", recon::BrdfModelName(m.brdf)},
                 {"to", to},
