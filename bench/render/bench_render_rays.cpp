@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "bench/render/raw_embree_tracer.h"
@@ -45,7 +47,11 @@ int main(int argc, char** argv) {
   std::string camera_name, lighting_name;
   int spp = 16, reps = 3;
   bool embree_spheres = false;
+  std::string lobe;
   app.add_option("--scene", scene_path, "scene.json")->capture_default_str();
+  app.add_option("--lobe", lobe,
+                 "Every material with an isotropic lobe takes this model, its values kept (e.g. "
+                 "ggx against ward_gmd: the lobe's cost in rays per second)");
   app.add_option("--camera", camera_name, "Camera (default: the first)");
   app.add_option("--lighting", lighting_name, "Lighting (default: the first)");
   app.add_option("--spp", spp, "Paths per pixel")->capture_default_str();
@@ -60,6 +66,17 @@ int main(int argc, char** argv) {
     load.check_images = false;
     igi::recon::Scene scene = igi::recon::LoadScene(scene_path, load);
     CompleteMaterials(&scene);
+    if (!lobe.empty()) {
+      const std::optional<igi::recon::BrdfModel> model = igi::recon::BrdfModelFromName(lobe);
+      if (!model || !igi::recon::HasSpecularLobe(*model) || igi::recon::IsAnisotropic(*model)) {
+        throw igi::InputError("--lobe " + lobe + ": must be an isotropic model with a lobe");
+      }
+      for (igi::recon::Material& m : scene.materials) {
+        if (igi::recon::HasSpecularLobe(m.brdf) && !igi::recon::IsAnisotropic(m.brdf)) {
+          m.brdf = *model;
+        }
+      }
+    }
     const int camera = camera_name.empty() ? 0 : scene.FindCamera(camera_name);
     const int lighting = lighting_name.empty() ? 0 : scene.FindLighting(lighting_name);
     if (camera < 0 || lighting < 0) throw igi::InputError("unknown --camera or --lighting");
