@@ -70,11 +70,12 @@ TEST(ConcealedLobeFamilyTest, AGgxLobeDeclaredWardIsNamedGgx) {
 
 // light_emission_profile, anisotropic_reflection and light_source_extent:
 // concealed_brdf_light_test.cpp; missing_geometry and pose_error: concealed_geometry_test.cpp.
-INSTANTIATE_TEST_SUITE_P(Effects, ConcealedEffectTest, testing::Values("specular_lobe_shape"));
-// The photo effects (labelled slow: CI names them in another renderer's photos,
-// concealed_outside_test.cpp).
+// Labelled slow: the photo effects (CI names them in another renderer's photos,
+// concealed_outside_test.cpp) and the Ward lobe's shape (CI names a GGX lobe declared Ward,
+// ConcealedLobeFamilyTest above).
 INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedEffectTest,
-                         testing::Values("vignetting", "exposure_scale", "camera_response"));
+                         testing::Values("vignetting", "exposure_scale", "camera_response",
+                                         "specular_lobe_shape"));
 
 TEST(ConcealedControlTest, NothingHiddenNothingReported) {
   test::PageCheck page;  // report.html in headless Chromium
