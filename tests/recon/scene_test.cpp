@@ -130,12 +130,8 @@ TEST(SceneTest, EveryProblemIsReportedNotOnlyTheFirst) {
   fs::remove_all(dir);
 }
 
-// The Fresnel-weighted models (igi's additions, docs/scene-format.md) take an optional "ior" in
-// (1, 5], default 1.5; the plain models do not accept the key.
-TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("igi_scene_fresnel_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+// The mini scene's document with every path absolute (written elsewhere, it still loads).
+Json MiniWithAbsolutePaths() {
   Json doc = ReadJsonFile(kMini);
   const fs::path mini = kMini.parent_path();
   for (auto& g : doc["geometry"]) g["file"] = (mini / g["file"].get<std::string>()).string();
@@ -148,6 +144,16 @@ TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
       photo["mask"] = (mini / photo["mask"].get<std::string>()).string();
     }
   }
+  return doc;
+}
+
+// The Fresnel-weighted models (igi's additions, docs/scene-format.md) take an optional "ior" in
+// (1, 5], default 1.5; the plain models do not accept the key.
+TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("igi_scene_fresnel_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Json doc = MiniWithAbsolutePaths();
   doc["materials"]["floor"]["brdf"] = "ward_gmd_fresnel";
   doc["materials"]["floor"]["ior"] = 1.33;
   doc["materials"]["box"]["brdf"] = "ward_aniso_fresnel";  // no ior: the default
@@ -187,18 +193,7 @@ TEST(SceneTest, MicrofacetModelsReadTheKeysOfTheirWardForms) {
   const fs::path dir =
       fs::temp_directory_path() / ("igi_scene_microfacet_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  Json doc = ReadJsonFile(kMini);
-  const fs::path mini = kMini.parent_path();
-  for (auto& g : doc["geometry"]) g["file"] = (mini / g["file"].get<std::string>()).string();
-  doc["materials"]["floor"]["rho_d_map"] = (mini / "textures/floor.exr").string();
-  doc["lights"]["spot"]["profile"]["ies"] = (mini / "lights/spot.ies").string();
-  doc["lights"]["panel"]["file"] = (mini / "geometry/panel.obj").string();
-  for (auto& photo : doc["photos"]) {
-    photo["file"] = (mini / photo["file"].get<std::string>()).string();
-    if (photo.contains("mask") && photo["mask"].is_string()) {
-      photo["mask"] = (mini / photo["mask"].get<std::string>()).string();
-    }
-  }
+  Json doc = MiniWithAbsolutePaths();
   doc["materials"]["floor"]["brdf"] = "ggx";
   doc["materials"]["box"] = {{"brdf", "beckmann_aniso"}, {"tangent", {1, 0, 0}}};
   WriteJsonFile(dir / "scene.json", doc);

@@ -28,7 +28,7 @@ using namespace test::lobe_plate;
 // dim light sample far from any highlight) and by a room whose one side is bright, its light as
 // PixelRecord::room samples (uniform over the hemisphere); the photos show the room reflected by
 // a Ward-GMD lobe, the model by a Ward lobe of the same ρs and α: specular_lobe_shape fits it at
-// amplitude 1, with the materials given. Without the room's samples there is nothing to fit.
+// amplitude 1, with the materials given.
 TEST(LobeChangeTest, TheRoomsReflectionCounts) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
@@ -69,8 +69,12 @@ TEST(LobeChangeTest, TheRoomsReflectionCounts) {
   EXPECT_EQ(c.params["to"], "ward_gmd");
   EXPECT_NEAR(c.params["amplitude"].get<double>(), 1.0, 0.05);
   EXPECT_GT(c.Gain(), 0.5);
+  // Without the room's samples no lobe explains the residual: the microfacet lobes differ from
+  // Ward's at the one dim lamp sample far from the highlight, and the best of them (Beckmann)
+  // fits there at a gain of 8e-5 of the held-out residual².
   for (PixelRecord& r : records) r.room.clear();
-  EXPECT_FALSE(PlateCandidate(false, records, rho_s, alpha, false).valid);
+  const CandidateResult none = PlateCandidate(false, records, rho_s, alpha, false);
+  EXPECT_TRUE(!none.valid || none.Gain() < 1e-3) << none.params.dump() << " " << none.Gain();
 }
 
 // Write changes the region's model to the params' other lobe and nothing else: its ρs and α stay
