@@ -247,18 +247,6 @@ class LobeTable {
   static constexpr double kMaxExponent = 60.0;
   static constexpr double kMaxGgxQ = 3e4;  // (1 + Q)² = 1e9
 
-  // Smith's Λ from a² (solver/render/microfacet.h's, for the squared tangent a²).
-  template <typename T>
-  T Lambda(const T& a2) const {
-    using std::exp;
-    using std::sqrt;
-    if (shape_ == recon::LobeShape::kGgx) return (sqrt(T(1.0) + a2) - T(1.0)) * T(0.5);
-    if (!(a2 > 1.0 / 36.0)) return T(0.0);
-    using std::erfc;
-    const T nu = T(1.0) / sqrt(a2);
-    return (exp(-nu * nu) / (nu * T(std::sqrt(render::kPi))) - erfc(nu)) * T(0.5);
-  }
-
   // A microfacet row's sums at the widened (αx², αy²): t and o of Term.
   template <typename T>
   void MicrofacetRow(int row, const T& ax2, const T& ay2, Eigen::Matrix<T, 3, 1>* t,
@@ -269,7 +257,8 @@ class LobeTable {
     const double imin = std::min(ScalarPart(ix), ScalarPart(iy));
     const bool ggx = shape_ == recon::LobeShape::kGgx;
     const double cut = ggx ? kMaxGgxQ : kMaxExponent;
-    const T lambda_o = Lambda<T>(ax2 * wo_l_[row][0] + ay2 * wo_l_[row][1]);
+    const T lambda_o =
+        render::microfacet::LambdaOfA2<T>(shape_, ax2 * wo_l_[row][0] + ay2 * wo_l_[row][1]);
     const T norm = T(1.0) / sqrt(ax2 * ay2);
     for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
       if (imin * double(qs_[k]) >= cut) break;
@@ -282,7 +271,8 @@ class LobeTable {
         d = exp(-q);
       }
       const T g2 = T(1.0) / (T(1.0) + lambda_o +
-                             Lambda<T>(ax2 * T(double(lx_[k])) + ay2 * T(double(ly_[k]))));
+                             render::microfacet::LambdaOfA2<T>(
+                                 shape_, ax2 * T(double(lx_[k])) + ay2 * T(double(ly_[k]))));
       const T w = d * g2 * norm;
       (*t)[0] += w * double(gr_[k]), (*t)[1] += w * double(gg_[k]), (*t)[2] += w * double(gb_[k]);
       (*o)[0] += w * double(orr_[k]), (*o)[1] += w * double(og_[k]), (*o)[2] += w * double(ob_[k]);

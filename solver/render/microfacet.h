@@ -28,20 +28,26 @@
 
 namespace igi::render::microfacet {
 
-// Smith's Λ(w) of `shape` for a direction w (w.z > 0) at roughness (αx, αy).
+// Smith's Λ of `shape` as a function of a² = (αx² wx² + αy² wy²)/wz² (the solver's lobe table
+// keeps a direction's squared tangents and forms a² at each roughness it tries).
 template <typename T>
-T Lambda(recon::LobeShape shape, const T& alpha_x, const T& alpha_y,
-         const Eigen::Matrix<T, 3, 1>& w) {
+T LambdaOfA2(recon::LobeShape shape, const T& a2) {
   using std::exp;
   using std::sqrt;
-  const T ax = alpha_x * w.x(), ay = alpha_y * w.y();
-  const T a2 = (ax * ax + ay * ay) / (w.z() * w.z());
   if (shape == recon::LobeShape::kGgx) return (sqrt(T(1.0) + a2) - T(1.0)) * T(0.5);
   // Beckmann: Λ is below 1e-17 once ν > 6 (a² < 1/36), and ν = 1/a is singular at the normal.
   if (!(a2 > 1.0 / 36.0)) return T(0.0);
   using std::erfc;
   const T nu = T(1.0) / sqrt(a2);
   return (exp(-nu * nu) / (nu * T(std::sqrt(kPi))) - erfc(nu)) * T(0.5);
+}
+
+// Smith's Λ(w) of `shape` for a direction w (w.z > 0) at roughness (αx, αy).
+template <typename T>
+T Lambda(recon::LobeShape shape, const T& alpha_x, const T& alpha_y,
+         const Eigen::Matrix<T, 3, 1>& w) {
+  const T ax = alpha_x * w.x(), ay = alpha_y * w.y();
+  return LambdaOfA2<T>(shape, (ax * ax + ay * ay) / (w.z() * w.z()));
 }
 
 // G1(w) = 1/(1 + Λ(w)): the share of microfacets of the visible projected area that w sees.
