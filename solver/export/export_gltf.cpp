@@ -156,7 +156,25 @@ int GltfBuilder::AddMaterial(const recon::Material& m) {
     base = base.cwiseMin(1.0);
     pbr["baseColorFactor"] = {base.x(), base.y(), base.z(), 1.0};
     Json specular = {{"specularFactor", 0.0}};
-    if (recon::HasSpecularLobe(m.brdf)) {
+    const bool exact_ggx = m.brdf == recon::BrdfModel::kGgx;
+    const bool metal = exact_ggx && !m.rho_d_map && !(internal::RegionRhoD(m).maxCoeff() > 0);
+    if (metal) {
+      // glTF's metal is F_schlick(baseColor)·D_ggx·V_smith_correlated: igi's ggx with ρd = 0.
+      pbr["metallicFactor"] = 1.0;
+      pbr["roughnessFactor"] = std::sqrt(*m.alpha);
+      pbr["baseColorFactor"] = {m.rho_s->x(), m.rho_s->y(), m.rho_s->z(), 1.0};
+      report_->Add("materials." + m.name,
+                   "ggx with rho_d 0 as metallic 1: baseColor = rho_s, roughness = sqrt(alpha) "
+                   "(exact)",
+                   0.0);
+    } else if (exact_ggx) {
+      // The same lobe on a dielectric: F0 = 0.04·specularColorFactor.
+      pbr["roughnessFactor"] = std::sqrt(*m.alpha);
+      specular = {{"specularFactor", 1.0}, {"specularColorFactor", Array3(*m.rho_s / 0.04)}};
+      report_->Add("materials." + m.name,
+                   "ggx lobe exact (roughness = sqrt(alpha), F0 = 0.04*specularColorFactor = "
+                   "rho_s); glTF weights the diffuse term by 1 - F, not compensated");
+    } else if (recon::HasSpecularLobe(m.brdf)) {
       LobeFitOptions options;
       options.target = LobeTarget::kGgxSchlick;
       const LobeFit fit = internal::FitAndReport(m, options, "glTF GGX + Schlick", report_);
@@ -164,7 +182,7 @@ int GltfBuilder::AddMaterial(const recon::Material& m) {
       const Eigen::Vector3d f0 = fit.scale * *m.rho_s / std::max(1e-12, m.rho_s->mean());
       specular = {{"specularFactor", 1.0}, {"specularColorFactor", Array3(f0 / 0.04)}};
     }
-    ext["KHR_materials_specular"] = specular;
+    if (!metal) ext["KHR_materials_specular"] = specular;
   }
   for (auto it = ext.begin(); it != ext.end(); ++it) extensions_.insert(it.key());
   material["pbrMetallicRoughness"] = pbr;

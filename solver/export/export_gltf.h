@@ -9,10 +9,15 @@
 //   baseColorFactor = rho_d (clamped to [0, 1]); rho_d_map -> baseColorTexture, an 8-bit PNG
 //   sRGB-encoded as glTF requires (the factor is then 1).
 //   lambert/black: KHR_materials_specular specularFactor 0 (no specular lobe: exact Lambert).
-//   Ward models: the specular lobe is fitted by glTF's GGX + Schlick (ward_fit.h, kGgxSchlick):
-//   roughness = √α_fit, and KHR_materials_specular specularColorFactor = F0_fit·(ρs/mean ρs)/0.04
-//   (glTF's dielectric F0 is 0.04·specularColorFactor). glTF also weights the diffuse by (1 − F);
-//   that darkening (≈ F0 at normal incidence) is not compensated. Anisotropy is dropped.
+//   ggx: glTF's own lobe (F_schlick·D_ggx·V with Smith's height-correlated V), so exact:
+//   roughness = √α, and with ρd = 0 (no map) metallicFactor 1 and baseColorFactor = ρs (glTF's
+//   metal takes F0 = baseColor: the whole BRDF exact); otherwise metallic 0 with
+//   KHR_materials_specular specularColorFactor = ρs/0.04 (glTF's dielectric F0 is
+//   0.04·specularColorFactor, the factor may exceed 1).
+//   Other models with a lobe: the lobe is fitted by glTF's GGX + Schlick (ward_fit.h,
+//   kGgxSchlick): roughness = √α_fit, and specularColorFactor = F0_fit·(ρs/mean ρs)/0.04.
+//   On a dielectric glTF also weights the diffuse by (1 − F); that darkening (≈ F0 at normal
+//   incidence) is not compensated. Anisotropy is dropped (ggx_aniso is fitted).
 //   emitter: emissiveFactor = radiance/max, KHR_materials_emissive_strength = max(radiance).
 // Lights (KHR_lights_punctual; values passed through 1:1 radiometrically: glTF's candela and lux
 //   are taken to mean W·sr⁻¹ and W·m⁻² — multiply by a luminous efficacy (683 lm/W at 555 nm) for

@@ -64,16 +64,20 @@ std::string BsdfText(const recon::Material& m, const std::filesystem::path& dir,
   } else {
     const double f0 = std::clamp(m.rho_s->mean(), 1e-4, 0.5);
     const double eta = (1 + std::sqrt(f0)) / (1 - std::sqrt(f0));
+    // GGX lobes keep their distribution; Ward's and Beckmann's lobes take Beckmann's.
+    const bool ggx = recon::Lobe(m.brdf) == recon::LobeShape::kGgx;
+    const std::string distribution = ggx ? "ggx" : "beckmann";
     LobeFitOptions options;
-    options.target = LobeTarget::kBeckmannDielectric;
+    options.target = ggx ? LobeTarget::kGgxDielectric : LobeTarget::kBeckmannDielectric;
     options.target_ior = eta;
-    const LobeFit fit =
-        internal::FitAndReport(m, options, "Mitsuba roughplastic (beckmann)", report);
+    const LobeFit fit = internal::FitAndReport(
+        m, options, "Mitsuba roughplastic (" + distribution + ")", report);
     report->Add("materials." + m.name,
                 "roughplastic's diffuse term carries Fresnel transmittances and internal "
                 "reflection: diffuse_reflectance = rho_d is not compensated");
     const Eigen::Vector3d spec = fit.scale * *m.rho_s / m.rho_s->mean();
-    inner = "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"beckmann\"/>" +
+    inner = "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"" +
+            distribution + "\"/>" +
             Float("alpha", fit.alpha) + Float("int_ior", eta) + Float("ext_ior", 1.0) +
             "<boolean name=\"nonlinear\" value=\"false\"/>" +
             DiffuseValue(m, "diffuse_reflectance", dir, report) +

@@ -5,10 +5,13 @@
 //
 // BSDFs (each wrapped in `twosided`, as igi's renderer shades both sides):
 //   lambert -> diffuse (exact); black -> diffuse 0; emitter -> an `area` emitter on its shape.
-//   Ward models -> roughplastic, distribution beckmann: int_ior η with ((η−1)/(η+1))² = mean ρs
-//     (clamped to [1e-4, 0.5]); alpha and specular_reflectance = k·ρs/mean ρs from the fit of
-//     the Ward lobe by k·F_dielectric(η)·D·G/(4 cosθi cosθo) (ward_fit.h, kBeckmannDielectric;
-//     the error is reported). diffuse_reflectance = rho_d (or a bitmap of rho_d_map); Mitsuba's
+//   Models with a lobe -> roughplastic, distribution ggx for the ggx models and beckmann for the
+//     others: int_ior η with ((η−1)/(η+1))² = mean ρs (clamped to [1e-4, 0.5]); alpha and
+//     specular_reflectance = k·ρs/mean ρs from the fit of the lobe by
+//     k·F_dielectric(η)·D·G1(wi)·G1(wo)/(4 cosθi cosθo) (ward_fit.h, kGgxDielectric or
+//     kBeckmannDielectric; the error is reported). A microfacet lobe keeps its distribution; what
+//     the fit absorbs is Mitsuba's exact dielectric Fresnel term against igi's Schlick factor and
+//     its separable Smith term against igi's height-correlated one. diffuse_reflectance = rho_d (or a bitmap of rho_d_map); Mitsuba's
 //     roughplastic scales its diffuse term by the Fresnel transmittances and internal
 //     reflection, which is not compensated (reported). Anisotropy is dropped.
 // Emitters: point -> point (intensity); spot -> spot along `direction` (cone: beam_width =

@@ -52,12 +52,20 @@ std::vector<DirectionPair> BuildPairs(double alpha_grid, bool anisotropic,
   return pairs;
 }
 
+// Smith's G1 of the Beckmann distribution by Walter et al.'s rational approximation (the form
+// Mitsuba 3 evaluates).
 double SmithG1Beckmann(const Eigen::Vector3d& v, double alpha) {
   const double tan2 = (v.x() * v.x() + v.y() * v.y()) / (v.z() * v.z());
   if (tan2 <= 0) return 1.0;
   const double a = 1.0 / (alpha * std::sqrt(tan2));
   if (a >= 1.6) return 1.0;
   return (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
+}
+
+// Smith's G1 of the GGX distribution: 2 / (1 + √(1 + α² tan²θ)).
+double SmithG1Ggx(const Eigen::Vector3d& v, double alpha) {
+  const double tan2 = (v.x() * v.x() + v.y() * v.y()) / (v.z() * v.z());
+  return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan2));
 }
 
 // The fit of `source` (grey ρs) at roughness `alpha` over `pairs`: k solved in closed form (the
@@ -95,6 +103,8 @@ std::string_view LobeTargetName(LobeTarget target) {
       return "ward_gmd";
     case LobeTarget::kBeckmannDielectric:
       return "beckmann_dielectric";
+    case LobeTarget::kGgxDielectric:
+      return "ggx_dielectric";
     case LobeTarget::kGgxSchlick:
       return "ggx_schlick";
   }
@@ -122,19 +132,23 @@ double TargetLobeValue(LobeTarget target, double alpha, double scale, double tar
   const double c = std::max(0.0, h.dot(wi));
   const double cos_h2 = h.z() * h.z();
   const double a2 = alpha * alpha;
+  const double ggx_denom = cos_h2 * (a2 - 1.0) + 1.0;
+  const double d_ggx = a2 / (render::kPi * ggx_denom * ggx_denom);
   if (target == LobeTarget::kBeckmannDielectric) {
     const double tan2 = (1.0 - cos_h2) / cos_h2;
     const double d = std::exp(-tan2 / a2) / (render::kPi * a2 * cos_h2 * cos_h2);
     const double g = SmithG1Beckmann(wo, alpha) * SmithG1Beckmann(wi, alpha);
     return scale * DielectricFresnel(c, target_ior) * d * g / (4.0 * wo.z() * wi.z());
   }
-  const double denom = cos_h2 * (a2 - 1.0) + 1.0;
-  const double d = a2 / (render::kPi * denom * denom);
+  if (target == LobeTarget::kGgxDielectric) {
+    const double g = SmithG1Ggx(wo, alpha) * SmithG1Ggx(wi, alpha);
+    return scale * DielectricFresnel(c, target_ior) * d_ggx * g / (4.0 * wo.z() * wi.z());
+  }
   const double nl = wi.z(), nv = wo.z();
   const double v =
       0.5 / (nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2));
   const double m = std::pow(1.0 - c, 5.0);
-  return (scale + (1.0 - scale) * m) * d * v;
+  return (scale + (1.0 - scale) * m) * d_ggx * v;
 }
 
 LobeFit FitSpecularLobe(const render::BrdfParams& source, const LobeFitOptions& options) {

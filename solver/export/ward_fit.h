@@ -1,6 +1,6 @@
 #pragma once
-// Fits of a Ward specular lobe (solver/render/brdf.h) by the lobes other renderers implement, for
-// the exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
+// Fits of a specular lobe (Ward's or a microfacet one: solver/render/brdf.h) by the lobes other
+// renderers implement, for the exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
 // values (ρd left out: the diffuse terms map exactly) over a grid of direction pairs covering the
 // lobe: view directions θo in [0°, max_theta_o_deg] (and several azimuths for an anisotropic
 // source), light directions parameterised by the half vector around the source's lobe (tanθh up to
@@ -22,8 +22,11 @@ enum class LobeTarget {
   // RADIANCE plastic/metal = contract ward_gmd: k·S_gmd(α); k is the fitted (grey) ρs.
   kWardGmd,
   // Mitsuba 3 roughplastic, distribution "beckmann": k·F(c, η)·D_beckmann(α)·G_smith / (4 cosθi
-  // cosθo), F the unpolarised dielectric Fresnel of relative index η; k = specular_reflectance.
+  // cosθo), F the unpolarised dielectric Fresnel of relative index η, G_smith = G1(wi)·G1(wo)
+  // (Mitsuba's separable form); k = specular_reflectance.
   kBeckmannDielectric,
+  // Mitsuba 3 roughplastic, distribution "ggx": as kBeckmannDielectric with GGX's D and G1.
+  kGgxDielectric,
   // glTF 2.0 metallic-roughness, metallic 0: F_schlick(c, F0 = k)·D_ggx(α)·V_smith_correlated(α),
   // where glTF's roughness is √α (α = roughness²); k is the fitted normal-incidence reflectance.
   kGgxSchlick,

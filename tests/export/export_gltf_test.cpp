@@ -11,10 +11,12 @@
 #include <map>
 
 #include "solver/export/export.h"
+#include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
 #include "tests/export/export_test_scene.h"
 #include "tests/temp_dir.h"
 #include "tools/common/image.h"
+#include "tools/common/json.h"
 
 namespace igi::exporter {
 namespace {
@@ -120,6 +122,74 @@ TEST(ExportGltf, EveryLightTypeAndTexture) {
   ASSERT_EQ(Materials(ai).at("matte")->GetTexture(aiTextureType_DIFFUSE, 0, &path),
             aiReturn_SUCCESS);
   EXPECT_STREQ(path.C_Str(), "textures/matte.png");
+}
+
+// glTF 2.0's metal (Appendix B of its specification), written here from the specification:
+// F_schlick(baseColor, v·h)·D_ggx·V_smith_correlated with α = roughness².
+Eigen::Vector3d GltfMetal(const Eigen::Vector3d& base_color, double roughness,
+                          const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  const Eigen::Vector3d h = (wo + wi).normalized();
+  const double a2 = std::pow(roughness, 4), nh = h.z(), nl = wi.z(), nv = wo.z();
+  const double d = a2 / (render::kPi * std::pow(nh * nh * (a2 - 1) + 1, 2));
+  const double v =
+      0.5 / (nl * std::sqrt(nv * nv * (1 - a2) + a2) + nv * std::sqrt(nl * nl * (1 - a2) + a2));
+  const Eigen::Vector3d f =
+      base_color + (Eigen::Vector3d::Ones() - base_color) * std::pow(1 - wo.dot(h), 5);
+  return f * d * v;
+}
+
+// ggx is glTF's own lobe: with ρd 0 it becomes a metal whose BRDF, read back from the file and
+// evaluated by the specification's formula, equals igi's renderer's; with ρd > 0 the lobe's
+// roughness and F0 are written as they are, not fitted.
+TEST(ExportGltf, GgxIsWrittenExactly) {
+  recon::Scene scene = test::SyntheticScene();
+  recon::Material& metal = scene.materials[1];
+  metal.brdf = recon::BrdfModel::kGgx;
+  metal.rho_d = Eigen::Vector3d::Zero(), metal.rho_s = Eigen::Vector3d(0.9, 0.6, 0.3);
+  metal.alpha = 0.16;
+  recon::Material& plastic = scene.materials[2];
+  plastic.brdf = recon::BrdfModel::kGgx;
+  plastic.rho_s = Eigen::Vector3d::Constant(0.05), plastic.alpha = 0.09;
+  const auto dir = test::UniqueTempDir("igi_export_gltf_ggx") / "out";
+  const ExportReport report = ExportScene(scene, dir, {.format = ExportFormat::kGltf});
+  const Json doc = ReadJsonFile(dir / "scene.gltf");
+  std::map<std::string, Json> materials;
+  for (const Json& m : doc.at("materials")) materials[m.at("name")] = m;
+
+  const Json& gold = materials.at("gold").at("pbrMetallicRoughness");
+  EXPECT_EQ(gold.at("metallicFactor").get<double>(), 1.0);
+  const double roughness = gold.at("roughnessFactor");
+  const Eigen::Vector3d base(gold.at("baseColorFactor")[0], gold.at("baseColorFactor")[1],
+                             gold.at("baseColorFactor")[2]);
+  render::BrdfParams igi;
+  igi.model = recon::BrdfModel::kGgx;
+  igi.rho_s = *metal.rho_s, igi.alpha = igi.alpha_x = igi.alpha_y = *metal.alpha;
+  for (double theta_o : {0.1, 0.6, 1.2}) {
+    for (double theta_i : {0.05, 0.5, 1.0, 1.4}) {
+      for (double phi : {0.0, 1.0, 3.0}) {
+        const Eigen::Vector3d wo(std::sin(theta_o), 0, std::cos(theta_o));
+        const Eigen::Vector3d wi(std::sin(theta_i) * std::cos(phi),
+                                 std::sin(theta_i) * std::sin(phi), std::cos(theta_i));
+        const Eigen::Vector3d want = render::EvalBrdf(igi, wo, wi);
+        const Eigen::Vector3d got = GltfMetal(base, roughness, wo, wi);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-6 * want[c]);
+      }
+    }
+  }
+  bool exact_reported = false;
+  for (const auto& a : report.approximations) {
+    exact_reported |= a.item == "materials.gold" && a.relative_error == 0.0;
+  }
+  EXPECT_TRUE(exact_reported);
+
+  const Json& old = materials.at("old_ward");
+  EXPECT_EQ(old.at("pbrMetallicRoughness").at("metallicFactor").get<double>(), 0.0);
+  EXPECT_NEAR(old.at("pbrMetallicRoughness").at("roughnessFactor").get<double>(), 0.3, 1e-12);
+  const Json& specular = old.at("extensions").at("KHR_materials_specular");
+  EXPECT_EQ(specular.at("specularFactor").get<double>(), 1.0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(0.04 * specular.at("specularColorFactor")[c].get<double>(), 0.05, 1e-12);
+  }
 }
 
 }  // namespace

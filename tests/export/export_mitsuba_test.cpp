@@ -104,5 +104,25 @@ TEST(ExportMitsuba, EveryLightType) {
   for (const auto& f : x.filenames) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
 }
 
+// A GGX region keeps its distribution: roughplastic with distribution ggx and the fitted alpha
+// within 5 % of its own; the Ward regions stay beckmann.
+TEST(ExportMitsuba, GgxKeepsItsDistribution) {
+  recon::Scene scene = test::SyntheticScene();
+  recon::Material& ggx = scene.materials[2];
+  ggx.brdf = recon::BrdfModel::kGgx, ggx.alpha = 0.15;
+  const auto dir = test::UniqueTempDir("igi_export_mi_ggx") / "out";
+  ExportScene(scene, dir, {.format = ExportFormat::kMitsuba});
+  const std::string xml = ReadFileToString(dir / "scene_all.xml");
+  std::smatch m;
+  const std::regex bsdf(
+      R"re(<!-- old_ward \(ggx\) -->\s*<bsdf[^\n]*name="distribution" value="(\w+)"/><float name="alpha" value="([0-9.e-]+)")re");
+  ASSERT_TRUE(std::regex_search(xml, m, bsdf)) << xml;
+  EXPECT_EQ(m[1], "ggx");
+  EXPECT_NEAR(std::stod(m[2]), 0.15, 0.05 * 0.15);
+  EXPECT_EQ(ReadXml(xml).types["bsdf:roughplastic"], 3);  // gold, old_ward, brushed
+  const std::regex beckmann(R"re(<!-- gold \(ward_gmd\) -->\s*<bsdf[^\n]*value="beckmann")re");
+  EXPECT_TRUE(std::regex_search(xml, beckmann));
+}
+
 }  // namespace
 }  // namespace igi::exporter
