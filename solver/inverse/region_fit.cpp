@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <utility>
 
 #include "solver/inverse/numeric.h"
@@ -106,7 +107,8 @@ class LobeTable {
     for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_})
       v->reserve(in.incident.size());
     if (microfacet_) {
-      for (std::vector<float>* v : {&lx_, &ly_, &orr_, &og_, &ob_}) v->reserve(in.incident.size());
+      for (std::vector<float>* v : {&lx_, &ly_, &ls_, &orr_, &og_, &ob_})
+        v->reserve(in.incident.size());
     }
     struct Entry {
       float qx, qy, lx, ly;
@@ -158,7 +160,7 @@ class LobeTable {
         qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
         gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
         if (microfacet_) {
-          lx_.push_back(e.lx), ly_.push_back(e.ly);
+          lx_.push_back(e.lx), ly_.push_back(e.ly), ls_.push_back(e.lx + e.ly);
           orr_.push_back(e.ov[0]), og_.push_back(e.ov[1]), ob_.push_back(e.ov[2]);
         }
       }
@@ -189,6 +191,16 @@ class LobeTable {
     Eigen::Matrix<T, 3, 1> sum = Eigen::Matrix<T, 3, 1>::Zero(), off = sum;
     if (row < 0) return {sum, off};
     const T ax2 = ax * ax + T(blur2_[row]), ay2 = ay * ay + T(blur2_[row]);
+    if (shape_ == recon::LobeShape::kGgx && !recon::IsAnisotropic(model_)) {
+      // One roughness: the sums and their derivatives in a² in double precision, then onto a².
+      Eigen::Vector3d t, o, dt, do_;
+      IsotropicGgxRowDerivative(row, ScalarPart(ax2), &t, &o, &dt, &do_);
+      for (int c = 0; c < 3; ++c) {
+        sum[c] = Linearised(t[c], dt[c], ax2);
+        off[c] = Linearised(o[c], do_[c], ax2);
+      }
+      return {sum, off};
+    }
     if (microfacet_) {
       MicrofacetRow<T>(row, ax2, ay2, &sum, &off);
       return {sum, off};
@@ -218,7 +230,9 @@ class LobeTable {
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      if (rows[i] >= 0 && microfacet_) {
+      if (rows[i] >= 0 && shape_ == recon::LobeShape::kGgx && ax == ay) {
+        IsotropicGgxRow(rows[i], ax * ax + blur2_[rows[i]], &f, &sum, &out.o[i]);
+      } else if (rows[i] >= 0 && microfacet_) {
         MicrofacetRow<double>(rows[i], ax * ax + blur2_[rows[i]], ay * ay + blur2_[rows[i]], &sum,
                               &out.o[i]);
       } else if (rows[i] >= 0) {
@@ -233,7 +247,7 @@ class LobeTable {
                 qs_.begin());
         f.resize(size_t(e - b));
         Exponentials(qx_.data() + b, qy_.data() + b, e - b, ix, iy, f.data());
-        sum = WeightedSum(f.data(), b, e - b) * scale;
+        sum = WeightedSum(f.data(), b, e - b, gr_, gg_, gb_) * scale;
       }
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
         sum -= s.held_lobe.cwiseProduct(s.irradiance) / render::kPi;
@@ -279,23 +293,82 @@ class LobeTable {
     }
   }
 
+  // MicrofacetRow of an isotropic GGX lobe at a² = `a2` (the α search's inner loop), in one
+  // single-precision pass over the row up to its cut-off: with s = √(1 + a²·tan²θ) for wo and
+  // wi, 1 + Λo + Λi = (so + si)/2, so each entry's D·G2 is 2/((1 + Q)²·(so + si)), Q = a²·qs.
+  void IsotropicGgxRow(int row, double a2, std::vector<float>* f, Eigen::Vector3d* t,
+                       Eigen::Vector3d* o) const {
+    const int b = begin_[row];
+    const int e = int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[row + 1],
+                                       float(kMaxGgxQ * a2)) -
+                      qs_.begin());
+    f->resize(size_t(e - b));
+    const float ia2 = float(1.0 / a2), a2f = float(a2);
+    const float so = float(std::sqrt(1.0 + a2 * (wo_l_[row][0] + wo_l_[row][1])));
+    const float* __restrict qs = qs_.data() + b;
+    const float* __restrict ls = ls_.data() + b;
+    float* __restrict out = f->data();
+    for (int k = 0; k < e - b; ++k) {
+      const float d1 = 1.0f + qs[k] * ia2;
+      out[k] = 2.0f / (d1 * d1 * (so + std::sqrt(1.0f + a2f * ls[k])));
+    }
+    const double norm = 1.0 / a2;
+    *t = WeightedSum(out, b, e - b, gr_, gg_, gb_) * norm;
+    *o = WeightedSum(out, b, e - b, orr_, og_, ob_) * norm;
+  }
+
+  // IsotropicGgxRow's sums t, o at a² and their derivatives in a² (the polish's Jacobian), in
+  // double precision: each entry's weight w = 2a²/((a² + qs)²·(so + si)) has
+  // d ln w / d a² = 1/a² − 2/(a² + qs) − (so' + si')/(so + si), s' = tan²θ/(2s).
+  void IsotropicGgxRowDerivative(int row, double a2, Eigen::Vector3d* t, Eigen::Vector3d* o,
+                                 Eigen::Vector3d* dt, Eigen::Vector3d* d_o) const {
+    t->setZero(), o->setZero(), dt->setZero(), d_o->setZero();
+    const double lo = wo_l_[row][0] + wo_l_[row][1];
+    const double so = std::sqrt(1.0 + a2 * lo), dso = lo / (2.0 * so);
+    for (int k = begin_[row]; k < begin_[row + 1]; ++k) {
+      const double qs = qs_[k];
+      if (qs >= kMaxGgxQ * a2) break;
+      const double si = std::sqrt(1.0 + a2 * double(ls_[k]));
+      const double sum_s = so + si, aq = a2 + qs;
+      const double w = 2.0 * a2 / (aq * aq * sum_s);
+      const double dw =
+          w * (1.0 / a2 - 2.0 / aq - (dso + double(ls_[k]) / (2.0 * si)) / sum_s);
+      const Eigen::Vector3d g(gr_[k], gg_[k], gb_[k]), m(orr_[k], og_[k], ob_[k]);
+      *t += w * g, *o += w * m, *dt += dw * g, *d_o += dw * m;
+    }
+  }
+
+  // value + d_value·(x − x₀) as a T: the value itself for double, a Jet whose derivative part is
+  // d_value times x's for a Jet.
+  template <typename T>
+  static T Linearised(double value, double d_value, const T& x) {
+    if constexpr (std::is_same_v<T, double>) {
+      return value;
+    } else {
+      T out(value);
+      out.v = d_value * x.v;
+      return out;
+    }
+  }
+
   static void Exponentials(const float* __restrict qx, const float* __restrict qy, int n, float ix,
                            float iy, float* __restrict f) {
     for (int k = 0; k < n; ++k) f[k] = ExpNonPositive(-(qx[k] * ix + qy[k] * iy));
   }
   // Σ f_k·(r, g, b)_k over entries [b, b + n), in two-lane double partial sums (SSE2 packets).
-  Eigen::Vector3d WeightedSum(const float* f, int b, int n) const {
+  static Eigen::Vector3d WeightedSum(const float* f, int b, int n, const std::vector<float>& r,
+                                     const std::vector<float>& g, const std::vector<float>& bl) {
     using A2 = Eigen::Array2d;
     A2 sr = A2::Zero(), sg = sr, sb = sr;
     int k = 0;
     for (; k + 2 <= n; k += 2) {
       const A2 fk(f[k], f[k + 1]);
-      sr += fk * A2(gr_[b + k], gr_[b + k + 1]);
-      sg += fk * A2(gg_[b + k], gg_[b + k + 1]);
-      sb += fk * A2(gb_[b + k], gb_[b + k + 1]);
+      sr += fk * A2(r[b + k], r[b + k + 1]);
+      sg += fk * A2(g[b + k], g[b + k + 1]);
+      sb += fk * A2(bl[b + k], bl[b + k + 1]);
     }
     Eigen::Vector3d sum(sr.sum(), sg.sum(), sb.sum());
-    for (; k < n; ++k) sum += double(f[k]) * Eigen::Vector3d(gr_[b + k], gg_[b + k], gb_[b + k]);
+    for (; k < n; ++k) sum += double(f[k]) * Eigen::Vector3d(r[b + k], g[b + k], bl[b + k]);
     return sum;
   }
   recon::BrdfModel model_;
@@ -308,8 +381,8 @@ class LobeTable {
   // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v (Ward: with the
   // Fresnel weight; microfacet: Schlick's (1 − m) part).
   std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
-  // Microfacet entries: wi's (lx, ly) and g·v's Schlick m part.
-  std::vector<float> lx_, ly_, orr_, og_, ob_;
+  // Microfacet entries: wi's (lx, ly) and their sum tan²θi, and g·v's Schlick m part.
+  std::vector<float> lx_, ly_, ls_, orr_, og_, ob_;
 };
 
 // The linear part for given specular terms: ρs and per-slot ρd by least squares.
