@@ -104,6 +104,15 @@ constexpr std::optional<BrdfModel> FindBrdfModel(LobeShape lobe, bool anisotropi
   return std::nullopt;
 }
 
+// The diffuse term a reflective model's ρd scales (the material's "diffuse", default lambert; any
+// lobe takes either).
+enum class DiffuseShape {
+  kLambert,    // ρd/π
+  kOrenNayar,  // Oren–Nayar's rough diffuse surface of slope deviation σ (solver/render/brdf.h)
+};
+std::string_view DiffuseShapeName(DiffuseShape shape);
+std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name);
+
 // "lambert", "ward", … as in kBrdfModels.
 std::string_view BrdfModelName(BrdfModel model);
 std::optional<BrdfModel> BrdfModelFromName(std::string_view name);

@@ -27,6 +27,16 @@ std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
   return std::nullopt;
 }
 
+std::string_view DiffuseShapeName(DiffuseShape shape) {
+  return shape == DiffuseShape::kOrenNayar ? "oren_nayar" : "lambert";
+}
+
+std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name) {
+  if (name == "lambert") return DiffuseShape::kLambert;
+  if (name == "oren_nayar") return DiffuseShape::kOrenNayar;
+  return std::nullopt;
+}
+
 std::string_view BrdfModelNames() {
   static const std::string names = [] {
     std::string s;
@@ -44,6 +54,7 @@ std::vector<std::string> Material::MissingForRendering() const {
     return missing;
   }
   if (!rho_d && !rho_d_map) missing.push_back("rho_d");
+  if (diffuse == DiffuseShape::kOrenNayar && !sigma) missing.push_back("sigma");
   if (!HasSpecularLobe(brdf)) return missing;
   if (!rho_s) missing.push_back("rho_s");
   if (IsAnisotropic(brdf)) {

@@ -41,6 +41,10 @@ struct Material {
   // kDefaultIor when absent (never an unknown to estimate).
   std::optional<double> ior;
   static constexpr double kDefaultIor = 1.5;
+  // The diffuse term (reflective models): Lambert's, or Oren–Nayar's with slope deviation
+  // `sigma` (radians, an unknown when absent).
+  DiffuseShape diffuse = DiffuseShape::kLambert;
+  std::optional<double> sigma;
 
   // Names of the values that rendering needs but this material lacks (empty = complete).
   std::vector<std::string> MissingForRendering() const;

@@ -75,11 +75,12 @@ std::set<std::string> ReadGeometry(const SceneLoader& ld, const JsonCursor& root
 const NumberRule kIorRule{1.0, 5.0, true, false};
 
 // Keys a material of each model may have: its albedo; a lobe's ρs and roughness (α, or αx, αy
-// and the tangent); the index of refraction of a lobe weighted by an ior's Fresnel factor.
+// and the tangent); the index of refraction of a lobe weighted by an ior's Fresnel factor; the
+// diffuse term's shape and its roughness.
 std::vector<std::string_view> MaterialKeys(BrdfModel model) {
   if (model == BrdfModel::kEmitter) return {"brdf", "radiance"};
   if (model == BrdfModel::kBlack) return {"brdf"};
-  std::vector<std::string_view> keys = {"brdf", "rho_d", "rho_d_map"};
+  std::vector<std::string_view> keys = {"brdf", "rho_d", "rho_d_map", "diffuse", "sigma"};
   if (!HasSpecularLobe(model)) return keys;
   keys.push_back("rho_s");
   if (IsAnisotropic(model)) {
@@ -115,6 +116,24 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
   if (c["alpha_y"].present()) m.alpha_y = c["alpha_y"].Number(roughness);
   if (c["tangent"].present()) m.tangent = c["tangent"].Direction();
   if (c["ior"].present()) m.ior = c["ior"].Number(kIorRule);
+  bool diffuse_known = true;  // (an unknown name is its own problem, not sigma's)
+  if (auto diffuse = c["diffuse"].present() ? c["diffuse"].String() : std::nullopt) {
+    if (auto shape = DiffuseShapeFromName(*diffuse)) {
+      m.diffuse = *shape;
+    } else {
+      c["diffuse"].Problem("unknown diffuse (known: lambert, oren_nayar)");
+      diffuse_known = false;
+    }
+  }
+  if (c["sigma"].present()) {
+    // Oren–Nayar's σ, the standard deviation of the facets' slope angle in radians: 0 is
+    // Lambert's surface; past ~0.8 rad the model's facets are steeper than its V-groove geometry
+    // assumes.
+    m.sigma = c["sigma"].Number(NumberRule::Between(0, 1));
+    if (diffuse_known && m.diffuse != DiffuseShape::kOrenNayar) {
+      c["sigma"].Problem("is read only with \"diffuse\": \"oren_nayar\"");
+    }
+  }
   if (c["radiance"].present() || m.brdf == BrdfModel::kEmitter) {
     m.radiance = c["radiance"].Rgb(NumberRule::NonNegative());
   }

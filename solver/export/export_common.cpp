@@ -72,6 +72,8 @@ render::BrdfParams ParamsOf(const recon::Material& material) {
   if (material.alpha_x) p.alpha_x = *material.alpha_x;
   if (material.alpha_y) p.alpha_y = *material.alpha_y;
   p.ior = material.ior.value_or(recon::Material::kDefaultIor);
+  p.diffuse = material.diffuse;
+  p.sigma = material.sigma.value_or(0.0);
   return p;
 }
 

@@ -31,6 +31,8 @@ std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet&
       in.alpha_y = m.params.alpha_y;
     }
     in.ior = m.params.ior;
+    in.diffuse = m.params.diffuse;
+    if (!m.unknown_sigma) in.sigma = m.params.sigma;
     if (m.last_fit.fitted && recon::HasSpecularLobe(m.params.model)) in.alpha_hint = m.params.alpha;
     if (stage == 2 && m.last_fit.fitted) in.albedo_varies = m.stage1_albedo_varies;
     if (options.uniform_albedo) in.albedo_varies = false;

@@ -16,6 +16,7 @@ namespace {
 Json ParamsJson(const MaterialState& m) {
   Json j;
   j["rho_d"] = {m.params.rho_d[0], m.params.rho_d[1], m.params.rho_d[2]};
+  if (m.params.diffuse == recon::DiffuseShape::kOrenNayar) j["sigma"] = m.params.sigma;
   if (recon::HasSpecularLobe(m.params.model)) {
     j["rho_s"] = {m.params.rho_s[0], m.params.rho_s[1], m.params.rho_s[2]};
     if (recon::IsAnisotropic(m.params.model)) {
@@ -242,6 +243,10 @@ double FitRegions(const StageData& d, const LightModel& light, int stage, int it
       m.params.alpha_y = f.alpha_y;
       change = std::max(change, RelativeChange(m.params.AlphaX(), old.AlphaX(), 0.005));
       change = std::max(change, RelativeChange(m.params.AlphaY(), old.AlphaY(), 0.005));
+    }
+    if (m.unknown_sigma) {
+      m.params.sigma = f.sigma;
+      change = std::max(change, RelativeChange(m.params.sigma, old.sigma, 0.05));
     }
     m.last_fit = f;
     if (m.unknown_rho_s) m.last_fit.rho_s = m.params.rho_s;

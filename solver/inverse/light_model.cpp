@@ -268,7 +268,7 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
           const int i = st.obs[k];
           const Observation& o = obs[i];
           const GatherPoint& gp = st.gather.points[light->point[i]];
-          const bool glossy = recon::HasSpecularLobe(materials[o.region].params.model);
+          const bool glossy = materials[o.region].KeepsIncident();
           const render::Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
           if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);

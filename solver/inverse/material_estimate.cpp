@@ -19,12 +19,15 @@ MaterialEstimate MaterialEstimate::FromScene(const recon::Scene& scene, const Pa
     s.unknown_rho_d = !m.rho_d && !m.rho_d_map;
     s.unknown_rho_s = spec && !m.rho_s;
     s.unknown_alpha = spec && (aniso ? !(m.alpha_x && m.alpha_y) : !m.alpha);
+    s.unknown_sigma = m.diffuse == recon::DiffuseShape::kOrenNayar && !m.sigma;
     s.params.rho_d = m.rho_d.value_or(Eigen::Vector3d::Constant(0.5));
     s.params.rho_s = m.rho_s.value_or(Eigen::Vector3d::Zero());
     s.params.alpha = m.alpha.value_or(0.1);
     s.params.alpha_x = m.alpha_x.value_or(m.alpha.value_or(0.1));
     s.params.alpha_y = m.alpha_y.value_or(m.alpha.value_or(0.1));
     s.params.ior = m.ior.value_or(recon::Material::kDefaultIor);
+    s.params.diffuse = m.diffuse;
+    s.params.sigma = m.sigma.value_or(0.0);
     s.tangent = m.tangent;
     if (m.rho_d_map) s.known_map = std::make_shared<const Image>(ReadImage(*m.rho_d_map, 3));
   }

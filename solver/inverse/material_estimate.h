@@ -24,6 +24,7 @@ struct MaterialState {
   render::BrdfParams params;  // complete: known values, or the current estimate
   bool reflective = false;
   bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
+  bool unknown_sigma = false;  // Oren–Nayar's σ (diffuse oren_nayar without "sigma")
   bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
   std::optional<Eigen::Vector3d> tangent;
   std::shared_ptr<const Image> known_map;    // a known rho_d_map
@@ -39,7 +40,15 @@ struct MaterialState {
   // (FitUnobservedAlbedos in solver/inverse/paper_stage.h): its relative uncertainty per channel
   // (NaN: not fitted).
   Eigen::Vector3d bounce_fit_sigma = Eigen::Vector3d::Constant(NAN);
-  bool NeedsFit() const { return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha); }
+  bool NeedsFit() const {
+    return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha || unknown_sigma);
+  }
+  // Whether the region's observations keep their incident lists for the fits: a lobe's, or
+  // Oren–Nayar's diffuse term, depends on the directions the light comes from.
+  bool KeepsIncident() const {
+    return recon::HasSpecularLobe(params.model) ||
+           params.diffuse == recon::DiffuseShape::kOrenNayar;
+  }
 };
 
 struct MaterialEstimate {

@@ -74,6 +74,7 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
           const GatherPoint& gp = st.gather.points[light.point[i]];
           const MaterialState& m = materials[o.region];
           const bool glossy = recon::HasSpecularLobe(m.params.model);
+          const bool keep = m.KeepsIncident();
           const render::Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           GatherQuery q;
           q.position = o.position.cast<double>();
@@ -90,7 +91,7 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
                                        : options.refine_rays;
           const int n = base * (glossy && obs.in_fit[i] ? 4 : 1);
           std::vector<IncidentLocal> inc;
-          if (glossy) inc = DirectIncident(st, gp, frame, n);
+          if (keep) inc = DirectIncident(st, gp, frame, n);
           const double eps = ray_epsilon[l];
           const bool summed = sums != nullptr && obs.in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);
@@ -130,7 +131,7 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
               }
               t += (w_lobe * dir.weight) * li;
             }
-            if (glossy) inc.push_back({wi_local.cast<float>(), (dir.weight * li).cast<float>()});
+            if (keep) inc.push_back({wi_local.cast<float>(), (dir.weight * li).cast<float>()});
           }
           if (summed) sums->Add(o.region, d_e, d_t, t);
           rays += k;

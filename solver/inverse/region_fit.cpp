@@ -802,7 +802,79 @@ std::optional<AlbedoModel> AlbedoModelFromName(std::string_view name) {
   return kAlbedoModelNames.FromName(name);
 }
 
+namespace {
+
+RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOptions& options);
+
+// `in` with each sample's irradiance replaced by Oren–Nayar's diffuse column A(σ)·E + B(σ)·G
+// (`g`: G per sample).
+RegionFitInput WithOrenNayarColumn(const RegionFitInput& in, const std::vector<Eigen::Vector3d>& g,
+                                   double sigma) {
+  RegionFitInput out;
+  static_cast<RegionFitSettings&>(out) = in;
+  out.diffuse = recon::DiffuseShape::kLambert;
+  out.samples = in.samples;
+  const double a = render::OrenNayarA(sigma), b = render::OrenNayarB(sigma);
+  for (size_t i = 0; i < out.samples.size(); ++i) {
+    out.samples[i].irradiance = a * in.samples[i].irradiance + b * g[i];
+  }
+  return out;
+}
+
+// The region fit with Oren–Nayar's diffuse term (RegionFitSettings::diffuse).
+RegionFitResult FitOrenNayar(const RegionFitInput& in, const RegionFitOptions& options) {
+  std::vector<Eigen::Vector3d> g(in.samples.size(), Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < in.samples.size(); ++i) {
+    const FitSample& s = in.samples[i];
+    const Eigen::Vector3d wo = s.wo.cast<double>();
+    if (!(wo.z() > 0.0)) continue;
+    for (int64_t k = 0; k < s.incident_count; ++k) {
+      const Eigen::Vector3d wi = s.incident[k].Wi().cast<double>();
+      if (wi.z() > 0.0) g[i] += render::OrenNayarG<double>(wo, wi) * s.incident[k].Value().cast<double>();
+    }
+  }
+  double sigma = in.sigma.value_or(0.0);
+  if (!in.sigma) {
+    // The profile cost of σ: the α search's projected cost (ρd, ρs solved), with the weights of
+    // Lambert's column at every σ so that the costs compare.
+    const Prepared weights = Prepare(in);
+    const LobeTable table(in);
+    std::optional<double> hint = in.alpha_hint;
+    auto cost = [&](double sg) {
+      RegionFitInput on = WithOrenNayarColumn(in, g, sg);
+      on.alpha_hint = hint;
+      Prepared pr = Prepare(on);
+      pr.w = weights.w;
+      const AlphaSearch a = SearchAlpha(on, pr, false, table);
+      if (recon::HasSpecularLobe(in.model) && !in.alpha) hint = a.ax;
+      return a.linear.cost;
+    };
+    constexpr int kGrid = 11;
+    double best = std::numeric_limits<double>::infinity();
+    int best_i = 0;
+    for (int i = 0; i < kGrid; ++i) {
+      const double c = cost(double(i) / (kGrid - 1));
+      if (c < best) best = c, best_i = i;
+    }
+    const double lo = std::max(0, best_i - 1) / double(kGrid - 1);
+    const double hi = std::min(kGrid - 1, best_i + 1) / double(kGrid - 1);
+    sigma = BrentMinimum(lo, hi, 1e-3, 30, cost);
+  }
+  RegionFitResult r = FitLambertColumn(WithOrenNayarColumn(in, g, sigma), options);
+  r.sigma = sigma;
+  return r;
+}
+
+}  // namespace
+
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
+  if (in.diffuse == recon::DiffuseShape::kOrenNayar) return FitOrenNayar(in, options);
+  return FitLambertColumn(in, options);
+}
+
+namespace {
+
+RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOptions& options) {
   RegionFitResult r;
   r.samples = static_cast<int>(in.samples.size());
   if (in.samples.empty()) {
@@ -920,5 +992,7 @@ RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& opti
   r.relative_rms = RelativeRms(in, t, r.slot_rho_d, r.rho_s, true);
   return r;
 }
+
+}  // namespace
 
 }  // namespace igi::solver

@@ -103,6 +103,13 @@ struct RegionFitSettings {
   std::optional<double> alpha;             // isotropic models
   std::optional<double> alpha_x, alpha_y;  // anisotropic models
   double ior = 1.5;
+  // The diffuse term: Lambert's, or Oren–Nayar's with a known or an unknown σ. With Oren–Nayar
+  // the diffuse column is ρd·(A(σ)·E + B(σ)·G)/π, G = Σ_k OrenNayarG(wo, wi_k)·v_k over the
+  // sample's incident list (solver/render/brdf.h): for a σ, linear in ρd as Lambert's. An unknown
+  // σ is searched over [0, 1] (a grid of 11, then Brent's method), the α search and the linear
+  // solve at each.
+  recon::DiffuseShape diffuse = recon::DiffuseShape::kLambert;
+  std::optional<double> sigma;
   bool grey_specular = true;  // one ρs for the three channels
   // The previous iteration's α (isotropic models): the search then starts near it instead of
   // scanning the whole range (it still scans when the minimum leaves the window).
@@ -147,6 +154,7 @@ struct RegionFitResult {
   std::vector<int> slot_count;                        // samples per slot
   Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
   double alpha = 0, alpha_x = 0, alpha_y = 0;
+  double sigma = 0;  // Oren–Nayar's σ (0 with Lambert's diffuse)
   // One-sigma uncertainties (NaN where unknown or not fitted).
   Eigen::Vector3d sigma_rho_d = Eigen::Vector3d::Constant(NAN);
   double sigma_rho_s = NAN, sigma_alpha = NAN, sigma_alpha_x = NAN, sigma_alpha_y = NAN;

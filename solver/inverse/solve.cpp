@@ -398,6 +398,7 @@ void SolverState::SummariseRegions() {
     rs.observations = m.observations;
     if (m.unknown_rho_d) rs.unknowns.push_back("rho_d");
     if (m.unknown_rho_s) rs.unknowns.push_back("rho_s");
+    if (m.unknown_sigma) rs.unknowns.push_back("sigma");
     if (m.unknown_alpha) {
       if (recon::IsAnisotropic(m.params.model)) {
         rs.unknowns.push_back("alpha_x");

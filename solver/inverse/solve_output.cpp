@@ -24,7 +24,8 @@ std::string SeenFile(const std::string& map_file) {
 Json Num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json Vec(const Eigen::Vector3d& v) { return Json::array({Num(v[0]), Num(v[1]), Num(v[2])}); }
 
-Json FitJson(const RegionFitResult& f, recon::BrdfModel model) {
+Json FitJson(const RegionFitResult& f, const render::BrdfParams& params) {
+  const recon::BrdfModel model = params.model;
   Json j;
   if (!f.fitted) {
     j["fitted"] = false;
@@ -33,6 +34,7 @@ Json FitJson(const RegionFitResult& f, recon::BrdfModel model) {
   }
   j["rho_d"] = Vec(f.rho_d);
   j["sigma_rho_d"] = Vec(f.sigma_rho_d);
+  if (params.diffuse == recon::DiffuseShape::kOrenNayar) j["sigma"] = Num(f.sigma);
   if (recon::HasSpecularLobe(model)) {
     j["rho_s"] = Vec(f.rho_s);
     j["sigma_rho_s"] = Num(f.sigma_rho_s);
@@ -72,6 +74,7 @@ Json SolvedSceneDocument(const recon::Scene& scene, const SolveSummary& summary,
     const render::BrdfParams& p = rs.final_params;
     if (!recon::IsReflective(scene.materials[r].brdf)) continue;
     doc.SetMaterialValue(name, "rho_d", Vec(p.rho_d));
+    if (p.diffuse == recon::DiffuseShape::kOrenNayar) doc.SetMaterialValue(name, "sigma", p.sigma);
     if (!rs.albedo_map_file.empty()) doc.SetMaterialValue(name, "rho_d_map", rs.albedo_map_file);
     if (recon::HasSpecularLobe(p.model)) {
       const bool grey = p.rho_s[0] == p.rho_s[1] && p.rho_s[1] == p.rho_s[2];
@@ -127,8 +130,8 @@ Json SolveReportJson(const SolveSummary& s, const SolveOptions& o) {
     rj["status"] = std::string(RegionStatusName(r.status));
     rj["unknowns"] = r.unknowns;
     rj["observations"] = r.observations;
-    rj["paper"] = FitJson(r.stage1, r.final_params.model);
-    rj["refined"] = FitJson(r.stage2, r.final_params.model);
+    rj["paper"] = FitJson(r.stage1, r.final_params);
+    rj["refined"] = FitJson(r.stage2, r.final_params);
     // scene.json's rho_d and where it comes from: the albedo map's mean over its seen texels
     // where the region has a map, else the fit's region mean (after the bound at 1).
     rj["rho_d"] = Vec(r.final_params.rho_d);

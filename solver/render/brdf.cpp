@@ -31,6 +31,10 @@ double Mean(const Eigen::Vector3d& v) { return (v[0] + v[1] + v[2]) / 3.0; }
 std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
   std::vector<BrdfParamProblem> problems;
   CheckRgb(params.rho_d, "rho_d", &problems);
+  if (params.diffuse == recon::DiffuseShape::kOrenNayar &&
+      !(std::isfinite(params.sigma) && params.sigma >= 0.0)) {
+    problems.push_back({"sigma", params.sigma, "must be finite and >= 0"});
+  }
   if (recon::HasSpecularLobe(params.model)) {
     CheckRgb(params.rho_s, "rho_s", &problems);
     if (recon::IsAnisotropic(params.model)) {
@@ -74,7 +78,7 @@ BrdfEval EvalGlossyBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& w
   if (!(wo.z() > 0.0)) return out;
   const bool above = wi.z() > 0.0;
   const double p_specular = SpecularLobeProbability(params, wo);
-  if (above) out.f = params.rho_d * kInvPi;
+  if (above) out.f = params.rho_d * (kInvPi * DiffuseFactor(params, wo, wi));
   out.pdf = (1.0 - p_specular) * CosineHemispherePdf(wi.z());
 
   const double ax = params.AlphaX();

@@ -35,6 +35,13 @@
 // η → ∞ (F0 → 1) W → 1 and the model becomes the plain one. W is symmetric in wi and wo, so the
 // models stay reciprocal. The diffuse term is not weighted.
 //
+// The diffuse term ρd/π is Lambert's unless the material's "diffuse" is oren_nayar: then it is
+// Oren and Nayar's rough diffuse surface (their qualitative model, 1994) of slope deviation σ,
+//   ρd/π·(A + B·max(0, cos(φi − φo))·sin(max(θi, θo))·tan(min(θi, θo))),
+//   A = 1 − σ²/(2(σ² + 0.33)),  B = 0.45σ²/(σ² + 0.09),
+// in vector form ρd/π·(A + B·max(0, wi.x wo.x + wi.y wo.y)/max(cosθi, cosθo)) (DiffuseFactor);
+// σ = 0 is Lambert's. Symmetric in wi and wo; sampled cosine-weighted as Lambert's.
+//
 // Sampling picks the diffuse lobe (cosine-weighted) or the specular lobe with probabilities from
 // the lobes' mean RGB albedos (SpecularLobeProbability). Ward's lobes and Beckmann's draw the half
 // vector's slopes (h.x/h.z, h.y/h.z) from a Gaussian with deviations αx/√2, αy/√2 (Ward's
@@ -76,6 +83,8 @@ struct BrdfParamsT {
   T alpha_x = T(0.1);
   T alpha_y = T(0.1);
   T ior = T(1.5);  // index of refraction, read by the *_fresnel models only; > 1
+  recon::DiffuseShape diffuse = recon::DiffuseShape::kLambert;
+  T sigma = T(0.0);  // Oren–Nayar's slope deviation (radians), read with diffuse kOrenNayar
 
   // The roughness along t and along b that the model uses.
   T AlphaX() const { return recon::IsAnisotropic(model) ? alpha_x : alpha; }
@@ -179,12 +188,43 @@ LobeWeightsT<T> SpecularWeights(recon::BrdfModel model, const T& alpha_x, const 
   return w;
 }
 
+// Oren–Nayar's A and B of σ (the header comment).
+template <typename T>
+T OrenNayarA(const T& sigma) {
+  const T s2 = sigma * sigma;
+  return T(1.0) - T(0.5) * s2 / (s2 + T(0.33));
+}
+template <typename T>
+T OrenNayarB(const T& sigma) {
+  const T s2 = sigma * sigma;
+  return T(0.45) * s2 / (s2 + T(0.09));
+}
+// The geometric part of Oren–Nayar's B term, max(0, cos(φi − φo))·sin(max θ)·tan(min θ) =
+// max(0, wi.x wo.x + wi.y wo.y)/max(cosθi, cosθo); wo and wi above the surface.
+template <typename T>
+T OrenNayarG(const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi) {
+  const T dot = wi.x() * wo.x() + wi.y() * wo.y();
+  if (!(dot > 0.0)) return T(0.0);
+  return dot / (wi.z() > wo.z() ? wi.z() : wo.z());
+}
+// The diffuse term over ρd/π: 1 for Lambert's, A + B·OrenNayarG for Oren–Nayar's.
+template <typename T>
+T DiffuseFactor(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,
+                const Eigen::Matrix<T, 3, 1>& wi) {
+  if (params.diffuse != recon::DiffuseShape::kOrenNayar) return T(1.0);
+  return OrenNayarA(params.sigma) + OrenNayarB(params.sigma) * OrenNayarG<T>(wo, wi);
+}
+inline double DiffuseFactor(const BrdfParams& params, const Eigen::Vector3d& wo,
+                            const Eigen::Vector3d& wi) {
+  return DiffuseFactor<double>(params, wo, wi);
+}
+
 // f(wo, wi), RGB per steradian; zero when wo or wi is at or below the surface.
 template <typename T>
 Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,
                                 const Eigen::Matrix<T, 3, 1>& wi) {
   if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) return Eigen::Matrix<T, 3, 1>::Zero();
-  Eigen::Matrix<T, 3, 1> f = params.rho_d * T(kInvPi);
+  Eigen::Matrix<T, 3, 1> f = params.rho_d * (T(kInvPi) * DiffuseFactor<T>(params, wo, wi));
   if (recon::HasSpecularLobe(params.model)) {
     const LobeWeightsT<T> w =
         SpecularWeights<T>(params.model, params.AlphaX(), params.AlphaY(), params.ior, wo, wi);
@@ -240,13 +280,14 @@ inline BrdfSample SampleBrdf(const BrdfParams& params, const Eigen::Vector3d& wo
                              const Eigen::Vector2d& u) {
   if (recon::HasSpecularLobe(params.model))
     return brdf_internal::SampleGlossyBrdf(params, wo, u_lobe, u);
-  BrdfSample sample;  // lambert: f = ρd/π, pdf = cosθ/π, weight = ρd exactly
+  BrdfSample sample;  // no lobe: f = ρd/π·F, pdf = cosθ/π, weight = ρd·F exactly
   if (!(wo.z() > 0.0)) return sample;
   sample.lobe = BrdfLobe::kDiffuse;
   sample.wi = SampleCosineHemisphere(u);
-  sample.f = params.rho_d * kInvPi;
+  const double factor = sample.wi.z() > 0.0 ? DiffuseFactor(params, wo, sample.wi) : 0.0;
+  sample.f = params.rho_d * (kInvPi * factor);
   sample.pdf = CosineHemispherePdf(sample.wi.z());
-  if (sample.Valid()) sample.weight = params.rho_d;
+  if (sample.Valid()) sample.weight = params.rho_d * factor;
   return sample;
 }
 
@@ -260,9 +301,9 @@ inline BrdfEval EvalBrdfAndPdf(const BrdfParams& params, const Eigen::Vector3d& 
                                const Eigen::Vector3d& wi) {
   if (recon::HasSpecularLobe(params.model))
     return brdf_internal::EvalGlossyBrdfAndPdf(params, wo, wi);
-  BrdfEval out;  // lambert: no lobe choice, no half vector
+  BrdfEval out;  // no lobe: no lobe choice, no half vector
   if (!(wo.z() > 0.0)) return out;
-  if (wi.z() > 0.0) out.f = params.rho_d * kInvPi;
+  if (wi.z() > 0.0) out.f = params.rho_d * (kInvPi * DiffuseFactor(params, wo, wi));
   out.pdf = CosineHemispherePdf(wi.z());
   return out;
 }

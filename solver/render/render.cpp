@@ -112,7 +112,7 @@ VertexShares BrdfShares(const BrdfParams& params, const Eigen::Vector3d& wo,
                             : LobeWeights{};
   for (int c = 0; c < 3; ++c) {
     if (!(f[c] > 0)) continue;
-    const double diffuse = params.rho_d[c] * kInvPi;
+    const double diffuse = params.rho_d[c] * kInvPi * DiffuseFactor(params, wo, wi);
     const double lobe = std::clamp((f[c] - diffuse) / f[c], 0.0, 1.0);
     out.d[c] = std::min(1.0, diffuse / f[c]);
     out.s[c] = w.offset > 0 ? std::clamp(params.rho_s[c] * w.scale / f[c], 0.0, 1.0) : lobe;

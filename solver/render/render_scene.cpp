@@ -57,6 +57,8 @@ ShadingMaterial MakeShadingMaterial(const recon::Material& m) {
   s.params.alpha_x = m.alpha_x.value_or(0.1);
   s.params.alpha_y = m.alpha_y.value_or(0.1);
   s.params.ior = m.ior.value_or(recon::Material::kDefaultIor);
+  s.params.diffuse = m.diffuse;
+  s.params.sigma = m.sigma.value_or(0.0);
   s.tangent = m.tangent;
   if (m.brdf == recon::BrdfModel::kEmitter)
     s.emission = m.radiance.value_or(Eigen::Vector3d::Zero());

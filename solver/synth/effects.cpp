@@ -325,6 +325,29 @@ Json LobeShape(Params& p, const SynthRoom& room, SynthScenes* s) {
   return Json{{"regions", changes}, {"note", "same rho_d, rho_s and alpha values"}};
 }
 
+Json DiffuseShapeEffect(Params& p, const SynthRoom& room, SynthScenes* s) {
+  std::vector<std::string> lambert;  // the regions without a lobe
+  for (auto it = room.materials.begin(); it != room.materials.end(); ++it) {
+    if (it.value().value("brdf", "") == "lambert") lambert.push_back(it.key());
+  }
+  std::vector<std::string> reflective = lambert;
+  reflective.insert(reflective.end(), room.glossy_regions.begin(), room.glossy_regions.end());
+  const auto regions = p.Names("regions", lambert, reflective);
+  const double sigma = p.Number("sigma", 0.4, 0.0, 1.0);
+  p.Finish();
+  for (const std::string& region : regions) {
+    Json& m = s->true_scene["materials"][region];
+    m["diffuse"] = "oren_nayar";
+    m["sigma"] = sigma;
+  }
+  return Json{{"regions", regions},
+              {"sigma", sigma},
+              {"model",
+               "diffuse rho_d/pi (A + B max(0, cos(phi_i - phi_o)) sin(max theta) tan(min theta)), "
+               "A = 1 - sigma^2/(2 (sigma^2 + 0.33)), B = 0.45 sigma^2/(sigma^2 + 0.09)"},
+              {"note", "same rho_d (and lobe) values"}};
+}
+
 Json Intensity(Params& p, const SynthRoom& room, SynthScenes* s) {
   const std::string light = p.Name("light", "lamp", LampNames(room));
   const double factor = p.Number("factor", 1.25, 0.01, 100.0);
@@ -434,6 +457,7 @@ Json SceneEffect(const EffectSpec& spec, Params& p, const SynthRoom& room, Synth
   if (n == "light_intensity") return Intensity(p, room, s);
   if (n == "specular_reflection") return SpecularAsDiffuse(p, room, s);
   if (n == "fresnel") return Fresnel(p, room, s);
+  if (n == "diffuse_shape") return DiffuseShapeEffect(p, room, s);
   p.Fail("", "", "unknown effect");
 }
 

@@ -30,6 +30,9 @@
 //   fresnel                 the glossy regions (regions=a/b/c) are truly Fresnel-weighted
 //                           (ward -> ward_fresnel, … : specular × F(c)/F0, Schlick, ior=1.5);
 //                           declared without Fresnel (solver/render/brdf.h defines the models)
+//   diffuse_shape           regions (regions=a/b/c; default: every region without a lobe) are
+//                           truly Oren–Nayar surfaces of slope deviation sigma (0.4), same ρd;
+//                           declared Lambertian
 
 #include <map>
 #include <optional>

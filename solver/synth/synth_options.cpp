@@ -180,7 +180,7 @@ const std::vector<std::string>& SupportedEffects() {
       "vignetting",       "light_emission_profile", "anisotropic_reflection", "light_source_extent",
       "missing_geometry", "ambient_light",          "exposure_scale",         "camera_response",
       "pose_error",       "specular_lobe_shape",    "light_intensity",        "specular_reflection",
-      "fresnel"};
+      "fresnel",          "diffuse_shape"};
   return kEffects;
 }
 

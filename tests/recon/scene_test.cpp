@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <tuple>
 
 #include "recon/colmap_model.h"
 
@@ -220,6 +221,58 @@ TEST(SceneTest, MicrofacetModelsReadTheKeysOfTheirWardForms) {
       EXPECT_NE(e.problems()[0].find(std::string("materials.floor.") + key), std::string::npos)
           << e.what();
     }
+  }
+  fs::remove_all(dir);
+}
+
+// Oren–Nayar's diffuse term (docs/scene-format.md): "diffuse": "oren_nayar" on any reflective
+// model with "sigma" in [0, 1] (an unknown when absent: rendering needs it); "sigma" without it,
+// an unknown diffuse name and σ out of range are one problem each.
+TEST(SceneTest, OrenNayarDiffuseReadsItsRoughness) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("igi_scene_oren_nayar_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Json doc = MiniWithAbsolutePaths();
+  doc["materials"]["floor"]["diffuse"] = "oren_nayar";
+  doc["materials"]["floor"]["sigma"] = 0.3;
+  doc["materials"]["box"] = {{"brdf", "ggx"}, {"diffuse", "oren_nayar"}};
+  WriteJsonFile(dir / "scene.json", doc);
+  const Scene scene = LoadScene(dir / "scene.json");
+  const Material& floor = scene.materials[scene.FindMaterial("floor")];
+  EXPECT_EQ(floor.diffuse, DiffuseShape::kOrenNayar);
+  EXPECT_EQ(floor.sigma, 0.3);
+  EXPECT_TRUE(floor.MissingForRendering().empty());
+  const Material& box = scene.materials[scene.FindMaterial("box")];
+  EXPECT_EQ(box.diffuse, DiffuseShape::kOrenNayar);
+  EXPECT_EQ(box.MissingForRendering(),
+            (std::vector<std::string>{"rho_d", "sigma", "rho_s", "alpha"}));
+
+  const std::tuple<const char*, Json, const char*> bad[] = {
+      {"sigma", -0.1, "must be in [0, 1]"},
+      {"sigma", 1.5, "must be in [0, 1]"},
+      {"diffuse", "rough", "unknown diffuse (known: lambert, oren_nayar)"}};
+  for (const auto& [key, value, rule] : bad) {
+    Json broken = doc;
+    broken["materials"]["floor"][key] = value;
+    WriteJsonFile(dir / "scene.json", broken);
+    try {
+      LoadScene(dir / "scene.json");
+      ADD_FAILURE() << key << " " << value;
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.problems().size(), 1u) << e.what();
+      EXPECT_NE(e.problems()[0].find(std::string("materials.floor.") + key), std::string::npos)
+          << e.what();
+      EXPECT_NE(e.problems()[0].find(rule), std::string::npos) << e.what();
+    }
+  }
+  Json lambert = doc;
+  lambert["materials"]["floor"].erase("diffuse");
+  WriteJsonFile(dir / "scene.json", lambert);
+  try {
+    LoadScene(dir / "scene.json");
+    ADD_FAILURE() << "sigma without oren_nayar was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("materials.floor.sigma"), std::string::npos) << e.what();
   }
   fs::remove_all(dir);
 }

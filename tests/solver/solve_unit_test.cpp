@@ -367,6 +367,40 @@ TEST(RegionFit, RecoversMicrofacetParametersExactlyFromNoiseFreeSamples) {
 // Samples whose pixels span normals up to 0.1 rad apart (lobe_blur2 up to 0.008, as on a 0.35 m
 // sphere seen at 3–4 cm per pixel): the fit recovers the surface's own α with each sample's
 // lobe widened by its spread; taken as sharp samples (spread ignored), the lobe comes out wider.
+// Oren–Nayar's diffuse term under Lambert's samples' light: the observed radiance rebuilt with
+// ρd·(A·E + B·G)/π, G over each sample's incident list. An unknown σ is recovered with ρd and
+// the lobe, from noise-free samples, alone and under a GGX lobe; σ 0 (Lambert's surface) stays
+// near 0.
+TEST(RegionFit, RecoversOrenNayarRoughnessWithTheAlbedoAndTheLobe) {
+  for (auto [model, sigma] : {std::pair{recon::BrdfModel::kLambert, 0.35},
+                              std::pair{recon::BrdfModel::kGgx, 0.5},
+                              std::pair{recon::BrdfModel::kLambert, 0.0}}) {
+    const Eigen::Vector3d rho_d(0.5, 0.4, 0.3);
+    RegionFitInput in = MakeSamples(model, {rho_d}, 0.08, 0.15, 0.0, 31);
+    const double a = render::OrenNayarA(sigma), b = render::OrenNayarB(sigma);
+    for (FitSample& smp : in.samples) {
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      const Eigen::Vector3d wo = smp.wo.cast<double>();
+      for (int64_t k = 0; k < smp.incident_count; ++k) {
+        const Eigen::Vector3d wi = smp.incident[k].Wi().cast<double>();
+        g += render::OrenNayarG<double>(wo, wi) * smp.incident[k].Value().cast<double>();
+      }
+      const Eigen::Vector3d lobe = smp.observed - rho_d.cwiseProduct(smp.irradiance) / render::kPi;
+      smp.observed = rho_d.cwiseProduct(a * smp.irradiance + b * g) / render::kPi + lobe;
+    }
+    in.diffuse = recon::DiffuseShape::kOrenNayar;
+    const RegionFitResult r = FitRegion(in, {});
+    const std::string what = std::string(recon::BrdfModelName(model)) + " sigma " +
+                             std::to_string(sigma) + ": fitted " + std::to_string(r.sigma);
+    EXPECT_NEAR(r.sigma, sigma, std::max(0.02, 0.05 * sigma)) << what;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.rho_d[c], rho_d[c], 0.01 * rho_d[c]) << what;
+    if (model == recon::BrdfModel::kGgx) {
+      EXPECT_NEAR(r.rho_s.mean(), 0.08, 0.02 * 0.08) << what;
+      EXPECT_NEAR(r.alpha, 0.15, 0.02 * 0.15) << what;
+    }
+  }
+}
+
 TEST(RegionFit, APixelsSpreadOfNormalsWidensItsLobeNotTheSurfaces) {
   const Eigen::Vector3d rho_d(0.3, 0.5, 0.2);
   RegionFitInput in = MakeSamples(recon::BrdfModel::kWard, {rho_d}, 0.06, 0.08, 0.0, 1, 0, 0.008);

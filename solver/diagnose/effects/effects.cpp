@@ -20,6 +20,7 @@ std::vector<std::unique_ptr<Effect>> MakeEffects() {
   effects.push_back(MakeAnisotropicReflection());
   effects.push_back(MakePoseError());
   effects.push_back(MakeSpecularReflection());
+  effects.push_back(MakeDiffuseShape());
   return effects;
 }
 

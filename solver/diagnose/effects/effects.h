@@ -33,6 +33,7 @@ std::unique_ptr<Effect> MakeFresnel();                // fresnel.cpp
 std::unique_ptr<Effect> MakeAnisotropicReflection();  // anisotropic_reflection.cpp
 std::unique_ptr<Effect> MakePoseError();              // pose_error.cpp
 std::unique_ptr<Effect> MakeSpecularReflection();     // specular_reflection.cpp
+std::unique_ptr<Effect> MakeDiffuseShape();           // diffuse_shape.cpp
 
 // ---------------------------------------------------------------- their fits
 // exposure_scale: one scale per photo, relative to its lighting's photos (materials solved) or
@@ -73,6 +74,14 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
 // explains beyond the current model re-fitted the same way. fresnel also searches the index.
 CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
                            bool fresnel);
+
+// diffuse_shape on `region` (Lambert's diffuse term): Oren–Nayar's term in its place, the
+// direct light's diffuse reflection split into Lambert's column and Oren–Nayar's geometric one
+// and credited with what the second explains beyond the first (a re-fitted albedo); σ from the
+// fitted ratio B/A (OrenNayarSigmaOfRatio).
+CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f, int region);
+// The σ whose Oren–Nayar B(σ)/A(σ) is `b_over_a` (0 when it is not positive, 1 beyond B/A at 1).
+double OrenNayarSigmaOfRatio(double b_over_a);
 
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
 // (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
