@@ -104,6 +104,19 @@ LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& opti
   return fit;
 }
 
+void ReportDiffuseShape(const recon::Material& material, std::string_view target,
+                        ExportReport* report) {
+  if (material.diffuse != recon::DiffuseShape::kOrenNayar) return;
+  const double sigma = material.sigma.value_or(0.0);
+  report->Add("materials." + material.name,
+              fmt::format("oren_nayar diffuse (sigma {:.4g}) written as {}'s Lambertian diffuse "
+                          "with the same rho_d: {} has no rough-diffuse model (Oren-Nayar's A "
+                          "{:.4g}, B {:.4g} left out)",
+                          sigma, target, target, render::OrenNayarA(sigma),
+                          render::OrenNayarB(sigma)),
+              1.0 - render::OrenNayarA(sigma));
+}
+
 void WriteText(const std::filesystem::path& dir, const std::string& relative,
                const std::string& text, ExportReport* report) {
   std::filesystem::create_directories((dir / relative).parent_path());

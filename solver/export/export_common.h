@@ -43,6 +43,13 @@ Eigen::Vector3d RegionRhoD(const recon::Material& material);
 LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& options,
                      std::string_view target_label, ExportReport* report);
 
+// Records that `material`'s Oren–Nayar diffuse term (if it has one) is written as Lambert's with
+// the same ρd, which none of the targets can do otherwise; the error given is 1 − A(σ), the
+// darkening at normal viewing the written model leaves out (toward grazing views and
+// back-scatter Oren–Nayar's albedo rises back toward ρd).
+void ReportDiffuseShape(const recon::Material& material, std::string_view target,
+                        ExportReport* report);
+
 // Writes `text` to dir/relative and records the file in the report.
 void WriteText(const std::filesystem::path& dir, const std::string& relative,
                const std::string& text, ExportReport* report);

@@ -136,6 +136,7 @@ int GltfBuilder::AddTexture(const recon::Material& m) {
 }
 
 int GltfBuilder::AddMaterial(const recon::Material& m) {
+  internal::ReportDiffuseShape(m, "glTF", report_);
   Json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   Json material = {{"name", m.name}, {"doubleSided", true}};
   Json ext;

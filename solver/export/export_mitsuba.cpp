@@ -56,6 +56,7 @@ std::string DiffuseValue(const recon::Material& m, const std::string& name,
 std::string BsdfText(const recon::Material& m, const std::filesystem::path& dir,
                      ExportReport* report) {
   const std::string id = SafeName(m.name);
+  internal::ReportDiffuseShape(m, "Mitsuba 3", report);
   std::string inner;
   if (m.brdf == recon::BrdfModel::kEmitter || m.brdf == recon::BrdfModel::kBlack) {
     inner = "<bsdf type=\"diffuse\">" + Rgb("reflectance", Eigen::Vector3d::Zero()) + "</bsdf>";

@@ -85,6 +85,7 @@ std::string MaterialText(const recon::Material& m, ExportReport* report) {
   }
   const Eigen::Vector3d rho_d =
       m.brdf == recon::BrdfModel::kBlack ? Eigen::Vector3d::Zero() : internal::RegionRhoD(m);
+  internal::ReportDiffuseShape(m, "RADIANCE", report);
   if (!recon::HasSpecularLobe(m.brdf)) {
     return text + Primitive("void", "plastic", name, "", {rho_d.x(), rho_d.y(), rho_d.z(), 0, 0});
   }

@@ -48,6 +48,26 @@ MapLight MapLightOf(const MapStageData& d) {
       out.e[i] = light.e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
     }
   }
+  // On a region with Oren–Nayar's diffuse term the maps divide by its column A·E + B·G, not by
+  // E: G = Σ OrenNayarG(wo, wi_k)·v_k over the observation's incident list, taken at the level of
+  // the E above (the list sums to the unsmoothed E).
+  for (size_t i = 0; i < d.obs.size() && i < light.incident.size(); ++i) {
+    const Observation& o = d.obs[i];
+    const render::BrdfParams& p = d.materials[o.region].params;
+    if (p.diffuse != recon::DiffuseShape::kOrenNayar) continue;
+    const Eigen::Vector3d wo = d.materials.LocalFrame(o.region, o.normal.cast<double>())
+                                   .ToLocal(o.view.cast<double>());
+    Eigen::Vector3d g = Eigen::Vector3d::Zero(), sum = g;
+    for (const IncidentLocal& inc : light.incident[i]) {
+      const Eigen::Vector3d v = inc.Value().cast<double>();
+      sum += v;
+      if (wo.z() > 0) g += render::OrenNayarG<double>(wo, inc.Wi().cast<double>()) * v;
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (sum[c] > 0) g[c] *= out.e[i][c] / sum[c];
+    }
+    out.e[i] = render::OrenNayarA(p.sigma) * out.e[i] + render::OrenNayarB(p.sigma) * g;
+  }
   return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -13,6 +14,7 @@
 #include "solver/diagnose/residual_fit.h"
 #include "solver/render/brdf.h"
 #include "solver/render/sampling.h"
+#include "tools/common/strings.h"
 
 namespace igi::diagnose {
 
@@ -29,23 +31,58 @@ double OrenNayarSigmaOfRatio(double b_over_a) {
   return 0.5 * (lo + hi);
 }
 
-CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f, int region) {
+double OrenNayarMeanG(double cos_o) {
+  // A table over θo in 1° steps of a 256 × 256 midpoint quadrature of the cosine-weighted
+  // hemisphere (cosθi = √(1 − u), φ = 2πv), interpolated linearly.
+  static const std::vector<double> table = [] {
+    std::vector<double> t(91);
+    constexpr int kN = 256;
+    for (int d = 0; d <= 90; ++d) {
+      const double theta = std::min(d, 89) * render::kPi / 180 + (d == 90 ? 0.9 * render::kPi / 180 : 0);
+      const Eigen::Vector3d wo(std::sin(theta), 0, std::cos(theta));
+      double sum = 0;
+      for (int i = 0; i < kN; ++i) {
+        for (int j = 0; j < kN; ++j) {
+          const double u = (i + 0.5) / kN, phi = 2 * render::kPi * (j + 0.5) / kN;
+          const double r = std::sqrt(u);
+          const Eigen::Vector3d wi(r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u));
+          sum += render::OrenNayarG<double>(wo, wi);
+        }
+      }
+      t[d] = sum / (kN * kN);
+    }
+    return t;
+  }();
+  const double deg = std::acos(std::clamp(cos_o, 0.0, 1.0)) * 180 / render::kPi;
+  const int i = std::min(89, int(deg));
+  const double w = deg - i;
+  return (1 - w) * table[i] + w * table[i + 1];
+}
+
+CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f,
+                             const std::vector<int>& regions) {
   CandidateResult out;
   out.effect = "diffuse_shape";
-  const recon::Material& m = cx.model.materials[region];
+  const int n = int(regions.size());
+  std::vector<int> slot(cx.model.materials.size(), -1);  // each region's place in `regions`
+  std::vector<std::string> names;
+  for (int k = 0; k < n; ++k) slot[regions[k]] = k, names.push_back(cx.model.materials[regions[k]].name);
+  const std::string label = n == 1 ? "region '" + names[0] + "'" : "regions " + Join(names, ", ");
   int count = 0;
-  for (const PixelRecord& r : f.records()) count += r.region == region && !r.outlier;
-  if (count < 50) return out;
-  // The direct light's diffuse reflection in two parts: Lambert's ρd·E/π and Oren–Nayar's
-  // geometric term ρd·G/π, G = Σ OrenNayarG(wo, wi)·E_light. After a refit with Oren–Nayar's
-  // term the region reflects s·ρd·(A·E + B·G)/π (s: the refit's albedo change), so the change
-  // is (s·A − 1)·ρd·E/π + s·B·ρd·G/π: linear in the two columns, credited only with what G
-  // explains beyond the first (a re-fitted albedo alone), and B/A = c₁/(1 + c₀).
-  const ResidualFit fit = f.FitBeyond(2, 1, [&](const PixelRecord& r, int c, double* b) {
-    if (r.region != region) return;
+  for (const PixelRecord& r : f.records()) count += r.region >= 0 && slot[r.region] >= 0 && !r.outlier;
+  if (n == 0 || count < 50) return out;
+  // A record's diffuse reflection in two parts: Lambert's ρd·E/π and Oren–Nayar's geometric
+  // term ρd·G/π (zero off `regions`). The direct light gives G = Σ OrenNayarG(wo, wi)·E_light.
+  // On a region without a lobe the model's value is its whole diffuse reflection, ρd·E/π with
+  // the light the room bounces in: that light, E − E_direct, arrives from the whole hemisphere and
+  // adds OrenNayarMeanG(cosθo) times itself to G. (On a region with a lobe only the direct light
+  // is split so.)
+  auto parts = [&](const PixelRecord& r, int c, double* e_part, double* g_part) {
+    *e_part = *g_part = 0;
+    if (r.region < 0 || slot[r.region] < 0 || !(r.albedo[c] > 0)) return false;
     const render::Frame frame = render::Frame::FromNormal(r.normal.cast<double>());
     const Eigen::Vector3d wo = frame.ToLocal(r.view.cast<double>());
-    if (!(wo.z() > 0)) return;
+    if (!(wo.z() > 0)) return false;
     double e = 0, g = 0;
     for (const RecordLightSample& ls : r.lights) {
       const Eigen::Vector3d wi = frame.ToLocal(ls.wi.cast<double>());
@@ -53,31 +90,69 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
       e += ls.irradiance[c];
       g += render::OrenNayarG<double>(wo, wi) * ls.irradiance[c];
     }
-    b[0] = r.albedo[c] * e / render::kPi;
-    b[1] = r.albedo[c] * g / render::kPi;
-  });
-  if (fit.coef.size() < 2 || !(1 + fit.coef[0] > 0)) {
-    out.note = "region " + m.name + ": no fit of the diffuse term's shape";
-    return out;
+    if (!recon::HasSpecularLobe(cx.model.materials[r.region].brdf)) {
+      const double e_all = r.sim[c] * render::kPi / r.albedo[c];
+      if (e_all > e) g += OrenNayarMeanG(wo.z()) * (e_all - e), e = e_all;
+    }
+    *e_part = r.albedo[c] * e / render::kPi;
+    *g_part = r.albedo[c] * g / render::kPi;
+    return true;
+  };
+  ResidualFit fit;
+  double sigma = 0, ratio = 0;
+  if (f.nuisance()) {
+    // Materials solved: after the refit a region reflects s·ρd·(A·E + B·G)/π (s its albedo's
+    // change), so the change is (s·A − 1)·ρd·E/π + s·B·ρd·G/π: one Lambert column per region
+    // (what re-fitted albedos alone explain, the base) and the shared G column, credited with
+    // what it explains beyond them; B/A = c_G/(1 + c̄), c̄ the regions' mean base coefficient.
+    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
+      double e = 0, g = 0;
+      if (!parts(r, c, &e, &g)) return;
+      b[slot[r.region]] = e;
+      b[n] = g;
+    });
+    if (fit.coef.size() == size_t(n + 1)) {
+      const double mean_base = fit.coef.head(n).mean();
+      if (1 + mean_base > 0) ratio = fit.coef[n] / (1 + mean_base);
+    }
+    sigma = OrenNayarSigmaOfRatio(ratio);
+  } else {
+    // Materials given: the refit renders ρd·(A·E + B·G)/π with the declared ρd, a change
+    // ρd·((A − 1)·E + B·G)/π fixed by σ: σ searched on a grid, the change's amplitude near 1.
+    for (int i = 1; i <= 20; ++i) {
+      const double sg = 0.05 * i;
+      const double a = render::OrenNayarA(sg), bb = render::OrenNayarB(sg);
+      const ResidualFit at = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+        double e = 0, g = 0;
+        if (parts(r, c, &e, &g)) b[0] = (a - 1) * e + bb * g;
+      });
+      if (at.coef.size() == 0 || !(at.coef[0] > 0.7 && at.coef[0] < 1.4)) continue;
+      if (fit.coef.size() == 0 || at.train_after < fit.train_after) fit = at, sigma = sg;
+    }
+    ratio = render::OrenNayarB(sigma) / render::OrenNayarA(sigma);
   }
-  const double ratio = fit.coef[1] / (1 + fit.coef[0]);
-  if (!(ratio > 0)) {
+  if (fit.coef.size() == 0 || !(sigma > 0)) {
     out.note = fmt::format(
-        "region {}: the residual does not rise toward back-scatter as a rough diffuse surface's "
-        "does (B/A {:.3f})",
-        m.name, ratio);
+        "{}: the residual does not rise toward back-scatter as a rough diffuse surface's does "
+        "(B/A {:.3f})",
+        label, ratio);
     return out;
   }
-  const double sigma = OrenNayarSigmaOfRatio(ratio);
   FillScores(fit, &out);
-  out.params = {{"region", m.name}, {"sigma", sigma}, {"b_over_a", ratio}};
-  out.where = {{"regions", {m.name}}, {"frame", "light and view azimuths"}};
+  if (n == 1) {
+    out.params = {{"region", names[0]}};
+  } else {
+    out.params = {{"regions", names}};
+  }
+  out.params["sigma"] = sigma;
+  out.params["b_over_a"] = ratio;
+  out.where = {{"regions", names}, {"frame", "light and view azimuths"}};
   out.num_params = 1;
   out.evidence = fmt::format(
-      "region '{}': its diffuse reflection is brighter where light and view share an azimuth "
-      "and flatter toward the terminator than Lambert's: Oren-Nayar's rough surface with sigma "
+      "{}: the diffuse reflection is brighter where light and view share an azimuth and "
+      "flatter toward the terminator than Lambert's: Oren-Nayar's rough surface with sigma "
       "~ {:.2f} rad explains it",
-      m.name, sigma);
+      label, sigma);
   out.valid = true;
   return out;
 }
@@ -87,16 +162,22 @@ namespace {
 class DiffuseShapeEffect final : public Effect {
  public:
   std::string Name() const override { return "diffuse_shape"; }
-  // Every reflective region with Lambert's diffuse term.
+  // Every reflective region with Lambert's diffuse term on its own, and the regions without a
+  // lobe together (one σ: a room's walls of one paint darken and back-scatter alike, which one
+  // region's fit sees only in part).
   void AddFits(const CandidateContext& cx, const RecordFits& in, const KeyFilter& allowed,
                std::vector<CandidateTask>* tasks) const override {
+    std::vector<int> matte;
     for (int g = 0; g < int(cx.model.materials.size()); ++g) {
       const recon::Material& m = cx.model.materials[g];
-      if (!recon::IsReflective(m.brdf) || m.diffuse != recon::DiffuseShape::kLambert ||
-          !allowed(Name() + ":" + m.name)) {
-        continue;
-      }
-      tasks->push_back({[&cx, &f = in.fitter, g] { return DiffuseShape(cx, f, g); }, true});
+      if (!recon::IsReflective(m.brdf) || m.diffuse != recon::DiffuseShape::kLambert) continue;
+      if (!recon::HasSpecularLobe(m.brdf)) matte.push_back(g);
+      if (!allowed(Name() + ":" + m.name)) continue;
+      tasks->push_back({[&cx, &f = in.fitter, g] { return DiffuseShape(cx, f, {g}); }, true});
+    }
+    if (matte.size() >= 2 && allowed(Name())) {
+      tasks->push_back(
+          {[&cx, &f = in.fitter, matte] { return DiffuseShape(cx, f, matte); }, true});
     }
   }
   HeldOutScope Scope(const CandidateResult& c, const DiagnosisModel& m) const override {
@@ -105,21 +186,30 @@ class DiffuseShapeEffect final : public Effect {
   // The region's diffuse term becomes Oren–Nayar's: with its σ where the region's albedo is
   // declared (nothing is solved then), without it otherwise (igi-solve fits σ with ρd).
   void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
-    const std::string region = c.params.at("region").get<std::string>();
-    Json m = doc->Material(region);
-    m["diffuse"] = "oren_nayar";
-    m.erase("sigma");
-    if (m.contains("rho_d") || m.contains("rho_d_map")) m["sigma"] = c.params.at("sigma");
-    doc->SetMaterial(region, std::move(m));
+    for (const std::string& region : Regions(c)) {
+      Json m = doc->Material(region);
+      m["diffuse"] = "oren_nayar";
+      m.erase("sigma");
+      if (m.contains("rho_d") || m.contains("rho_d_map")) m["sigma"] = c.params.at("sigma");
+      doc->SetMaterial(region, std::move(m));
+    }
   }
   // The kept step's description with the σ the refit solved.
   void DescribeKept(CandidateResult* c, const recon::Scene& refit) const override {
-    const std::string region = c->params.at("region").get<std::string>();
-    for (const recon::Material& m : refit.materials) {
-      if (m.name != region || !m.sigma) continue;
-      c->params["sigma_solved"] = *m.sigma;
-      c->evidence += fmt::format("; solved: sigma {:.3f}", *m.sigma);
+    Json solved = Json::object();
+    for (const std::string& region : Regions(*c)) {
+      const int r = refit.FindMaterial(region);
+      if (r >= 0 && refit.materials[r].sigma) solved[region] = *refit.materials[r].sigma;
     }
+    if (solved.empty()) return;
+    c->params["sigma_solved"] = solved;
+    c->evidence += "; solved sigma: " + solved.dump();
+  }
+
+ private:
+  static std::vector<std::string> Regions(const CandidateResult& c) {
+    if (c.params.contains("region")) return {c.params.at("region").get<std::string>()};
+    return c.params.at("regions").get<std::vector<std::string>>();
   }
 };
 

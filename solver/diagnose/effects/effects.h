@@ -75,13 +75,19 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
 CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
                            bool fresnel);
 
-// diffuse_shape on `region` (Lambert's diffuse term): Oren–Nayar's term in its place, the
-// direct light's diffuse reflection split into Lambert's column and Oren–Nayar's geometric one
-// and credited with what the second explains beyond the first (a re-fitted albedo); σ from the
-// fitted ratio B/A (OrenNayarSigmaOfRatio).
-CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f, int region);
+// diffuse_shape on `regions` (Lambert's diffuse term; one σ for all): Oren–Nayar's term in its
+// place. With the materials solved, the direct light's diffuse reflection is split into Lambert's
+// column per region and Oren–Nayar's geometric one, credited with what the latter explains beyond
+// re-fitted albedos, σ from the fitted ratio B/A (OrenNayarSigmaOfRatio); with them given, the
+// change ρd·((A − 1)·E + B·G)/π at a grid of σ with its amplitude near 1.
+CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f,
+                             const std::vector<int>& regions);
 // The σ whose Oren–Nayar B(σ)/A(σ) is `b_over_a` (0 when it is not positive, 1 beyond B/A at 1).
 double OrenNayarSigmaOfRatio(double b_over_a);
+// The mean of Oren–Nayar's geometric term OrenNayarG(wo, wi) over cosine-weighted wi, for a view
+// at cosθo = `cos_o`: light arriving alike from every direction of the hemisphere (the room's
+// bounced light) reflects ρd·E·(A + B·OrenNayarMeanG)/π.
+double OrenNayarMeanG(double cos_o);
 
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
 // (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
