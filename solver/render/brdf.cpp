@@ -58,6 +58,34 @@ std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
   return problems;
 }
 
+double OrenNayarMeanG(double cos_o) {
+  // A table over θo in 1° steps of a 256 × 256 midpoint quadrature of the cosine-weighted
+  // hemisphere (cosθi = √(1 − u), φ = 2πv), interpolated linearly.
+  static const std::vector<double> table = [] {
+    std::vector<double> t(91);
+    constexpr int kN = 256;
+    for (int d = 0; d <= 90; ++d) {
+      const double theta = std::min(double(d), 89.9) * kPi / 180;
+      const Eigen::Vector3d wo(std::sin(theta), 0, std::cos(theta));
+      double sum = 0;
+      for (int i = 0; i < kN; ++i) {
+        for (int j = 0; j < kN; ++j) {
+          const double u = (i + 0.5) / kN, phi = 2 * kPi * (j + 0.5) / kN;
+          const double r = std::sqrt(u);
+          const Eigen::Vector3d wi(r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u));
+          sum += OrenNayarG<double>(wo, wi);
+        }
+      }
+      t[d] = sum / (kN * kN);
+    }
+    return t;
+  }();
+  const double deg = std::acos(std::clamp(cos_o, 0.0, 1.0)) * 180 / kPi;
+  const int i = std::min(89, int(deg));
+  const double w = deg - i;
+  return (1 - w) * table[i] + w * table[i + 1];
+}
+
 double SpecularLobeProbability(const BrdfParams& params, const Eigen::Vector3d& wo) {
   if (!recon::HasSpecularLobe(params.model)) return 0.0;
   const double diffuse = Mean(params.rho_d);

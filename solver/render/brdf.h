@@ -219,6 +219,12 @@ inline double DiffuseFactor(const BrdfParams& params, const Eigen::Vector3d& wo,
   return DiffuseFactor<double>(params, wo, wi);
 }
 
+// The mean of OrenNayarG(wo, wi) over cosine-weighted wi for a view at cosθo = `cos_o` (by the
+// term's symmetry, also its mean over cosine-weighted wo for a light at that angle): light
+// arriving alike from every direction of the hemisphere reflects ρd·E·(A + B·OrenNayarMeanG)/π
+// toward the view. 0 at normal viewing, 0.30 at 60°.
+double OrenNayarMeanG(double cos_o);
+
 // f(wo, wi), RGB per steradian; zero when wo or wi is at or below the surface.
 template <typename T>
 Eigen::Matrix<T, 3, 1> EvalBrdf(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,

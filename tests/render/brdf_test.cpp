@@ -556,6 +556,12 @@ TEST(BrdfEnergyTest, OrenNayarAlbedoIsAtMostOneBelowGrazing) {
   }
   p.sigma = 0.5;
   EXPECT_NEAR(Albedo(p, Dir(60, 0)), 0.8831, 2e-4);  // the midpoint quadrature's value
+  // The albedo is A + B·OrenNayarMeanG(cosθo): the term's mean over the cosine-weighted light.
+  for (double theta : {0.0, 30.0, 60.0, 85.0}) {
+    const double mean_g = OrenNayarMeanG(std::cos(theta * kPi / 180));
+    EXPECT_NEAR(Albedo(p, Dir(theta, 10)), OrenNayarA(0.5) + OrenNayarB(0.5) * mean_g, 1e-3)
+        << theta;
+  }
 }
 
 TEST(BrdfEnergyTest, FresnelWeightRaisesTheSpecularAlbedoMostTowardGrazing) {

@@ -31,34 +31,6 @@ double OrenNayarSigmaOfRatio(double b_over_a) {
   return 0.5 * (lo + hi);
 }
 
-double OrenNayarMeanG(double cos_o) {
-  // A table over θo in 1° steps of a 256 × 256 midpoint quadrature of the cosine-weighted
-  // hemisphere (cosθi = √(1 − u), φ = 2πv), interpolated linearly.
-  static const std::vector<double> table = [] {
-    std::vector<double> t(91);
-    constexpr int kN = 256;
-    for (int d = 0; d <= 90; ++d) {
-      const double theta = std::min(d, 89) * render::kPi / 180 + (d == 90 ? 0.9 * render::kPi / 180 : 0);
-      const Eigen::Vector3d wo(std::sin(theta), 0, std::cos(theta));
-      double sum = 0;
-      for (int i = 0; i < kN; ++i) {
-        for (int j = 0; j < kN; ++j) {
-          const double u = (i + 0.5) / kN, phi = 2 * render::kPi * (j + 0.5) / kN;
-          const double r = std::sqrt(u);
-          const Eigen::Vector3d wi(r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u));
-          sum += render::OrenNayarG<double>(wo, wi);
-        }
-      }
-      t[d] = sum / (kN * kN);
-    }
-    return t;
-  }();
-  const double deg = std::acos(std::clamp(cos_o, 0.0, 1.0)) * 180 / render::kPi;
-  const int i = std::min(89, int(deg));
-  const double w = deg - i;
-  return (1 - w) * table[i] + w * table[i + 1];
-}
-
 CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f,
                              const std::vector<int>& regions) {
   CandidateResult out;
@@ -92,7 +64,7 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
     }
     if (!recon::HasSpecularLobe(cx.model.materials[r.region].brdf)) {
       const double e_all = r.sim[c] * render::kPi / r.albedo[c];
-      if (e_all > e) g += OrenNayarMeanG(wo.z()) * (e_all - e), e = e_all;
+      if (e_all > e) g += render::OrenNayarMeanG(wo.z()) * (e_all - e), e = e_all;
     }
     *e_part = r.albedo[c] * e / render::kPi;
     *g_part = r.albedo[c] * g / render::kPi;

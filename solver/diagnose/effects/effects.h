@@ -84,10 +84,7 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
                              const std::vector<int>& regions);
 // The σ whose Oren–Nayar B(σ)/A(σ) is `b_over_a` (0 when it is not positive, 1 beyond B/A at 1).
 double OrenNayarSigmaOfRatio(double b_over_a);
-// The mean of Oren–Nayar's geometric term OrenNayarG(wo, wi) over cosine-weighted wi, for a view
-// at cosθo = `cos_o`: light arriving alike from every direction of the hemisphere (the room's
-// bounced light) reflects ρd·E·(A + B·OrenNayarMeanG)/π.
-double OrenNayarMeanG(double cos_o);
+
 
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
 // (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
