@@ -108,13 +108,13 @@ void ReportDiffuseShape(const recon::Material& material, std::string_view target
                         ExportReport* report) {
   if (material.diffuse != recon::DiffuseShape::kOrenNayar) return;
   const double sigma = material.sigma.value_or(0.0);
-  report->Add("materials." + material.name,
-              fmt::format("oren_nayar diffuse (sigma {:.4g}) written as {}'s Lambertian diffuse "
-                          "with the same rho_d: {} has no rough-diffuse model (Oren-Nayar's A "
-                          "{:.4g}, B {:.4g} left out)",
-                          sigma, target, target, render::OrenNayarA(sigma),
-                          render::OrenNayarB(sigma)),
-              1.0 - render::OrenNayarA(sigma));
+  report->Add(
+      "materials." + material.name,
+      fmt::format("oren_nayar diffuse (sigma {:.4g}) written as {}'s Lambertian diffuse "
+                  "with the same rho_d: {} has no rough-diffuse model (Oren-Nayar's A "
+                  "{:.4g}, B {:.4g} left out)",
+                  sigma, target, target, render::OrenNayarA(sigma), render::OrenNayarB(sigma)),
+      1.0 - render::OrenNayarA(sigma));
 }
 
 void WriteText(const std::filesystem::path& dir, const std::string& relative,

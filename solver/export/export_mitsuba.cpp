@@ -71,15 +71,14 @@ std::string BsdfText(const recon::Material& m, const std::filesystem::path& dir,
     LobeFitOptions options;
     options.target = ggx ? LobeTarget::kGgxDielectric : LobeTarget::kBeckmannDielectric;
     options.target_ior = eta;
-    const LobeFit fit = internal::FitAndReport(
-        m, options, "Mitsuba roughplastic (" + distribution + ")", report);
+    const LobeFit fit =
+        internal::FitAndReport(m, options, "Mitsuba roughplastic (" + distribution + ")", report);
     report->Add("materials." + m.name,
                 "roughplastic's diffuse term carries Fresnel transmittances and internal "
                 "reflection: diffuse_reflectance = rho_d is not compensated");
     const Eigen::Vector3d spec = fit.scale * *m.rho_s / m.rho_s->mean();
-    inner = "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"" +
-            distribution + "\"/>" +
-            Float("alpha", fit.alpha) + Float("int_ior", eta) + Float("ext_ior", 1.0) +
+    inner = "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"" + distribution +
+            "\"/>" + Float("alpha", fit.alpha) + Float("int_ior", eta) + Float("ext_ior", 1.0) +
             "<boolean name=\"nonlinear\" value=\"false\"/>" +
             DiffuseValue(m, "diffuse_reflectance", dir, report) +
             Rgb("specular_reflectance", spec) + "</bsdf>";

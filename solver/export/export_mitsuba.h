@@ -11,9 +11,10 @@
 //     k·F_dielectric(η)·D·G1(wi)·G1(wo)/(4 cosθi cosθo) (ward_fit.h, kGgxDielectric or
 //     kBeckmannDielectric; the error is reported). A microfacet lobe keeps its distribution; what
 //     the fit absorbs is Mitsuba's exact dielectric Fresnel term against igi's Schlick factor and
-//     its separable Smith term against igi's height-correlated one. diffuse_reflectance = rho_d (or a bitmap of rho_d_map); Mitsuba's
-//     roughplastic scales its diffuse term by the Fresnel transmittances and internal
-//     reflection, which is not compensated (reported). Anisotropy is dropped.
+//     its separable Smith term against igi's height-correlated one. diffuse_reflectance = rho_d (or
+//     a bitmap of rho_d_map); Mitsuba's roughplastic scales its diffuse term by the Fresnel
+//     transmittances and internal reflection, which is not compensated (reported). Anisotropy is
+//     dropped.
 // Emitters: point -> point (intensity); spot -> spot along `direction` (cone: beam_width =
 //   inner_deg, cutoff_angle = outer_deg; cos_power / IES: the 90% and 10% angles; without a
 //   profile -> point); directional -> directional (irradiance); sphere -> sphere shape with an

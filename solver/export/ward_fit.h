@@ -1,12 +1,12 @@
 #pragma once
 // Fits of a specular lobe (Ward's or a microfacet one: solver/render/brdf.h) by the lobes other
-// renderers implement, for the exporters of solver/export/. Every fit is a weighted least-squares match of the specular BRDF
-// values (ρd left out: the diffuse terms map exactly) over a grid of direction pairs covering the
-// lobe: view directions θo in [0°, max_theta_o_deg] (and several azimuths for an anisotropic
-// source), light directions parameterised by the half vector around the source's lobe (tanθh up to
-// 8 α). The residuals are those of f·cosθi·cosθo (the BRDF in projected solid angle on both sides,
-// which stays bounded at grazing angles where f itself grows like 1/cos²), i.e. each pair is
-// weighted by cos²θi·cos²θo·dωi·dωo.
+// renderers implement, for the exporters of solver/export/. Every fit is a weighted least-squares
+// match of the specular BRDF values (ρd left out: the diffuse terms map exactly) over a grid of
+// direction pairs covering the lobe: view directions θo in [0°, max_theta_o_deg] (and several
+// azimuths for an anisotropic source), light directions parameterised by the half vector around the
+// source's lobe (tanθh up to 8 α). The residuals are those of f·cosθi·cosθo (the BRDF in projected
+// solid angle on both sides, which stays bounded at grazing angles where f itself grows like
+// 1/cos²), i.e. each pair is weighted by cos²θi·cos²θo·dωi·dωo.
 //
 // The scale k of the target is solved in closed form for each roughness; the roughness is
 // searched by golden section on log α. The error reported is the relative RMS error

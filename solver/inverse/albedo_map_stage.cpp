@@ -55,8 +55,8 @@ MapLight MapLightOf(const MapStageData& d) {
     const Observation& o = d.obs[i];
     const render::BrdfParams& p = d.materials[o.region].params;
     if (p.diffuse != recon::DiffuseShape::kOrenNayar) continue;
-    const Eigen::Vector3d wo = d.materials.LocalFrame(o.region, o.normal.cast<double>())
-                                   .ToLocal(o.view.cast<double>());
+    const Eigen::Vector3d wo =
+        d.materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
     Eigen::Vector3d g = Eigen::Vector3d::Zero(), sum = g;
     for (const IncidentLocal& inc : light.incident[i]) {
       const Eigen::Vector3d v = inc.Value().cast<double>();

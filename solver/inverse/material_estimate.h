@@ -25,7 +25,7 @@ struct MaterialState {
   bool reflective = false;
   bool unknown_rho_d = false, unknown_rho_s = false, unknown_alpha = false;
   bool unknown_sigma = false;  // Oren–Nayar's σ (diffuse oren_nayar without "sigma")
-  bool no_highlight = false;  // ρs and α cannot be recovered: ρs is held at 0
+  bool no_highlight = false;   // ρs and α cannot be recovered: ρs is held at 0
   std::optional<Eigen::Vector3d> tangent;
   std::shared_ptr<const Image> known_map;    // a known rho_d_map
   std::vector<Eigen::Vector3d> patch_rho_d;  // per region slot; NaN = the region's rho_d

@@ -63,7 +63,8 @@ MeasuredBrdf ReadCornellBrdf(const std::filesystem::path& file) {
     }
     if (int(out.wavelengths_nm.size()) < count) {
       for (double v : values) {
-        if (int(out.wavelengths_nm.size()) == count) fail(line_no, line, "more wavelengths than given");
+        if (int(out.wavelengths_nm.size()) == count)
+          fail(line_no, line, "more wavelengths than given");
         if (Band(v) < 0) fail(line_no, fmt::format("{}", v), "wavelength outside [400, 700] nm");
         out.wavelengths_nm.push_back(v);
         bands.push_back(Band(v));

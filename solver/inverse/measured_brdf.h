@@ -56,7 +56,6 @@ struct MeasuredFit {
 
 // Fits `model` (an isotropic reflective model: lambert or one with a lobe; a *_fresnel model
 // with `ior`) to `measured`, with one grey ρs as the solver fits it.
-MeasuredFit FitMeasuredBrdf(const MeasuredBrdf& measured, recon::BrdfModel model,
-                            double ior = 1.5);
+MeasuredFit FitMeasuredBrdf(const MeasuredBrdf& measured, recon::BrdfModel model, double ior = 1.5);
 
 }  // namespace igi::solver

@@ -299,9 +299,9 @@ class LobeTable {
   void IsotropicGgxRow(int row, double a2, std::vector<float>* f, Eigen::Vector3d* t,
                        Eigen::Vector3d* o) const {
     const int b = begin_[row];
-    const int e = int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[row + 1],
-                                       float(kMaxGgxQ * a2)) -
-                      qs_.begin());
+    const int e =
+        int(std::lower_bound(qs_.begin() + b, qs_.begin() + begin_[row + 1], float(kMaxGgxQ * a2)) -
+            qs_.begin());
     f->resize(size_t(e - b));
     const float ia2 = float(1.0 / a2), a2f = float(a2);
     const float so = float(std::sqrt(1.0 + a2 * (wo_l_[row][0] + wo_l_[row][1])));
@@ -331,8 +331,7 @@ class LobeTable {
       const double si = std::sqrt(1.0 + a2 * double(ls_[k]));
       const double sum_s = so + si, aq = a2 + qs;
       const double w = 2.0 * a2 / (aq * aq * sum_s);
-      const double dw =
-          w * (1.0 / a2 - 2.0 / aq - (dso + double(ls_[k]) / (2.0 * si)) / sum_s);
+      const double dw = w * (1.0 / a2 - 2.0 / aq - (dso + double(ls_[k]) / (2.0 * si)) / sum_s);
       const Eigen::Vector3d g(gr_[k], gg_[k], gb_[k]), m(orr_[k], og_[k], ob_[k]);
       *t += w * g, *o += w * m, *dt += dw * g, *d_o += dw * m;
     }
@@ -830,7 +829,8 @@ RegionFitResult FitOrenNayar(const RegionFitInput& in, const RegionFitOptions& o
     if (!(wo.z() > 0.0)) continue;
     for (int64_t k = 0; k < s.incident_count; ++k) {
       const Eigen::Vector3d wi = s.incident[k].Wi().cast<double>();
-      if (wi.z() > 0.0) g[i] += render::OrenNayarG<double>(wo, wi) * s.incident[k].Value().cast<double>();
+      if (wi.z() > 0.0)
+        g[i] += render::OrenNayarG<double>(wo, wi) * s.incident[k].Value().cast<double>();
     }
   }
   double sigma = in.sigma.value_or(0.0);

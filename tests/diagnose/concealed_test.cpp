@@ -68,6 +68,20 @@ TEST(ConcealedLobeFamilyTest, AGgxLobeDeclaredWardIsNamedGgx) {
   test::ExpectReachesTheFloor(o);
 }
 
+// The same for a Beckmann lobe declared Ward (slow-labelled below: the same candidate and
+// search as GGX's).
+class ConcealedLobeFamilyNameTest : public testing::TestWithParam<const char*> {};
+TEST_P(ConcealedLobeFamilyNameTest, ALobeDeclaredWardIsNamedAsItIs) {
+  const std::string lobe = GetParam();
+  const ConcealedOutcome o = DiagnoseConcealed("specular_lobe_shape:to=" + lobe, 11);
+  const Json& d = o.diagnosis;
+  ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["effect"], "specular_lobe_shape") << d.dump(1);
+  EXPECT_EQ(d["steps"][0]["params"]["to"], lobe) << d.dump(1);
+  test::ExpectReachesTheFloor(o);
+}
+INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedLobeFamilyNameTest, testing::Values("beckmann"));
+
 // light_emission_profile, anisotropic_reflection and light_source_extent:
 // concealed_brdf_light_test.cpp; missing_geometry and pose_error: concealed_geometry_test.cpp.
 // Labelled slow: the photo effects (CI names them in another renderer's photos,

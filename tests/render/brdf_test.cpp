@@ -525,12 +525,12 @@ TEST(BrdfEvalTest, OrenNayarMatchesItsAngleForm) {
   p.sigma = 0.4;
   const double s2 = 0.16, a = 1 - 0.5 * s2 / (s2 + 0.33), b = 0.45 * s2 / (s2 + 0.09);
   EXPECT_NEAR(EvalBrdf(p, Dir(0, 0), Dir(70, 40))[0], 0.6 / kPi * a, 1e-15);
-  for (auto [ti, to, dphi] : {std::tuple{60.0, 20.0, 0.0}, {20.0, 60.0, 30.0}, {75.0, 75.0, 80.0},
-                              {30.0, 50.0, 120.0}}) {
+  for (auto [ti, to, dphi] :
+       {std::tuple{60.0, 20.0, 0.0}, {20.0, 60.0, 30.0}, {75.0, 75.0, 80.0}, {30.0, 50.0, 120.0}}) {
     const double alpha = std::max(ti, to) * kPi / 180, beta = std::min(ti, to) * kPi / 180;
-    const double want = 0.6 / kPi *
-                        (a + b * std::max(0.0, std::cos(dphi * kPi / 180)) * std::sin(alpha) *
-                                 std::tan(beta));
+    const double want =
+        0.6 / kPi *
+        (a + b * std::max(0.0, std::cos(dphi * kPi / 180)) * std::sin(alpha) * std::tan(beta));
     EXPECT_NEAR(EvalBrdf(p, Dir(to, 15), Dir(ti, 15 + dphi))[0], want, 1e-14 * want)
         << ti << " " << to << " " << dphi;
     EXPECT_NEAR(EvalBrdf(p, Dir(ti, 15 + dphi), Dir(to, 15))[0], want, 1e-14 * want);

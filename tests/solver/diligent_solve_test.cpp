@@ -242,8 +242,8 @@ std::vector<double> RelightAgainstPerPixelLambert(const std::vector<const BallFi
       // The unit sphere at the origin: origin + t·d with |.| = 1, the nearer root.
       const double b = origin.dot(d), c = origin.squaredNorm() - 1, disc = b * b - c;
       if (disc <= 0) continue;
-      pixels.push_back({x, y, d, (origin + (-b - std::sqrt(disc)) * d).normalized(),
-                        Eigen::Vector3d::Zero()});
+      pixels.push_back(
+          {x, y, d, (origin + (-b - std::sqrt(disc)) * d).normalized(), Eigen::Vector3d::Zero()});
     }
   }
   std::vector<Eigen::Vector3d> num(pixels.size(), Eigen::Vector3d::Zero()), den = num;

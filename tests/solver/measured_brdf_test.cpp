@@ -19,7 +19,7 @@ std::filesystem::path MeasuredDir() {
 }
 
 constexpr recon::BrdfModel kModels[] = {
-    recon::BrdfModel::kLambert, recon::BrdfModel::kWard,     recon::BrdfModel::kWardGmd,
+    recon::BrdfModel::kLambert,        recon::BrdfModel::kWard,     recon::BrdfModel::kWardGmd,
     recon::BrdfModel::kWardGmdFresnel, recon::BrdfModel::kBeckmann, recon::BrdfModel::kGgx};
 
 TEST(MeasuredBrdf, ReadsTheCornellFiles) {
@@ -31,8 +31,8 @@ TEST(MeasuredBrdf, ReadsTheCornellFiles) {
   const MeasuredBrdfSample& s = acryl.samples[0];
   EXPECT_NEAR(s.wi.z(), std::cos(0.872665), 1e-12);
   EXPECT_NEAR(s.wo.x(), std::sin(0.573513), 1e-12);
-  const double blue = (0.014369 + 0.018226 + 0.021071 + 0.025607 + 0.033963 + 0.035622 +
-                       0.032200 + 0.026240 + 0.018363 + 0.011235) /
+  const double blue = (0.014369 + 0.018226 + 0.021071 + 0.025607 + 0.033963 + 0.035622 + 0.032200 +
+                       0.026240 + 0.018363 + 0.011235) /
                       10;
   EXPECT_NEAR(s.f[2], blue, 1e-12);
 }

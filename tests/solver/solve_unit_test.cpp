@@ -372,9 +372,9 @@ TEST(RegionFit, RecoversMicrofacetParametersExactlyFromNoiseFreeSamples) {
 // the lobe, from noise-free samples, alone and under a GGX lobe; σ 0 (Lambert's surface) stays
 // near 0.
 TEST(RegionFit, RecoversOrenNayarRoughnessWithTheAlbedoAndTheLobe) {
-  for (auto [model, sigma] : {std::pair{recon::BrdfModel::kLambert, 0.35},
-                              std::pair{recon::BrdfModel::kGgx, 0.5},
-                              std::pair{recon::BrdfModel::kLambert, 0.0}}) {
+  for (auto [model, sigma] :
+       {std::pair{recon::BrdfModel::kLambert, 0.35}, std::pair{recon::BrdfModel::kGgx, 0.5},
+        std::pair{recon::BrdfModel::kLambert, 0.0}}) {
     const Eigen::Vector3d rho_d(0.5, 0.4, 0.3);
     RegionFitInput in = MakeSamples(model, {rho_d}, 0.08, 0.15, 0.0, 31);
     const double a = render::OrenNayarA(sigma), b = render::OrenNayarB(sigma);

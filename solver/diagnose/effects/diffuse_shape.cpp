@@ -38,10 +38,12 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
   const int n = int(regions.size());
   std::vector<int> slot(cx.model.materials.size(), -1);  // each region's place in `regions`
   std::vector<std::string> names;
-  for (int k = 0; k < n; ++k) slot[regions[k]] = k, names.push_back(cx.model.materials[regions[k]].name);
+  for (int k = 0; k < n; ++k)
+    slot[regions[k]] = k, names.push_back(cx.model.materials[regions[k]].name);
   const std::string label = n == 1 ? "region '" + names[0] + "'" : "regions " + Join(names, ", ");
   int count = 0;
-  for (const PixelRecord& r : f.records()) count += r.region >= 0 && slot[r.region] >= 0 && !r.outlier;
+  for (const PixelRecord& r : f.records())
+    count += r.region >= 0 && slot[r.region] >= 0 && !r.outlier;
   if (n == 0 || count < 50) return out;
   // A record's diffuse reflection in two parts: Lambert's ρd·E/π and Oren–Nayar's geometric
   // term ρd·G/π (zero off `regions`). The direct light gives G = Σ OrenNayarG(wo, wi)·E_light.
@@ -148,8 +150,7 @@ class DiffuseShapeEffect final : public Effect {
       tasks->push_back({[&cx, &f = in.fitter, g] { return DiffuseShape(cx, f, {g}); }, true});
     }
     if (matte.size() >= 2 && allowed(Name())) {
-      tasks->push_back(
-          {[&cx, &f = in.fitter, matte] { return DiffuseShape(cx, f, matte); }, true});
+      tasks->push_back({[&cx, &f = in.fitter, matte] { return DiffuseShape(cx, f, matte); }, true});
     }
   }
   HeldOutScope Scope(const CandidateResult& c, const DiagnosisModel& m) const override {

@@ -85,7 +85,6 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
 // The σ whose Oren–Nayar B(σ)/A(σ) is `b_over_a` (0 when it is not positive, 1 beyond B/A at 1).
 double OrenNayarSigmaOfRatio(double b_over_a);
 
-
 // The colourless specular factor S of isotropic model `model` at roughness `alpha`
 // (solver/render/brdf.h), for a record's world-frame normal, view and light directions.
 double IsotropicLobe(recon::BrdfModel model, double alpha, const Eigen::Vector3f& n,
