@@ -148,6 +148,23 @@ Json MiniWithAbsolutePaths() {
   return doc;
 }
 
+// `doc` with materials.floor.KEY set to `value`, written to dir/scene.json: loading it must fail
+// with exactly one problem, naming that key (and `rule`, when given).
+void ExpectOneFloorProblem(const Json& doc, const fs::path& dir, const std::string& key,
+                           const Json& value, const std::string& rule = "") {
+  Json broken = doc;
+  broken["materials"]["floor"][key] = value;
+  WriteJsonFile(dir / "scene.json", broken);
+  try {
+    LoadScene(dir / "scene.json");
+    ADD_FAILURE() << key << " " << value;
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u) << e.what();
+    EXPECT_NE(e.problems()[0].find("materials.floor." + key), std::string::npos) << e.what();
+    EXPECT_NE(e.problems()[0].find(rule), std::string::npos) << e.what();
+  }
+}
+
 // The Fresnel-weighted models (igi's additions, docs/scene-format.md) take an optional "ior" in
 // (1, 5], default 1.5; the plain models do not accept the key.
 TEST(SceneTest, FresnelModelsReadTheirIndexOfRefraction) {
@@ -209,19 +226,7 @@ TEST(SceneTest, MicrofacetModelsReadTheKeysOfTheirWardForms) {
 
   const std::pair<const char*, Json> bad[] = {
       {"ior", 1.5}, {"rho_s", 1.2}, {"alpha", 0.0}, {"alpha", 1.5}, {"alpha_x", 0.2}};
-  for (const auto& [key, value] : bad) {
-    Json broken = doc;
-    broken["materials"]["floor"][key] = value;
-    WriteJsonFile(dir / "scene.json", broken);
-    try {
-      LoadScene(dir / "scene.json");
-      ADD_FAILURE() << key << " " << value;
-    } catch (const InputError& e) {
-      ASSERT_EQ(e.problems().size(), 1u) << e.what();
-      EXPECT_NE(e.problems()[0].find(std::string("materials.floor.") + key), std::string::npos)
-          << e.what();
-    }
-  }
+  for (const auto& [key, value] : bad) ExpectOneFloorProblem(doc, dir, key, value);
   fs::remove_all(dir);
 }
 
@@ -251,20 +256,7 @@ TEST(SceneTest, OrenNayarDiffuseReadsItsRoughness) {
       {"sigma", -0.1, "must be in [0, 1]"},
       {"sigma", 1.5, "must be in [0, 1]"},
       {"diffuse", "rough", "unknown diffuse (known: lambert, oren_nayar)"}};
-  for (const auto& [key, value, rule] : bad) {
-    Json broken = doc;
-    broken["materials"]["floor"][key] = value;
-    WriteJsonFile(dir / "scene.json", broken);
-    try {
-      LoadScene(dir / "scene.json");
-      ADD_FAILURE() << key << " " << value;
-    } catch (const InputError& e) {
-      ASSERT_EQ(e.problems().size(), 1u) << e.what();
-      EXPECT_NE(e.problems()[0].find(std::string("materials.floor.") + key), std::string::npos)
-          << e.what();
-      EXPECT_NE(e.problems()[0].find(rule), std::string::npos) << e.what();
-    }
-  }
+  for (const auto& [key, value, rule] : bad) ExpectOneFloorProblem(doc, dir, key, value, rule);
   Json lambert = doc;
   lambert["materials"]["floor"].erase("diffuse");
   WriteJsonFile(dir / "scene.json", lambert);
