@@ -54,12 +54,13 @@ const std::vector<std::string> kModelled = {"missing_geometry",
                                             "fresnel",
                                             "anisotropic_reflection",
                                             "pose_error",
-                                            "specular_reflection"};
+                                            "specular_reflection",
+                                            "diffuse_shape"};
 
 // MakeEffects makes each modelled effect once, in the driver's order (the effects tried alone
 // first: a missing object before any albedo map). Every name is one of the shared table
-// (docs/diagnose-effects.md) except albedo_texture, the name igi adds (new names are allowed) for
-// the albedo maps its step gives the refit; indirect_illumination is the one name of the table no
+// (docs/diagnose-effects.md) except the names igi adds (new names are allowed): albedo_texture,
+// for the albedo maps its step gives the refit, and diffuse_shape; indirect_illumination is the one name of the table no
 // effect models (the renderer's model has the bounces).
 TEST(EffectRegistryTest, NamesAreUniqueAndTheContracts) {
   const std::vector<std::unique_ptr<Effect>> effects = MakeEffects();
@@ -70,7 +71,7 @@ TEST(EffectRegistryTest, NamesAreUniqueAndTheContracts) {
   for (const std::string& name : names) {
     const bool in_contract =
         std::find(kContractEffects.begin(), kContractEffects.end(), name) != kContractEffects.end();
-    EXPECT_EQ(in_contract, name != "albedo_texture") << name;
+    EXPECT_EQ(in_contract, name != "albedo_texture" && name != "diffuse_shape") << name;
   }
 }
 
@@ -189,7 +190,10 @@ TEST(EvaluateCandidatesTest, FitsTheCandidatesNotExcludedInTheEffectsOrder) {
                                        "light_intensity:lamp",
                                        "light_source_extent:lamp",
                                        "specular_reflection:floor",
-                                       "specular_reflection:wall"};
+                                       "specular_reflection:wall",
+                                       "diffuse_shape:floor",
+                                       "diffuse_shape:wall",
+                                       "diffuse_shape"};
   auto keys = [&](const std::vector<std::string>& ex) {
     std::vector<std::string> out;
     for (const CandidateResult& c :

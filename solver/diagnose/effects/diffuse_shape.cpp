@@ -41,6 +41,12 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
   for (int k = 0; k < n; ++k)
     slot[regions[k]] = k, names.push_back(cx.model.materials[regions[k]].name);
   const std::string label = n == 1 ? "region '" + names[0] + "'" : "regions " + Join(names, ", ");
+  // Its target from the start: the key (CandidateResult::Key) of a fit that fails names it too.
+  if (n == 1) {
+    out.params = {{"region", names[0]}};
+  } else {
+    out.params = {{"regions", names}};
+  }
   int count = 0;
   for (const PixelRecord& r : f.records())
     count += r.region >= 0 && slot[r.region] >= 0 && !r.outlier;
@@ -113,11 +119,6 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
     return out;
   }
   FillScores(fit, &out);
-  if (n == 1) {
-    out.params = {{"region", names[0]}};
-  } else {
-    out.params = {{"regions", names}};
-  }
   out.params["sigma"] = sigma;
   out.params["b_over_a"] = ratio;
   out.where = {{"regions", names}, {"frame", "light and view azimuths"}};

@@ -53,10 +53,12 @@ TEST(LightIntensityTest, ASoftShadowIsNotAWeakerLight) {
                                        "camera_response",
                                        "ambient_light",
                                        "light_emission_profile:lamp",
-                                       "light_source_extent:lamp"};
+                                       "light_source_extent:lamp",
+                                       "diffuse_shape"};
   for (const char* region : {"floor", "blocker"}) {
     for (const char* e :
-         {"specular_lobe_shape:", "fresnel:", "anisotropic_reflection:", "specular_reflection:"}) {
+         {"specular_lobe_shape:", "fresnel:", "anisotropic_reflection:", "specular_reflection:",
+          "diffuse_shape:"}) {
       excluded.push_back(std::string(e) + region);
     }
   }
