@@ -47,6 +47,13 @@ std::vector<recon::Photo> Select(const std::vector<recon::Photo>& all, int first
   return out;
 }
 
+// Whether pixel (x, y), not on the image's border, and its four neighbours are inside `mask`:
+// the mask eroded by one pixel.
+bool InsideEroded(const Image& mask, int x, int y) {
+  return mask.at(x, y) > 0.5f && mask.at(x - 1, y) > 0.5f && mask.at(x + 1, y) > 0.5f &&
+         mask.at(x, y - 1) > 0.5f && mask.at(x, y + 1) > 0.5f;
+}
+
 // Relative RMS sqrt(Σ(pred − photo)² / Σ photo²) of `solved` rendered at the pixels of `photos`
 // that are inside the mask eroded by one pixel (the silhouette of the mesh and the mask differ
 // by a few boundary pixels) and not clipped, every `stride`-th pixel, all channels.
@@ -59,13 +66,9 @@ double HeldOutResidual(const recon::Scene& solved, const std::vector<recon::Phot
     const recon::Camera& cam = solved.cameras[p.camera];
     const render::Renderer renderer(solved, p.lighting);
     const Eigen::Vector3d origin = cam.CenterInWorld();
-    auto inside = [&](int x, int y) { return mask.at(x, y) > 0.5f; };
     for (int y = 1; y + 1 < photo.height; y += stride) {
       for (int x = 1; x + 1 < photo.width; x += stride) {
-        if (!inside(x, y) || !inside(x - 1, y) || !inside(x + 1, y) || !inside(x, y - 1) ||
-            !inside(x, y + 1)) {
-          continue;
-        }
+        if (!InsideEroded(mask, x, y)) continue;
         const Eigen::Vector3d l(photo.at(x, y, 0), photo.at(x, y, 1), photo.at(x, y, 2));
         if (l.maxCoeff() >= 1.0) continue;  // clipped: 65535 / 65535
         const Eigen::Vector3d dir = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
@@ -221,10 +224,6 @@ std::vector<double> RelightAgainstPerPixelLambert(const std::vector<const BallFi
   const recon::Camera& cam = scene.cameras[photos.fitted.front().camera];
   const Eigen::Vector3d origin = cam.CenterInWorld();
   const Image mask = ReadImage(*photos.fitted.front().mask, 1);
-  auto inside = [&](int x, int y) {
-    return mask.at(x, y) > 0.5f && mask.at(x - 1, y) > 0.5f && mask.at(x + 1, y) > 0.5f &&
-           mask.at(x, y - 1) > 0.5f && mask.at(x, y + 1) > 0.5f;
-  };
   // A photo's light: the unit direction toward it and its irradiance.
   auto light_of = [&](const recon::Photo& p) {
     const recon::Light& l = scene.lights[scene.lightings[p.lighting].lights.at(0)];
@@ -237,7 +236,7 @@ std::vector<double> RelightAgainstPerPixelLambert(const std::vector<const BallFi
   std::vector<Pixel> pixels;
   for (int y = 1; y + 1 < mask.height; y += 2) {
     for (int x = 1; x + 1 < mask.width; x += 2) {
-      if (!inside(x, y)) continue;
+      if (!InsideEroded(mask, x, y)) continue;
       const Eigen::Vector3d d = cam.WorldRayFromImg(Eigen::Vector2d(x + 0.5, y + 0.5));
       // The unit sphere at the origin: origin + t·d with |.| = 1, the nearer root.
       const double b = origin.dot(d), c = origin.squaredNorm() - 1, disc = b * b - c;
