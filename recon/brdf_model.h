@@ -105,10 +105,11 @@ constexpr std::optional<BrdfModel> FindBrdfModel(LobeShape lobe, bool anisotropi
 }
 
 // The diffuse term a reflective model's ρd scales (the material's "diffuse", default lambert; any
-// lobe takes either).
+// lobe takes any).
 enum class DiffuseShape {
   kLambert,    // ρd/π
   kOrenNayar,  // Oren–Nayar's rough diffuse surface of slope deviation σ (solver/render/brdf.h)
+  kCoated,     // a Lambertian base under a smooth clear coat (solver/render/brdf.h)
 };
 std::string_view DiffuseShapeName(DiffuseShape shape);
 std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "tools/common/enum_names.h"
+
 namespace igi::recon {
 namespace {
 
@@ -27,14 +29,16 @@ std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
   return std::nullopt;
 }
 
-std::string_view DiffuseShapeName(DiffuseShape shape) {
-  return shape == DiffuseShape::kOrenNayar ? "oren_nayar" : "lambert";
-}
+namespace {
+constexpr EnumNames<DiffuseShape, 3> kDiffuseShapeNames{{{DiffuseShape::kLambert, "lambert"},
+                                                         {DiffuseShape::kOrenNayar, "oren_nayar"},
+                                                         {DiffuseShape::kCoated, "coated"}}};
+}  // namespace
+
+std::string_view DiffuseShapeName(DiffuseShape shape) { return kDiffuseShapeNames.Name(shape); }
 
 std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name) {
-  if (name == "lambert") return DiffuseShape::kLambert;
-  if (name == "oren_nayar") return DiffuseShape::kOrenNayar;
-  return std::nullopt;
+  return kDiffuseShapeNames.FromName(name);
 }
 
 std::string_view BrdfModelNames() {

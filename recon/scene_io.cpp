@@ -121,7 +121,7 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
     if (auto shape = DiffuseShapeFromName(*diffuse)) {
       m.diffuse = *shape;
     } else {
-      c["diffuse"].Problem("unknown diffuse (known: lambert, oren_nayar)");
+      c["diffuse"].Problem("unknown diffuse (known: lambert, oren_nayar, coated)");
       diffuse_known = false;
     }
   }

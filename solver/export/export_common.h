@@ -46,7 +46,8 @@ LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& opti
 // Records that `material`'s Oren–Nayar diffuse term (if it has one) is written as Lambert's with
 // the same ρd, which none of the targets can do otherwise; the error given is 1 − A(σ), the
 // darkening at normal viewing the written model leaves out (toward grazing views and
-// back-scatter Oren–Nayar's albedo rises back toward ρd).
+// back-scatter Oren–Nayar's albedo rises back toward ρd). A coated diffuse term is written the
+// same way, its error 1 − (20/21)², the mean of the coat's two transmittances left out.
 void ReportDiffuseShape(const recon::Material& material, std::string_view target,
                         ExportReport* report);
 

@@ -48,25 +48,24 @@ MapLight MapLightOf(const MapStageData& d) {
       out.e[i] = light.e_stage1[i].cwiseProduct(now[i].cwiseQuotient(then[i]));
     }
   }
-  // On a region with Oren–Nayar's diffuse term the maps divide by its column A·E + B·G, not by
-  // E: G = Σ OrenNayarG(wo, wi_k)·v_k over the observation's incident list, taken at the level of
-  // the E above (the list sums to the unsmoothed E).
+  // On a region whose diffuse term is not Lambert's the maps divide by its column
+  // Σ DiffuseFactor(wo, wi_k)·v_k over the observation's incident list (Oren–Nayar's A·E + B·G),
+  // not by E, taken at the level of the E above (the list sums to the unsmoothed E).
   for (size_t i = 0; i < d.obs.size() && i < light.incident.size(); ++i) {
     const Observation& o = d.obs[i];
     const render::BrdfParams& p = d.materials[o.region].params;
-    if (p.diffuse != recon::DiffuseShape::kOrenNayar) continue;
+    if (p.diffuse == recon::DiffuseShape::kLambert) continue;
     const Eigen::Vector3d wo =
         d.materials.LocalFrame(o.region, o.normal.cast<double>()).ToLocal(o.view.cast<double>());
-    Eigen::Vector3d g = Eigen::Vector3d::Zero(), sum = g;
+    Eigen::Vector3d column = Eigen::Vector3d::Zero(), sum = column;
     for (const IncidentLocal& inc : light.incident[i]) {
-      const Eigen::Vector3d v = inc.Value().cast<double>();
+      const Eigen::Vector3d v = inc.Value().cast<double>(), wi = inc.Wi().cast<double>();
       sum += v;
-      if (wo.z() > 0) g += render::OrenNayarG<double>(wo, inc.Wi().cast<double>()) * v;
+      if (wo.z() > 0 && wi.z() > 0) column += render::DiffuseFactor(p, wo, wi) * v;
     }
     for (int c = 0; c < 3; ++c) {
-      if (sum[c] > 0) g[c] *= out.e[i][c] / sum[c];
+      if (sum[c] > 0) out.e[i][c] *= column[c] / sum[c];
     }
-    out.e[i] = render::OrenNayarA(p.sigma) * out.e[i] + render::OrenNayarB(p.sigma) * g;
   }
   return out;
 }

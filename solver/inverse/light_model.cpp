@@ -211,7 +211,8 @@ Eigen::Vector3d IndirectRadiance(const PatchSet& patches, const MaterialEstimate
 }
 
 // D_q: the diffuse radiance of each patch: the photos' mean over its observations less their
-// predicted specular part; patches no photo of the lighting sees get ρd·E/π.
+// predicted specular part; patches no photo of the lighting sees get ρd·E/π, times the diffuse
+// term's mean over light and view where it is not Lambert's (render::DiffuseMeanFactor).
 void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
                          const MaterialEstimate& materials, const std::vector<Eigen::Vector3d>& t,
                          const std::vector<Eigen::Vector3d>& t0, int num_threads,
@@ -228,10 +229,11 @@ void UpdatePatchRadiance(const ObservationSet& obs, const PatchSet& patches,
     for (int q = 0; q < patches.size(); ++q) {
       if (count[q] > 0) {
         st->patch_d[q] = (sum[q] / count[q]).cast<float>();
-      } else if (recon::IsReflective(materials[patches.patch_region[q]].params.model)) {
+      } else if (const render::BrdfParams& p = materials[patches.patch_region[q]].params;
+                 recon::IsReflective(p.model)) {
         st->patch_d[q] =
             (materials.PatchAlbedo(patches, q).cwiseProduct(st->patch_e[q].cast<double>()) /
-             render::kPi)
+             render::kPi * render::DiffuseMeanFactor(p))
                 .cast<float>();
       } else {
         st->patch_d[q].setZero();

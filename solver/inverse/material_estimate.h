@@ -43,11 +43,10 @@ struct MaterialState {
   bool NeedsFit() const {
     return reflective && (unknown_rho_d || unknown_rho_s || unknown_alpha || unknown_sigma);
   }
-  // Whether the region's observations keep their incident lists for the fits: a lobe's, or
-  // Oren–Nayar's diffuse term, depends on the directions the light comes from.
+  // Whether the region's observations keep their incident lists for the fits: a lobe's, or any
+  // diffuse term but Lambert's, depends on the directions the light comes from.
   bool KeepsIncident() const {
-    return recon::HasSpecularLobe(params.model) ||
-           params.diffuse == recon::DiffuseShape::kOrenNayar;
+    return recon::HasSpecularLobe(params.model) || params.diffuse != recon::DiffuseShape::kLambert;
   }
 };
 

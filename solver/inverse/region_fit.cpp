@@ -865,10 +865,39 @@ RegionFitResult FitOrenNayar(const RegionFitInput& in, const RegionFitOptions& o
   return r;
 }
 
+// `in` with each sample's irradiance replaced by the coated base's column Σ_k T(cosθo)·
+// T(cosθi_k)·v_k over its incident list.
+RegionFitInput WithCoatedColumn(const RegionFitInput& in) {
+  RegionFitInput out;
+  static_cast<RegionFitSettings&>(out) = in;
+  out.diffuse = recon::DiffuseShape::kLambert;
+  out.samples = in.samples;
+  render::BrdfParams coated;
+  coated.diffuse = recon::DiffuseShape::kCoated;
+  for (FitSample& s : out.samples) {
+    const Eigen::Vector3d wo = s.wo.cast<double>();
+    Eigen::Vector3d column = Eigen::Vector3d::Zero();
+    for (int64_t k = 0; wo.z() > 0.0 && k < s.incident_count; ++k) {
+      const Eigen::Vector3d wi = s.incident[k].Wi().cast<double>();
+      if (wi.z() > 0.0)
+        column += render::DiffuseFactor(coated, wo, wi) * s.incident[k].Value().cast<double>();
+    }
+    s.irradiance = column;
+  }
+  return out;
+}
+
 }  // namespace
 
 RegionFitResult FitRegion(const RegionFitInput& in, const RegionFitOptions& options) {
-  if (in.diffuse == recon::DiffuseShape::kOrenNayar) return FitOrenNayar(in, options);
+  switch (in.diffuse) {
+    case recon::DiffuseShape::kOrenNayar:
+      return FitOrenNayar(in, options);
+    case recon::DiffuseShape::kCoated:
+      return FitLambertColumn(WithCoatedColumn(in), options);
+    case recon::DiffuseShape::kLambert:
+      break;
+  }
   return FitLambertColumn(in, options);
 }
 

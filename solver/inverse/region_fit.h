@@ -107,7 +107,8 @@ struct RegionFitSettings {
   // the diffuse column is ρd·(A(σ)·E + B(σ)·G)/π, G = Σ_k OrenNayarG(wo, wi_k)·v_k over the
   // sample's incident list (solver/render/brdf.h): for a σ, linear in ρd as Lambert's. An unknown
   // σ is searched over [0, 1] (a grid of 11, then Brent's method), the α search and the linear
-  // solve at each.
+  // solve at each. With the coated base's term (no parameter) the column is
+  // ρd·Σ_k T(cosθo)·T(cosθi_k)·v_k/π, fitted as Lambert's.
   recon::DiffuseShape diffuse = recon::DiffuseShape::kLambert;
   std::optional<double> sigma;
   bool grey_specular = true;  // one ρs for the three channels

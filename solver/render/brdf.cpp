@@ -86,6 +86,29 @@ double OrenNayarMeanG(double cos_o) {
   return (1 - w) * table[i] + w * table[i + 1];
 }
 
+double DiffuseMeanFactor(const BrdfParams& params) {
+  switch (params.diffuse) {
+    case recon::DiffuseShape::kOrenNayar: {
+      // OrenNayarMeanG's mean over the cosine-weighted view (2c dc), by the midpoint rule.
+      static const double mean_g = [] {
+        constexpr int kN = 512;
+        double sum = 0;
+        for (int i = 0; i < kN; ++i) {
+          const double c = (i + 0.5) / kN;
+          sum += OrenNayarMeanG(c) * 2 * c / kN;
+        }
+        return sum;
+      }();
+      return OrenNayarA(params.sigma) + OrenNayarB(params.sigma) * mean_g;
+    }
+    case recon::DiffuseShape::kCoated:
+      return (20.0 / 21.0) * (20.0 / 21.0);  // T's mean 1 − 2∫(1 − c)⁵c dc, on both sides
+    case recon::DiffuseShape::kLambert:
+      break;
+  }
+  return 1.0;
+}
+
 double SpecularLobeProbability(const BrdfParams& params, const Eigen::Vector3d& wo) {
   if (!recon::HasSpecularLobe(params.model)) return 0.0;
   const double diffuse = Mean(params.rho_d);

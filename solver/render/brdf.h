@@ -40,7 +40,14 @@
 //   ρd/π·(A + B·max(0, cos(φi − φo))·sin(max(θi, θo))·tan(min(θi, θo))),
 //   A = 1 − σ²/(2(σ² + 0.33)),  B = 0.45σ²/(σ² + 0.09),
 // in vector form ρd/π·(A + B·max(0, wi.x wo.x + wi.y wo.y)/max(cosθi, cosθo)) (DiffuseFactor);
-// σ = 0 is Lambert's. Symmetric in wi and wo; sampled cosine-weighted as Lambert's.
+// σ = 0 is Lambert's. When "diffuse" is coated it is a Lambertian base under a smooth clear coat:
+// light reaches the base and leaves it through the coat's surface, each time losing Schlick's
+// reflectance F(θ) = F0 + (1 − F0)(1 − cosθ)⁵, so the term is ρd/π·(1 − F(θi))(1 − F(θo)) =
+//   ρd/π·(1 − F0)²·T(cosθi)·T(cosθo),  T(c) = 1 − (1 − c)⁵,
+// with (1 − F0)² folded into ρd (ρd is the albedo at normal light and view): the shape has no
+// parameter, 1 at normal incidence and 0 at grazing, so the coated base darkens toward the
+// terminator and the silhouette, where Lambert's stays flat. Both are symmetric in wi and wo and
+// sampled cosine-weighted as Lambert's.
 //
 // Sampling picks the diffuse lobe (cosine-weighted) or the specular lobe with probabilities from
 // the lobes' mean RGB albedos (SpecularLobeProbability). Ward's lobes and Beckmann's draw the half
@@ -207,12 +214,27 @@ T OrenNayarG(const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi)
   if (!(dot > 0.0)) return T(0.0);
   return dot / (wi.z() > wo.z() ? wi.z() : wo.z());
 }
-// The diffuse term over ρd/π: 1 for Lambert's, A + B·OrenNayarG for Oren–Nayar's.
+// The clear coat's transmission shape T(c) = 1 − (1 − c)⁵ at a cosine c in [0, 1].
+template <typename T>
+T CoatTransmission(const T& c) {
+  const T m = T(1.0) - c;
+  const T m2 = m * m;
+  return T(1.0) - m2 * m2 * m;
+}
+// The diffuse term over ρd/π: 1 for Lambert's, A + B·OrenNayarG for Oren–Nayar's,
+// T(cosθi)·T(cosθo) for the coated base's; wo and wi above the surface.
 template <typename T>
 T DiffuseFactor(const BrdfParamsT<T>& params, const Eigen::Matrix<T, 3, 1>& wo,
                 const Eigen::Matrix<T, 3, 1>& wi) {
-  if (params.diffuse != recon::DiffuseShape::kOrenNayar) return T(1.0);
-  return OrenNayarA(params.sigma) + OrenNayarB(params.sigma) * OrenNayarG<T>(wo, wi);
+  switch (params.diffuse) {
+    case recon::DiffuseShape::kOrenNayar:
+      return OrenNayarA(params.sigma) + OrenNayarB(params.sigma) * OrenNayarG<T>(wo, wi);
+    case recon::DiffuseShape::kCoated:
+      return CoatTransmission<T>(wo.z()) * CoatTransmission<T>(wi.z());
+    case recon::DiffuseShape::kLambert:
+      break;
+  }
+  return T(1.0);
 }
 inline double DiffuseFactor(const BrdfParams& params, const Eigen::Vector3d& wo,
                             const Eigen::Vector3d& wi) {
@@ -224,6 +246,12 @@ inline double DiffuseFactor(const BrdfParams& params, const Eigen::Vector3d& wo,
 // arriving alike from every direction of the hemisphere reflects ρd·E·(A + B·OrenNayarMeanG)/π
 // toward the view. 0 at normal viewing, 0.30 at 60°.
 double OrenNayarMeanG(double cos_o);
+
+// DiffuseFactor's mean over cosine-weighted light and view: light that arrives alike from the
+// whole hemisphere leaves toward a view drawn alike (another surface's, on average) with radiance
+// ρd·E·DiffuseMeanFactor/π. 1 for Lambert's, A + B·(OrenNayarMeanG's mean) for Oren–Nayar's,
+// (20/21)² for the coated base's.
+double DiffuseMeanFactor(const BrdfParams& params);
 
 // f(wo, wi), RGB per steradian; zero when wo or wi is at or below the surface.
 template <typename T>

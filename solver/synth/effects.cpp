@@ -152,9 +152,10 @@ std::pair<std::string, std::string> SplitFresnel(const std::string& brdf) {
   return {brdf, ""};
 }
 
+// The anisotropic form of a glossy region's model (ggx -> ggx_aniso, ward_gmd_fresnel ->
+// ward_gmd_aniso_fresnel).
 std::string Anisotropic(const std::string& brdf) {
-  const auto [base, fresnel] = SplitFresnel(brdf);
-  return (base == "ward_gmd" ? "ward_gmd_aniso" : "ward_aniso") + fresnel;
+  return std::string(recon::BrdfModelName(recon::AnisotropicForm(*recon::BrdfModelFromName(brdf))));
 }
 
 Json Anisotropy(Params& p, const SynthRoom& room, SynthScenes* s) {
@@ -333,14 +334,22 @@ Json DiffuseShapeEffect(Params& p, const SynthRoom& room, SynthScenes* s) {
   std::vector<std::string> reflective = lambert;
   reflective.insert(reflective.end(), room.glossy_regions.begin(), room.glossy_regions.end());
   const auto regions = p.Names("regions", lambert, reflective);
+  const std::string to = p.Name("to", "oren_nayar", {"oren_nayar", "coated"});
   const double sigma = p.Number("sigma", 0.4, 0.0, 1.0);
   p.Finish();
   for (const std::string& region : regions) {
     Json& m = s->true_scene["materials"][region];
-    m["diffuse"] = "oren_nayar";
-    m["sigma"] = sigma;
+    m["diffuse"] = to;
+    if (to == "oren_nayar") m["sigma"] = sigma;
+  }
+  if (to == "coated") {
+    return Json{{"regions", regions},
+                {"to", to},
+                {"model", "diffuse rho_d/pi T(cos theta_i) T(cos theta_o), T(c) = 1 - (1 - c)^5"},
+                {"note", "same rho_d (and lobe) values"}};
   }
   return Json{{"regions", regions},
+              {"to", to},
               {"sigma", sigma},
               {"model",
                "diffuse rho_d/pi (A + B max(0, cos(phi_i - phi_o)) sin(max theta) tan(min theta)), "

@@ -113,11 +113,31 @@ TEST(ConcealedUnknownMaterialsTest, OrenNayarSurfacesDeclaredLambertianAreNamed)
   ASSERT_FALSE(d["steps"].empty()) << d.dump(1);
   const Json& step = d["steps"][0];
   EXPECT_EQ(step["effect"], "diffuse_shape") << d.dump(1);
+  EXPECT_EQ(step["params"]["to"], "oren_nayar") << step.dump(1);
   ASSERT_TRUE(step["params"].contains("sigma_solved")) << step.dump(1);
   for (const auto& [region, sigma] : step["params"]["sigma_solved"].items()) {
     EXPECT_NEAR(sigma.get<double>(), 0.4, 0.06) << region;
   }
   test::ExpectReachesTheFloor(o);
+}
+
+// Coated paints in photos of regions declared Lambertian, every value unknown: every region
+// without a lobe is truly a Lambertian base under a clear coat (ρd/π·T(cosθi)·T(cosθo)); the
+// first physical step is diffuse_shape with the coat, not Oren–Nayar's surface.
+TEST(ConcealedUnknownMaterialsTest, CoatedSurfacesDeclaredLambertianAreNamed) {
+  const ConcealedOutcome o = DiagnoseConcealed("diffuse_shape:to=coated", 11, nullptr, "", false);
+  const Json& d = o.diagnosis;
+  const Json* first = nullptr;
+  for (const Json& s : d["steps"]) {
+    if (s["effect"] != "albedo_texture") {
+      first = &s;
+      break;
+    }
+  }
+  ASSERT_NE(first, nullptr) << d.dump(1);
+  EXPECT_EQ((*first)["effect"], "diffuse_shape") << d.dump(1);
+  EXPECT_EQ((*first)["params"]["to"], "coated") << d.dump(1);
+  ExpectReachesTheFloor(o);
 }
 
 TEST(ConcealedUnknownMaterialsTest, SpecularLobeShapeIsNamedOnAGrazingView) {

@@ -11,7 +11,8 @@
 //    the baseline's (below it when a step was kept);
 //  - the effects it names (kept or tried) are among those a sphere under distant LEDs photographed
 //    by a fixed linear camera can show: the lights' calibrated intensities (light_intensity,
-//    exposure_scale), the ball's real lobe (specular_lobe_shape, fresnel), a pose / projection
+//    exposure_scale), the ball's real lobe (specular_lobe_shape, fresnel) and its paint's
+//    diffuse term (diffuse_shape: a coated base darkens toward the terminator), a pose / projection
 //    error of the camera (pose_error: the camera is modelled from the mask's centroid and area,
 //    DiLiGenT's Normal_gt gives a 0.44 px smaller radius and a centre 0.3 px away), stray light
 //    (ambient_light) and the camera's response. Never: vignetting (the ball covers the image's
@@ -130,8 +131,8 @@ TEST(DiligentDiagnoseTest, FindsOnlyPlausiblePhysicsOnTheRealBall) {
   EXPECT_LT(d["noise_floor"].get<double>(), base);
 
   const std::set<std::string> plausible = {
-      "light_intensity", "exposure_scale", "specular_lobe_shape", "fresnel",
-      "pose_error",      "ambient_light",  "camera_response"};
+      "light_intensity", "exposure_scale", "specular_lobe_shape", "fresnel",       "pose_error",
+      "ambient_light",   "camera_response", "diffuse_shape"};
   double held = base;
   for (const Json& s : d["steps"]) {
     const std::string effect = s["effect"].get<std::string>();

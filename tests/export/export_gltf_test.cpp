@@ -9,6 +9,8 @@
 
 #include <assimp/Importer.hpp>
 #include <map>
+#include <string>
+#include <tuple>
 
 #include "solver/export/export.h"
 #include "solver/render/brdf.h"
@@ -192,27 +194,31 @@ TEST(ExportGltf, GgxIsWrittenExactly) {
   }
 }
 
-// No target has Oren–Nayar's diffuse term: it is written as Lambert's with the same ρd, and the
-// report names it with the darkening at normal viewing left out, 1 − A(σ).
-TEST(ExportGltf, OrenNayarDiffuseIsReportedAsLambert) {
-  recon::Scene scene = test::SyntheticScene();
-  scene.materials[0].diffuse = recon::DiffuseShape::kOrenNayar;
-  scene.materials[0].sigma = 0.3;
-  const auto dir = test::UniqueTempDir("igi_export_gltf_on") / "out";
-  const ExportReport report = ExportScene(scene, dir, {.format = ExportFormat::kGltf});
-  bool reported = false;
-  for (const auto& a : report.approximations) {
-    if (a.item != "materials.matte" || a.description.find("oren_nayar") == std::string::npos)
-      continue;
-    reported = true;
-    ASSERT_TRUE(a.relative_error.has_value());
-    EXPECT_NEAR(*a.relative_error, 1 - render::OrenNayarA(0.3), 1e-12);
-  }
-  EXPECT_TRUE(reported);
-  const Json doc = ReadJsonFile(dir / "scene.gltf");
-  for (const Json& m : doc.at("materials")) {
-    if (m.at("name") != "matte") continue;
-    EXPECT_NEAR(m.at("pbrMetallicRoughness").at("baseColorFactor")[0].get<double>(), 0.5, 1e-12);
+// No target has Oren–Nayar's or the coated base's diffuse term: each is written as Lambert's with
+// the same ρd, and the report names it with what is left out: the darkening at normal viewing,
+// 1 − A(σ), or the coat's two mean transmittances, 1 − (20/21)².
+TEST(ExportGltf, DiffuseShapesAreReportedAsLambert) {
+  for (const auto& [shape, name, error] :
+       {std::tuple{recon::DiffuseShape::kOrenNayar, "oren_nayar", 1 - render::OrenNayarA(0.3)},
+        std::tuple{recon::DiffuseShape::kCoated, "coated", 1 - 400.0 / 441.0}}) {
+    recon::Scene scene = test::SyntheticScene();
+    scene.materials[0].diffuse = shape;
+    if (shape == recon::DiffuseShape::kOrenNayar) scene.materials[0].sigma = 0.3;
+    const auto dir = test::UniqueTempDir(std::string("igi_export_gltf_") + name) / "out";
+    const ExportReport report = ExportScene(scene, dir, {.format = ExportFormat::kGltf});
+    bool reported = false;
+    for (const auto& a : report.approximations) {
+      if (a.item != "materials.matte" || a.description.find(name) == std::string::npos) continue;
+      reported = true;
+      ASSERT_TRUE(a.relative_error.has_value());
+      EXPECT_NEAR(*a.relative_error, error, 1e-12) << name;
+    }
+    EXPECT_TRUE(reported) << name;
+    const Json doc = ReadJsonFile(dir / "scene.gltf");
+    for (const Json& m : doc.at("materials")) {
+      if (m.at("name") != "matte") continue;
+      EXPECT_NEAR(m.at("pbrMetallicRoughness").at("baseColorFactor")[0].get<double>(), 0.5, 1e-12);
+    }
   }
 }
 

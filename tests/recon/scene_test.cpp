@@ -255,8 +255,18 @@ TEST(SceneTest, OrenNayarDiffuseReadsItsRoughness) {
   const std::tuple<const char*, Json, const char*> bad[] = {
       {"sigma", -0.1, "must be in [0, 1]"},
       {"sigma", 1.5, "must be in [0, 1]"},
-      {"diffuse", "rough", "unknown diffuse (known: lambert, oren_nayar)"}};
+      {"diffuse", "rough", "unknown diffuse (known: lambert, oren_nayar, coated)"}};
   for (const auto& [key, value, rule] : bad) ExpectOneFloorProblem(doc, dir, key, value, rule);
+  // The coated base's term has no parameter: "coated" needs nothing more and takes no sigma.
+  Json coated = doc;
+  coated["materials"]["floor"]["diffuse"] = "coated";
+  coated["materials"]["floor"].erase("sigma");
+  WriteJsonFile(dir / "scene.json", coated);
+  const Scene coated_scene = LoadScene(dir / "scene.json");
+  const Material& coated_floor = coated_scene.materials[coated_scene.FindMaterial("floor")];
+  EXPECT_EQ(coated_floor.diffuse, DiffuseShape::kCoated);
+  EXPECT_TRUE(coated_floor.MissingForRendering().empty());
+  ExpectOneFloorProblem(coated, dir, "sigma", 0.2, "is read only with \"diffuse\": \"oren_nayar\"");
   Json lambert = doc;
   lambert["materials"]["floor"].erase("diffuse");
   WriteJsonFile(dir / "scene.json", lambert);

@@ -564,6 +564,63 @@ TEST(BrdfEnergyTest, OrenNayarAlbedoIsAtMostOneBelowGrazing) {
   }
 }
 
+// The coated base's diffuse term: ρd/π·T(cosθi)·T(cosθo), T(c) = 1 − (1 − c)⁵, the Schlick
+// transmittance with F0 folded into ρd: ρd/π at normal light and view, reciprocal, and the
+// darkening toward grazing light a Lambertian surface does not have (T(cos 80°) = 0.6147).
+TEST(BrdfEvalTest, CoatedDiffuseIsTheCoatsTwoTransmittances) {
+  BrdfParams p = Grey(recon::BrdfModel::kLambert, 0.6, 0.0, 0.1, 0.1);
+  p.diffuse = recon::DiffuseShape::kCoated;
+  EXPECT_NEAR(EvalBrdf(p, Dir(0, 0), Dir(0, 0))[0], 0.6 / kPi, 1e-15);
+  EXPECT_NEAR(CoatTransmission(std::cos(80 * kPi / 180)), 0.6147, 1e-4);
+  for (auto [ti, to, dphi] :
+       {std::tuple{60.0, 20.0, 0.0}, {20.0, 60.0, 30.0}, {75.0, 75.0, 80.0}, {85.0, 5.0, 170.0}}) {
+    const double ci = std::cos(ti * kPi / 180), co = std::cos(to * kPi / 180);
+    const double want = 0.6 / kPi * (1 - std::pow(1 - ci, 5)) * (1 - std::pow(1 - co, 5));
+    EXPECT_NEAR(EvalBrdf(p, Dir(to, 15), Dir(ti, 15 + dphi))[0], want, 1e-14) << ti << " " << to;
+    EXPECT_NEAR(EvalBrdf(p, Dir(ti, 15 + dphi), Dir(to, 15))[0], want, 1e-14);
+  }
+  // Under a lobe the diffuse term is the same and the lobe is added unchanged.
+  BrdfParams ggx = Grey(recon::BrdfModel::kGgx, 0.6, 0.04, 0.2, 0.2);
+  BrdfParams coated_ggx = ggx;
+  coated_ggx.diffuse = recon::DiffuseShape::kCoated;
+  const Eigen::Vector3d wo = Dir(30, 0), wi = Dir(50, 160);
+  EXPECT_NEAR((EvalBrdf(coated_ggx, wo, wi) - EvalBrdf(ggx, wo, wi))[0],
+              0.6 / kPi * (CoatTransmission(wo.z()) * CoatTransmission(wi.z()) - 1), 1e-15);
+}
+
+// The coated term only takes energy away: with ρd = 1 its albedo is T(cosθo)·20/21 (T's mean
+// over the cosine-weighted light is 1 − 2∫(1 − c)⁵c dc = 20/21), below 1 at every view.
+TEST(BrdfEnergyTest, CoatedDiffuseAlbedoIsTheViewsTransmittanceTimesTheMean) {
+  BrdfParams p = Grey(recon::BrdfModel::kLambert, 1.0, 0.0, 0.1, 0.1);
+  p.diffuse = recon::DiffuseShape::kCoated;
+  for (double theta : {0.0, 30.0, 60.0, 80.0, 88.0}) {
+    const double a = Albedo(p, Dir(theta, 20));
+    EXPECT_NEAR(a, CoatTransmission(std::cos(theta * kPi / 180)) * 20.0 / 21.0, 1e-4) << theta;
+    EXPECT_LT(a, 1.0);
+  }
+}
+
+// DiffuseMeanFactor is the directional albedo's mean over cosine-weighted views (with ρd = 1):
+// what a patch that no photo sees sends the rest of the room under light from everywhere.
+TEST(BrdfEnergyTest, DiffuseMeanFactorIsTheAlbedosMeanOverViews) {
+  BrdfParams p = Grey(recon::BrdfModel::kLambert, 1.0, 0.0, 0.1, 0.1);
+  EXPECT_EQ(DiffuseMeanFactor(p), 1.0);
+  p.diffuse = recon::DiffuseShape::kCoated;
+  BrdfParams on = p;
+  on.diffuse = recon::DiffuseShape::kOrenNayar;
+  on.sigma = 0.5;
+  for (const BrdfParams& q : {p, on}) {
+    constexpr int kN = 24;  // midpoint rule in cos²θo: the cosine weight's 2c dc
+    double mean = 0;
+    for (int i = 0; i < kN; ++i) {
+      const double theta = std::acos(std::sqrt((i + 0.5) / kN)) * 180 / kPi;
+      mean += Albedo(q, Dir(theta, 30)) / kN;
+    }
+    EXPECT_NEAR(DiffuseMeanFactor(q), mean, 2e-3) << recon::DiffuseShapeName(q.diffuse);
+  }
+  EXPECT_NEAR(DiffuseMeanFactor(p), 400.0 / 441.0, 1e-15);
+}
+
 TEST(BrdfEnergyTest, FresnelWeightRaisesTheSpecularAlbedoMostTowardGrazing) {
   // The albedo ratio fresnel/plain (ρd = 0, ρs = 1, α = 0.1, ior 1.5) is ~1 at normal viewing
   // (c ≈ 1 over the whole lobe) and grows toward grazing, as Schlick's factor does at the mirror
@@ -633,11 +690,14 @@ std::vector<SamplingCase> SamplingCases() {
     params.push_back(Grey(model, 0.2, 0.04, 0.05, 0.25));
     params.push_back(Grey(model, 0.0, 0.9, 0.6, 0.1));
   }
-  // Oren–Nayar's diffuse term alone and under a lobe: drawn cosine-weighted, weighted by f.
+  // Oren–Nayar's and the coated diffuse term alone and under a lobe: drawn cosine-weighted,
+  // weighted by f.
   for (recon::BrdfModel model : {recon::BrdfModel::kLambert, recon::BrdfModel::kGgx}) {
     params.push_back(Grey(model, 0.6, 0.2, 0.2, 0.2));
     params.back().diffuse = recon::DiffuseShape::kOrenNayar;
     params.back().sigma = 0.5;
+    params.push_back(Grey(model, 0.6, 0.2, 0.2, 0.2));
+    params.back().diffuse = recon::DiffuseShape::kCoated;
   }
   std::vector<SamplingCase> cases;
   for (const BrdfParams& p : params) {

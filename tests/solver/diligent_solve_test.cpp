@@ -99,17 +99,16 @@ BallPhotos SplitPhotos(const std::vector<recon::Photo>& all, Split split) {
 
 BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& out_dir,
                 bool uniform_albedo = false, Split split = Split::kTwelve,
-                bool oren_nayar = false) {
+                recon::DiffuseShape diffuse = recon::DiffuseShape::kLambert) {
   recon::Scene scene = recon::LoadScene(kBall / "scene.json", recon::SceneLoadOptions{});
   EXPECT_EQ(scene.photos.size(), 48u);
   const auto [fitted, held_out] = SplitPhotos(scene.photos, split);
   scene.photos = fitted;
   scene.materials[0].brdf = brdf;
   scene.document["materials"]["ball"]["brdf"] = brdf_name;
-  if (oren_nayar) {  // σ unknown: fitted with ρd and the lobe
-    scene.materials[0].diffuse = recon::DiffuseShape::kOrenNayar;
-    scene.document["materials"]["ball"]["diffuse"] = "oren_nayar";
-  }
+  // Oren–Nayar's σ unknown: fitted with ρd and the lobe.
+  scene.materials[0].diffuse = diffuse;
+  scene.document["materials"]["ball"]["diffuse"] = recon::DiffuseShapeName(diffuse);
 
   SolveOptions options;
   options.pixel_stride = 2;
@@ -142,7 +141,7 @@ BallFit FitBall(recon::BrdfModel brdf, const char* brdf_name, const fs::path& ou
     m.rho_s = fit.region.final_params.rho_s;
     m.alpha = fit.region.final_params.alpha;
   }
-  if (oren_nayar) m.sigma = fit.region.final_params.sigma;
+  if (diffuse == recon::DiffuseShape::kOrenNayar) m.sigma = fit.region.final_params.sigma;
   EXPECT_TRUE(m.MissingForRendering().empty());
   fit.held_out = HeldOutResidual(solved, held_out, 2);
   fit.solved = solved;
@@ -297,32 +296,38 @@ std::vector<double> RelightAgainstPerPixelLambert(const std::vector<const BallFi
 // relights the even 24, against the per-pixel Lambertian fit with known normals of the same 24
 // photos, on the same pixels. The goal is a relighting error at most half the baseline's.
 // Measured (per-pixel Lambert 0.1266): ward 0.0856 (0.676 of it), beckmann 0.0852 (0.673),
-// ggx 0.0803 (0.634; ρs 0.0113, α 0.034). The bounds hold these with a margin. GGX with
-// Oren–Nayar's diffuse term, σ free, fits σ 0.001: the ball's diffuse is no rough surface's (its
-// fall-off toward the terminator is below Lambert's, where Oren–Nayar's back-scatter would lift
-// it), and the relighting is GGX's.
+// ggx 0.0803 (0.634; ρs 0.0113, α 0.034). GGX with Oren–Nayar's diffuse term, σ free, fits σ
+// 0.001: the ball's diffuse is no rough surface's (its fall-off toward the terminator is below
+// Lambert's, where Oren–Nayar's back-scatter would lift it), and the relighting is GGX's. The
+// coated base's diffuse term makes that fall-off: GGX over it relights at 0.0714 (0.564; ρd (0.519,
+// 0.437, 0.284), the albedo at normal light, where plain GGX fits (0.501, 0.422, 0.274); ρs 0.0108,
+// α 0.031). The bounds hold these with a margin.
 TEST(DiligentSolve, HalvesRelightAgainstPerPixelLambert) {
   const fs::path out = test::UniqueTempDir("igi_diligent_halves");
   const BallFit ward = FitBall(recon::BrdfModel::kWard, "ward", out, true, Split::kHalves);
   const BallFit ggx = FitBall(recon::BrdfModel::kGgx, "ggx", out, true, Split::kHalves);
   const BallFit beckmann =
       FitBall(recon::BrdfModel::kBeckmann, "beckmann", out, true, Split::kHalves);
-  const BallFit ggx_on =
-      FitBall(recon::BrdfModel::kGgx, "ggx", out, true, Split::kHalves, /*oren_nayar=*/true);
+  const BallFit ggx_on = FitBall(recon::BrdfModel::kGgx, "ggx", out, true, Split::kHalves,
+                                 recon::DiffuseShape::kOrenNayar);
+  const BallFit ggx_coated = FitBall(recon::BrdfModel::kGgx, "ggx", out, true, Split::kHalves,
+                                     recon::DiffuseShape::kCoated);
   fs::remove_all(out);
   const recon::Scene all = recon::LoadScene(kBall / "scene.json", recon::SceneLoadOptions{});
   const std::vector<double> err = RelightAgainstPerPixelLambert(
-      {&ward, &beckmann, &ggx, &ggx_on}, SplitPhotos(all.photos, Split::kHalves));
+      {&ward, &beckmann, &ggx, &ggx_on, &ggx_coated}, SplitPhotos(all.photos, Split::kHalves));
   std::printf(
       "relighting the even 24 lights: per-pixel Lambert %.4f; ward %.4f (%.3f), beckmann %.4f "
-      "(%.3f), ggx %.4f (%.3f), ggx + oren_nayar %.4f (%.3f, sigma %.3f)\n",
+      "(%.3f), ggx %.4f (%.3f), ggx + oren_nayar %.4f (%.3f, sigma %.3f), ggx + coated %.4f "
+      "(%.3f)\n",
       err[0], err[1], err[1] / err[0], err[2], err[2] / err[0], err[3], err[3] / err[0], err[4],
-      err[4] / err[0], ggx_on.region.final_params.sigma);
+      err[4] / err[0], ggx_on.region.final_params.sigma, err[5], err[5] / err[0]);
   EXPECT_LT(err[3], err[1]);  // GGX's long tail relights the highlight better than Ward's
   EXPECT_LT(err[3], 0.7 * err[0]);
   EXPECT_LT(err[1], 0.75 * err[0]);
   EXPECT_LT(ggx_on.region.final_params.sigma, 0.05);
   EXPECT_NEAR(err[4], err[3], 0.01 * err[3]);
+  EXPECT_LT(err[5], 0.93 * err[3]);  // the coat's fall-off toward the terminator (0.89)
 }
 
 }  // namespace

@@ -415,6 +415,26 @@ TEST(SynthEffects, SceneEffectsChangeOnlyTheTrueScene) {
   EXPECT_FALSE(f.scenes.declared_scene["materials"]["glossy_sphere"].contains("rho_s"));
 }
 
+// diffuse_shape: the regions without a lobe take Oren–Nayar's term (σ 0.4 by default) or the
+// coated base's (no parameter) in the true scene only.
+TEST(SynthEffects, DiffuseShapeChangesTheTrueDiffuseTerm) {
+  Fixture f;
+  const Json on = f.Apply("diffuse_shape:regions=matte_box,sigma=0.3");
+  EXPECT_EQ(on[0]["params"]["to"], "oren_nayar");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["matte_box"]["diffuse"], "oren_nayar");
+  EXPECT_EQ(f.scenes.true_scene["materials"]["matte_box"]["sigma"], 0.3);
+  EXPECT_FALSE(f.scenes.declared_scene["materials"]["matte_box"].contains("diffuse"));
+  Fixture g;
+  const Json coated = g.Apply("diffuse_shape:to=coated");
+  EXPECT_EQ(coated[0]["params"]["to"], "coated");
+  for (const std::string& region : coated[0]["params"]["regions"]) {
+    EXPECT_EQ(g.scenes.true_scene["materials"][region]["diffuse"], "coated") << region;
+    EXPECT_FALSE(g.scenes.true_scene["materials"][region].contains("sigma")) << region;
+    EXPECT_FALSE(g.scenes.declared_scene["materials"][region].contains("diffuse")) << region;
+  }
+  EXPECT_THROW(g.Apply("diffuse_shape:to=rough"), InputError);
+}
+
 // fresnel: the glossy regions become *_fresnel in the true scene only, with the ior; it
 // composes with the effects that rename the model (before or after them).
 TEST(SynthEffects, FresnelWeightsTheTrueGlossyRegionsOnly) {
@@ -436,6 +456,11 @@ TEST(SynthEffects, FresnelWeightsTheTrueGlossyRegionsOnly) {
   EXPECT_EQ(f.scenes.true_scene["materials"]["glossy_box"]["brdf"], "ward_aniso_fresnel");
   f.Apply("specular_lobe_shape:regions=floor");
   EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_gmd_fresnel");
+  // A microfacet region takes its own anisotropic form.
+  Fixture ggx;
+  ggx.scenes.true_scene["materials"]["glossy_box"]["brdf"] = "ggx";
+  ggx.Apply("anisotropic_reflection");
+  EXPECT_EQ(ggx.scenes.true_scene["materials"]["glossy_box"]["brdf"], "ggx_aniso");
   f.Apply("fresnel:regions=floor,ior=2");  // again: the model stays, the ior changes
   EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["brdf"], "ward_gmd_fresnel");
   EXPECT_EQ(f.scenes.true_scene["materials"]["floor"]["ior"], 2.0);

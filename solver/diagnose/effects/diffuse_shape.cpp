@@ -1,11 +1,13 @@
 // diffuse_shape (docs/diagnose-effects.md): a region whose diffuse reflection is not Lambert's
 // but Oren–Nayar's rough surface (solver/render/brdf.h): brighter where the light comes from the
-// viewer's side (back-scatter), flatter toward the terminator.
+// viewer's side (back-scatter), flatter toward the terminator; or a coated base's, darker toward
+// grazing light and view.
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +33,77 @@ double OrenNayarSigmaOfRatio(double b_over_a) {
   return 0.5 * (lo + hi);
 }
 
+namespace {
+
+// T's mean over the cosine-weighted hemisphere (solver/render/brdf.h): 20/21.
+constexpr double kMeanCoatTransmission = 20.0 / 21.0;
+
+// Oren–Nayar's term in place of Lambert's on the records' regions: σ and the fit.
+ResidualFit FitOrenNayar(const ResidualFitter& f, int n,
+                         const std::function<bool(const PixelRecord&, int, double*)>& parts,
+                         double* sigma, double* ratio) {
+  ResidualFit fit;
+  if (f.nuisance()) {
+    // Materials solved: after the refit a region reflects s·ρd·(A·E + B·G)/π (s its albedo's
+    // change), so the change is (s·A − 1)·ρd·E/π + s·B·ρd·G/π: one Lambert column per region
+    // (what re-fitted albedos alone explain, the base) and the shared G column, credited with
+    // what it explains beyond them; B/A = c_G/(1 + c̄), c̄ the regions' mean base coefficient.
+    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
+      double p[4];
+      if (!parts(r, c, p)) return;
+      b[int(p[3])] = p[0];
+      b[n] = p[1];
+    });
+    if (fit.coef.size() == size_t(n + 1)) {
+      const double mean_base = fit.coef.head(n).mean();
+      if (1 + mean_base > 0) *ratio = fit.coef[n] / (1 + mean_base);
+    }
+    *sigma = OrenNayarSigmaOfRatio(*ratio);
+    return fit;
+  }
+  // Materials given: the refit renders ρd·(A·E + B·G)/π with the declared ρd, a change
+  // ρd·((A − 1)·E + B·G)/π fixed by σ: σ searched on a grid, the change's amplitude near 1.
+  for (int i = 1; i <= 20; ++i) {
+    const double sg = 0.05 * i;
+    const double a = render::OrenNayarA(sg), bb = render::OrenNayarB(sg);
+    const ResidualFit at = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+      double p[4];
+      if (parts(r, c, p)) b[0] = (a - 1) * p[0] + bb * p[1];
+    });
+    if (at.coef.size() == 0 || !(at.coef[0] > 0.7 && at.coef[0] < 1.4)) continue;
+    if (fit.coef.size() == 0 || at.train_after < fit.train_after) fit = at, *sigma = sg;
+  }
+  *ratio = render::OrenNayarB(*sigma) / render::OrenNayarA(*sigma);
+  return fit;
+}
+
+// The coated base's term in place of Lambert's: the change ρd·(C − E)/π, C the coat's column.
+// With the materials solved it is credited beyond a re-fitted albedo per region (the refit's
+// ρd takes the term's level); its coefficient must then be positive. With them given it is
+// fixed, its amplitude near 1. Empty when neither holds.
+ResidualFit FitCoated(const ResidualFitter& f, int n,
+                      const std::function<bool(const PixelRecord&, int, double*)>& parts) {
+  ResidualFit fit;
+  if (f.nuisance()) {
+    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
+      double p[4];
+      if (!parts(r, c, p)) return;
+      b[int(p[3])] = p[0];
+      b[n] = p[2] - p[0];
+    });
+    if (fit.coef.size() == size_t(n + 1) && fit.coef[n] > 0) return fit;
+    return {};
+  }
+  fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
+    double p[4];
+    if (parts(r, c, p)) b[0] = p[2] - p[0];
+  });
+  if (fit.coef.size() == 1 && fit.coef[0] > 0.7 && fit.coef[0] < 1.4) return fit;
+  return {};
+}
+
+}  // namespace
+
 CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f,
                              const std::vector<int>& regions) {
   CandidateResult out;
@@ -51,84 +124,78 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
   for (const PixelRecord& r : f.records())
     count += r.region >= 0 && slot[r.region] >= 0 && !r.outlier;
   if (n == 0 || count < 50) return out;
-  // A record's diffuse reflection in two parts: Lambert's ρd·E/π and Oren–Nayar's geometric
-  // term ρd·G/π (zero off `regions`). The direct light gives G = Σ OrenNayarG(wo, wi)·E_light.
-  // On a region without a lobe the model's value is its whole diffuse reflection, ρd·E/π with
-  // the light the room bounces in: that light, E − E_direct, arrives from the whole hemisphere and
-  // adds OrenNayarMeanG(cosθo) times itself to G. (On a region with a lobe only the direct light
-  // is split so.)
-  auto parts = [&](const PixelRecord& r, int c, double* e_part, double* g_part) {
-    *e_part = *g_part = 0;
+  // A record's diffuse reflection in parts, p[0..3]: Lambert's ρd·E/π, Oren–Nayar's geometric
+  // term ρd·G/π, the coated base's ρd·C/π (all zero off `regions`) and the region's slot. The
+  // direct light gives G = Σ OrenNayarG(wo, wi)·E_light and C = Σ T(cosθo)·T(cosθi)·E_light. On
+  // a region without a lobe the model's value is its whole diffuse reflection, ρd·E/π with the
+  // light the room bounces in: that light, E − E_direct, arrives from the whole hemisphere and
+  // adds OrenNayarMeanG(cosθo) times itself to G and T(cosθo)·20/21 times itself to C. (On a
+  // region with a lobe only the direct light is split so.)
+  auto parts = [&](const PixelRecord& r, int c, double* p) {
+    p[0] = p[1] = p[2] = p[3] = 0;
     if (r.region < 0 || slot[r.region] < 0 || !(r.albedo[c] > 0)) return false;
     const render::Frame frame = render::Frame::FromNormal(r.normal.cast<double>());
     const Eigen::Vector3d wo = frame.ToLocal(r.view.cast<double>());
     if (!(wo.z() > 0)) return false;
-    double e = 0, g = 0;
+    const double t_o = render::CoatTransmission(wo.z());
+    double e = 0, g = 0, coat = 0;
     for (const RecordLightSample& ls : r.lights) {
       const Eigen::Vector3d wi = frame.ToLocal(ls.wi.cast<double>());
       if (!(wi.z() > 0)) continue;
       e += ls.irradiance[c];
       g += render::OrenNayarG<double>(wo, wi) * ls.irradiance[c];
+      coat += t_o * render::CoatTransmission(wi.z()) * ls.irradiance[c];
     }
     if (!recon::HasSpecularLobe(cx.model.materials[r.region].brdf)) {
       const double e_all = r.sim[c] * render::kPi / r.albedo[c];
-      if (e_all > e) g += render::OrenNayarMeanG(wo.z()) * (e_all - e), e = e_all;
+      if (e_all > e) {
+        g += render::OrenNayarMeanG(wo.z()) * (e_all - e);
+        coat += t_o * kMeanCoatTransmission * (e_all - e);
+        e = e_all;
+      }
     }
-    *e_part = r.albedo[c] * e / render::kPi;
-    *g_part = r.albedo[c] * g / render::kPi;
+    p[0] = r.albedo[c] * e / render::kPi;
+    p[1] = r.albedo[c] * g / render::kPi;
+    p[2] = r.albedo[c] * coat / render::kPi;
+    p[3] = slot[r.region];
     return true;
   };
-  ResidualFit fit;
   double sigma = 0, ratio = 0;
-  if (f.nuisance()) {
-    // Materials solved: after the refit a region reflects s·ρd·(A·E + B·G)/π (s its albedo's
-    // change), so the change is (s·A − 1)·ρd·E/π + s·B·ρd·G/π: one Lambert column per region
-    // (what re-fitted albedos alone explain, the base) and the shared G column, credited with
-    // what it explains beyond them; B/A = c_G/(1 + c̄), c̄ the regions' mean base coefficient.
-    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
-      double e = 0, g = 0;
-      if (!parts(r, c, &e, &g)) return;
-      b[slot[r.region]] = e;
-      b[n] = g;
-    });
-    if (fit.coef.size() == size_t(n + 1)) {
-      const double mean_base = fit.coef.head(n).mean();
-      if (1 + mean_base > 0) ratio = fit.coef[n] / (1 + mean_base);
-    }
-    sigma = OrenNayarSigmaOfRatio(ratio);
-  } else {
-    // Materials given: the refit renders ρd·(A·E + B·G)/π with the declared ρd, a change
-    // ρd·((A − 1)·E + B·G)/π fixed by σ: σ searched on a grid, the change's amplitude near 1.
-    for (int i = 1; i <= 20; ++i) {
-      const double sg = 0.05 * i;
-      const double a = render::OrenNayarA(sg), bb = render::OrenNayarB(sg);
-      const ResidualFit at = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
-        double e = 0, g = 0;
-        if (parts(r, c, &e, &g)) b[0] = (a - 1) * e + bb * g;
-      });
-      if (at.coef.size() == 0 || !(at.coef[0] > 0.7 && at.coef[0] < 1.4)) continue;
-      if (fit.coef.size() == 0 || at.train_after < fit.train_after) fit = at, sigma = sg;
-    }
-    ratio = render::OrenNayarB(sigma) / render::OrenNayarA(sigma);
-  }
-  if (fit.coef.size() == 0 || !(sigma > 0)) {
+  ResidualFit fit = FitOrenNayar(f, n, parts, &sigma, &ratio);
+  if (!(sigma > 0)) fit = {};
+  const ResidualFit coated = FitCoated(f, n, parts);
+  // The shape that explains more of the residual (the lower squared error after the fit).
+  const bool coat = coated.coef.size() > 0 &&
+                    (fit.coef.size() == 0 || coated.train_after < fit.train_after);
+  if (!coat && fit.coef.size() == 0) {
     out.note = fmt::format(
-        "{}: the residual does not rise toward back-scatter as a rough diffuse surface's does "
-        "(B/A {:.3f})",
+        "{}: the residual neither rises toward back-scatter as a rough diffuse surface's does "
+        "(B/A {:.3f}) nor falls toward grazing light as a coated one's",
         label, ratio);
     return out;
   }
+  out.where = {{"regions", names}, {"frame", "light and view directions"}};
+  out.num_params = coat ? 0 : 1;
+  out.valid = true;
+  if (coat) {
+    FillScores(coated, &out);
+    out.params["to"] = "coated";
+    out.evidence = fmt::format(
+        "{}: the diffuse reflection falls toward grazing light and view below Lambert's "
+        "cosine: a Lambertian base under a smooth clear coat, each crossing of the coat "
+        "losing Schlick's reflectance, explains it",
+        label);
+    return out;
+  }
   FillScores(fit, &out);
+  out.params["to"] = "oren_nayar";
   out.params["sigma"] = sigma;
   out.params["b_over_a"] = ratio;
-  out.where = {{"regions", names}, {"frame", "light and view azimuths"}};
-  out.num_params = 1;
   out.evidence = fmt::format(
       "{}: the diffuse reflection is brighter where light and view share an azimuth and "
       "flatter toward the terminator than Lambert's: Oren-Nayar's rough surface with sigma "
       "~ {:.2f} rad explains it",
       label, sigma);
-  out.valid = true;
   return out;
 }
 
@@ -157,14 +224,16 @@ class DiffuseShapeEffect final : public Effect {
   HeldOutScope Scope(const CandidateResult& c, const DiagnosisModel& m) const override {
     return RegionScope(c, m);
   }
-  // The region's diffuse term becomes Oren–Nayar's: with its σ where the region's albedo is
-  // declared (nothing is solved then), without it otherwise (igi-solve fits σ with ρd).
+  // The region's diffuse term becomes the named one; Oren–Nayar's with its σ where the region's
+  // albedo is declared (nothing is solved then), without it otherwise (igi-solve fits σ with ρd).
   void Write(const CandidateResult& c, recon::SceneDocument* doc) const override {
+    const std::string to = c.params.value("to", "oren_nayar");
     for (const std::string& region : Regions(c)) {
       Json m = doc->Material(region);
-      m["diffuse"] = "oren_nayar";
+      m["diffuse"] = to;
       m.erase("sigma");
-      if (m.contains("rho_d") || m.contains("rho_d_map")) m["sigma"] = c.params.at("sigma");
+      if (to == "oren_nayar" && (m.contains("rho_d") || m.contains("rho_d_map")))
+        m["sigma"] = c.params.at("sigma");
       doc->SetMaterial(region, std::move(m));
     }
   }

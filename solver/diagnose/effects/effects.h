@@ -75,11 +75,12 @@ CandidateResult SpecularReflection(const CandidateContext& cx, const ResidualFit
 CandidateResult LobeChange(const CandidateContext& cx, const ResidualFitter& f, int region,
                            bool fresnel);
 
-// diffuse_shape on `regions` (Lambert's diffuse term; one σ for all): Oren–Nayar's term in its
-// place. With the materials solved, the direct light's diffuse reflection is split into Lambert's
-// column per region and Oren–Nayar's geometric one, credited with what the latter explains beyond
-// re-fitted albedos, σ from the fitted ratio B/A (OrenNayarSigmaOfRatio); with them given, the
-// change ρd·((A − 1)·E + B·G)/π at a grid of σ with its amplitude near 1.
+// diffuse_shape on `regions` (Lambert's diffuse term; one shape for all): Oren–Nayar's term or
+// the coated base's in its place, whichever explains more (params "to"). With the materials
+// solved, the direct light's diffuse reflection is split into Lambert's column per region and
+// the shape's own column, credited with what the latter explains beyond re-fitted albedos, σ
+// from the fitted ratio B/A (OrenNayarSigmaOfRatio); with them given, the change ρd·((A − 1)·E +
+// B·G)/π at a grid of σ, or ρd·(C − E)/π, with its amplitude near 1.
 CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f,
                              const std::vector<int>& regions);
 // The σ whose Oren–Nayar B(σ)/A(σ) is `b_over_a` (0 when it is not positive, 1 beyond B/A at 1).
