@@ -76,14 +76,16 @@ TEST_P(SolveMicrofacet, RecoversTheGlossyRegionsLobes) {
 
 // The anisotropic form: the glossy box's lobe made anisotropic in the photos (igi-synth's
 // anisotropic_reflection: αx 0.03 along the box's long side, αy 0.15) and declared so in
-// scene.json (the model and the tangent; ρd, ρs, αx and αy unknown). The solver fits both
-// roughnesses from the box's highlights: within 10 % of the truth, ρs within 5 %.
+// scene.json (the model and the tangent; ρd, ρs, αx and αy unknown), from 64-path photos. The
+// solver fits both roughnesses from the box's highlights: ρs, αx and αy within 5 % of the truth.
+// Measured: ggx_aniso ρs +0.9 %, αx +2.0 %, αy +0.4 %; beckmann_aniso +0.0 %, +1.3 %, −0.7 %
+// (from 256-path photos: within 1.2 %).
 TEST_P(SolveMicrofacet, RecoversAnAnisotropicLobe) {
   const std::string model(recon::BrdfModelName(GetParam()));
   const fs::path tmp = test::UniqueTempDir("solve_aniso_" + model);
   synth::SynthOptions so;
   so.out = tmp / "capture";
-  so.spp = 256;
+  so.spp = 64;
   so.glossy_brdf = GetParam();
   so.effects = {synth::ParseEffectSpec("anisotropic_reflection")};
   synth::Synthesize(so);
@@ -91,25 +93,27 @@ TEST_P(SolveMicrofacet, RecoversAnAnisotropicLobe) {
   const std::string aniso(recon::BrdfModelName(recon::AnisotropicForm(GetParam())));
   ASSERT_EQ(truth["brdf"], aniso);
   Json declared = ReadJsonFile(so.out / "scene.json");
-  Json& box = declared["materials"]["glossy_box"];
-  box["brdf"] = aniso;
-  box["tangent"] = truth["tangent"];
+  declared["materials"]["glossy_box"]["brdf"] = aniso;
+  declared["materials"]["glossy_box"]["tangent"] = truth["tangent"];
   WriteJsonFile(so.out / "scene.json", declared);
 
   SolveOptions o;
   o.refine_iterations = 1;
-  Solve(recon::LoadScene(so.out / "scene.json"), o, tmp / "out");
-  const recon::Scene solved = recon::LoadScene(tmp / "out" / "scene.json");
-  ASSERT_GE(solved.FindMaterial("glossy_box"), 0);
-  const recon::Material& m = solved.materials[solved.FindMaterial("glossy_box")];
-  ASSERT_TRUE(m.alpha_x && m.alpha_y && m.rho_s);
+  const SolveSummary s = Solve(recon::LoadScene(so.out / "scene.json"), o, tmp / "out");
+  const RegionSolution* box = nullptr;
+  for (const RegionSolution& r : s.regions) {
+    if (r.name == "glossy_box") box = &r;
+  }
+  ASSERT_NE(box, nullptr);
+  const render::BrdfParams& m = box->final_params;
+  ASSERT_EQ(m.model, recon::AnisotropicForm(GetParam()));
   const double ax = truth["alpha_x"].get<double>(), ay = truth["alpha_y"].get<double>();
   std::printf("%s glossy box: rho_s %+.2f %%, alpha_x %.4f (%+.2f %%), alpha_y %.4f (%+.2f %%)\n",
-              aniso.c_str(), 100 * (m.rho_s->mean() / truth["rho_s"].get<double>() - 1),
-              *m.alpha_x, 100 * (*m.alpha_x / ax - 1), *m.alpha_y, 100 * (*m.alpha_y / ay - 1));
-  EXPECT_LT(RelErr(m.rho_s->mean(), truth["rho_s"].get<double>()), 0.05);
-  EXPECT_LT(RelErr(*m.alpha_x, ax), 0.10);
-  EXPECT_LT(RelErr(*m.alpha_y, ay), 0.10);
+              aniso.c_str(), 100 * (m.rho_s.mean() / truth["rho_s"].get<double>() - 1), m.alpha_x,
+              100 * (m.alpha_x / ax - 1), m.alpha_y, 100 * (m.alpha_y / ay - 1));
+  EXPECT_LT(RelErr(m.rho_s.mean(), truth["rho_s"].get<double>()), 0.05);
+  EXPECT_LT(RelErr(m.alpha_x, ax), 0.05);
+  EXPECT_LT(RelErr(m.alpha_y, ay), 0.05);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, SolveMicrofacet,
