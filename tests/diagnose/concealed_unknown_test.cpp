@@ -18,6 +18,15 @@ using test::ConcealedOutcome;
 using test::DiagnoseConcealed;
 using test::ExpectReachesTheFloor;
 
+// The first kept step that is not albedo_texture (igi-synth's floor is textured: its maps may
+// come first), or null.
+const Json* FirstPhysicalStep(const Json& diagnosis) {
+  for (const Json& s : diagnosis["steps"]) {
+    if (s["effect"] != "albedo_texture") return &s;
+  }
+  return nullptr;
+}
+
 // ambient_light with the materials unknown (solved at every step), both lightings photographed
 // (under one lighting an ambient term's shape on a surface is an albedo texture). The candidate's
 // basis is then the ambient light's first reflection: the solved albedos already carry its share
@@ -114,7 +123,9 @@ TEST(ConcealedUnknownMaterialsTest, OrenNayarSurfacesDeclaredLambertianAreNamed)
   EXPECT_EQ(step["params"]["to"], "oren_nayar") << step.dump(1);
   ASSERT_TRUE(step["params"].contains("sigma_solved")) << step.dump(1);
   for (const auto& [region, sigma] : step["params"]["sigma_solved"].items()) {
-    if (region != "ceiling") EXPECT_NEAR(sigma.get<double>(), 0.4, 0.06) << region;
+    if (region != "ceiling") {
+      EXPECT_NEAR(sigma.get<double>(), 0.4, 0.06) << region;
+    }
   }
   test::ExpectReachesTheFloor(o);
 }
@@ -125,13 +136,7 @@ TEST(ConcealedUnknownMaterialsTest, OrenNayarSurfacesDeclaredLambertianAreNamed)
 TEST(ConcealedUnknownMaterialsTest, CoatedSurfacesDeclaredLambertianAreNamed) {
   const ConcealedOutcome o = DiagnoseConcealed("diffuse_shape:to=coated", 11, nullptr, "", false);
   const Json& d = o.diagnosis;
-  const Json* first = nullptr;
-  for (const Json& s : d["steps"]) {
-    if (s["effect"] != "albedo_texture") {
-      first = &s;
-      break;
-    }
-  }
+  const Json* first = FirstPhysicalStep(d);
   ASSERT_NE(first, nullptr) << d.dump(1);
   EXPECT_EQ((*first)["effect"], "diffuse_shape") << d.dump(1);
   EXPECT_EQ((*first)["params"]["to"], "coated") << d.dump(1);
@@ -142,13 +147,7 @@ TEST(ConcealedUnknownMaterialsTest, SpecularLobeShapeIsNamedOnAGrazingView) {
   const ConcealedOutcome o = DiagnoseConcealed(
       "specular_lobe_shape", 11, nullptr, " --lamp-position 2,2,0.6 --grazing-cameras 1", false);
   const Json& d = o.diagnosis;
-  const Json* first = nullptr;
-  for (const Json& s : d["steps"]) {
-    if (s["effect"] != "albedo_texture") {
-      first = &s;
-      break;
-    }
-  }
+  const Json* first = FirstPhysicalStep(d);
   ASSERT_NE(first, nullptr) << d.dump(1);
   EXPECT_EQ((*first)["effect"], "specular_lobe_shape") << d.dump(1);
   EXPECT_EQ((*first)["params"]["to"], "ward_gmd") << d.dump(1);

@@ -133,8 +133,8 @@ TEST(DiligentDiagnoseTest, FindsOnlyPlausiblePhysicsOnTheRealBall) {
   EXPECT_LT(d["noise_floor"].get<double>(), base);
 
   const std::set<std::string> plausible = {
-      "light_intensity", "exposure_scale", "specular_lobe_shape", "fresnel",       "pose_error",
-      "ambient_light",   "camera_response", "diffuse_shape"};
+      "light_intensity", "exposure_scale", "specular_lobe_shape", "fresnel",
+      "pose_error",      "ambient_light",  "camera_response",     "diffuse_shape"};
   double held = base;
   for (const Json& s : d["steps"]) {
     const std::string effect = s["effect"].get<std::string>();

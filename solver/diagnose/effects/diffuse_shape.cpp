@@ -38,23 +38,33 @@ namespace {
 // T's mean over the cosine-weighted hemisphere (solver/render/brdf.h): 20/21.
 constexpr double kMeanCoatTransmission = 20.0 / 21.0;
 
+// A record's diffuse parts (DiffuseShape below): false where the record is not of the regions.
+using DiffuseParts = std::function<bool(const PixelRecord&, int, double*)>;
+
+// Materials solved: one Lambert column per region (what re-fitted albedos alone explain, the
+// base) and a shape's own column `extra` (of the parts), credited with what it explains beyond
+// them.
+ResidualFit FitBeyondAlbedos(const ResidualFitter& f, int n, const DiffuseParts& parts,
+                             double (*extra)(const double* p)) {
+  return f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
+    double p[4];
+    if (!parts(r, c, p)) return;
+    b[int(p[3])] = p[0];
+    b[n] = extra(p);
+  });
+}
+
 // Oren–Nayar's term in place of Lambert's on the records' regions: σ and the fit.
-ResidualFit FitOrenNayar(const ResidualFitter& f, int n,
-                         const std::function<bool(const PixelRecord&, int, double*)>& parts,
-                         double* sigma, double* ratio) {
+ResidualFit FitOrenNayar(const ResidualFitter& f, int n, const DiffuseParts& parts, double* sigma,
+                         double* ratio) {
   ResidualFit fit;
   if (f.nuisance()) {
     // Materials solved: after the refit a region reflects s·ρd·(A·E + B·G)/π (s its albedo's
     // change), so the change is (s·A − 1)·ρd·E/π + s·B·ρd·G/π: one Lambert column per region
     // (what re-fitted albedos alone explain, the base) and the shared G column, credited with
     // what it explains beyond them; B/A = c_G/(1 + c̄), c̄ the regions' mean base coefficient.
-    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
-      double p[4];
-      if (!parts(r, c, p)) return;
-      b[int(p[3])] = p[0];
-      b[n] = p[1];
-    });
-    if (fit.coef.size() == size_t(n + 1)) {
+    fit = FitBeyondAlbedos(f, n, parts, [](const double* p) { return p[1]; });
+    if (fit.coef.size() == n + 1) {
       const double mean_base = fit.coef.head(n).mean();
       if (1 + mean_base > 0) *ratio = fit.coef[n] / (1 + mean_base);
     }
@@ -81,17 +91,11 @@ ResidualFit FitOrenNayar(const ResidualFitter& f, int n,
 // With the materials solved it is credited beyond a re-fitted albedo per region (the refit's
 // ρd takes the term's level); its coefficient must then be positive. With them given it is
 // fixed, its amplitude near 1. Empty when neither holds.
-ResidualFit FitCoated(const ResidualFitter& f, int n,
-                      const std::function<bool(const PixelRecord&, int, double*)>& parts) {
+ResidualFit FitCoated(const ResidualFitter& f, int n, const DiffuseParts& parts) {
   ResidualFit fit;
   if (f.nuisance()) {
-    fit = f.FitBeyond(n + 1, n, [&](const PixelRecord& r, int c, double* b) {
-      double p[4];
-      if (!parts(r, c, p)) return;
-      b[int(p[3])] = p[0];
-      b[n] = p[2] - p[0];
-    });
-    if (fit.coef.size() == size_t(n + 1) && fit.coef[n] > 0) return fit;
+    fit = FitBeyondAlbedos(f, n, parts, [](const double* p) { return p[2] - p[0]; });
+    if (fit.coef.size() == n + 1 && fit.coef[n] > 0) return fit;
     return {};
   }
   fit = f.Fit(1, [&](const PixelRecord& r, int c, double* b) {
@@ -165,8 +169,8 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
   if (!(sigma > 0)) fit = {};
   const ResidualFit coated = FitCoated(f, n, parts);
   // The shape that explains more of the residual (the lower squared error after the fit).
-  const bool coat = coated.coef.size() > 0 &&
-                    (fit.coef.size() == 0 || coated.train_after < fit.train_after);
+  const bool coat =
+      coated.coef.size() > 0 && (fit.coef.size() == 0 || coated.train_after < fit.train_after);
   if (!coat && fit.coef.size() == 0) {
     out.note = fmt::format(
         "{}: the residual neither rises toward back-scatter as a rough diffuse surface's does "
