@@ -107,14 +107,12 @@ LobeFit FitAndReport(const recon::Material& material, const LobeFitOptions& opti
 void ReportDiffuseShape(const recon::Material& material, std::string_view target,
                         ExportReport* report) {
   if (material.diffuse == recon::DiffuseShape::kCoated) {
-    // T's mean over the cosine-weighted hemisphere: 1 − 2∫(1 − c)⁵c dc = 20/21.
-    constexpr double kMeanT = 20.0 / 21.0;
     report->Add("materials." + material.name,
                 fmt::format("coated diffuse written as {}'s Lambertian diffuse with the same "
                             "rho_d: the coat's transmittances T(cos theta_i)·T(cos theta_o) are "
                             "left out (each {:.4g} on average over the hemisphere)",
-                            target, kMeanT),
-                1.0 - kMeanT * kMeanT);
+                            target, render::kMeanCoatTransmission),
+                1.0 - render::kMeanCoatTransmission * render::kMeanCoatTransmission);
     return;
   }
   if (material.diffuse != recon::DiffuseShape::kOrenNayar) return;

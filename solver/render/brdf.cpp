@@ -102,7 +102,7 @@ double DiffuseMeanFactor(const BrdfParams& params) {
       return OrenNayarA(params.sigma) + OrenNayarB(params.sigma) * mean_g;
     }
     case recon::DiffuseShape::kCoated:
-      return (20.0 / 21.0) * (20.0 / 21.0);  // T's mean 1 − 2∫(1 − c)⁵c dc, on both sides
+      return kMeanCoatTransmission * kMeanCoatTransmission;  // on both sides
     case recon::DiffuseShape::kLambert:
       break;
   }

@@ -214,6 +214,9 @@ T OrenNayarG(const Eigen::Matrix<T, 3, 1>& wo, const Eigen::Matrix<T, 3, 1>& wi)
   if (!(dot > 0.0)) return T(0.0);
   return dot / (wi.z() > wo.z() ? wi.z() : wo.z());
 }
+// T's mean over the cosine-weighted hemisphere, 1 − 2∫(1 − c)⁵c dc: light arriving alike from
+// every direction crosses the coat with this share on average.
+inline constexpr double kMeanCoatTransmission = 20.0 / 21.0;
 // The clear coat's transmission shape T(c) = 1 − (1 − c)⁵ at a cosine c in [0, 1].
 template <typename T>
 T CoatTransmission(const T& c) {

@@ -35,9 +35,6 @@ double OrenNayarSigmaOfRatio(double b_over_a) {
 
 namespace {
 
-// T's mean over the cosine-weighted hemisphere (solver/render/brdf.h): 20/21.
-constexpr double kMeanCoatTransmission = 20.0 / 21.0;
-
 // A record's diffuse parts (DiffuseShape below): false where the record is not of the regions.
 using DiffuseParts = std::function<bool(const PixelRecord&, int, double*)>;
 
@@ -154,7 +151,7 @@ CandidateResult DiffuseShape(const CandidateContext& cx, const ResidualFitter& f
       const double e_all = r.sim[c] * render::kPi / r.albedo[c];
       if (e_all > e) {
         g += render::OrenNayarMeanG(wo.z()) * (e_all - e);
-        coat += t_o * kMeanCoatTransmission * (e_all - e);
+        coat += t_o * render::kMeanCoatTransmission * (e_all - e);
         e = e_all;
       }
     }
