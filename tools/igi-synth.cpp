@@ -36,6 +36,11 @@ int main(int argc, char** argv) {
   app.add_flag("--overwrite", o.overwrite, "Allow a non-empty --out folder");
   app.add_flag("--textured-walls", o.textured_walls,
                "Give every region a high-frequency albedo texture (for registration tests)");
+  app.add_flag("--satin", o.satin,
+               "Make the matte box a satin finish: a faint broad lobe (rho_s 0.03, alpha 0.25) of "
+               "--glossy-brdf's model");
+  app.add_flag("--poster", o.poster,
+               "Hang a striped poster (region poster, four colours, a rho_d_map) on wall_x4");
   app.add_flag("--unposed", o.unposed,
                "scene.json without cameras and photos (poses to be recovered); truth keeps them");
   app.add_option("--cameras", o.cameras, "Number of cameras (first ones see the highlights)");

@@ -65,8 +65,15 @@ double ScalarPart(const ceres::Jet<J, N>& x) {
 
 // The lobe of every sample at one α: ρs_c·t_c + o_c, with o the part that ρs does not scale (the
 // microfacet models' grazing Fresnel, LobeWeights in solver/render/brdf.h; zero for Ward's lobes).
+//
+// The incident lists are Monte Carlo estimates, so t is noisy, and a least-squares slope on a
+// noisy column is biased toward zero (regression dilution): ρs low, ρd high, most on a faint
+// broad lobe whose true t varies little from sample to sample. `half` is t from the even-indexed
+// incident samples alone (twice their sum); the odd ones give 2t − half, an independent estimate
+// of the same t, and Σ half·(2t − half) estimates Σ t² without the noise's share (SolveLinear).
+// Where a table does not split its rows (the microfacet lobes), half is t.
 struct LobeTerms {
-  std::vector<Eigen::Vector3d> t, o;
+  std::vector<Eigen::Vector3d> t, o, half;
   Eigen::Vector3d Lobe(size_t i, const Eigen::Vector3d& rho_s) const {
     return rho_s.cwiseProduct(t[i]) + o[i];
   }
@@ -104,7 +111,7 @@ class LobeTable {
     begin_.reserve(order.size() + 1);
     // At most one entry per incident sample: reserved once (grown by doubling, the arrays held
     // up to twice the region's incident light).
-    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_})
+    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_, &even_})
       v->reserve(in.incident.size());
     if (microfacet_) {
       for (std::vector<float>* v : {&lx_, &ly_, &ls_, &orr_, &og_, &ob_})
@@ -113,6 +120,7 @@ class LobeTable {
     struct Entry {
       float qx, qy, lx, ly;
       Eigen::Vector3f gv, ov;
+      bool even;
     };
     std::vector<Entry> row;
     for (const auto& [start, i] : order) {
@@ -131,6 +139,7 @@ class LobeTable {
         const Eigen::Vector3d wi = inc.Wi().cast<double>();
         const Eigen::Vector3d v = inc.Value().cast<double>();
         Entry e{};
+        e.even = k % 2 == 0;
         if (microfacet_) {
           if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) continue;
           const Eigen::Vector3d h = wo + wi;
@@ -159,6 +168,7 @@ class LobeTable {
       for (const Entry& e : row) {
         qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
         gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
+        even_.push_back(e.even ? 2.0f : 0.0f);
         if (microfacet_) {
           lx_.push_back(e.lx), ly_.push_back(e.ly), ls_.push_back(e.lx + e.ly);
           orr_.push_back(e.ov[0]), og_.push_back(e.ov[1]), ob_.push_back(e.ov[2]);
@@ -225,11 +235,12 @@ class LobeTable {
     LobeTerms out;
     out.t.assign(in.samples.size(), Eigen::Vector3d::Zero());
     out.o.assign(in.samples.size(), Eigen::Vector3d::Zero());
+    out.half = out.t;
     if (!recon::HasSpecularLobe(model_)) return out;
     std::vector<float> f;
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero(), half = Eigen::Vector3d::Constant(kNan);
       if (rows[i] >= 0 && shape_ == recon::LobeShape::kGgx && ax == ay) {
         IsotropicGgxRow(rows[i], ax * ax + blur2_[rows[i]], &f, &sum, &out.o[i]);
       } else if (rows[i] >= 0 && microfacet_) {
@@ -248,11 +259,16 @@ class LobeTable {
         f.resize(size_t(e - b));
         Exponentials(qx_.data() + b, qy_.data() + b, e - b, ix, iy, f.data());
         sum = WeightedSum(f.data(), b, e - b, gr_, gg_, gb_) * scale;
+        for (int k = 0; k < e - b; ++k) f[size_t(k)] *= even_[size_t(b + k)];
+        half = WeightedSum(f.data(), b, e - b, gr_, gg_, gb_) * scale;
       }
+      if (!half.allFinite()) half = sum;
       if (in.use_held_albedo && !in.fit_rho_d && s.held_lobe.allFinite()) {
-        sum -= s.held_lobe.cwiseProduct(s.irradiance) / render::kPi;
+        const Eigen::Vector3d held = s.held_lobe.cwiseProduct(s.irradiance) / render::kPi;
+        sum -= held, half -= held;
       }
       out.t[i] = sum;
+      out.half[i] = half;
     }
     return out;
   }
@@ -378,8 +394,9 @@ class LobeTable {
   std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
   std::vector<std::array<double, 2>> wo_l_;   // microfacet: each row's wo (lx, ly)
   // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v (Ward: with the
-  // Fresnel weight; microfacet: Schlick's (1 − m) part).
-  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_;
+  // Fresnel weight; microfacet: Schlick's (1 − m) part), and 2 for an even-indexed incident
+  // sample, 0 for an odd one (LobeTerms::half).
+  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_, even_;
   // Microfacet entries: wi's (lx, ly) and their sum tan²θi, and g·v's Schlick m part.
   std::vector<float> lx_, ly_, ls_, orr_, og_, ob_;
 };
@@ -390,14 +407,23 @@ struct LinearSolution {
   Eigen::Vector3d rho_s = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> slot_rho_d;
   double sum_v2 = 0;  // Σ v² of the projected specular column (grey), for ρs's variance
+  // ρs² times the incident lists' noise in Σ v² (the part of the cost that is the column's noise
+  // alone, taken off `cost`).
+  double noise_cost = 0;
 };
+
+// Σ v² without the noise's share from the split-half estimate Σ v_half·(2v − v_half), held
+// within [½, 1] of Σ v² (a column more than half noise is not taken apart further).
+double DenoisedSquares(double squares, double split) {
+  return std::clamp(split, 0.5 * squares, squares);
+}
 
 // The lobe's part that ρs does not scale (LobeTerms::o) is taken off the observed radiance.
 LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr, const LobeTerms& lt,
                            bool per_patch) {
   const std::vector<Eigen::Vector3d>& t = lt.t;
   const int slots = per_patch ? in.num_slots : 1;
-  std::vector<Eigen::Vector3d> A(slots, Eigen::Vector3d::Zero()), B = A, C = A;
+  std::vector<Eigen::Vector3d> A(slots, Eigen::Vector3d::Zero()), B = A, C = A, C_half = A;
   const size_t n = in.samples.size();
   auto slot_of = [&](size_t i) { return per_patch ? in.samples[i].slot : 0; };
   if (in.fit_rho_d) {
@@ -407,9 +433,13 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr, const L
       A[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(pr.a[i]);
       B[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(in.samples[i].observed - lt.o[i]);
       C[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(t[i]);
+      C_half[s] += w2.cwiseProduct(pr.a[i]).cwiseProduct(lt.half[i]);
     }
   }
-  std::vector<Eigen::Vector3d> u(n), v(n);
+  // u: the observed radiance less the albedo's share, v: the specular column less its share,
+  // both projected off the albedo column; v_half the same of LobeTerms::half, whose product with
+  // the other half's (2v − v_half) sums to Σ v² less the incident lists' noise.
+  std::vector<Eigen::Vector3d> u(n), v(n), v_half(n);
   for (size_t i = 0; i < n; ++i) {
     const FitSample& smp = in.samples[i];
     const Eigen::Vector3d observed = smp.observed - lt.o[i];
@@ -419,11 +449,14 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr, const L
         const int s = slot_of(i);
         const double ratio_b = A[s][c] > 0 ? B[s][c] / A[s][c] : 0.0;
         const double ratio_c = A[s][c] > 0 ? C[s][c] / A[s][c] : 0.0;
+        const double ratio_h = A[s][c] > 0 ? C_half[s][c] / A[s][c] : 0.0;
         u[i][c] = w * (observed[c] - a * ratio_b);
         v[i][c] = w * (t[i][c] - a * ratio_c);
+        v_half[i][c] = w * (lt.half[i][c] - a * ratio_h);
       } else {
         u[i][c] = w * (observed[c] - smp.rho_d_known[c] * a);
         v[i][c] = w * t[i][c];
+        v_half[i][c] = w * lt.half[i][c];
       }
     }
   }
@@ -432,25 +465,33 @@ LinearSolution SolveLinear(const RegionFitInput& in, const Prepared& pr, const L
   if (spec && (in.rho_s_grey || in.rho_s_rgb)) {
     sol.rho_s = in.rho_s_rgb ? *in.rho_s_rgb : Eigen::Vector3d::Constant(*in.rho_s_grey);
   } else if (spec && in.grey_specular) {
-    double uv = 0, vv = 0;
+    double uv = 0, vv = 0, vv_split = 0;
     for (size_t i = 0; i < n; ++i) {
       uv += u[i].dot(v[i]);
       vv += v[i].squaredNorm();
+      vv_split += v_half[i].dot(2 * v[i] - v_half[i]);
     }
-    sol.rho_s.setConstant(vv > 0 ? std::max(0.0, uv / vv) : 0.0);
-    sol.sum_v2 = vv;
+    const double vv_true = DenoisedSquares(vv, vv_split);
+    sol.rho_s.setConstant(vv_true > 0 ? std::max(0.0, uv / vv_true) : 0.0);
+    sol.sum_v2 = vv_true;
+    sol.noise_cost = sol.rho_s[0] * sol.rho_s[0] * (vv - vv_true);
   } else if (spec) {
     for (int c = 0; c < 3; ++c) {
-      double uv = 0, vv = 0;
+      double uv = 0, vv = 0, vv_split = 0;
       for (size_t i = 0; i < n; ++i) {
         uv += u[i][c] * v[i][c];
         vv += v[i][c] * v[i][c];
+        vv_split += v_half[i][c] * (2 * v[i][c] - v_half[i][c]);
       }
-      sol.rho_s[c] = vv > 0 ? std::max(0.0, uv / vv) : 0.0;
-      sol.sum_v2 += vv / 3;
+      const double vv_true = DenoisedSquares(vv, vv_split);
+      sol.rho_s[c] = vv_true > 0 ? std::max(0.0, uv / vv_true) : 0.0;
+      sol.sum_v2 += vv_true / 3;
+      sol.noise_cost += sol.rho_s[c] * sol.rho_s[c] * (vv - vv_true);
     }
   }
-  sol.cost = 0;
+  // The cost less the incident lists' noise in the specular column (ρs²·its share of Σ v²), so
+  // that the α search compares the lobes' fits, not their noise.
+  sol.cost = -sol.noise_cost;
   for (size_t i = 0; i < n; ++i) sol.cost += (u[i] - v[i].cwiseProduct(sol.rho_s)).squaredNorm();
   sol.slot_rho_d.assign(slots, Eigen::Vector3d::Constant(kNan));
   if (in.fit_rho_d) {
@@ -919,6 +960,15 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
   r.rho_s = pa.rho_s;
   r.alpha = r.alpha_x = pa.ax;
   r.alpha_y = pa.ay;
+  if (a.linear.noise_cost > 0 && !a.linear.slot_rho_d.empty()) {
+    // The search's minimum has the incident lists' noise taken out (SolveLinear); Ceres'
+    // polish minimises the plain squares, whose minimum that noise pulls toward a weaker lobe.
+    // The polish gives the uncertainties.
+    if (in.fit_rho_d) r.rho_d = a.linear.slot_rho_d[0];
+    r.rho_s = a.linear.rho_s;
+    r.alpha = r.alpha_x = a.ax;
+    r.alpha_y = a.ay;
+  }
   r.sigma_rho_d = pa.sigma_rho_d;
   r.sigma_rho_s = pa.sigma_rho_s;
   r.sigma_alpha = r.sigma_alpha_x = pa.sigma_ax;
@@ -940,13 +990,26 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
   std::vector<int> counts;
   r.albedo_varies = in.albedo_varies ? *in.albedo_varies : AlbedoVaries(in, pr, patch, t, &counts);
   if (r.albedo_varies && !in.albedo_varies) {
-    // More parameters must earn their place: the per-patch albedo has to cut the residual of
-    // the constant albedo by 10 % or more.
-    std::vector<Eigen::Vector3d> filled = patch.slot_rho_d;
-    for (Eigen::Vector3d& v : filled) {
-      if (!v.allFinite()) v = r.rho_d;
+    // More parameters must earn their place: over the patches of three samples or more (those
+    // AlbedoVaries measured), the per-patch albedo's residual variance per degree of freedom
+    // has to be under 0.81 of the constant albedo's (its rms 10 % lower). Per degree of freedom,
+    // because a patch's albedo fits some of its own samples' noise: on a region of few samples
+    // per patch the plain residual falls however uniform the albedo is.
+    double rss_patch = 0, rss_constant = 0, values = 0;
+    int patch_albedos = 0;
+    std::vector<char> counted(in.num_slots, 0);
+    for (size_t i = 0; i < in.samples.size(); ++i) {
+      const FitSample& s = in.samples[i];
+      const Eigen::Vector3d& rd = patch.slot_rho_d[s.slot];
+      if (counts[s.slot] < 3 || !rd.allFinite()) continue;
+      const Eigen::Vector3d lobe = t.Lobe(i, r.rho_s);
+      rss_patch += (rd.cwiseProduct(pr.a[i]) + lobe - s.observed).squaredNorm();
+      rss_constant += (r.rho_d.cwiseProduct(pr.a[i]) + lobe - s.observed).squaredNorm();
+      values += 3;
+      if (!counted[s.slot]) counted[s.slot] = 1, ++patch_albedos;
     }
-    r.albedo_varies = RelativeRms(in, t, filled, r.rho_s, true) < 0.9 * r.relative_rms;
+    const double dof_patch = values - 3.0 * patch_albedos;
+    r.albedo_varies = dof_patch > 0 && rss_patch / dof_patch < 0.81 * rss_constant / values;
   }
   if (!r.albedo_varies) return r;
   // The albedo varies: ρs and α again with each patch's albedo held (NaN: the region's), twice.

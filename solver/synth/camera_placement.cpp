@@ -125,6 +125,19 @@ std::vector<PlacedCamera> PlaceCameras(const SynthRoom& room, const SynthOptions
     eyes.push_back(c.eye);
     cameras.push_back(pc);
   }
+  // With a poster, the first two overview cameras face it from 1.8 m, 25° to either side of its
+  // normal (−x), at its height.
+  for (int side = -1; room.poster_center && side <= 1 && int(cameras.size()) < options.cameras;
+       side += 2) {
+    constexpr double kAngle = 25.0 * std::numbers::pi / 180.0, kDistance = 1.8;
+    const Vector3d eye =
+        *room.poster_center + kDistance * Vector3d(-std::cos(kAngle), side * std::sin(kAngle), 0);
+    PlacedCamera pc;
+    pc.camera = LookAtCamera(name(), eye, *room.poster_center, options.width, options.height,
+                             options.fov_deg);
+    eyes.push_back(eye);
+    cameras.push_back(pc);
+  }
   const Vector3d center = 0.5 * room.size - Vector3d(0, 0, 0.8);
   for (int k = 0; int(cameras.size()) < options.cameras; ++k) {
     const double angle = 2 * std::numbers::pi * (0.125 + 0.618034 * k) + 0.3 * rng.UniformDouble();

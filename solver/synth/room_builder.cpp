@@ -1,6 +1,7 @@
 #include "solver/synth/room_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -149,6 +150,32 @@ void TextureEveryRegion(const SynthOptions& options, bool rho_d_known, SynthRoom
   }
 }
 
+// The poster's stripes: vertical bands of 10 cm (10 texels of 1 cm) cycling through red, yellow,
+// blue and white, so that each channel's mean differs from the others' and from the grey mean.
+Image MakePosterTexture() {
+  constexpr int kWidth = 120, kHeight = 90, kStripe = 10;
+  const std::array<Vector3d, 4> colours = {Vector3d(0.75, 0.15, 0.12), Vector3d(0.80, 0.70, 0.15),
+                                           Vector3d(0.12, 0.25, 0.70), Vector3d(0.85, 0.85, 0.80)};
+  Image img(kWidth, kHeight, 3);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const Vector3d& a = colours[(x / kStripe) % colours.size()];
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(a[c]);
+    }
+  }
+  return img;
+}
+
+// The poster: 1.2 m × 0.9 m on wall_x4 (x = s.x), centred at y = 2.0 m, z = 1.45 m, 5 mm into
+// the room, facing −x; u runs along −y (left to right seen from the room), v up. Returns its
+// centre.
+Vector3d AddPoster(const Vector3d& s, SynthMesh* mesh) {
+  const double x = s.x() - 0.005, y0 = 1.4, y1 = 2.6, z0 = 1.0, z1 = 1.9;
+  mesh->AddQuad({x, y1, z0}, {x, y0, z0}, {x, y0, z1}, {x, y1, z1}, "poster",
+                {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1), Vector2d(0, 1)});
+  return {x, 0.5 * (y0 + y1), 0.5 * (z0 + z1)};
+}
+
 void AddRoomShell(const Vector3d& s, SynthMesh* mesh) {
   auto uv = [](double u0, double v0, double u1, double v1) {
     return std::array<Vector2d, 4>{Vector2d(u0, v0), Vector2d(u1, v0), Vector2d(u1, v1),
@@ -237,8 +264,19 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   m["glossy_box"] = Glossy(g, {0.1, 0.2, 0.5}, 0.08, 0.05);
   m["glossy_sphere"] = Glossy(g, {0.5, 0.15, 0.1}, 0.1, 0.1);
   m["matte_box"] = Lambert({0.7, 0.7, 0.7});
+  if (options.satin) m["matte_box"] = Glossy(g, {0.6, 0.6, 0.55}, 0.03, 0.25);
   if (options.textured_walls) TextureEveryRegion(options, rho_d_known, &room);
   room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
+  if (options.satin) room.glossy_regions.push_back("matte_box");
+  if (options.poster) {
+    room.poster_center = AddPoster(room.size, &room.mesh);
+    Image texture = MakePosterTexture();
+    const std::string file =
+        rho_d_known ? "textures/poster_albedo.exr" : "truth/textures/poster_albedo.exr";
+    m["poster"] = Lambert(ImageMean(texture));
+    m["poster"]["rho_d_map"] = file;
+    room.region_textures.emplace_back(file, std::move(texture));
+  }
 
   const double radius = options.lamp == LampShape::kPoint ? 0.0 : 0.04;
   room.lamps.push_back(

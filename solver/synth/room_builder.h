@@ -5,10 +5,12 @@
 //   wall_y4        ward, glossy paint            glossy_box     ward, blue, sharp lobe
 //   glossy_sphere  ward, red, smooth normals     matte_box      lambert
 //   ceiling, wall_x0, wall_x4, wall_y0           lambert, different colours
+// (--satin: the matte box a faint broad lobe; --poster: a striped poster on wall_x4)
 // and two small lamps: "lamp" (lighting L0) and "lamp2" (lighting L1). Every material value is
 // known (this is the TRUE scene); effects and the declared scene.json derive from it.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,8 @@ struct SynthRoom {
   // --textured-walls: the other regions' albedo textures, (file relative to the scene folder,
   // linear RGB image); empty otherwise.
   std::vector<std::pair<std::string, Image>> region_textures;
+  // --poster: the poster's centre (it faces −x); the first overview cameras look at it.
+  std::optional<Eigen::Vector3d> poster_center;
 
   // igi-scene "lights" and "lightings" for the lamps as they are.
   Json LightsJson() const;

@@ -140,6 +140,14 @@ struct SynthOptions {
   // and grout without the grain, low-pass filtered (Gaussian, σ = 2 texels = 6.25 cm) so that the
   // photos resolve it (albedo-map accuracy tests: the truth is then recoverable from the pixels).
   FloorTexture floor_texture = FloorTexture::kTiles;
+  // The matte box is a satin finish instead of Lambertian: a faint, broad lobe of the glossy
+  // model (ρd 0.6/0.6/0.55, ρs 0.03, α 0.25), whose "highlight" covers most of what a camera
+  // sees of it; it joins the glossy regions (last in placement order).
+  bool satin = false;
+  // A striped poster (region "poster", Lambertian, 1.2 m × 0.9 m, 5 mm in front of wall_x4):
+  // vertical stripes of 10 cm in four colours whose channels differ (rho_d_map), for the albedo
+  // map's per-channel balance.
+  bool poster = false;
   // scene.json declares no "cameras" and no "photos" (an unposed capture: the poses must be
   // recovered, e.g. by igi-register); truth/scene.json keeps the true cameras.
   bool unposed = false;

@@ -279,6 +279,8 @@ Json TruthJson(const SynthOptions& options, const SynthScenes& scenes, const Jso
                 {"scene", "truth/scene.json"},
                 {"unknowns", options.unknowns},
                 {"floor_texture", std::string(FloorTextureName(options.floor_texture))},
+                {"satin", options.satin},
+                {"poster", options.poster},
                 {"cameras", CameraTruth(cameras)},
                 {"photos", r.photo_truth},
                 {"sensor", SensorTruth(options)},
