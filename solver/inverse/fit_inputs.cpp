@@ -66,6 +66,7 @@ std::vector<RegionFitInput> FitInputs(const recon::Scene& scene, const PatchSet&
     s.lobe_blur2 = o.lobe_blur2;
     s.incident = light.incident[i].data();  // read in place: the fit copies nothing
     s.incident_count = int64_t(light.incident[i].size());
+    if (i < light.incident_direct.size()) s.incident_rays_from = light.incident_direct[i];
     in.samples.push_back(s);
   }
   return inputs;

@@ -262,6 +262,7 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
   light->e_direct.resize(n);
   light->e_indirect.resize(n);
   light->incident.resize(n);
+  light->incident_direct.resize(n, 0);
   for (LightingState& st : light->lightings) {
     if (!st.active) continue;
     ParallelFor(
@@ -274,6 +275,7 @@ void IncidentFromPatches(const ObservationSet& obs, const PatchSet& patches,
           const render::Frame frame = materials.LocalFrame(o.region, o.normal.cast<double>());
           std::vector<IncidentLocal> inc;
           if (glossy) inc = DirectIncident(st, gp, frame, gp.indirect_end - gp.indirect_begin);
+          light->incident_direct[i] = int32_t(inc.size());
           Eigen::Vector3d e = Eigen::Vector3d::Zero();
           for (int64_t d = gp.indirect_begin; d < gp.indirect_end; ++d) {
             const IndirectSample& s = st.gather.indirect[d];

@@ -70,7 +70,10 @@ struct LightModel {
   // (SmoothIrradiance): the irradiance the fits divide by; `e` at the end of stage 1.
   std::vector<Eigen::Vector3d> e_direct, e_indirect, e, e_stage1;
   std::vector<std::vector<IncidentLocal>> incident;  // in the local frame (glossy regions)
-  std::vector<Eigen::Vector3d> t;                    // T = Σ scale·v at the current α
+  // Per observation: how many of its incident samples, first in its list, are the lights' direct
+  // samples; the rest are Monte Carlo hemisphere rays (FitSample::incident_rays_from).
+  std::vector<int32_t> incident_direct;
+  std::vector<Eigen::Vector3d> t;  // T = Σ scale·v at the current α
   // O = Σ offset·v at the current α: the lobe's part that ρs does not scale (the microfacet
   // models' grazing Fresnel; zero for Ward's lobes), so that the lobe is ρs∘T + O.
   std::vector<Eigen::Vector3d> t0;

@@ -58,6 +58,7 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
   const int64_t chunk_size = (num_obs + num_chunks - 1) / num_chunks;
   std::vector<JointSums> chunk_sums(joint ? num_chunks : 0);
   const bool final_round = int(round) >= options.refine_iterations;
+  light.incident_direct.resize(obs.size(), 0);
   Progress progress(fmt::format("igi-solve: path tracing, round {}", round), num_chunks, 2.0,
                     options.show_progress && ProgressAllowed());
   ParallelFor(
@@ -92,6 +93,7 @@ RenderCost RenderIncident(const StageData& d, const recon::Scene& model,
           const int n = base * (glossy && obs.in_fit[i] ? 4 : 1);
           std::vector<IncidentLocal> inc;
           if (keep) inc = DirectIncident(st, gp, frame, n);
+          light.incident_direct[i] = int32_t(inc.size());
           const double eps = ray_epsilon[l];
           const bool summed = sums != nullptr && obs.in_fit[i];
           const Eigen::Vector3d wo = frame.ToLocal(q.view);

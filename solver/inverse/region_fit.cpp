@@ -68,10 +68,11 @@ double ScalarPart(const ceres::Jet<J, N>& x) {
 //
 // The incident lists are Monte Carlo estimates, so t is noisy, and a least-squares slope on a
 // noisy column is biased toward zero (regression dilution): ρs low, ρd high, most on a faint
-// broad lobe whose true t varies little from sample to sample. `half` is t from the even-indexed
-// incident samples alone (twice their sum); the odd ones give 2t − half, an independent estimate
-// of the same t, and Σ half·(2t − half) estimates Σ t² without the noise's share (SolveLinear).
-// Where a table does not split its rows (the microfacet lobes), half is t.
+// broad lobe whose true t varies little from sample to sample. `half` is t with the Monte Carlo
+// rays of each incident list (FitSample::incident_rays_from) halved: its exact samples, and its
+// even-indexed rays twice; the odd rays give 2t − half, an independent estimate of the same t,
+// and Σ half·(2t − half) estimates Σ t² without the rays' noise (SolveLinear). Where a table
+// does not split its rows (the microfacet lobes), or a list has no rays, half is t.
 struct LobeTerms {
   std::vector<Eigen::Vector3d> t, o, half;
   Eigen::Vector3d Lobe(size_t i, const Eigen::Vector3d& rho_s) const {
@@ -111,7 +112,7 @@ class LobeTable {
     begin_.reserve(order.size() + 1);
     // At most one entry per incident sample: reserved once (grown by doubling, the arrays held
     // up to twice the region's incident light).
-    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_, &even_})
+    for (std::vector<float>* v : {&qx_, &qy_, &qs_, &gr_, &gg_, &gb_, &half_})
       v->reserve(in.incident.size());
     if (microfacet_) {
       for (std::vector<float>* v : {&lx_, &ly_, &ls_, &orr_, &og_, &ob_})
@@ -120,7 +121,7 @@ class LobeTable {
     struct Entry {
       float qx, qy, lx, ly;
       Eigen::Vector3f gv, ov;
-      bool even;
+      float half;  // its weight in LobeTerms::half
     };
     std::vector<Entry> row;
     for (const auto& [start, i] : order) {
@@ -139,7 +140,11 @@ class LobeTable {
         const Eigen::Vector3d wi = inc.Wi().cast<double>();
         const Eigen::Vector3d v = inc.Value().cast<double>();
         Entry e{};
-        e.even = k % 2 == 0;
+        // An exact sample counts in both halves, a ray in one: even-indexed rays (from the
+        // first) twice.
+        e.half = k < s.incident_rays_from              ? 1.0f
+                 : (k - s.incident_rays_from) % 2 == 0 ? 2.0f
+                                                       : 0.0f;
         if (microfacet_) {
           if (!(wo.z() > 0.0) || !(wi.z() > 0.0)) continue;
           const Eigen::Vector3d h = wo + wi;
@@ -168,7 +173,7 @@ class LobeTable {
       for (const Entry& e : row) {
         qx_.push_back(e.qx), qy_.push_back(e.qy), qs_.push_back(e.qx + e.qy);
         gr_.push_back(e.gv[0]), gg_.push_back(e.gv[1]), gb_.push_back(e.gv[2]);
-        even_.push_back(e.even ? 2.0f : 0.0f);
+        half_.push_back(e.half);
         if (microfacet_) {
           lx_.push_back(e.lx), ly_.push_back(e.ly), ls_.push_back(e.lx + e.ly);
           orr_.push_back(e.ov[0]), og_.push_back(e.ov[1]), ob_.push_back(e.ov[2]);
@@ -259,7 +264,7 @@ class LobeTable {
         f.resize(size_t(e - b));
         Exponentials(qx_.data() + b, qy_.data() + b, e - b, ix, iy, f.data());
         sum = WeightedSum(f.data(), b, e - b, gr_, gg_, gb_) * scale;
-        for (int k = 0; k < e - b; ++k) f[size_t(k)] *= even_[size_t(b + k)];
+        for (int k = 0; k < e - b; ++k) f[size_t(k)] *= half_[size_t(b + k)];
         half = WeightedSum(f.data(), b, e - b, gr_, gg_, gb_) * scale;
       }
       if (!half.allFinite()) half = sum;
@@ -394,9 +399,8 @@ class LobeTable {
   std::vector<double> blur2_;                 // each row's addition to α² (FitSample::lobe_blur2)
   std::vector<std::array<double, 2>> wo_l_;   // microfacet: each row's wo (lx, ly)
   // Per entry: h_x²/h_z², h_y²/h_z², their sum (ascending within a row), g·v (Ward: with the
-  // Fresnel weight; microfacet: Schlick's (1 − m) part), and 2 for an even-indexed incident
-  // sample, 0 for an odd one (LobeTerms::half).
-  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_, even_;
+  // Fresnel weight; microfacet: Schlick's (1 − m) part), and its weight in LobeTerms::half.
+  std::vector<float> qx_, qy_, qs_, gr_, gg_, gb_, half_;
   // Microfacet entries: wi's (lx, ly) and their sum tan²θi, and g·v's Schlick m part.
   std::vector<float> lx_, ly_, ls_, orr_, og_, ob_;
 };

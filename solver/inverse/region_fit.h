@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -91,6 +92,10 @@ struct FitSample {
   // also names the sample to the fit's lobe table.
   const IncidentLocal* incident = nullptr;
   int64_t incident_count = 0;
+  // The index of its first incident sample that is a Monte Carlo hemisphere ray (those before it
+  // are exact, or the lights' own samples); the fit splits the rays into two halves to take
+  // their noise out of the specular column (LobeTerms::half). Default: no ray.
+  int64_t incident_rays_from = std::numeric_limits<int64_t>::max();
 };
 
 // What a region's fit knows and decides, apart from its samples.

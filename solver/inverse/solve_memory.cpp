@@ -67,9 +67,9 @@ SolveMemoryEstimate EstimateSolveMemory(const recon::Scene& scene, const SolveOp
   e.lobe_observation_bytes =
       e.observation_bytes + (2 * direct + rays + stage2_rays) * sizeof(IncidentLocal);
   // A fitted one: three times stage 2's directions more, and its fit's lobe table (an entry per
-  // incident sample, six floats, for every region at once in the worst case).
+  // incident sample, seven floats, for every region at once in the worst case).
   e.fitted_lobe_bytes = 3 * stage2_rays * sizeof(IncidentLocal) +
-                        (direct + 4 * std::max(rays, stage2_rays)) * 6 * sizeof(float);
+                        (direct + 4 * std::max(rays, stage2_rays)) * 7 * sizeof(float);
 
   double lightings = 0;
   for (const recon::Lighting& l : scene.lightings) lightings += l.lights.empty() ? 0.0 : 1.0;
