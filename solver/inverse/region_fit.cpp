@@ -758,13 +758,11 @@ double RelativeRms(const RegionFitInput& in, const LobeTerms& lt,
 // Each slot's albedo from its samples whose specular part is under 10 % of the radiance (least
 // squares per channel); NaN for a slot without such a sample.
 std::vector<Eigen::Vector3d> OffHighlightAlbedo(const RegionFitInput& in, const Prepared& pr,
-                                                const LobeTerms& lt, const Eigen::Vector3d& rho_s,
-                                                const Eigen::Vector3d& rho_d_mean) {
+                                                const LobeTerms& lt, const Eigen::Vector3d& rho_s) {
   std::vector<Eigen::Vector3d> num(in.num_slots, Eigen::Vector3d::Zero()), den = num;
   for (size_t i = 0; i < in.samples.size(); ++i) {
     const FitSample& s = in.samples[i];
     const Eigen::Vector3d spec = lt.Lobe(i, rho_s);
-    (void)rho_d_mean;
     if ((spec.array() > 0.1 * s.observed.array().max(0.0)).any()) continue;
     const Eigen::Vector3d w2 = pr.w[i].cwiseProduct(pr.w[i]);
     num[s.slot] += w2.cwiseProduct(pr.a[i]).cwiseProduct(s.observed - spec);
@@ -990,7 +988,7 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
   // into that patch's albedo instead of constraining ρs and α.
   LinearSolution patch;
   patch.rho_s = r.rho_s;
-  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s, r.rho_d);
+  patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, r.rho_s);
   std::vector<int> counts;
   r.albedo_varies = in.albedo_varies ? *in.albedo_varies : AlbedoVaries(in, pr, patch, t, &counts);
   if (r.albedo_varies && !in.albedo_varies) {
@@ -1029,7 +1027,7 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
     b = SearchAlpha(held, ph, false, table);
     t = table.Terms(in, rows, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
-    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s);
   }
   for (int round = 0; round < 2 && !held.use_held_albedo; ++round) {
     for (FitSample& smp : held.samples) {
@@ -1039,7 +1037,7 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
     b = SearchAlpha(held, pr, false, table);
     t = table.Terms(in, rows, b.ax, b.ay);
     patch.rho_s = b.linear.rho_s;
-    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s, r.rho_d);
+    patch.slot_rho_d = OffHighlightAlbedo(in, pr, t, b.linear.rho_s);
   }
   r.albedo_model = AlbedoModel::kPerPatch;
   r.rho_s = b.linear.rho_s;
