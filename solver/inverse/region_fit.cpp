@@ -999,7 +999,9 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
     // per patch the plain residual falls however uniform the albedo is.
     double rss_patch = 0, rss_constant = 0, values = 0;
     int patch_albedos = 0;
-    std::vector<char> counted(in.num_slots, 0);
+    for (int k = 0; k < in.num_slots; ++k) {
+      patch_albedos += counts[k] >= 3 && patch.slot_rho_d[k].allFinite();
+    }
     for (size_t i = 0; i < in.samples.size(); ++i) {
       const FitSample& s = in.samples[i];
       const Eigen::Vector3d& rd = patch.slot_rho_d[s.slot];
@@ -1008,7 +1010,6 @@ RegionFitResult FitLambertColumn(const RegionFitInput& in, const RegionFitOption
       rss_patch += (rd.cwiseProduct(pr.a[i]) + lobe - s.observed).squaredNorm();
       rss_constant += (r.rho_d.cwiseProduct(pr.a[i]) + lobe - s.observed).squaredNorm();
       values += 3;
-      if (!counted[s.slot]) counted[s.slot] = 1, ++patch_albedos;
     }
     const double dof_patch = values - 3.0 * patch_albedos;
     r.albedo_varies = dof_patch > 0 && rss_patch / dof_patch < 0.81 * rss_constant / values;

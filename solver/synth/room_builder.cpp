@@ -263,8 +263,8 @@ SynthRoom BuildRoom(const SynthOptions& options) {
   m["wall_y4"] = Glossy(g, {0.55, 0.55, 0.45}, 0.05, 0.07);
   m["glossy_box"] = Glossy(g, {0.1, 0.2, 0.5}, 0.08, 0.05);
   m["glossy_sphere"] = Glossy(g, {0.5, 0.15, 0.1}, 0.1, 0.1);
-  m["matte_box"] = Lambert({0.7, 0.7, 0.7});
-  if (options.satin) m["matte_box"] = Glossy(g, {0.6, 0.6, 0.55}, 0.03, 0.25);
+  m["matte_box"] =
+      options.satin ? Glossy(g, {0.6, 0.6, 0.55}, 0.03, 0.25) : Lambert({0.7, 0.7, 0.7});
   if (options.textured_walls) TextureEveryRegion(options, rho_d_known, &room);
   room.glossy_regions = {"glossy_box", "glossy_sphere", "floor", "wall_y4"};
   if (options.satin) room.glossy_regions.push_back("matte_box");
