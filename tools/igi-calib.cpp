@@ -10,18 +10,27 @@
 //     Exit 3 (camera.json written) when the board was not found in some views; they are listed
 //     in camera.json "rejected_views". Exit 1 when fewer than 3 views show the board.
 // (vignetting is added beside these as a subcommand of its own.)
+//   igi-calib colour IMAGE --chart REF.cie --out colour.json [--response response.json]
+//             [--corners x0,y0,x1,y1,x2,y2,x3,y3] [--half-size]
+//     The 3x3 camera RGB -> linear sRGB matrix from a ColorChecker 24 (calib/colour_chart.h);
+//     raw photos are decoded linearly in the camera's own RGB. Exit 2 when no chart is found.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "calib/bracket.h"
+#include "calib/colour_chart.h"
 #include "calib/intrinsics.h"
+#include "calib/response_curve.h"
 #include "calib/response_plot.h"
 #include "calib/response_recovery.h"
+#include "hdr/raw_decode.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
+#include "tools/common/image.h"
 #include "tools/common/json.h"
 
 namespace {
@@ -177,6 +186,123 @@ int RunIntrinsics(IntrinsicsCommand& cmd) {
   throw igi::PartialError(problems);
 }
 
+struct ColourCommand {
+  std::string image;
+  std::string chart;
+  std::string out;
+  std::string response;         // response.json that linearises an 8/16-bit photo
+  std::vector<double> corners;  // the patch grid's corners by hand: x0,y0,…,x3,y3
+  bool half_size = false;
+  igi::calib::PatchSamplingOptions sampling;
+};
+
+CLI::App* AddColourCommand(CLI::App& app, ColourCommand* cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "colour", "Fit the camera RGB -> linear sRGB matrix from a photographed ColorChecker");
+  sub->add_option("image", cmd->image,
+                  "Photo of a ColorChecker 24: raw (decoded linearly), float (linear) or 8/16-bit "
+                  "with --response")
+      ->required();
+  sub->add_option("--chart", cmd->chart, "The chart's reference values (ArgyllCMS .cie)")
+      ->required();
+  sub->add_option("--out", cmd->out, "Output colour.json")->required();
+  sub->add_option("--response", cmd->response, "response.json of an 8/16-bit photo");
+  sub->add_option("--corners", cmd->corners,
+                  "The patch grid's outer corners by hand when it is not found, pixels "
+                  "x,y of dark skin, bluish green, black, white (8 numbers)")
+      ->delimiter(',')
+      ->expected(8);
+  sub->add_flag("--half-size", cmd->half_size, "Raw: 2x2 binning instead of demosaicing");
+  sub->add_option("--inner-fraction", cmd->sampling.inner_fraction,
+                  "Side of the square sampled in each patch, fraction of the patch (default 0.5)");
+  sub->add_option("--trim-fraction", cmd->sampling.trim_fraction,
+                  "Fraction of values dropped at each end before averaging (default 0.1)");
+  return sub;
+}
+
+int RunColour(const ColourCommand& cmd) {
+  namespace calib = igi::calib;
+  cmd.sampling.Validate();
+  const calib::ChartReference reference = calib::ReadChartReference(cmd.chart);
+  calib::ColourFile colour;
+  calib::ColourFitOptions fit_options;
+  igi::hdr::RawDecodeOptions decode;
+  decode.half_size = cmd.half_size;
+  const bool raw = igi::hdr::IsRawFile(cmd.image);
+  igi::Image image;
+  if (raw) {  // the camera's own RGB: no white balance, no colour matrix
+    decode.white_balance = igi::hdr::RawWhiteBalance::kNone;
+    decode.color = igi::hdr::RawColor::kRaw;
+    image = igi::hdr::DecodeRaw(cmd.image, decode).image;
+    fit_options.clip_level = 1;
+    colour.input = calib::ColourInput::kCameraRaw;
+  } else {
+    const igi::PixelType type = igi::ReadImageInfo(cmd.image).type;
+    const bool integer = type == igi::PixelType::kUInt8 || type == igi::PixelType::kUInt16;
+    if (integer == cmd.response.empty()) {
+      throw igi::InputError(igi::DescribeProblem(
+          cmd.image, "--response", cmd.response.empty() ? "none" : cmd.response,
+          "an 8/16-bit photo needs one to be linearised; a float photo takes none"));
+    }
+    image = igi::ReadImage(cmd.image, 3);
+    if (integer) {
+      const calib::ResponseCurve curve = calib::ReadResponseJson(cmd.response);
+      for (size_t i = 0; i < image.pixels.size(); ++i) {
+        const int c = std::min(int(i % 3), curve.num_channels() - 1);
+        image.pixels[i] = float(std::exp(curve.LnExposure(c, image.pixels[i])));
+      }
+    }
+    colour.input = calib::ColourInput::kLinear;
+  }
+  std::optional<calib::ChartLocation> location;
+  if (!cmd.corners.empty()) {
+    location.emplace();
+    for (int i = 0; i < 4; ++i) location->corners[i] = {cmd.corners[2 * i], cmd.corners[2 * i + 1]};
+  } else {
+    location = calib::FindColourChart(image);
+  }
+  if (!location) {
+    throw igi::InputError(igi::DescribeProblem(
+        cmd.image, "", "", "no ColorChecker found (give the patch grid's corners with --corners)"));
+  }
+  try {
+    const std::vector<Eigen::Vector3d> patches =
+        calib::SamplePatches(image, *location, cmd.sampling);
+    const calib::ColourFit fit = calib::FitColourMatrix(patches, reference, fit_options);
+    colour.matrix = fit.matrix;
+    colour.exposure_scale = fit.exposure_scale;
+    colour.delta_e2000 = fit.delta_e2000;
+    if (raw) {  // the raw decoder's own colour as shot, and with the chart's grey balance
+      decode.white_balance = igi::hdr::RawWhiteBalance::kCamera;
+      decode.color = igi::hdr::RawColor::kSrgb;
+      const std::vector<Eigen::Vector3d> as_shot = calib::SamplePatches(
+          igi::hdr::DecodeRaw(cmd.image, decode).image, *location, cmd.sampling);
+      auto at_best_exposure = [&](std::vector<Eigen::Vector3d> srgb) {
+        const double scale = calib::BestExposureScale(srgb, reference);
+        for (Eigen::Vector3d& v : srgb) v *= scale;
+        return calib::EvaluateDeltaE(srgb, reference);
+      };
+      colour.as_shot_delta_e2000 = at_best_exposure(as_shot);
+      colour.camera_matrix_delta_e2000 =
+          at_best_exposure(calib::GreyBalancedDecoderColour(patches, as_shot));
+    }
+  } catch (igi::Error& e) {
+    throw e.AddContext("chart in " + cmd.image);
+  }
+  colour.chart = std::filesystem::path(cmd.chart).filename().string();
+  colour.image = std::filesystem::path(cmd.image).filename().string();
+  calib::WriteColourFile(cmd.out, colour);
+  std::printf("%s: camera RGB -> linear sRGB, DeltaE2000 mean %.2f max %.2f over 24 patches",
+              cmd.out.c_str(), colour.delta_e2000.mean, colour.delta_e2000.max);
+  if (colour.camera_matrix_delta_e2000 && colour.as_shot_delta_e2000) {
+    std::printf("; raw decoder's matrix, grey-balanced: mean %.2f max %.2f, as shot: mean %.2f",
+                colour.camera_matrix_delta_e2000->mean, colour.camera_matrix_delta_e2000->max,
+                colour.as_shot_delta_e2000->mean);
+  }
+  std::printf("\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -188,9 +314,12 @@ int main(int argc, char** argv) {
   CLI::App* response_app = AddResponseCommand(app, &response);
   IntrinsicsCommand intrinsics;
   CLI::App* intrinsics_app = AddIntrinsicsCommand(app, &intrinsics);
+  ColourCommand colour;
+  CLI::App* colour_app = AddColourCommand(app, &colour);
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     if (response_app->parsed()) return RunResponse(response);
     if (intrinsics_app->parsed()) return RunIntrinsics(intrinsics);
+    if (colour_app->parsed()) return RunColour(colour);
     throw igi::InputError("no subcommand: use igi-calib response|intrinsics …");
   });
 }
