@@ -14,20 +14,32 @@
 //             [--corners x0,y0,x1,y1,x2,y2,x3,y3] [--half-size]
 //     The 3x3 camera RGB -> linear sRGB matrix from a ColorChecker 24 (calib/colour_chart.h);
 //     raw photos are decoded linearly in the camera's own RGB. Exit 2 when no chart is found.
+//   igi-calib lights --scene scene.json --sphere REGION|x,y,z,r [--sphere …] --out lights.json
+//             [--photos LIST] [--target REGION --reflectance R[,G,B]]
+//             [--type auto|point|directional] [--level F] [--saturated V]
+//     Each lighting's light from the highlights on glossy spheres (calib/light_calibration.h):
+//     a direction from one view, a position triangulated from several views or spheres; its
+//     strength from a Lambertian target. Exit 2 (nothing written) when a photo shows no sphere.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "calib/bracket.h"
 #include "calib/colour_chart.h"
 #include "calib/intrinsics.h"
+#include "calib/light_calibration.h"
 #include "calib/response_curve.h"
 #include "calib/response_plot.h"
 #include "calib/response_recovery.h"
 #include "hdr/raw_decode.h"
+#include "solver/render/ray_scene.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
@@ -303,6 +315,262 @@ int RunColour(const ColourCommand& cmd) {
   return 0;
 }
 
+struct LightsCommand {
+  std::string scene;
+  std::vector<std::string> spheres;  // each a region of the scene, or "x,y,z,radius" (metres)
+  std::vector<std::string> photos;   // the photos that show the spheres; empty = all
+  std::string target;                // region of a Lambertian target; empty = emission kept
+  std::vector<double> reflectance;   // the target's reflectance: grey or RGB
+  std::string type = "auto";         // checked against auto|point|directional when parsed
+  std::string out;
+  igi::calib::HighlightOptions highlight;
+};
+
+CLI::App* AddLightsCommand(CLI::App& app, LightsCommand* cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "lights",
+      "Light directions or positions from highlights on glossy spheres, intensities "
+      "from a diffuse target of known reflectance");
+  sub->add_option("--scene", cmd->scene, "scene.json with the cameras, photos and lightings")
+      ->required();
+  sub->add_option("--sphere", cmd->spheres,
+                  "A glossy sphere: a region of the scene's mesh (a sphere is fitted to its "
+                  "vertices) or x,y,z,radius in metres; repeat for several spheres")
+      ->required();
+  sub->add_option("--photos", cmd->photos,
+                  "The photos showing the spheres, as scene.json names them (default: all)")
+      ->delimiter(',');
+  auto* target = sub->add_option("--target", cmd->target,
+                                 "Region of a Lambertian target that gives each light's strength");
+  sub->add_option("--reflectance", cmd->reflectance, "The target's reflectance, grey or R,G,B")
+      ->delimiter(',')
+      ->needs(target);
+  sub->add_option("--type", cmd->type,
+                  "auto (the scene light's kind), point (triangulated) or directional")
+      ->check(CLI::IsMember({"auto", "point", "directional"}));
+  sub->add_option("--out", cmd->out, "Output lights.json")->required();
+  sub->add_option("--level", cmd->highlight.level,
+                  "Highlight threshold, fraction from the sphere's median to its peak (0.2)");
+  sub->add_option("--saturated", cmd->highlight.saturated,
+                  "Value at which a channel is clipped, e.g. 1 for photos from 8/16-bit files "
+                  "(default: none)");
+  sub->add_option("--min-contrast", cmd->highlight.min_contrast,
+                  "Least peak / median luminance of a highlight (3)");
+  return sub;
+}
+
+// The spheres of --sphere: given, or fitted to a region's vertices.
+std::vector<igi::calib::Sphere> LightSpheres(const LightsCommand& cmd,
+                                             const igi::recon::Scene& scene) {
+  std::vector<igi::calib::Sphere> spheres;
+  for (const std::string& text : cmd.spheres) {
+    igi::calib::Sphere sphere;
+    sphere.name = text;
+    if (text.find(',') != std::string::npos) {
+      std::vector<double> v;
+      std::stringstream in(text);
+      for (std::string part; std::getline(in, part, ',');) {
+        char* end = nullptr;
+        v.push_back(std::strtod(part.c_str(), &end));
+        if (end == part.c_str() || *end != '\0') v.push_back(NAN);
+      }
+      if (v.size() != 4 || !std::isfinite(v[0] + v[1] + v[2] + v[3]) || !(v[3] > 0)) {
+        throw igi::InputError(
+            igi::DescribeProblem("", "--sphere", text, "must be a region or x,y,z,radius (> 0)"));
+      }
+      sphere.center = {v[0], v[1], v[2]};
+      sphere.radius = v[3];
+    } else {
+      const int region = scene.FindMaterial(text);
+      std::vector<Eigen::Vector3d> points;
+      for (size_t t = 0; region >= 0 && t < scene.mesh.num_triangles(); ++t) {
+        if (scene.mesh.triangle_region[t] != region) continue;
+        for (int k = 0; k < 3; ++k)
+          points.push_back(scene.mesh.positions[size_t(scene.mesh.triangles[t][k])].cast<double>());
+      }
+      const auto fit = igi::calib::FitSphere(points);
+      if (!fit || fit->fit_rms > 0.01 * fit->radius) {
+        throw igi::InputError(igi::DescribeProblem(
+            cmd.scene, "--sphere", text,
+            region < 0 ? "no such region" : "the region's vertices are not on a sphere (1 %)"));
+      }
+      sphere = *fit;
+      sphere.name = text;
+    }
+    spheres.push_back(sphere);
+  }
+  return spheres;
+}
+
+// The lit pixels of the target region in photo `p` under the calibrated light `light_index`.
+std::vector<igi::calib::TargetSample> TargetSamples(const igi::recon::Scene& scene, size_t p,
+                                                    const igi::render::RayScene& rays, int region,
+                                                    const igi::Image& image,
+                                                    const igi::calib::CalibratedLight& light,
+                                                    double saturated) {
+  const igi::recon::Photo& photo = scene.photos[p];
+  const igi::recon::Camera& camera = scene.cameras[size_t(photo.camera)];
+  std::optional<igi::Image> mask;
+  if (photo.mask) mask = igi::ReadImage(*photo.mask, 1);
+  std::vector<igi::calib::TargetSample> samples;
+  const Eigen::Vector3d eye = camera.CenterInWorld();
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (mask && mask->at(x, y) <= 0) continue;
+      const Eigen::Vector2d px(x + 0.5, y + 0.5);
+      const auto hit = rays.TraceSurface(eye, camera.WorldRayFromImg(px));
+      if (!hit || hit->region != region) continue;
+      const Eigen::Vector3d to_light =
+          light.position ? Eigen::Vector3d(light.position->position - hit->position)
+                         : light.direction->to_light;
+      const double distance = light.position ? to_light.norm() : INFINITY;
+      const Eigen::Vector3d origin = hit->position + hit->n_geo * rays.ray_epsilon();
+      if (rays.Occluded(origin, to_light.normalized(), distance, 0)) continue;
+      igi::calib::TargetSample s{Eigen::Vector3d::Zero(), hit->position, hit->n_s};
+      const double scale = photo.exposure_scale * camera.VignettingFactor(px);
+      bool clipped = false;
+      for (int c = 0; c < 3; ++c) {
+        clipped = clipped || image.at(x, y, c) >= saturated;
+        s.radiance[c] = photo.LinearFromRecorded(image.at(x, y, c)) / scale;
+      }
+      if (!clipped) samples.push_back(s);
+    }
+  }
+  return samples;
+}
+
+// One lighting's light from its photos' rays (a direction, or a triangulated position) and,
+// with a target region, its strength; its scene entry updated. Throws InputError.
+igi::calib::CalibratedLight CalibrateLighting(const LightsCommand& cmd,
+                                              const igi::recon::Scene& scene, int li,
+                                              const std::vector<igi::calib::LightRay>& rays,
+                                              const std::vector<size_t>& photos, int target,
+                                              const Eigen::Vector3d& rho) {
+  namespace calib = igi::calib;
+  using igi::recon::LightType;
+  const igi::recon::Lighting& lighting = scene.lightings[size_t(li)];
+  const igi::recon::Light& light = scene.lights[size_t(lighting.lights[0])];
+  calib::CalibratedLight cl;
+  cl.name = light.name;
+  cl.lighting = lighting.name;
+  cl.entry = scene.document["lights"][light.name];
+  cl.rays = rays;
+  const bool directional =
+      cmd.type == "directional" || (cmd.type == "auto" && light.type == LightType::kDirectional);
+  const bool same = directional == (light.type == LightType::kDirectional);
+  if (light.type == LightType::kArea || light.type == LightType::kAmbient ||
+      (target >= 0 && light.type == LightType::kSpot) || (!same && target < 0)) {
+    throw igi::InputError(igi::DescribeProblem(
+        cmd.scene, "lights." + light.name, std::string(igi::recon::LightTypeName(light.type)),
+        "cannot be calibrated as " + std::string(directional ? "directional" : "point") +
+            " from highlights" + (target < 0 ? " without --target" : "")));
+  }
+  if (directional) {
+    cl.direction = calib::AverageDirection(rays);
+    if (!same) cl.entry = {{"type", "directional"}};
+    cl.entry["direction"] = {-cl.direction->to_light.x(), -cl.direction->to_light.y(),
+                             -cl.direction->to_light.z()};
+  } else {
+    cl.position = calib::TriangulateRays(rays, light.name);
+    const Eigen::Vector3d& x = cl.position->position;
+    if (!same) cl.entry = {{"type", "point"}};
+    cl.entry[light.type == LightType::kSphere ? "center" : "position"] = {x.x(), x.y(), x.z()};
+  }
+  if (target >= 0) {
+    igi::render::RayScene ray_scene(scene, li);
+    std::vector<calib::TargetSample> samples;
+    for (size_t p : photos) {
+      const auto more =
+          TargetSamples(scene, p, ray_scene, target, igi::ReadImage(scene.photos[p].file, 3), cl,
+                        cmd.highlight.saturated);
+      samples.insert(samples.end(), more.begin(), more.end());
+    }
+    cl.emission = directional ? calib::DirectionalIrradianceFromTarget(
+                                    samples, -cl.direction->to_light, rho, light.name)
+                              : calib::PointIntensityFromTarget(samples, cl.position->position, rho,
+                                                                light.name);
+    Eigen::Vector3d v = cl.emission->value;
+    if (light.type == LightType::kSphere) v /= std::numbers::pi * light.radius * light.radius;
+    cl.entry[directional                        ? "irradiance"
+             : light.type == LightType::kSphere ? "radiance"
+                                                : "intensity"] = {v.x(), v.y(), v.z()};
+  }
+  return cl;
+}
+
+int RunLights(const LightsCommand& cmd) {
+  namespace calib = igi::calib;
+  cmd.highlight.Validate();
+  if (!cmd.target.empty() && cmd.reflectance.size() != 1 && cmd.reflectance.size() != 3) {
+    throw igi::InputError("--reflectance: must be given with --target, one number or R,G,B");
+  }
+  Eigen::Vector3d rho = Eigen::Vector3d::Ones();
+  for (int c = 0; c < 3 && !cmd.reflectance.empty(); ++c) {
+    rho[c] = cmd.reflectance[std::min(size_t(c), cmd.reflectance.size() - 1)];
+    if (!(rho[c] > 0 && rho[c] <= 1)) throw igi::InputError("--reflectance: must be in (0, 1]");
+  }
+  const igi::recon::Scene scene = igi::recon::LoadScene(cmd.scene);
+  const int target = cmd.target.empty() ? -1 : scene.FindMaterial(cmd.target);
+  if (!cmd.target.empty() && target < 0) {
+    throw igi::InputError(
+        igi::DescribeProblem(cmd.scene, "--target", cmd.target, "no such region"));
+  }
+  const std::vector<calib::Sphere> spheres = LightSpheres(cmd, scene);
+  // Every photo's rays, by lighting.
+  std::map<int, std::vector<size_t>> photos_of;
+  std::map<int, std::vector<calib::LightRay>> rays_of;
+  igi::ProblemList problems;
+  for (size_t p = 0; p < scene.photos.size(); ++p) {
+    const std::string name = scene.document["photos"][p]["file"].get<std::string>();
+    if (!cmd.photos.empty() &&
+        std::find(cmd.photos.begin(), cmd.photos.end(), name) == cmd.photos.end())
+      continue;
+    const igi::recon::Photo& photo = scene.photos[p];
+    const igi::recon::Camera& camera = scene.cameras[size_t(photo.camera)];
+    const calib::SphereView view{
+        camera.CenterInWorld(),
+        [&](const Eigen::Vector2d& px) { return camera.WorldRayFromImg(px); },
+        [&](const Eigen::Vector3d& x) { return camera.ImgFromWorld(x); }};
+    const igi::Image image = igi::ReadImage(photo.file, 3);
+    std::optional<igi::Image> mask;
+    if (photo.mask) mask = igi::ReadImage(*photo.mask, 1);
+    photos_of[photo.lighting].push_back(p);
+    for (const calib::Sphere& sphere : spheres) {
+      try {
+        rays_of[photo.lighting].push_back(calib::MeasureLightRay(
+            image, mask ? &*mask : nullptr, sphere, view, cmd.highlight, name));
+      } catch (const igi::InputError& e) {
+        problems.Append(e);
+      }
+    }
+  }
+  problems.ThrowIfAny();
+  if (rays_of.empty()) throw igi::InputError("--photos: none of the scene's photos was named");
+  std::vector<calib::CalibratedLight> lights;
+  for (const auto& [li, rays] : rays_of) {
+    const igi::recon::Lighting& lighting = scene.lightings[size_t(li)];
+    if (lighting.lights.size() != 1) {
+      problems.Add(cmd.scene, "lightings." + lighting.name,
+                   std::to_string(lighting.lights.size()) + " lights",
+                   "a lighting calibrated from highlights must hold one light");
+      continue;
+    }
+    try {
+      lights.push_back(CalibrateLighting(cmd, scene, li, rays, photos_of[li], target, rho));
+    } catch (const igi::InputError& e) {
+      problems.Append(e);
+    }
+  }
+  problems.ThrowIfAny();
+  calib::WriteLightsFile(cmd.out, spheres, lights);
+  size_t views = 0;
+  for (const calib::CalibratedLight& l : lights) views += l.rays.size();
+  std::printf("%s: %zu light(s) from %zu highlight(s) on %zu sphere(s)%s\n", cmd.out.c_str(),
+              lights.size(), views, spheres.size(),
+              cmd.target.empty() ? "" : ", strengths from the target");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -316,10 +584,13 @@ int main(int argc, char** argv) {
   CLI::App* intrinsics_app = AddIntrinsicsCommand(app, &intrinsics);
   ColourCommand colour;
   CLI::App* colour_app = AddColourCommand(app, &colour);
+  LightsCommand lights;
+  CLI::App* lights_app = AddLightsCommand(app, &lights);
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     if (response_app->parsed()) return RunResponse(response);
     if (intrinsics_app->parsed()) return RunIntrinsics(intrinsics);
     if (colour_app->parsed()) return RunColour(colour);
+    if (lights_app->parsed()) return RunLights(lights);
     throw igi::InputError("no subcommand: use igi-calib response|intrinsics …");
   });
 }
