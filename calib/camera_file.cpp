@@ -1,5 +1,8 @@
 #include "calib/camera_file.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <optional>
 #include <string_view>
 
@@ -34,7 +37,11 @@ void Validate(const CameraFile& camera, const std::string& file,
   ProblemList problems;
   const std::string model(ColmapCameraModelName(camera.model));
   const size_t count = unknown_model ? 0 : NumParams(camera.model);
-  if (count == 0) {
+  if (!camera.HasIntrinsics() && !unknown_model) {
+    if (!camera.vignetting) {
+      problems.Add(file, "params", "absent", "a camera.json holds intrinsics, vignetting or both");
+    }
+  } else if (count == 0) {
     problems.Add(file, "model", unknown_model.value_or(model),
                  "must be SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV");
   } else if (camera.params.size() != count) {
@@ -48,10 +55,32 @@ void Validate(const CameraFile& camera, const std::string& file,
   if (!camera.params.empty() && !(camera.params[0] > 0)) {
     problems.Add(file, "params[0]", std::to_string(camera.params[0]), "focal length must be > 0");
   }
+  if (camera.vignetting) {
+    const Vignetting& v = camera.vignetting->model;
+    // V must stay positive over the image (r² ≤ 1) for the fall-off to be divided out.
+    if (!(std::abs(v.k1) <= 2) || !(std::abs(v.k2) <= 2) || !(v.Factor(1.0) > 0.01) ||
+        !(v.Factor(0.5) > 0.01)) {
+      problems.Add(file, "vignetting", fmt::format("k1 {:g}, k2 {:g}", v.k1, v.k2),
+                   "|k1|, |k2| ≤ 2 and 1 + k1 r² + k2 r⁴ > 0.01 over the image");
+    }
+  }
   problems.ThrowIfAny();
 }
 
+// Whether the model's parameters begin (f, cx, cy) rather than (fx, fy, cx, cy).
+bool OneFocal(ColmapCameraModel model) {
+  return model == ColmapCameraModel::kSimplePinhole || model == ColmapCameraModel::kSimpleRadial ||
+         model == ColmapCameraModel::kRadial;
+}
+
 }  // namespace
+
+double CameraFile::principal_x_px() const {
+  return HasIntrinsics() ? params[OneFocal(model) ? 1 : 2] : 0.5 * width;
+}
+double CameraFile::principal_y_px() const {
+  return HasIntrinsics() ? params[OneFocal(model) ? 2 : 3] : 0.5 * height;
+}
 
 constexpr EnumNames<ColmapCameraModel, 6> kColmapCameraModelNames{
     {{ColmapCameraModel::kSimplePinhole, "SIMPLE_PINHOLE"},
@@ -73,10 +102,10 @@ void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera
   Json json;
   json["format"] = "igi-camera";
   json["version"] = 1;
-  json["model"] = std::string(ColmapCameraModelName(camera.model));
+  if (camera.HasIntrinsics()) json["model"] = std::string(ColmapCameraModelName(camera.model));
   json["width"] = camera.width;
   json["height"] = camera.height;
-  json["params"] = camera.params;
+  if (camera.HasIntrinsics()) json["params"] = camera.params;
   json["rms_px"] = camera.rms_px;
   json["views"] = camera.views;
   if (!camera.per_view_rms_px.empty()) json["per_view_rms_px"] = camera.per_view_rms_px;
@@ -90,6 +119,10 @@ void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera
         {"cols", camera.board_cols}, {"rows", camera.board_rows}, {"square_m", camera.square_m}};
   }
   json["flags"] = camera.flags;
+  if (const auto& v = camera.vignetting) {
+    json["vignetting"] = {{"k1", v->model.k1},   {"k2", v->model.k2},     {"method", v->method},
+                          {"rms_ln", v->rms_ln}, {"samples", v->samples}, {"photos", v->photos}};
+  }
   WriteJsonFile(path, json, 1);
 }
 
@@ -100,13 +133,19 @@ CameraFile ReadCameraFile(const std::filesystem::path& path) {
   const JsonCursor root = JsonCursor::Root(json, file, &problems);
   CameraFile camera;
   if (!root.ExpectObject({"format", "version", "model", "width", "height", "params", "rms_px",
-                          "views", "per_view_rms_px", "rejected_views", "board", "flags"})) {
+                          "views", "per_view_rms_px", "rejected_views", "board", "flags",
+                          "vignetting"})) {
     problems.ThrowIfAny();
   }
   if (auto format = root["format"].Enum({"igi-camera"})) (void)format;
   if (root["version"].present()) root["version"].Integer(NumberRule::Between(1, 1));
   std::optional<std::string> unknown_model;
-  if (auto model = root["model"].NonEmptyString()) {
+  // The intrinsics are optional as a pair: a file may hold the vignetting alone.
+  const bool intrinsics =
+      root["model"].present() || root["params"].present() || !root["vignetting"].present();
+  if (!intrinsics) {
+    // Neither key: HasIntrinsics() is false.
+  } else if (auto model = root["model"].NonEmptyString()) {
     if (const auto known = ColmapCameraModelFromName(*model)) {
       camera.model = *known;
     } else {
@@ -115,7 +154,9 @@ CameraFile ReadCameraFile(const std::filesystem::path& path) {
   }
   if (auto w = root["width"].Integer(NumberRule::Positive())) camera.width = static_cast<int>(*w);
   if (auto h = root["height"].Integer(NumberRule::Positive())) camera.height = static_cast<int>(*h);
-  if (auto params = root["params"].Numbers(0)) camera.params = *params;
+  if (intrinsics) {
+    if (auto params = root["params"].Numbers(0)) camera.params = *params;
+  }
   if (root["rms_px"].present()) camera.rms_px = root["rms_px"].Number().value_or(-1);
   if (root["views"].present()) {
     const size_t n = root["views"].ArraySize();
@@ -149,6 +190,24 @@ CameraFile ReadCameraFile(const std::filesystem::path& path) {
     for (size_t i = 0; i < n; ++i) {
       if (auto f = root["flags"][i].String()) camera.flags.push_back(*f);
     }
+  }
+  if (root["vignetting"].present()) {
+    const JsonCursor v = root["vignetting"];
+    v.ExpectObject({"k1", "k2", "method", "rms_ln", "samples", "photos"});
+    CameraVignetting vignetting;
+    vignetting.model.k1 = v["k1"].Number().value_or(0);
+    vignetting.model.k2 = v["k2"].Number().value_or(0);
+    if (v["method"].present()) vignetting.method = v["method"].String().value_or("");
+    if (v["rms_ln"].present()) {
+      vignetting.rms_ln = v["rms_ln"].Number(NumberRule::NonNegative()).value_or(0);
+    }
+    if (v["samples"].present()) {
+      vignetting.samples = int(v["samples"].Integer(NumberRule::NonNegative()).value_or(0));
+    }
+    if (v["photos"].present()) {
+      vignetting.photos = int(v["photos"].Integer(NumberRule::NonNegative()).value_or(0));
+    }
+    camera.vignetting = vignetting;
   }
   problems.ThrowIfAny();
   Validate(camera, file, unknown_model);

@@ -1,10 +1,14 @@
 #pragma once
 // camera.json (docs/file-formats.md, "format": "igi-camera", "version": 1): a camera's
-// intrinsics as igi-calib intrinsics measures them and igi-register uses them.
+// intrinsics as igi-calib intrinsics measures them and igi-register uses them, and its
+// vignetting as igi-calib vignetting measures it and igi-hdr removes it. A file holds the
+// intrinsics, the vignetting, or both.
 //
 //   {"format": "igi-camera", "version": 1, "model": "OPENCV", "width": 640, "height": 480,
 //    "params": [fx, fy, cx, cy, k1, k2, p1, p2], "rms_px": 0.39, "views": ["left01.jpg", …],
-//    "per_view_rms_px": [0.19, …], "rejected_views": [{"file": …, "reason": …}], "board": {…}}
+//    "per_view_rms_px": [0.19, …], "rejected_views": [{"file": …, "reason": …}], "board": {…},
+//    "vignetting": {"k1": -0.31, "k2": 0.04, "method": "flat_field", "rms_ln": 0.004,
+//                   "samples": 6912, "photos": 4}}
 //
 // `params` follow COLMAP's model and order and COLMAP's pixel convention (the centre of the
 // top-left pixel is (0.5, 0.5)); focal lengths and the principal point are in pixels.
@@ -16,6 +20,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "calib/vignetting.h"
 
 namespace igi::calib {
 
@@ -40,7 +46,17 @@ struct RejectedView {
   std::string reason;
 };
 
+// camera.json's "vignetting": the fall-off (calib/vignetting.h) and how it was measured.
+struct CameraVignetting {
+  Vignetting model;
+  std::string method;  // "flat_field" or "overlap"
+  double rms_ln = 0;   // RMS residual of the fit, ln units
+  int samples = 0;     // blocks or pairs fitted
+  int photos = 0;
+};
+
 struct CameraFile {
+  // The intrinsics: `params` empty when the file holds the vignetting only.
   ColmapCameraModel model = ColmapCameraModel::kPinhole;  // "model": the COLMAP model name
   int width = 0;                                          // pixels
   int height = 0;                                         // pixels
@@ -54,10 +70,16 @@ struct CameraFile {
   int board_rows = 0;
   double square_m = 0;
   std::vector<std::string> flags;  // calibration flags, e.g. "fix_aspect_ratio"
+  std::optional<CameraVignetting> vignetting;
+
+  bool HasIntrinsics() const { return !params.empty(); }
+  // The principal point: the intrinsics' (cx, cy), else the image centre.
+  double principal_x_px() const;
+  double principal_y_px() const;
 };
 
 // Validates and writes `camera` atomically. Throws InputError when it breaks a rule (unknown
-// model, wrong params count, non-positive size).
+// model, wrong params count, non-positive size, neither intrinsics nor vignetting).
 void WriteCameraFile(const std::filesystem::path& path, const CameraFile& camera);
 // Reads and validates a camera.json; throws InputError listing every problem.
 CameraFile ReadCameraFile(const std::filesystem::path& path);

@@ -686,6 +686,12 @@ void WriteColourFile(const std::filesystem::path& path, const ColourFile& colour
     throw InputError(DescribeProblem(path.string(), "exposure_scale",
                                      fmt::format("{}", colour.exposure_scale), "must be > 0"));
   }
+  // What the reader requires: one ΔE per patch of the chart.
+  if (colour.delta_e2000.per_patch.size() != 24) {
+    throw InputError(DescribeProblem(path.string(), "delta_e2000.per_patch",
+                                     fmt::format("{} values", colour.delta_e2000.per_patch.size()),
+                                     "must be 24, one per patch"));
+  }
   Json json;
   json["format"] = "igi-colour";
   json["version"] = 1;

@@ -163,6 +163,7 @@ StreamMergeSummary MergeBracketStreamed(const std::vector<std::filesystem::path>
         merger.Merge(band_pointers, width, y1 - y0, radiance.data(), mask.data(), &progress);
     summary.saturated_pixels += counts.saturated_pixels;
     summary.black_pixels += counts.black_pixels;
+    outputs.correction.Apply(radiance.data(), y0, y1, width, channels);
     radiance_out->WriteRows(y0, y1, radiance.data());
     if (mask_out) mask_out->WriteRows(y0, y1, mask.data());
     ++summary.bands;

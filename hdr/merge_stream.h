@@ -21,6 +21,7 @@
 
 #include "calib/response_curve.h"
 #include "hdr/align.h"
+#include "hdr/correction.h"
 #include "hdr/merge.h"
 #include "tools/common/image.h"
 
@@ -38,6 +39,7 @@ struct StreamOutputs {
   std::filesystem::path radiance;   // linear radiance, float (OpenEXR)
   ImageMetadata radiance_metadata;  // written as the radiance map's attributes
   std::filesystem::path mask;       // 8-bit, 1 channel: 1 = good, 0 = bad; empty = none
+  RadianceCorrection correction;    // applied to each merged band before it is written
 };
 
 struct StreamMergeSummary {

@@ -9,7 +9,11 @@
 //             [--fix-principal-point]
 //     Exit 3 (camera.json written) when the board was not found in some views; they are listed
 //     in camera.json "rejected_views". Exit 1 when fewer than 3 views show the board.
-// (vignetting is added beside these as a subcommand of its own.)
+//   igi-calib vignetting FLAT_FIELDS… --out camera.json [--camera camera.json]
+//             [--response response.json | --linear]
+//   igi-calib vignetting --scene scene.json --out camera.json [--camera camera.json]
+//     The fall-off 1 + k1 r² + k2 r⁴ (calib/vignetting.h) from flat fields, or from the overlap of
+//     a registered scene's photos; written into camera.json beside the intrinsics of --camera.
 //   igi-calib colour IMAGE --chart REF.cie --out colour.json [--response response.json]
 //             [--corners x0,y0,x1,y1,x2,y2,x3,y3] [--half-size]
 //     The 3x3 camera RGB -> linear sRGB matrix from a ColorChecker 24 (calib/colour_chart.h);
@@ -38,7 +42,11 @@
 #include "calib/response_curve.h"
 #include "calib/response_plot.h"
 #include "calib/response_recovery.h"
+#include "calib/vignetting.h"
+#include "hdr/flat_field.h"
 #include "hdr/raw_decode.h"
+#include "recon/scene.h"
+#include "solver/inverse/vignetting_overlap.h"
 #include "solver/render/ray_scene.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
@@ -196,6 +204,106 @@ int RunIntrinsics(IntrinsicsCommand& cmd) {
     problems.push_back(igi::DescribeProblem(view.file, "", "", view.reason + "; view rejected"));
   }
   throw igi::PartialError(problems);
+}
+
+struct VignettingCommand {
+  std::vector<std::string> images;
+  std::string scene;
+  std::string camera;  // camera.json whose intrinsics are kept; empty = none
+  std::string out;
+  std::string response;
+  bool linear = false;
+  igi::solver::OverlapOptions overlap;
+  bool free_exposures = false;
+};
+
+CLI::App* AddVignettingCommand(CLI::App& app, VignettingCommand* cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "vignetting",
+      "Measure the fall-off 1 + k1 r^2 + k2 r^4 from flat fields or from a scene's photos");
+  auto* images = sub->add_option("images", cmd->images,
+                                 "Flat fields: a lit diffuse target filling the frame, moved "
+                                 "between photos (raw, 8/16-bit with a response, or float)");
+  sub->add_option("--scene", cmd->scene,
+                  "Measure from the overlap of this registered scene's photos instead")
+      ->excludes(images);
+  sub->add_option("--camera", cmd->camera,
+                  "camera.json whose intrinsics (principal point) are kept in the output");
+  sub->add_option("--out", cmd->out, "Output camera.json")->required();
+  auto* response =
+      sub->add_option("--response", cmd->response, "response.json of 8/16-bit flat fields");
+  sub->add_flag("--linear", cmd->linear, "8/16-bit flat fields are linear")->excludes(response);
+  sub->add_option("--samples", cmd->overlap.samples_per_photo,
+                  "--scene: pixels traced per photo (a grid)")
+      ->check(CLI::Range(64, 1 << 24))
+      ->capture_default_str();
+  sub->add_flag("--free-exposures", cmd->free_exposures,
+                "--scene: fit each photo's exposure too (photos not of one radiance scale)");
+  return sub;
+}
+
+int RunVignetting(const VignettingCommand& cmd) {
+  if (cmd.images.empty() == cmd.scene.empty()) {
+    throw igi::InputError("igi-calib vignetting: give either FLAT_FIELDS or --scene");
+  }
+  igi::calib::CameraFile camera;
+  if (!cmd.camera.empty()) camera = igi::calib::ReadCameraFile(cmd.camera);
+  igi::calib::CameraVignetting result;
+  if (!cmd.images.empty()) {
+    igi::hdr::FlatFieldReadOptions read;
+    if (!cmd.response.empty()) read.response = igi::calib::ReadResponseJson(cmd.response);
+    if (cmd.linear) read.response = igi::calib::LinearResponse(65536, 1);
+    std::vector<igi::calib::FlatField> fields;
+    igi::ProblemList problems;
+    for (const std::string& image : cmd.images) {
+      try {
+        fields.push_back(igi::hdr::ReadFlatField(image, read));
+      } catch (const igi::InputError& e) {
+        problems.Append(e);
+      }
+    }
+    problems.ThrowIfAny();
+    if (!cmd.camera.empty() &&
+        (fields[0].width != camera.width || fields[0].height != camera.height)) {
+      throw igi::InputError(igi::DescribeProblem(
+          fields[0].name, "",
+          std::to_string(fields[0].width) + "x" + std::to_string(fields[0].height),
+          "must be the size in " + cmd.camera + " (" + std::to_string(camera.width) + "x" +
+              std::to_string(camera.height) + ")"));
+    }
+    camera.width = fields[0].width;
+    camera.height = fields[0].height;
+    const igi::calib::VignettingFit fit =
+        igi::calib::FitFlatFields(fields, camera.principal_x_px(), camera.principal_y_px());
+    result = {fit.vignetting, "flat_field", fit.rms_ln, fit.samples, fit.photos};
+  } else {
+    const igi::recon::Scene scene = igi::recon::LoadScene(cmd.scene);
+    if (scene.photos.empty()) {
+      throw igi::InputError(
+          igi::DescribeProblem(cmd.scene, "photos", "none", "the overlap of photos needs photos"));
+    }
+    const igi::recon::Camera& first = scene.cameras[size_t(scene.photos[0].camera)];
+    if (!cmd.camera.empty() && (first.width != camera.width || first.height != camera.height)) {
+      throw igi::InputError(
+          igi::DescribeProblem(cmd.scene, "cameras." + first.name,
+                               std::to_string(first.width) + "x" + std::to_string(first.height),
+                               "must be the size in " + cmd.camera));
+    }
+    camera.width = first.width;
+    camera.height = first.height;
+    const igi::solver::OverlapPairs pairs = igi::solver::CollectOverlapPairs(scene, cmd.overlap);
+    const igi::calib::VignettingFit fit =
+        igi::calib::FitOverlap(pairs.pairs, int(scene.photos.size()), cmd.free_exposures);
+    result = {fit.vignetting, "overlap", fit.rms_ln, fit.samples, fit.photos};
+  }
+  camera.vignetting = result;
+  igi::calib::WriteCameraFile(cmd.out, camera);
+  std::printf("%s: vignetting k1 %.4f k2 %.4f (corner %.1f %%) from %d %s (%d %s), RMS %.2f %%\n",
+              cmd.out.c_str(), result.model.k1, result.model.k2,
+              100 * (result.model.Factor(1.0) - 1), result.photos,
+              result.method == "overlap" ? "photos" : "flat fields", result.samples,
+              result.method == "overlap" ? "pairs" : "blocks", 100 * result.rms_ln);
+  return 0;
 }
 
 struct ColourCommand {
@@ -574,9 +682,10 @@ int RunLights(const LightsCommand& cmd) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("igi-calib: camera calibration (response curves, intrinsics)", "igi-calib");
+  CLI::App app("igi-calib: camera calibration (response curves, intrinsics, vignetting)",
+               "igi-calib");
   igi::CommonFlags flags;
-  igi::AddCommonFlags(app, &flags);
+  igi::AddCommonFlags(app, &flags, /*computes=*/true);
   app.require_subcommand(1);
   ResponseCommand response;
   CLI::App* response_app = AddResponseCommand(app, &response);
@@ -584,13 +693,16 @@ int main(int argc, char** argv) {
   CLI::App* intrinsics_app = AddIntrinsicsCommand(app, &intrinsics);
   ColourCommand colour;
   CLI::App* colour_app = AddColourCommand(app, &colour);
+  VignettingCommand vignetting;
+  CLI::App* vignetting_app = AddVignettingCommand(app, &vignetting);
   LightsCommand lights;
   CLI::App* lights_app = AddLightsCommand(app, &lights);
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     if (response_app->parsed()) return RunResponse(response);
     if (intrinsics_app->parsed()) return RunIntrinsics(intrinsics);
     if (colour_app->parsed()) return RunColour(colour);
+    if (vignetting_app->parsed()) return RunVignetting(vignetting);
     if (lights_app->parsed()) return RunLights(lights);
-    throw igi::InputError("no subcommand: use igi-calib response|intrinsics …");
+    throw igi::InputError("no subcommand: use igi-calib response|intrinsics|vignetting …");
   });
 }

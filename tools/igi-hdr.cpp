@@ -2,6 +2,8 @@
 // docs/memory.md).
 //   igi-hdr IMAGES… --out radiance.exr [--response response.json] [--exposures LIST |
 //           --exposure-file FILE] [--linear] [--weighting noise|hat] [--align] [--mask-out FILE]
+//           [--camera camera.json] [--colour colour.json]   (the camera's vignetting divided
+//           out, its colour matrix applied: igi-calib vignetting, igi-calib colour)
 //   igi-hdr RAW_FILES… --out radiance.exr          (DNG, CR2, NEF, …: decoded linearly)
 //   igi-hdr --manifest DIR/manifest.jsonl --out radiance.exr   (one output per bracket)
 // Pixels saturated or black in every exposure are counted, printed and masked (mask: 0 = bad).
@@ -32,6 +34,8 @@ struct Flags {
   std::string manifest;
   std::string out;
   std::string mask_out;  // empty = OUT_mask.png
+  std::string camera;    // camera.json whose vignetting is divided out; empty = none
+  std::string colour;    // colour.json whose matrix takes camera RGB to linear sRGB; empty = none
   bool align = false;
   bool black_given = false;   // --black on the command line (else raw input uses 0)
   bool whole_images = false;  // load every frame whole instead of merging band by band
@@ -160,11 +164,12 @@ struct MergeCounts {
 };
 
 MergeCounts MergeWhole(Job& job, const igi::hdr::MergeOptions& merge, const Flags& flags,
-                       const fs::path& mask) {
+                       const igi::hdr::RadianceCorrection& correction, const fs::path& mask) {
   if (flags.align) AlignJob(&job.input);
   const igi::hdr::MergeResult result =
       igi::hdr::MergeBracket(job.input.images, job.input.exposures_s, job.input.response, merge);
   igi::Image radiance = result.radiance;
+  correction.Apply(radiance.pixels.data(), 0, radiance.height, radiance.width, radiance.channels);
   radiance.metadata["igi:response"] = job.input.response_source;
   radiance.metadata["igi:weighting"] = std::string(igi::hdr::MergeWeightingName(merge.weighting));
   igi::WriteImage(job.out, radiance);
@@ -176,7 +181,7 @@ MergeCounts MergeWhole(Job& job, const igi::hdr::MergeOptions& merge, const Flag
 }
 
 MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, const Flags& flags,
-                          const fs::path& mask) {
+                          const igi::hdr::RadianceCorrection& correction, const fs::path& mask) {
   std::vector<igi::hdr::PixelShift> shifts;
   if (flags.align) {
     // Shifts from the frames' 8-bit grey levels (1 byte a pixel), applied while streaming.
@@ -190,6 +195,7 @@ MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, c
   outputs.radiance_metadata["igi:weighting"] =
       std::string(igi::hdr::MergeWeightingName(merge.weighting));
   outputs.mask = mask;
+  outputs.correction = correction;
   const igi::hdr::StreamMergeSummary summary =
       igi::hdr::MergeBracketStreamed(job.input.paths, job.input.exposures_s, shifts,
                                      job.input.response, merge, flags.stream, outputs);
@@ -198,15 +204,31 @@ MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, c
 
 int Run(Flags& flags) {
   Validate(flags);
+  // The corrections are read first: a colour matrix fitted to raw camera RGB sets how raw
+  // files are decoded.
+  const igi::hdr::RadianceCorrection correction(flags.camera, flags.colour);
+  flags.input.raw = correction.RawInputOptions(flags.input.raw);
   std::vector<Job> jobs = LoadJobs(flags);
+  // Every bracket is checked before the first is written.
+  for (const Job& job : jobs) {
+    const fs::path& first = job.input.paths.front();
+    if (job.input.headers_only) {
+      const igi::ImageInfo info = igi::ReadImageInfo(first);
+      correction.Check(first.string(), info.width, info.height, info.channels, job.input.raw);
+    } else {
+      const igi::Image& image = job.input.images[0];
+      correction.Check(first.string(), image.width, image.height, image.channels, job.input.raw);
+    }
+  }
   for (Job& job : jobs) {
     igi::hdr::MergeOptions merge = flags.merge;
     merge.bits = job.input.bits;
     // Raw data has its black level subtracted: only a zero value carries no signal.
     if (job.input.raw && !flags.black_given) merge.black = 0.0;
     const fs::path mask = MaskPath(job.out, flags.mask_out, jobs.size() == 1);
-    const MergeCounts counts = job.input.headers_only ? MergeStreamed(job, merge, flags, mask)
-                                                      : MergeWhole(job, merge, flags, mask);
+    const MergeCounts counts = job.input.headers_only
+                                   ? MergeStreamed(job, merge, flags, correction, mask)
+                                   : MergeWhole(job, merge, flags, correction, mask);
     const double total = double(counts.pixels);
     std::printf(
         "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
@@ -245,6 +267,11 @@ int main(int argc, char** argv) {
   app.add_option("--saturated", flags.merge.saturated, "Normalised level at or above = saturated");
   app.add_flag("--align", flags.align, "Align hand-held brackets (median threshold bitmaps)");
   app.add_option("--mask-out", flags.mask_out, "Mask of bad pixels (default OUT_mask.png)");
+  app.add_option("--camera", flags.camera,
+                 "camera.json whose vignetting (igi-calib vignetting) is divided out");
+  app.add_option("--colour", flags.colour,
+                 "colour.json (igi-calib colour): camera RGB -> linear sRGB; with a matrix of raw "
+                 "camera RGB, raw files are decoded without white balance or colour matrix");
   app.add_option("--raw-white-balance", flags.raw_white_balance, "camera or none");
   app.add_option("--raw-color", flags.raw_color, "srgb (linear) or raw (camera RGB)");
   app.add_flag("--half-size", flags.input.raw.half_size, "Raw: 2x2 binning, no demosaicing");

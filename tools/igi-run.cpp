@@ -22,7 +22,11 @@ PHOTOS_DIR layout (one sub-folder per photo):
       raw files               *.dng *.cr2 *.nef ... decoded linearly (no response needed)
       one radiance map        *.exr or *.hdr, used as it is
       a capture               manifest.jsonl of igi-capture (merged with igi-hdr --manifest)
-  PHOTOS_DIR/camera.json      optional known intrinsics (igi-calib intrinsics) for registration
+  PHOTOS_DIR/camera.json      optional camera calibration (or --camera): its intrinsics
+                              (igi-calib intrinsics) go to registration, its vignetting
+                              (igi-calib vignetting) is divided out of every photo
+  PHOTOS_DIR/colour.json      optional colour matrix (igi-calib colour, or --colour) applied
+                              to every photo
   PHOTOS_DIR/markers.json     optional control points (igi-markers) for registration
 Output: DIR/01-response 02-hdr 03-register 04-solve 05-diagnose 06-report (renders, exports),
 DIR/report.html.
@@ -53,7 +57,7 @@ int main(int argc, char** argv) {
   // --demo's choice flags as typed; SetChoices parses them into `demo` and validates it.
   igi::pipeline::DemoChoiceFlags demo_choices;
   bool run_demo = false;
-  std::string photos, scene, out, bin;
+  std::string photos, scene, out, bin, camera, colour;
   app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
   app.add_option("--scene", scene, "scene.json: geometry, materials, lights, lightings");
   app.add_option("--out", out, "Output folder (stages resume from it)")->required();
@@ -82,6 +86,10 @@ int main(int argc, char** argv) {
                  "The report's renders and photo figures at most this many megapixels (block "
                  "means of the photos; 0 = their size)")
       ->capture_default_str();
+  app.add_option("--camera", camera,
+                 "camera.json (intrinsics, vignetting) instead of PHOTOS_DIR/camera.json");
+  app.add_option("--colour", colour,
+                 "colour.json (igi-calib colour) instead of PHOTOS_DIR/colour.json");
   app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
   app.add_option("--demo-cameras", demo.cameras, "--demo: cameras")->capture_default_str();
   app.add_option("--demo-ceiling-cameras", demo.ceiling_cameras,
@@ -100,6 +108,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     o.photos_dir = photos;
+    o.camera = camera;
+    o.colour = colour;
     o.scene = scene;
     o.out = out;
     o.bin_dir = bin;

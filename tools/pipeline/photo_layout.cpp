@@ -155,10 +155,12 @@ PhotoLayout ScanPhotosDir(const fs::path& dir, const std::vector<std::string>& l
       layout.camera = e.path();
     } else if (name == "markers.json") {
       layout.markers = e.path();
+    } else if (name == "colour.json") {
+      layout.colour = e.path();
     } else if (name[0] != '.' && name != "README.md" && name != "README.txt") {
       problems.Add(e.path().string(), "", name,
                    "is not part of the layout (one sub-folder per photo, camera.json, "
-                   "markers.json)");
+                   "colour.json, markers.json)");
     }
   }
   std::sort(layout.photos.begin(), layout.photos.end(),

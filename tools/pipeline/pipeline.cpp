@@ -80,6 +80,10 @@ Context Validate(const RunOptions& o) {
     }
   } else {
     ctx.layout = ScanPhotosDir(o.photos_dir, Lightings(ctx.scene));
+    if (!o.camera.empty()) ctx.layout.camera = o.camera;
+    if (!o.colour.empty()) ctx.layout.colour = o.colour;
+    if (!ctx.layout.camera.empty()) ctx.camera = calib::ReadCameraFile(ctx.layout.camera);
+    if (!ctx.layout.colour.empty()) ctx.colour = calib::ReadColourFile(ctx.layout.colour);
   }
   std::vector<std::string> tools = {"igi-solve", "igi-render", "igi-export"};
   if (!o.hdr_photos) tools.insert(tools.end(), {"igi-calib", "igi-hdr", "igi-register"});
@@ -119,7 +123,13 @@ std::vector<Stage> Stages(const Context& ctx) {
          fp->AddFile(p.exposure_file);
        },
        ResponseStage},
-      {"02-hdr", !o.hdr_photos, [&](Fingerprint* fp) { fp->AddFile(o.photos_dir); }, HdrStage},
+      {"02-hdr", !o.hdr_photos,
+       [&](Fingerprint* fp) {
+         fp->AddFile(o.photos_dir);
+         if (ctx.camera) fp->AddFile(ctx.layout.camera);
+         if (ctx.colour) fp->AddFile(ctx.layout.colour);
+       },
+       HdrStage},
       {"03-register", !o.hdr_photos,
        [&](Fingerprint* fp) {
          AddSceneFiles(ctx, fp, false);

@@ -2,9 +2,12 @@
 // Shared by pipeline.cpp and pipeline_stages.cpp: the run's context and a stage's runner.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "calib/camera_file.h"
+#include "calib/colour_chart.h"
 #include "recon/scene.h"
 #include "tools/common/json.h"
 #include "tools/pipeline/photo_layout.h"
@@ -16,8 +19,10 @@ namespace igi::pipeline::internal {
 struct Context {
   RunOptions options;
   std::filesystem::path bin;
-  PhotoLayout layout;  // empty with hdr_photos
-  recon::Scene scene;  // the input scene (geometry loaded)
+  PhotoLayout layout;                       // empty with hdr_photos
+  std::optional<calib::CameraFile> camera;  // layout.camera read, when there is one
+  std::optional<calib::ColourFile> colour;  // layout.colour read, when there is one
+  recon::Scene scene;                       // the input scene (geometry loaded)
   Json scene_json;
   std::filesystem::path Dir(const std::string& stage) const { return options.out / stage; }
   std::filesystem::path SolveInput() const;  // the scene.json given to igi-solve

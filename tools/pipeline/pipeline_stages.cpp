@@ -4,6 +4,7 @@
 
 #include <optional>
 
+#include "hdr/correction.h"
 #include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
@@ -42,6 +43,31 @@ void ResponseStage(const Context& ctx, StageRun* run) {
 
 void HdrStage(const Context& ctx, StageRun* run) {
   const fs::path response = ctx.Dir("01-response") / "response.json";
+  // The camera's vignetting divided out of every photo and its colour matrix applied (igi-hdr
+  // --camera, --colour; a radiance map given as it is, here).
+  const bool vignetting = ctx.camera && ctx.camera->vignetting;
+  const hdr::RadianceCorrection correction(vignetting ? ctx.layout.camera : fs::path(),
+                                           ctx.layout.colour);
+  if (vignetting) {
+    const calib::CameraVignetting& v = *ctx.camera->vignetting;
+    run->details["vignetting"] = {{"file", ctx.layout.camera.string()},
+                                  {"k1", v.model.k1},
+                                  {"k2", v.model.k2},
+                                  {"method", v.method},
+                                  {"rms_ln", v.rms_ln}};
+  }
+  if (ctx.colour) {
+    std::vector<std::vector<double>> rows;
+    for (int r = 0; r < 3; ++r) {
+      rows.push_back(
+          {ctx.colour->matrix(r, 0), ctx.colour->matrix(r, 1), ctx.colour->matrix(r, 2)});
+    }
+    run->details["colour"] = {{"file", ctx.layout.colour.string()},
+                              {"matrix", rows},
+                              {"input", std::string(calib::ColourInputName(ctx.colour->input))},
+                              {"delta_e2000_mean", ctx.colour->delta_e2000.mean},
+                              {"delta_e2000_max", ctx.colour->delta_e2000.max}};
+  }
   Json photos = Json::array();
   for (const PhotoSource& p : ctx.layout.photos) {
     const fs::path out = run->dir() / (p.name + ".exr");
@@ -49,7 +75,10 @@ void HdrStage(const Context& ctx, StageRun* run) {
     if (p.kind == PhotoSourceKind::kRadiance) {
       WriteImageOptions wo;
       wo.type = PixelType::kFloat;
-      WriteImage(out, ReadImage(p.images[0], 3), wo);
+      Image radiance = ReadImage(p.images[0], 3);
+      correction.Check(p.images[0].string(), radiance.width, radiance.height, 3, false);
+      correction.Apply(radiance.pixels.data(), 0, radiance.height, radiance.width, 3);
+      WriteImage(out, radiance, wo);
       continue;
     }
     std::vector<std::string> args = ThreadArgs(ctx);
@@ -60,6 +89,8 @@ void HdrStage(const Context& ctx, StageRun* run) {
       if (p.kind == PhotoSourceKind::kBracket) Append(&args, {"--response", response.string()});
       if (!p.exposure_file.empty()) Append(&args, {"--exposure-file", p.exposure_file.string()});
     }
+    if (vignetting) Append(&args, {"--camera", ctx.layout.camera.string()});
+    if (ctx.colour) Append(&args, {"--colour", ctx.layout.colour.string()});
     Append(&args, {"--out", out.string()});
     run->Tool("igi-hdr", args);
   }
@@ -75,7 +106,9 @@ void RegisterStage(const Context& ctx, StageRun* run) {
   std::vector<std::string> args = ThreadArgs(ctx);
   Append(&args, {"--images", images.string(), "--scene", ctx.options.scene.string(), "--out",
                  out.string()});
-  if (!ctx.layout.camera.empty()) Append(&args, {"--camera", ctx.layout.camera.string()});
+  if (ctx.camera && ctx.camera->HasIntrinsics()) {
+    Append(&args, {"--camera", ctx.layout.camera.string()});
+  }
   if (!ctx.layout.markers.empty()) Append(&args, {"--markers", ctx.layout.markers.string()});
   Append(&args, ctx.options.register_args);
   run->Tool("igi-register", args, /*partial_ok=*/true);

@@ -13,6 +13,11 @@ struct RunOptions {
   std::filesystem::path scene;       // scene.json: geometry, materials, lights, lightings
   std::filesystem::path out;         // DIR: 01-response ... 06-report, report.html
   std::filesystem::path bin_dir;     // where igi-calib, igi-hdr, ... live (empty = igi-run's)
+  // camera.json (igi-calib intrinsics and/or vignetting); empty = PHOTOS_DIR/camera.json if any.
+  // Its intrinsics go to igi-register, its vignetting to igi-hdr (divided out of every photo).
+  std::filesystem::path camera;
+  // colour.json (igi-calib colour); empty = PHOTOS_DIR/colour.json if any. Applied by igi-hdr.
+  std::filesystem::path colour;
   // The photos are radiance maps already and the scene has its cameras and photos: the
   // response, HDR and registration stages are skipped and the scene is solved as it is.
   bool hdr_photos = false;
@@ -35,7 +40,7 @@ struct RunOptions {
   // rendered at its size divided by ReductionFactor, each photo shown as the means of its blocks
   // of that size (0 = the photos' size).
   double report_megapixels = 0.5;
-  int num_threads = 0;       // --threads given to every stage (0 = all cores)
+  int num_threads = 0;  // --threads given to every stage (0 = all cores)
 
   void Validate() const;  // InputError naming the flag
 };

@@ -103,6 +103,40 @@ void ResponseSection(const fs::path& out, HtmlReport* page) {
                  "pixel level", "ln exposure");
 }
 
+// The calibrations the HDR stage applied (from its marker's details).
+void CalibrationSection(const fs::path& out, HtmlReport* page) {
+  page->Heading("Camera calibration");
+  const auto marker = ReadStageMarker(out / "02-hdr");
+  std::vector<std::vector<std::string>> rows;
+  if (marker && marker->details.contains("vignetting")) {
+    const Json& v = marker->details["vignetting"];
+    const double k1 = v["k1"].get<double>(), k2 = v["k2"].get<double>();
+    rows.push_back(
+        {"vignetting 1 + k1 r² + k2 r⁴ (divided out)",
+         fmt::format("k1 {:.4f}, k2 {:.4f} (corner {:+.1f} %)", k1, k2, 100 * (k1 + k2)),
+         fmt::format("{}, RMS {:.2f} %", v.value("method", "?"), 100 * v.value("rms_ln", 0.0)),
+         v.value("file", "")});
+  }
+  if (marker && marker->details.contains("colour")) {
+    const Json& c = marker->details["colour"];
+    std::vector<std::string> matrix;
+    for (const Json& row : c["matrix"]) matrix.push_back(Num(row, "{:.3f}"));
+    rows.push_back({"colour: camera RGB → linear sRGB (applied)",
+                    fmt::format("{}", fmt::join(matrix, " ")),
+                    fmt::format("ColorChecker, {} input, ΔE2000 mean {:.2f}, max {:.2f}",
+                                c.value("input", "?"), c.value("delta_e2000_mean", 0.0),
+                                c.value("delta_e2000_max", 0.0)),
+                    c.value("file", "")});
+  }
+  if (rows.empty()) {
+    page->Note(
+        "No vignetting or colour matrix was applied: PHOTOS_DIR holds no camera.json with "
+        "a vignetting and no colour.json (igi-calib vignetting, igi-calib colour).");
+    return;
+  }
+  page->Table({"calibration", "values", "measured by", "file"}, rows);
+}
+
 void CamerasSection(const fs::path& out, HtmlReport* page) {
   page->Heading("Registered cameras");
   const fs::path scene_file = out / "03-register" / "scene.json";
@@ -173,6 +207,10 @@ void ParametersSection(const fs::path& out, HtmlReport* page) {
 // the solved model as photo K records it).
 void PhotosSection(const fs::path& out, int max_photos, HtmlReport* page) {
   page->Heading("Photos, re-renders of the solved model, residuals");
+  if (!fs::exists(out / "04-solve" / "scene.json")) {
+    page->Note("The solve stage has not finished.", "error");
+    return;
+  }
   recon::SceneLoadOptions load;
   load.load_geometry = load.check_images = false;
   const recon::Scene scene = recon::LoadScene(out / "04-solve" / "scene.json", load);
@@ -296,6 +334,7 @@ void WriteRunReport(const RunReportInputs& in) {
   page.Paragraph("Run folder: " + fs::absolute(in.out).string());
   StagesSection(in.out, &page);
   ResponseSection(in.out, &page);
+  CalibrationSection(in.out, &page);
   CamerasSection(in.out, &page);
   ParametersSection(in.out, &page);
   PhotosSection(in.out, in.max_photos, &page);
