@@ -248,6 +248,17 @@ int RunVignetting(const VignettingCommand& cmd) {
   }
   igi::calib::CameraFile camera;
   if (!cmd.camera.empty()) camera = igi::calib::ReadCameraFile(cmd.camera);
+  // The photos' size becomes camera.json's; with --camera it must be the size stated there.
+  const auto set_size = [&](const std::string& what, int width, int height) {
+    if (!cmd.camera.empty() && (width != camera.width || height != camera.height)) {
+      throw igi::InputError(igi::DescribeProblem(
+          what, "", std::to_string(width) + "x" + std::to_string(height),
+          "must be the size in " + cmd.camera + " (" + std::to_string(camera.width) + "x" +
+              std::to_string(camera.height) + ")"));
+    }
+    camera.width = width;
+    camera.height = height;
+  };
   igi::calib::CameraVignetting result;
   if (!cmd.images.empty()) {
     igi::hdr::FlatFieldReadOptions read;
@@ -263,16 +274,7 @@ int RunVignetting(const VignettingCommand& cmd) {
       }
     }
     problems.ThrowIfAny();
-    if (!cmd.camera.empty() &&
-        (fields[0].width != camera.width || fields[0].height != camera.height)) {
-      throw igi::InputError(igi::DescribeProblem(
-          fields[0].name, "",
-          std::to_string(fields[0].width) + "x" + std::to_string(fields[0].height),
-          "must be the size in " + cmd.camera + " (" + std::to_string(camera.width) + "x" +
-              std::to_string(camera.height) + ")"));
-    }
-    camera.width = fields[0].width;
-    camera.height = fields[0].height;
+    set_size(fields[0].name, fields[0].width, fields[0].height);
     const igi::calib::VignettingFit fit =
         igi::calib::FitFlatFields(fields, camera.principal_x_px(), camera.principal_y_px());
     result = {fit.vignetting, "flat_field", fit.rms_ln, fit.samples, fit.photos};
@@ -283,14 +285,7 @@ int RunVignetting(const VignettingCommand& cmd) {
           igi::DescribeProblem(cmd.scene, "photos", "none", "the overlap of photos needs photos"));
     }
     const igi::recon::Camera& first = scene.cameras[size_t(scene.photos[0].camera)];
-    if (!cmd.camera.empty() && (first.width != camera.width || first.height != camera.height)) {
-      throw igi::InputError(
-          igi::DescribeProblem(cmd.scene, "cameras." + first.name,
-                               std::to_string(first.width) + "x" + std::to_string(first.height),
-                               "must be the size in " + cmd.camera));
-    }
-    camera.width = first.width;
-    camera.height = first.height;
+    set_size(cmd.scene + ": cameras." + first.name, first.width, first.height);
     const igi::solver::OverlapPairs pairs = igi::solver::CollectOverlapPairs(scene, cmd.overlap);
     const igi::calib::VignettingFit fit =
         igi::calib::FitOverlap(pairs.pairs, int(scene.photos.size()), cmd.free_exposures);
@@ -682,8 +677,9 @@ int RunLights(const LightsCommand& cmd) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("igi-calib: camera calibration (response curves, intrinsics, vignetting)",
-               "igi-calib");
+  CLI::App app(
+      "igi-calib: camera calibration (response curves, intrinsics, vignetting, colour, lights)",
+      "igi-calib");
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
   app.require_subcommand(1);
@@ -703,6 +699,7 @@ int main(int argc, char** argv) {
     if (colour_app->parsed()) return RunColour(colour);
     if (vignetting_app->parsed()) return RunVignetting(vignetting);
     if (lights_app->parsed()) return RunLights(lights);
-    throw igi::InputError("no subcommand: use igi-calib response|intrinsics|vignetting …");
+    throw igi::InputError(
+        "no subcommand: use igi-calib response|intrinsics|vignetting|colour|lights …");
   });
 }
