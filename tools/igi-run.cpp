@@ -27,6 +27,8 @@ PHOTOS_DIR layout (one sub-folder per photo):
                               (igi-calib vignetting) is divided out of every photo
   PHOTOS_DIR/colour.json      optional colour matrix (igi-calib colour, or --colour) applied
                               to every photo
+  PHOTOS_DIR/lights.json      optional calibrated lights (igi-calib lights, or --lights):
+                              they replace the scene's lights of the same names
   PHOTOS_DIR/markers.json     optional control points (igi-markers) for registration
 Output: DIR/01-response 02-hdr 03-register 04-solve 05-diagnose 06-report (renders, exports),
 DIR/report.html.
@@ -57,7 +59,7 @@ int main(int argc, char** argv) {
   // --demo's choice flags as typed; SetChoices parses them into `demo` and validates it.
   igi::pipeline::DemoChoiceFlags demo_choices;
   bool run_demo = false;
-  std::string photos, scene, out, bin, camera, colour;
+  std::string photos, scene, out, bin, camera, colour, lights;
   app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
   app.add_option("--scene", scene, "scene.json: geometry, materials, lights, lightings");
   app.add_option("--out", out, "Output folder (stages resume from it)")->required();
@@ -88,6 +90,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--camera", camera,
                  "camera.json (intrinsics, vignetting) instead of PHOTOS_DIR/camera.json");
+  app.add_option("--lights", lights,
+                 "lights.json (igi-calib lights) instead of PHOTOS_DIR/lights.json");
   app.add_option("--colour", colour,
                  "colour.json (igi-calib colour) instead of PHOTOS_DIR/colour.json");
   app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
@@ -110,6 +114,7 @@ int main(int argc, char** argv) {
     o.photos_dir = photos;
     o.camera = camera;
     o.colour = colour;
+    o.lights = lights;
     o.scene = scene;
     o.out = out;
     o.bin_dir = bin;

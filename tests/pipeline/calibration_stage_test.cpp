@@ -13,6 +13,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/error.h"
 #include "tools/common/image.h"
+#include "tools/common/json.h"
 #include "tools/pipeline/pipeline.h"
 #include "tools/pipeline/run_report.h"
 #include "tools/pipeline/stage_marker.h"
@@ -73,6 +74,50 @@ TEST(CalibrationStageTest, HdrStageDividesOutTheCamerasVignetting) {
             "vignetting": {"k1": -1.2, "k2": 0.1}})";
   o.out = dir / "refused";
   EXPECT_THROW(RunPipeline(o), InputError);
+  EXPECT_FALSE(fs::exists(o.out));
+  fs::remove_all(dir);
+}
+
+// Calibrated lights (igi-calib lights' lights.json) replace the scene's entries of the same names
+// in the scene igi-solve gets, the solve stage records them and the report lists them; a
+// lights.json naming a light the scene lacks stops the run before anything is written.
+TEST(CalibrationStageTest, CalibratedLightsReplaceTheScenesInTheSolve) {
+  const fs::path dir = test::UniqueTempDir("igi_calibration_lights");
+  const Json lamp = {{"type", "sphere"},
+                     {"center", {2.01, 1.99, 2.6}},
+                     {"radius", 0.1},
+                     {"radiance", {990.0, 990.0, 990.0}}};
+  WriteJsonFile(dir / "lights.json",
+                Json{{"format", "igi-lights"}, {"version", 1}, {"lights", {{"lamp", lamp}}}});
+  RunOptions o;
+  o.hdr_photos = true;
+  o.scene = kRoom / "scene.json";
+  o.lights = dir / "lights.json";
+  o.out = dir / "run";
+  o.bin_dir = IGI_BIN_DIR;
+  o.skip_diagnose = true;
+  o.stop_after = "04-solve";
+  o.solve_args = {"--refine-iterations=0", "--indirect-rays=16"};
+  RunPipeline(o);
+  const Json solved_input = ReadJsonFile(o.out / "04-solve" / "input" / "scene.json");
+  EXPECT_EQ(solved_input["lights"]["lamp"], lamp);
+  EXPECT_EQ(solved_input["lights"]["lamp2"]["radiance"][0].get<double>(), 1500.0);
+  WriteRunReport({o.out});
+  std::ifstream report(o.out / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(report)), {});
+  EXPECT_NE(html.find("lights (replace the scene&#39;s)"), std::string::npos);
+
+  WriteJsonFile(dir / "bad.json", Json{{"format", "igi-lights"},
+                                       {"version", 1},
+                                       {"lights", {{"lamp9", lamp}}}});
+  o.lights = dir / "bad.json";
+  o.out = dir / "refused";
+  try {
+    RunPipeline(o);
+    ADD_FAILURE() << "a light the scene lacks was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.json: lights.lamp9"), std::string::npos) << e.what();
+  }
   EXPECT_FALSE(fs::exists(o.out));
   fs::remove_all(dir);
 }

@@ -157,10 +157,12 @@ PhotoLayout ScanPhotosDir(const fs::path& dir, const std::vector<std::string>& l
       layout.markers = e.path();
     } else if (name == "colour.json") {
       layout.colour = e.path();
+    } else if (name == "lights.json") {
+      layout.lights = e.path();
     } else if (name[0] != '.' && name != "README.md" && name != "README.txt") {
       problems.Add(e.path().string(), "", name,
                    "is not part of the layout (one sub-folder per photo, camera.json, "
-                   "colour.json, markers.json)");
+                   "colour.json, lights.json, markers.json)");
     }
   }
   std::sort(layout.photos.begin(), layout.photos.end(),

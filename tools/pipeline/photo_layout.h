@@ -13,6 +13,7 @@
 //   PHOTOS_DIR/camera.json      optional: known intrinsics (igi-calib intrinsics) for igi-register
 //                               and vignetting (igi-calib vignetting) for igi-hdr
 //   PHOTOS_DIR/colour.json      optional: the colour matrix (igi-calib colour) for igi-hdr
+//   PHOTOS_DIR/lights.json      optional: calibrated lights (igi-calib lights) for the scene
 //   PHOTOS_DIR/markers.json     optional: control points (igi-markers) for igi-register
 //
 // Every other entry of PHOTOS_DIR is an error (exit 2), so that a typo is not silently dropped.
@@ -41,6 +42,7 @@ struct PhotoLayout {
   std::filesystem::path camera;     // optional camera.json
   std::filesystem::path markers;    // optional markers.json
   std::filesystem::path colour;     // optional colour.json (igi-calib colour)
+  std::filesystem::path lights;     // optional lights.json (igi-calib lights)
   // The bracket the response curve is recovered from (the one with the most images), or -1
   // when no photo is an LDR bracket.
   int ResponseSource() const;

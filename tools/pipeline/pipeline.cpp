@@ -7,6 +7,7 @@
 #include <chrono>
 #include <functional>
 
+#include "recon/scene_document.h"
 #include "tools/common/error.h"
 #include "tools/pipeline/pipeline_internal.h"
 #include "tools/pipeline/subprocess.h"
@@ -17,6 +18,35 @@ using internal::Context;
 using internal::StageRun;
 
 namespace internal {
+
+void Context::ApplyLights(Json* scene_json) const {
+  for (const auto& [name, entry] : lights.items()) (*scene_json)["lights"][name] = entry;
+}
+
+// Reads lights.json's "lights" into ctx and puts them into ctx.scene_json, checked by the scene
+// reader's rules: every name must be a light of the scene.
+void ReadCalibratedLights(const fs::path& file, Context* ctx) {
+  const Json doc = ReadJsonFile(file);
+  ProblemList problems;
+  if (doc.value("format", "") != "igi-lights" || !doc.contains("lights") ||
+      !doc["lights"].is_object()) {
+    problems.Add(file.string(), "format", doc.value("format", ""),
+                 "must be an igi-lights file with a \"lights\" object (igi-calib lights)");
+    problems.ThrowIfAny();
+  }
+  for (const auto& [name, entry] : doc["lights"].items()) {
+    if (!ctx->scene_json.contains("lights") || !ctx->scene_json["lights"].contains(name)) {
+      problems.Add(file.string(), "lights." + name, "", "not a light of the scene");
+    }
+  }
+  problems.ThrowIfAny();
+  ctx->lights_file = file;
+  ctx->lights = doc["lights"];
+  ctx->ApplyLights(&ctx->scene_json);
+  recon::SceneLoadOptions load;
+  load.load_geometry = load.check_images = false;
+  recon::SceneDocument(ctx->scene_json).Validate(ctx->options.scene.parent_path(), load);
+}
 
 fs::path Context::SolveInput() const {
   return options.hdr_photos ? options.scene : Dir("03-register") / "scene.json";
@@ -84,7 +114,10 @@ Context Validate(const RunOptions& o) {
     if (!o.colour.empty()) ctx.layout.colour = o.colour;
     if (!ctx.layout.camera.empty()) ctx.camera = calib::ReadCameraFile(ctx.layout.camera);
     if (!ctx.layout.colour.empty()) ctx.colour = calib::ReadColourFile(ctx.layout.colour);
+    if (!o.lights.empty()) ctx.layout.lights = o.lights;
   }
+  const fs::path lights = o.hdr_photos ? o.lights : ctx.layout.lights;
+  if (!lights.empty()) ReadCalibratedLights(lights, &ctx);
   std::vector<std::string> tools = {"igi-solve", "igi-render", "igi-export"};
   if (!o.hdr_photos) tools.insert(tools.end(), {"igi-calib", "igi-hdr", "igi-register"});
   if (!o.skip_diagnose) tools.push_back("igi-diagnose");
@@ -133,12 +166,14 @@ std::vector<Stage> Stages(const Context& ctx) {
       {"03-register", !o.hdr_photos,
        [&](Fingerprint* fp) {
          AddSceneFiles(ctx, fp, false);
+         if (!ctx.lights_file.empty()) fp->AddFile(ctx.lights_file);
          for (const std::string& a : o.register_args) fp->AddText(a);
        },
        RegisterStage},
       {"04-solve", true,
        [&](Fingerprint* fp) {
          if (o.hdr_photos) AddSceneFiles(ctx, fp, true);
+         if (!ctx.lights_file.empty()) fp->AddFile(ctx.lights_file);
          for (const std::string& a : o.solve_args) fp->AddText(a);
          fp->AddText(fmt::format("radiance_scale {:.17g}", o.radiance_scale));
        },

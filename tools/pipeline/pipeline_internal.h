@@ -22,7 +22,11 @@ struct Context {
   PhotoLayout layout;                       // empty with hdr_photos
   std::optional<calib::CameraFile> camera;  // layout.camera read, when there is one
   std::optional<calib::ColourFile> colour;  // layout.colour read, when there is one
-  recon::Scene scene;                       // the input scene (geometry loaded)
+  std::filesystem::path lights_file;        // lights.json, empty = none
+  Json lights = Json::object();             // its "lights": name -> scene.json light object
+  // Replaces the lights of `scene_json` named in `lights` by their calibrated entries.
+  void ApplyLights(Json* scene_json) const;
+  recon::Scene scene;  // the input scene (geometry loaded)
   Json scene_json;
   std::filesystem::path Dir(const std::string& stage) const { return options.out / stage; }
   std::filesystem::path SolveInput() const;  // the scene.json given to igi-solve

@@ -132,13 +132,16 @@ void RegisterStage(const Context& ctx, StageRun* run) {
 }
 
 // The scene igi-solve gets: the solvable scene as it is, or with --radiance-scale written as
-// every photo's exposure_scale (a copy in DIR/04-solve/input/, its paths rebased).
+// every photo's exposure_scale and the calibrated lights in place (a copy in
+// DIR/04-solve/input/, its paths rebased).
 fs::path SolveScene(const Context& ctx, const fs::path& stage_dir) {
-  if (ctx.options.radiance_scale == 1.0) return ctx.SolveInput();
+  if (ctx.options.radiance_scale == 1.0 && ctx.lights.empty()) return ctx.SolveInput();
   const fs::path input = ctx.SolveInput();
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  recon::SceneDocument scene(ReadJsonFile(input));
+  Json doc = ReadJsonFile(input);
+  ctx.ApplyLights(&doc);
+  recon::SceneDocument scene(std::move(doc));
   scene.RebasePaths(input.parent_path(), dir);
   for (size_t i = 0; i < scene.NumPhotos(); ++i) {
     scene.SetPhotoExposure(i, scene.PhotoExposure(i).value_or(1.0) * ctx.options.radiance_scale);
@@ -154,6 +157,11 @@ void SolveStage(const Context& ctx, StageRun* run) {
   Append(&args, ctx.options.solve_args);
   run->Tool("igi-solve", args, /*partial_ok=*/true);
   run->details["radiance_scale"] = ctx.options.radiance_scale;
+  if (!ctx.lights.empty()) {
+    Json names = Json::array();
+    for (const auto& [name, entry] : ctx.lights.items()) names.push_back(name);
+    run->details["lights"] = {{"file", ctx.lights_file.string()}, {"names", names}};
+  }
 }
 
 // The scene igi-diagnose gets: the one igi-solve got (materials unknown where they were, so
@@ -166,7 +174,9 @@ fs::path DiagnoseScene(const Context& ctx, const fs::path& stage_dir) {
   const recon::SceneDocument solved(ReadJsonFile(ctx.Dir("04-solve") / "scene.json"));
   const fs::path dir = stage_dir / "input";
   fs::create_directories(dir);
-  recon::SceneDocument scene(ReadJsonFile(input));
+  Json doc = ReadJsonFile(input);
+  ctx.ApplyLights(&doc);
+  recon::SceneDocument scene(std::move(doc));
   scene.RebasePaths(input.parent_path(), dir);
   if (scene.NumPhotos() != solved.NumPhotos()) {
     throw Error("stage 05-diagnose: " + (ctx.Dir("04-solve") / "scene.json").string() + " has " +

@@ -18,6 +18,9 @@ struct RunOptions {
   std::filesystem::path camera;
   // colour.json (igi-calib colour); empty = PHOTOS_DIR/colour.json if any. Applied by igi-hdr.
   std::filesystem::path colour;
+  // lights.json (igi-calib lights); empty = PHOTOS_DIR/lights.json if any. Its lights replace the
+  // scene's entries of the same names in the scene igi-solve and igi-diagnose get.
+  std::filesystem::path lights;
   // The photos are radiance maps already and the scene has its cameras and photos: the
   // response, HDR and registration stages are skipped and the scene is solved as it is.
   bool hdr_photos = false;

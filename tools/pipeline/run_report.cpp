@@ -128,10 +128,17 @@ void CalibrationSection(const fs::path& out, HtmlReport* page) {
                                 c.value("delta_e2000_max", 0.0)),
                     c.value("file", "")});
   }
+  const auto solve = ReadStageMarker(out / "04-solve");
+  if (solve && solve->details.contains("lights")) {
+    const Json& l = solve->details["lights"];
+    const auto names = l["names"].get<std::vector<std::string>>();
+    rows.push_back({"lights (replace the scene's)", fmt::format("{}", fmt::join(names, ", ")),
+                    "igi-calib lights", l.value("file", "")});
+  }
   if (rows.empty()) {
     page->Note(
-        "No vignetting or colour matrix was applied: PHOTOS_DIR holds no camera.json with "
-        "a vignetting and no colour.json (igi-calib vignetting, igi-calib colour).");
+        "No calibration was applied: no camera.json with a vignetting, no colour.json and no "
+        "lights.json (igi-calib vignetting, colour, lights).");
     return;
   }
   page->Table({"calibration", "values", "measured by", "file"}, rows);
