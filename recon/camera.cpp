@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "calib/vignetting.h"
+
 namespace igi::recon {
 
 std::string_view CameraModelName(CameraModel model) {
@@ -14,10 +16,8 @@ Eigen::Vector3d Camera::CenterInWorld() const { return cam_from_world.Inverse().
 
 double Camera::VignettingFactor(const Eigen::Vector2d& pixel) const {
   if (!HasVignetting()) return 1.0;
-  const double dx = pixel.x() - principal_x_px(), dy = pixel.y() - principal_y_px();
-  const double half_diag2 = 0.25 * (double(width) * width + double(height) * height);
-  const double r2 = (dx * dx + dy * dy) / half_diag2;
-  return 1.0 + vignetting_k1 * r2 + vignetting_k2 * r2 * r2;
+  return calib::Vignetting{vignetting_k1, vignetting_k2}.Factor(calib::VignettingRadius2(
+      pixel.x(), pixel.y(), principal_x_px(), principal_y_px(), width, height));
 }
 
 namespace {

@@ -85,20 +85,17 @@ OverlapPairs CollectOverlapPairs(const recon::Scene& scene, const OverlapOptions
   if (std::none_of(compared.begin(), compared.end(), [](bool c) { return c; })) {
     compared.assign(scene.materials.size(), true);
   }
-  // The region seen at continuous pixel p of `camera`, when the pixels around it (one pixel
-  // away, diagonally) see it too: a value read there is not a mix of two surfaces, nor of a
-  // surface and a light. -1 otherwise.
-  auto region_around = [&](const recon::Camera& camera, const Eigen::Vector2d& p) {
+  // Whether the pixels one pixel away (diagonally) from continuous pixel p of `camera` see
+  // `region` as p does: a value read there is not a mix of two surfaces, nor of a surface and
+  // a light.
+  auto region_around = [&](const recon::Camera& camera, const Eigen::Vector2d& p, int region) {
     const Eigen::Vector3d origin = camera.CenterInWorld();
-    int region = -2;
-    for (const Eigen::Vector2d& d :
-         {Eigen::Vector2d(0, 0), Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1),
-          Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1)}) {
+    for (const Eigen::Vector2d& d : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1),
+                                     Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1)}) {
       const auto hit = rays.TraceSurface(origin, camera.WorldRayFromImg(p + d).normalized());
-      if (!hit || (region != -2 && hit->region != region)) return -1;
-      region = hit->region;
+      if (!hit || hit->region != region) return false;
     }
-    return region;
+    return true;
   };
   std::vector<std::vector<PairRef>> refs(static_cast<size_t>(num_photos));
   std::vector<int> hits(static_cast<size_t>(num_photos), 0);
@@ -117,7 +114,7 @@ OverlapPairs CollectOverlapPairs(const recon::Scene& scene, const OverlapOptions
         const auto hit = rays.TraceSurface(origin, dir);
         if (!hit || !compared[size_t(hit->region)] ||
             std::abs(dir.dot(hit->n_geo)) < options.min_cos ||
-            region_around(cam_a, pixel_a) != hit->region) {
+            !region_around(cam_a, pixel_a, hit->region)) {
           continue;
         }
         ++hits[size_t(a)];
@@ -133,7 +130,7 @@ OverlapPairs CollectOverlapPairs(const recon::Scene& scene, const OverlapOptions
           const auto pixel_b = cam_b.ImgFromWorld(hit->position);
           if (!pixel_b || !Inside(cam_b, *pixel_b, 2)) continue;
           if (rays.Occluded(start, to_b / distance, distance)) continue;
-          if (region_around(cam_b, *pixel_b) != hit->region) continue;
+          if (!region_around(cam_b, *pixel_b, hit->region)) continue;
           refs[size_t(a)].push_back({a, b, pixel_a, *pixel_b});
         }
       }

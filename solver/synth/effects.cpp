@@ -5,6 +5,7 @@
 #include <numbers>
 #include <set>
 
+#include "calib/vignetting.h"
 #include "recon/scene.h"
 #include "solver/render/sampling.h"
 #include "tools/common/error.h"
@@ -408,11 +409,8 @@ Json SpecularAsDiffuse(Params& p, const SynthRoom& room, SynthScenes* s) {
 
 double PhotoEffects::VignettingFactor(const recon::Camera& camera, double x, double y) const {
   if (!vignetting) return 1.0;
-  const double dx = x - camera.principal_x_px(), dy = y - camera.principal_y_px();
-  const double half_diag2 =
-      0.25 * (double(camera.width) * camera.width + double(camera.height) * camera.height);
-  const double r2 = (dx * dx + dy * dy) / half_diag2;
-  return 1.0 + vignetting->first * r2 + vignetting->second * r2 * r2;
+  return calib::Vignetting{vignetting->first, vignetting->second}.Factor(calib::VignettingRadius2(
+      x, y, camera.principal_x_px(), camera.principal_y_px(), camera.width, camera.height));
 }
 
 void PhotoEffects::ApplyBeforeSensor(const std::string& photo_file, const recon::Camera& camera,
