@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "calib/pixel_sampling.h"
@@ -28,8 +29,15 @@ int ResolveLevels(const Bracket& bracket, const ResponseOptions& options) {
   return bracket.bits_per_sample == 8 ? 256 : 1024;
 }
 
+// Makes g non-decreasing outward from the middle level (where the gauge holds g at 0, inside the
+// data): a running maximum above it, a running minimum below it. Levels without data hold only the
+// smoothness term's extrapolation, which can swing far; a running maximum from level 0 would carry
+// such a swing at the dark end across the whole curve, anchored in the middle it only flattens the
+// empty end.
 void MakeMonotonic(std::vector<double>* g) {
-  for (size_t z = 1; z < g->size(); ++z) (*g)[z] = std::max((*g)[z], (*g)[z - 1]);
+  const size_t middle = g->size() / 2;
+  for (size_t z = middle + 1; z < g->size(); ++z) (*g)[z] = std::max((*g)[z], (*g)[z - 1]);
+  for (size_t z = middle; z-- > 0;) (*g)[z] = std::min((*g)[z], (*g)[z + 1]);
 }
 
 std::string ImagesLabel(const Bracket& bracket) {
@@ -124,16 +132,17 @@ void AddSmoothness(double lambda, int levels, Eigen::MatrixXd* h) {
   }
 }
 
-// Residual RMS over the usable data equations, in ln units (unweighted), with each ln E_i at
-// its weighted optimum.
+// Residual RMS over the data equations, in ln units (unweighted), with each ln E_i at its
+// weighted optimum.
 double ResidualRms(const std::vector<std::vector<Equation>>& equations,
-                   const std::vector<double>& g, int levels, const ResponseOptions& options) {
+                   const std::vector<double>& g) {
   double sum = 0.0;
   int count = 0;
   const auto g_at = [&](const Equation& eq) {
     return (1.0 - eq.a) * g[size_t(eq.k)] + eq.a * g[size_t(eq.k) + 1];
   };
   for (const auto& sample : equations) {
+    if (sample.empty()) continue;
     double num = 0.0, den = 0.0;
     for (const Equation& eq : sample) {
       num += eq.w * eq.w * (g_at(eq) - eq.ln_t);
@@ -141,8 +150,6 @@ double ResidualRms(const std::vector<std::vector<Equation>>& equations,
     }
     const double ln_e = num / den;
     for (const Equation& eq : sample) {
-      const double v = (eq.k + eq.a) / (levels - 1);
-      if (v <= options.black || v >= options.saturated) continue;
       const double r = g_at(eq) - ln_e - eq.ln_t;
       sum += r * r;
       ++count;
@@ -163,7 +170,7 @@ struct ChannelSystem {
 };
 
 ChannelSystem BuildChannelSystem(const Bracket& bracket, const std::vector<int64_t>& pixels,
-                                 int channel, int levels) {
+                                 int channel, int levels, const ResponseOptions& options) {
   ChannelSystem s;
   for (int half = 0; half < 2; ++half) {
     s.h[half] = Eigen::MatrixXd::Zero(levels, levels);
@@ -173,12 +180,13 @@ ChannelSystem BuildChannelSystem(const Bracket& bracket, const std::vector<int64
   for (size_t i = 0; i < pixels.size(); ++i) {
     for (size_t j = 0; j < bracket.images.size(); ++j) {
       const Image& image = bracket.images[j];
-      const double z =
-          image.pixels[size_t(pixels[i]) * image.channels + channel] * double(levels - 1);
+      const double v = image.pixels[size_t(pixels[i]) * image.channels + channel];
+      if (v <= options.black || v >= options.saturated) continue;
+      const double z = v * double(levels - 1);
       const int k = std::min(int(z), levels - 2);
       s.equations[i].push_back({k, z - k, HatWeight(z, levels), std::log(bracket.exposures_s[j])});
     }
-    AddSample(s.equations[i], &s.h[i % 2], &s.rhs[i % 2]);
+    if (!s.equations[i].empty()) AddSample(s.equations[i], &s.h[i % 2], &s.rhs[i % 2]);
   }
   s.smooth = Eigen::MatrixXd::Zero(levels, levels);
   AddSmoothness(1.0, levels, &s.smooth);
@@ -246,15 +254,48 @@ double ChooseLambda(const ChannelSystem& s, const ResponseOptions& options) {
 std::vector<double> SolveDebevecChannel(const Bracket& bracket, const std::vector<int64_t>& pixels,
                                         int channel, int levels, const ResponseOptions& options,
                                         double* lambda, double* rms) {
-  const ChannelSystem s = BuildChannelSystem(bracket, pixels, channel, levels);
+  const ChannelSystem s = BuildChannelSystem(bracket, pixels, channel, levels, options);
   *lambda = options.lambda == kLambdaAuto ? ChooseLambda(s, options) : options.lambda;
   std::vector<double> g = SolveCurve(s.h[0] + s.h[1], s.rhs[0] + s.rhs[1], s.smooth, *lambda);
-  *rms = ResidualRms(s.equations, g, levels, options);
+  *rms = ResidualRms(s.equations, g);
   MakeMonotonic(&g);
   return g;
 }
 
 }  // namespace
+
+double DetectBlackFloor(const Bracket& bracket, int channel) {
+  const auto shortest = std::min_element(bracket.exposures_s.begin(), bracket.exposures_s.end());
+  const Image& image = bracket.images[size_t(shortest - bracket.exposures_s.begin())];
+  constexpr int kBins = 256;
+  constexpr int kPileWidth = 4;  // levels from the pile's mode to its top, at most
+  std::array<int64_t, kBins> histogram{};
+  const int64_t pixels = int64_t(image.width) * image.height;
+  for (int64_t p = 0; p < pixels; ++p) {
+    const float v = image.pixels[size_t(p) * image.channels + channel];
+    ++histogram[size_t(std::clamp(int(std::lround(v * (kBins - 1))), 0, kBins - 1))];
+  }
+  const int first = int(std::floor(kMinBlack * (kBins - 1))) + 1;
+  const int last = int(0.25 * (kBins - 1));
+  int mode = first;
+  for (int b = first; b <= last; ++b) {
+    if (histogram[size_t(b)] > histogram[size_t(mode)]) mode = b;
+  }
+  int64_t pile = 0;
+  for (int b = std::max(0, mode - 2); b <= std::min(kBins - 1, mode + 2); ++b) {
+    pile += histogram[size_t(b)];
+  }
+  if (pile * 10 <= pixels) return 0.0;
+  int top = mode;
+  while (top + 1 < kBins && histogram[size_t(top + 1)] * 10 >= histogram[size_t(mode)]) ++top;
+  // A broad mode is dark scene content, not a floor; so is a mode at the window's lower edge
+  // (the tail of values falling from true black).
+  if (top - mode > kPileWidth || mode - 3 < first ||
+      histogram[size_t(mode - 3)] * 10 >= histogram[size_t(mode)]) {
+    return 0.0;
+  }
+  return double(top + 1) / (kBins - 1);
+}
 
 double ParseLambda(const std::string& text) {
   const std::string trimmed(Trim(text));
@@ -262,6 +303,16 @@ double ParseLambda(const std::string& text) {
   const std::optional<double> value = ParseDouble(trimmed);
   if (!value || !(*value >= 0.0) || !std::isfinite(*value)) {
     throw InputError(DescribeProblem("--lambda", "", text, "must be auto or a number >= 0"));
+  }
+  return *value;
+}
+
+double ParseBlack(const std::string& text) {
+  const std::string trimmed(Trim(text));
+  if (ToLower(trimmed) == "auto") return kBlackAuto;
+  const std::optional<double> value = ParseDouble(trimmed);
+  if (!value || !(*value >= 0.0 && *value < 1.0)) {
+    throw InputError(DescribeProblem("--black", "", text, "must be auto or a number in [0, 1)"));
   }
   return *value;
 }
@@ -289,9 +340,9 @@ void ResponseOptions::Validate() const {
     problems.Add("--levels", "", fmt::format("{}", levels), "must be 0 (auto) or 16..65536");
   }
   if (samples < 0) problems.Add("--samples", "", fmt::format("{}", samples), "must be >= 0");
-  if (!(black >= 0.0 && black < saturated && saturated <= 1.0)) {
+  if (!((black == kBlackAuto || black >= 0.0) && black < saturated && saturated <= 1.0)) {
     problems.Add("--black/--saturated", "", fmt::format("{}/{}", black, saturated),
-                 "need 0 <= black < saturated <= 1");
+                 "need black auto or 0 <= black < saturated <= 1");
   }
   if (!(robertson_smoothing >= 0.0)) {
     problems.Add("--robertson-smoothing", "", fmt::format("{}", robertson_smoothing),
@@ -306,14 +357,26 @@ void ResponseOptions::Validate() const {
 ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& options) {
   options.Validate();
   const int levels = ResolveLevels(bracket, options);
-  if (options.method == ResponseRecoveryMethod::kRobertson)
-    return RecoverRobertson(bracket, options, levels);
+  // Each channel's black level; the pixel sampling and Robertson's fit take the highest.
+  std::vector<double> black;
+  for (int c = 0; c < bracket.channels(); ++c) {
+    black.push_back(options.black == kBlackAuto ? std::max(kMinBlack, DetectBlackFloor(bracket, c))
+                                                : options.black);
+  }
+  ResponseOptions resolved = options;
+  resolved.black = 0.0;
+  for (double b : black) resolved.black = std::max(resolved.black, b);
+  if (options.method == ResponseRecoveryMethod::kRobertson) {
+    ResponseSummary summary = RecoverRobertson(bracket, resolved, levels);
+    summary.black.assign(black.size(), resolved.black);
+    return summary;
+  }
   const int p = int(bracket.images.size());
   SamplingOptions sampling;
   sampling.samples = options.samples > 0
                          ? options.samples
                          : std::min(4000, std::max(1000, 3 * levels / std::max(p - 1, 1)));
-  sampling.black = options.black;
+  sampling.black = resolved.black;
   sampling.saturated = options.saturated;
   const std::vector<int64_t> pixels = SelectSamplePixels(bracket, sampling);
   ResponseSummary summary;
@@ -322,19 +385,23 @@ ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& o
   summary.curve.method = ResponseRecoveryMethodName(ResponseRecoveryMethod::kDebevec);
   summary.curve.levels = levels;
   summary.curve.channels = DefaultChannelNames(bracket.channels());
+  summary.black = black;
   for (int c = 0; c < bracket.channels(); ++c) {
-    const int equations = CountEquations(bracket, pixels, c, options);
+    ResponseOptions channel_options = options;
+    channel_options.black = black[size_t(c)];
+    const int equations = CountEquations(bracket, pixels, c, channel_options);
     CheckEnoughEquations(bracket, equations, levels, c);
     summary.equations = std::min(summary.equations, equations);
     double rms = 0.0, lambda = 0.0;
     summary.curve.g.push_back(
-        SolveDebevecChannel(bracket, pixels, c, levels, options, &lambda, &rms));
+        SolveDebevecChannel(bracket, pixels, c, levels, channel_options, &lambda, &rms));
     summary.rms_residual.push_back(rms);
     summary.lambda.push_back(lambda);
   }
-  spdlog::info("debevec: {} samples, {} equations, lambda {}{}, rms {:.4f}", summary.samples,
-               summary.equations, fmt::join(summary.lambda, "/"),
-               options.lambda == kLambdaAuto ? " (auto)" : "", summary.rms_residual.front());
+  spdlog::info("debevec: {} samples, {} equations, lambda {}{}, black {:.3f}, rms {:.4f}",
+               summary.samples, summary.equations, fmt::join(summary.lambda, "/"),
+               options.lambda == kLambdaAuto ? " (auto)" : "", fmt::join(black, "/"),
+               summary.rms_residual.front());
   return summary;
 }
 

@@ -22,7 +22,11 @@
 // is in the summary. Measured on the synthetic 5-image x4 brackets (tests/calib): lambda 10
 // leaves 2.7-5.4 % errors, auto <= 1 %.
 //
-// Both return g non-decreasing (a running maximum removes the wiggles of levels with no data).
+// Values at or below the black level (by default each channel's black floor, see
+// DetectBlackFloor) or at or above the saturation level take no part in either fit.
+//
+// Both return g non-decreasing (running extrema outward from the middle level flatten the
+// wiggles of levels with no data).
 // Too few usable pixels is an InputError naming the images and the rule.
 
 #include <array>
@@ -37,12 +41,17 @@
 namespace igi::calib {
 
 inline constexpr double kLambdaAuto = -1.0;
+// ResponseOptions::black: each channel's black floor (DetectBlackFloor), at least kMinBlack.
+inline constexpr double kBlackAuto = -1.0;
+inline constexpr double kMinBlack = 0.02;
 inline constexpr std::array<double, 5> kAutoLambdas = {3, 10, 30, 100, 300};
 inline constexpr double kAutoLambdaNoise = 0.0015;  // ln units (0.15 % RMS)
 inline constexpr double kAutoLambdaSlack = 1.25;
 
 // "auto" -> kLambdaAuto, else a number >= 0. Throws InputError "--lambda: TEXT: RULE".
 double ParseLambda(const std::string& text);
+// "auto" -> kBlackAuto, else a number in [0, 1). Throws InputError "--black: TEXT: RULE".
+double ParseBlack(const std::string& text);
 
 // The recovery method (see the top of this file): kDebevec, Debevec & Malik's least squares;
 // kRobertson, Robertson et al.'s maximum likelihood.
@@ -61,7 +70,9 @@ struct ResponseOptions {
   // Sampled pixels (debevec); 0 = min(4000, max(1000, 3 levels / (P-1))). Many samples cost
   // little (each adds a P x P block) and average the noise that ripples the curve.
   int samples = 0;
-  double black = 0.02;      // normalised value at or below which a value is unusable
+  // Normalised value at or below which a value is unusable (it takes no part in the fit), or
+  // kBlackAuto: per channel, max(kMinBlack, DetectBlackFloor).
+  double black = kBlackAuto;
   double saturated = 0.98;  // normalised value at or above which a value is unusable
   // robertson: weight of a second-difference penalty on ln I(z) applied at every iteration
   // (0 = none, Robertson's original). A bracket with one constant exposure ratio leaves
@@ -83,7 +94,21 @@ struct ResponseSummary {
   std::vector<double> lambda;  // debevec: per channel, the lambda used (chosen when auto)
   bool converged = true;
   std::vector<double> rms_residual;  // per channel, ln units, over usable data equations
+  std::vector<double> black;         // per channel, the black level used (normalised)
 };
+
+// The black floor of one channel of a bracket: the value that the pixels receiving (almost) no
+// light pile up at, above true black, as a scanned film's base or a camera's black pedestal. It
+// is read from the shortest exposure, where most of a scene is dark: the most common of its
+// values in (kMinBlack, 0.25], if more than 10 % of the pixels lie within two levels (of 255) of
+// it and the pile is narrow: the count falls below a tenth of the mode's within four levels
+// above it and is below a tenth three levels below it (a broad mode is dark scene content, and a
+// mode at the window's lower edge the tail of values falling from true black). The floor is the top
+// of the pile, the first value above the mode held by fewer than a tenth as many pixels. Values at
+// the floor carry no exposure (every time darker than the floor's gives the same value) and noise;
+// counted as data with Debevec's hat weight they bend the curve's toe. Returns 0 when there is no
+// pile (a bracket whose darkest photo is not mostly dark, or whose dark pixels are at true black).
+double DetectBlackFloor(const Bracket& bracket, int channel);
 
 ResponseSummary RecoverResponse(const Bracket& bracket, const ResponseOptions& options);
 

@@ -2,7 +2,7 @@
 // calibration:
 //   igi-calib response IMAGES… (--exposures LIST | --exposure-file FILE | EXIF) --out response.json
 //             [--method debevec|robertson] [--lambda auto|L] [--samples N] [--levels N]
-//             [--plot FILE]
+//             [--black auto|B] [--plot FILE]
 //   igi-calib intrinsics IMAGES… --board COLSxROWS --square METRES --out camera.json
 //             [--board-type charuco --dictionary DICT_4X4_50 --marker METRES]
 //             [--model PINHOLE|OPENCV|FULL_OPENCV] [--fix-aspect-ratio] [--zero-tangent-dist]
@@ -62,6 +62,7 @@ struct ResponseCommand {
   std::string plot;  // empty = OUT with the extension .svg
   bool no_plot = false;
   std::string lambda = "auto";
+  std::string black = "auto";
   std::string method = "debevec";  // checked against debevec|robertson when parsed
   igi::calib::ResponseOptions options;
 };
@@ -86,8 +87,9 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
   sub->add_option("--samples", cmd->options.samples, "Debevec sample pixels (0 = auto)");
   sub->add_option("--levels", cmd->options.levels,
                   "Levels of the curve (0 = 256 for 8-bit, 1024 for 16-bit)");
-  sub->add_option("--black", cmd->options.black,
-                  "Normalised level at or below which a value is unusable (default 0.02)");
+  sub->add_option("--black", cmd->black,
+                  "Normalised level at or below which a value is unusable, or auto (default): "
+                  "each channel's black floor, at least 0.02");
   sub->add_option("--saturated", cmd->options.saturated,
                   "Normalised level at or above which a value is unusable (default 0.98)");
   sub->add_option("--max-iterations", cmd->options.max_iterations, "Robertson iterations");
@@ -99,6 +101,7 @@ CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
 int RunResponse(ResponseCommand cmd) {
   cmd.options.method = igi::calib::ResponseRecoveryMethodFromName(cmd.method).value();
   cmd.options.lambda = igi::calib::ParseLambda(cmd.lambda);
+  cmd.options.black = igi::calib::ParseBlack(cmd.black);
   cmd.options.Validate();
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
   const igi::calib::Bracket bracket = igi::calib::LoadBracket(paths, cmd.exposures);
@@ -118,6 +121,8 @@ int RunResponse(ResponseCommand cmd) {
     info["converged"] = summary.converged;
   }
   info["rms_residual_ln"] = summary.rms_residual;
+  info["black"] = summary.black;  // per channel
+  info["black_mode"] = cmd.options.black == igi::calib::kBlackAuto ? "auto" : "given";
   igi::calib::WriteResponseJson(cmd.out, summary.curve, info);
   std::string plot;
   if (!cmd.no_plot) {
