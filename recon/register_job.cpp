@@ -94,6 +94,56 @@ Json SceneWithCameras(const RegisterOptions& options, Json scene, const ColmapMo
   return std::move(doc).json();
 }
 
+Json IntrinsicsRefinementJson(const IntrinsicsRefinementSummary& r) {
+  Json adjustments = Json::array();
+  for (const IntrinsicsAdjustment& a : r.adjustments) {
+    Json cameras = Json::array();
+    for (const CameraIntrinsicsFit& c : a.cameras) {
+      cameras.push_back({{"camera_id", c.camera_id},
+                         {"images", c.images},
+                         {"model_before", c.model_before},
+                         {"tested", c.tested},
+                         {"focal_before_px", c.focal_before_px},
+                         {"focal_px", c.focal_px},
+                         {"focal_sigma_px", c.focal_sigma_px},
+                         {"aspect", c.aspect},
+                         {"aspect_sigma", c.aspect_sigma},
+                         {"aspect_significance", c.aspect_significance},
+                         {"principal_point_px", c.principal_point_px},
+                         {"principal_point_sigma_px", c.principal_point_sigma_px},
+                         {"principal_point_offset_px", c.offset_px},
+                         {"principal_point_significance", c.principal_point_significance},
+                         {"verdict", c.verdict}});
+    }
+    adjustments.push_back({{"iterations", a.iterations},
+                           {"termination", a.termination},
+                           {"rms_before_px", a.rms_before_px},
+                           {"rms_after_px", a.rms_after_px},
+                           {"covariance", a.covariance},
+                           {"cameras", cameras}});
+  }
+  Json kept = Json::object();
+  for (const auto& [id, terms] : r.kept) kept[std::to_string(id)] = terms;
+  Json j = {{"mode", std::string(PrincipalPointRefinementName(r.mode))},
+            {"kept", kept},
+            {"images", r.images},
+            {"points", r.points},
+            {"observations", r.observations},
+            {"adjustments", adjustments}};
+  if (!r.skipped.empty()) j["skipped"] = r.skipped;
+  return j;
+}
+
+// Refines the principal point and aspect ratio of the cameras COLMAP self-calibrated in this run;
+// returns report.json's "intrinsics_refinement" (null when the intrinsics were known or given).
+Json RefineIntrinsics(const RegisterOptions& options, ColmapRunSummary* run) {
+  if (options.colmap.intrinsics || !options.colmap_model.empty()) return nullptr;
+  IntrinsicsRefinementOptions refinement;
+  refinement.mode = options.refine_principal_point;
+  refinement.threads = options.colmap.threads;
+  return IntrinsicsRefinementJson(RefineSelfCalibratedIntrinsics(&run->model, refinement));
+}
+
 Json BaseReport(const ColmapRunSummary& run, const RegisterOptions& options) {
   Json report;
   report["format"] = "igi-register-report";
@@ -345,9 +395,11 @@ RegisterSummary Register(const RegisterOptions& options, const RegisterInputs& i
   ColmapRunSummary run = options.colmap_model.empty()
                              ? RunColmap(options.images, out / "colmap", options.colmap)
                              : LoadColmapRun(options.images, options.colmap_model);
+  const Json intrinsics = RefineIntrinsics(options, &run);
   Json alignment;
   if (inputs.scene) alignment = AlignToScene(options, inputs, &run);
   Json report = BaseReport(run, options);
+  if (!intrinsics.is_null()) report["intrinsics_refinement"] = intrinsics;
   AddRegistered(run.model, alignment, &report);
   if (inputs.scene) report["alignment"] = alignment;
   WriteColmapModelText(run.model, out / "sparse");

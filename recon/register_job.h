@@ -2,6 +2,10 @@
 // igi-register's job (docs/file-formats.md: report.json, markers): photos -> camera poses with
 // COLMAP 3.8 (or an existing COLMAP model), optionally brought into a scene's frame.
 //
+// When COLMAP self-calibrated the camera, its principal point (held at the image centre) and
+// aspect ratio are refined where the photos determine them (recon/intrinsics_refinement.h)
+// before anything else; report.json's "intrinsics_refinement" says what was tried and kept.
+//
 // In a scene's frame the model is placed by the markers' control points when given, then by
 // fitting the sparse points to the scene mesh (robust point-to-plane ICP with scale; without
 // markers from a principal-axes start), then each pose is refined against the mesh; photos whose
@@ -21,6 +25,7 @@
 #include <vector>
 
 #include "recon/colmap_runner.h"
+#include "recon/intrinsics_refinement.h"
 #include "recon/registration.h"
 #include "recon/scene.h"
 #include "tools/common/json.h"
@@ -37,6 +42,10 @@ struct RegisterOptions {
   ColmapRunOptions colmap;
   // The file `colmap.intrinsics` were read from, named in the photo size check's message.
   std::string camera_file;
+  // After COLMAP self-calibrates (no `colmap.intrinsics`, no `colmap_model`): refine the principal
+  // point and the aspect ratio, keeping each only where the photos determine it (kAuto), always
+  // (kOn) or never (kOff) (recon/intrinsics_refinement.h).
+  PrincipalPointRefinement refine_principal_point = PrincipalPointRefinement::kAuto;
   bool no_mesh_fit = false;          // with `scene`: align by `markers` only, no mesh fit
   bool no_pose_refinement = false;   // with `scene`: no per-photo refinement against the mesh
   bool no_joint_refinement = false;  // with `scene`: no final joint refinement of poses, points

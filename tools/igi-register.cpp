@@ -14,10 +14,13 @@
 // Writes DIR/sparse/ (COLMAP TXT model), DIR/report.json and, with --scene, DIR/scene.json (the
 // input scene with one camera per registered photo, in the scene's frame, and its photos).
 // COLMAP's own database, models and log go to DIR/colmap/ (--colmap-model: an existing model
-// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL);
-// --guided-matching turns on COLMAP's guided matching (recon/colmap_runner.h: what it does). Exit 3
-// when some photos did not register (listed in report.json); exit 1 when COLMAP is missing, of
-// another version than 3.8, or reconstructs nothing; exit 2 for bad input (nothing written).
+// instead). Without --camera COLMAP self-calibrates --camera-model (default SIMPLE_RADIAL) with the
+// principal point at the image centre; --refine-principal-point (auto by default) then refines
+// the principal point and the aspect ratio where the photos determine them
+// (recon/intrinsics_refinement.h; docs/registration.md); --guided-matching turns on COLMAP's guided
+// matching (recon/colmap_runner.h: what it does). Exit 3 when some photos did not register (listed
+// in report.json); exit 1 when COLMAP is missing, of another version than 3.8, or reconstructs
+// nothing; exit 2 for bad input (nothing written).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -70,6 +73,7 @@ int main(int argc, char** argv) {
   igi::recon::RegisterOptions options;
   std::string camera;
   std::string camera_model = "SIMPLE_RADIAL";  // checked against kSelfCalibratedModels when parsed
+  std::string refine_principal_point = "auto";
   bool multi_camera = false;
   app.add_option("--images", options.images, "Folder of photos")->required();
   app.add_option("--out", options.out, "Output folder")->required();
@@ -89,6 +93,11 @@ int main(int argc, char** argv) {
                  "COLMAP camera model self-calibrated without --camera: SIMPLE_RADIAL "
                  "(default), RADIAL, OPENCV, PINHOLE or SIMPLE_PINHOLE")
       ->check(CLI::IsMember(igi::recon::kSelfCalibratedModels));
+  app.add_option("--refine-principal-point", refine_principal_point,
+                 "Without --camera, after COLMAP's mapping: refine the principal point and the "
+                 "aspect ratio fy/fx, keeping each where the photos determine it (auto, default), "
+                 "always (on) or never (off: COLMAP's, the principal point at the image centre)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   app.add_flag("--guided-matching", options.colmap.guided_matching,
                "COLMAP matches each photo pair again along its epipolar geometry (more correct "
                "matches, 2-2.4x the matching time)");
@@ -116,6 +125,8 @@ int main(int argc, char** argv) {
                "Accept a COLMAP other than 3.8");
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
     options.colmap.camera_model = igi::calib::ColmapCameraModelFromName(camera_model).value();
+    options.refine_principal_point =
+        igi::recon::PrincipalPointRefinementFromName(refine_principal_point).value();
     return Run(camera, multi_camera, flags, &options);
   });
 }

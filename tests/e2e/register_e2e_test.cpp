@@ -95,7 +95,7 @@ TEST(RegisterE2eTest, MarkersNamingPointsTheSceneLacksExit2) {
 
 // The joint refinement's and the model's flags: a --colmap-model that is not a folder, a
 // non-positive --marker-sigma or --mesh-sigma, too few --min-pose-inliers, a --camera-model
-// igi cannot read. Exit 2, nothing written.
+// igi cannot read, an unknown --refine-principal-point. Exit 2 with one line, nothing written.
 TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
   const fs::path dir = test::UniqueTempDir("igi_register_e2e");
   const fs::path out = dir / "out";
@@ -104,10 +104,12 @@ TEST(RegisterE2eTest, BadRefinementFlagsExit2) {
   auto r = RunTool("igi-register", base + " --colmap-model " + Quote((dir / "none").string()));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--colmap-model"), std::string::npos) << r.err;
-  for (const std::string flag : {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3",
-                                 "--camera-model FULL_OPENCV"}) {
+  for (const std::string flag :
+       {"--marker-sigma 0", "--mesh-sigma -1", "--min-pose-inliers 3", "--camera-model FULL_OPENCV",
+        "--refine-principal-point sometimes"}) {
     r = RunTool("igi-register", base + " " + flag);
     EXPECT_EQ(r.exit_code, 2) << flag << ": " << r.err;
+    EXPECT_EQ(ErrorLines(r.err), 1) << flag << ": " << r.err;
   }
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(dir);

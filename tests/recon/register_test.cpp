@@ -1,6 +1,6 @@
 // Registration with COLMAP 3.8 on real photos (Sceaux castle, openMVG sample, © 2012 Pierre
 // Moulon; ../shared/data/real/sceaux_castle), downscaled 4x to keep the test fast, and the
-// marker-based alignment on a synthetic model with known truth.
+// command lines igi gives COLMAP (a fake COLMAP that logs them).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -25,8 +25,6 @@ namespace fs = std::filesystem;
 
 const fs::path kSceaux = fs::path(IGI_SHARED_DATA_DIR) / "real" / "sceaux_castle";
 constexpr int kDownscale = 4;  // 2832x2128 -> 708x532
-// K.txt: fx = fy = 2905.88 px at full size.
-constexpr double kFocalFullPx = 2905.88;
 
 // The Sceaux photos downscaled kDownscale times (area averaging) into `dir`.
 void WriteDownscaledSceaux(const fs::path& dir) {
@@ -118,10 +116,11 @@ TEST(ColmapRunnerTest, CameraModelGuidedMatchingAndFeatureCapArePassed) {
   fs::remove_all(dir);
 }
 
-// Every Sceaux photo registers, and the focal length COLMAP self-calibrates (not given the
-// intrinsics: its prior is 1.2 x the larger side, as the downscaled JPEGs carry no EXIF) with
-// igi's defaults (SIMPLE_RADIAL, no guided matching) is close to K.txt.
-TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
+// Every Sceaux photo registers with igi's defaults (SIMPLE_RADIAL, no guided matching) in one
+// shared camera, each with enough well-fitting observations. (The self-calibrated intrinsics are
+// measured against real ground truth on Herz-Jesu-P8: herzjesu_register_test.cpp. Sceaux's K.txt
+// does not say its distortion model, on which its focal length depends.)
+TEST(ColmapRunnerTest, SceauxRegisters) {
   const fs::path dir = test::UniqueTempDir("igi_colmap_sceaux");
   WriteDownscaledSceaux(dir / "images");
   const ColmapRunSummary run = RunColmap(dir / "images", dir / "work", ColmapRunOptions{});
@@ -130,19 +129,7 @@ TEST(ColmapRunnerTest, SceauxRegistersWithFocalFromKTxt) {
   EXPECT_TRUE(run.unregistered.empty());
   EXPECT_EQ(run.model.images.size(), 11u);
   ASSERT_EQ(run.model.cameras.size(), 1u);  // one camera shared by every photo
-  const ColmapCamera& camera = run.model.cameras.begin()->second;
-  const double expected = kFocalFullPx / kDownscale;
-  std::printf("Sceaux: %s focal %.2f px, K.txt %.2f px (%.2f %%)\n", camera.model.c_str(),
-              camera.params[0], expected, 100 * (camera.params[0] / expected - 1));
-  // The target is 2 %, which igi does NOT reach on the full-size photos, so this checks 3 % to
-  // catch regressions. Measured (bench/RESULTS.md "Registration"): here with the defaults
-  // +1.9..+2.3 % (COLMAP's matching is not deterministic); with guided matching +1.65, +1.75,
-  // +1.86 % (three runs of this test), with DSP-SIFT +1.87..+1.97 %. But at full size every
-  // feature, matching and mapper variant tried gives 2970-2975 px (+2.2..+2.4 %), so the
-  // quarter-size values under 2 % are scatter, not a better estimate. The focal depends on the
-  // distortion model (full size: FOV -1.8 %, SIMPLE_RADIAL +2.3 %, RADIAL +2.9 %), and K.txt's
-  // model is not known.
-  EXPECT_NEAR(camera.params[0], expected, 0.03 * expected);
+  EXPECT_EQ(run.model.cameras.begin()->second.model, "SIMPLE_RADIAL");
   for (const ImageReprojection& r : ReprojectionErrors(run.model)) {
     EXPECT_GT(r.observations, 50) << r.name;
     EXPECT_LT(r.rms_px, 1.5) << r.name;  // COLMAP's default filter keeps errors under 4 px
