@@ -150,5 +150,9 @@ Json CameraJson(const Camera& camera);
 
 // Loads and validates `path`. Throws InputError listing every problem ("FILE: KEY: VALUE: RULE").
 Scene LoadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
+// Loads and validates a document held in memory as if it were read from the file `path`: `path`'s
+// folder resolves relative paths and messages name `path`, which need not exist.
+Scene LoadSceneFromDocument(Json document, const std::filesystem::path& path,
+                              const SceneLoadOptions& options = {});
 
 }  // namespace igi::recon

@@ -35,7 +35,7 @@ std::string Rebase(const std::string& path, const fs::path& from, const fs::path
 SceneDocument::SceneDocument(Json document) : doc_(std::move(document)) {}
 
 void SceneDocument::Validate(const fs::path& dir, const SceneLoadOptions& options) const {
-  LoadSceneDocument(doc_, dir / "scene.json", options);
+  LoadSceneFromDocument(doc_, dir / "scene.json", options);
 }
 
 void SceneDocument::RebasePaths(const fs::path& from_dir, const fs::path& to_dir) {

@@ -199,10 +199,10 @@ void BindRegions(const SceneLoader& ld, const JsonCursor& root,
 }  // namespace
 
 Scene LoadScene(const fs::path& path, const SceneLoadOptions& options) {
-  return LoadSceneDocument(ReadJsonFile(path), path, options);
+  return LoadSceneFromDocument(ReadJsonFile(path), path, options);
 }
 
-Scene LoadSceneDocument(Json document, const fs::path& path, const SceneLoadOptions& options) {
+Scene LoadSceneFromDocument(Json document, const fs::path& path, const SceneLoadOptions& options) {
   Scene scene;
   scene.file = fs::absolute(path).lexically_normal();
   scene.dir = scene.file.parent_path();

@@ -1,6 +1,6 @@
 #pragma once
-// Internal to recon: the state shared by the parts of LoadScene (recon/scene_io*.cpp), and
-// LoadScene of a document in memory (SceneDocument::Validate). Not public API.
+// Internal to recon: the state shared by the parts of LoadScene (recon/scene_io*.cpp). Not public
+// API.
 
 #include <filesystem>
 #include <optional>
@@ -29,10 +29,5 @@ struct SceneLoader {
 void ReadLightsAndLightings(const SceneLoader& ld, const JsonCursor& root, Scene* scene);
 void ReadCameras(const SceneLoader& ld, const JsonCursor& root, Scene* scene);
 void ReadPhotos(const SceneLoader& ld, const JsonCursor& root, Scene* scene);
-
-// LoadScene of `document` as if read from the file `path` (its folder resolves relative paths;
-// messages name `path`).
-Scene LoadSceneDocument(Json document, const std::filesystem::path& path,
-                        const SceneLoadOptions& options);
 
 }  // namespace igi::recon
