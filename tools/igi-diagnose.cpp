@@ -7,6 +7,7 @@
 
 #include "recon/scene.h"
 #include "solver/diagnose/diagnose.h"
+#include "solver/diagnose/diagnose_flags.h"
 #include "tools/common/cli.h"
 #include "tools/common/error.h"
 
@@ -20,56 +21,16 @@ int main(int argc, char** argv) {
   igi::CommonFlags common;
   igi::AddCommonFlags(app, &common, true);
   std::string scene_path, out_dir;
-  igi::diagnose::DiagnoseOptions o;
+  igi::diagnose::DiagnoseOptions flags;
   app.add_option("scene", scene_path, "scene.json (unknown materials are solved first)")
       ->required();
   app.add_option("--out", out_dir,
                  "output folder (diagnosis.json, scene.json, report.html, steps/)")
       ->required();
-  app.add_option("--spp", o.spp, "paths per pixel of the re-renders")->capture_default_str();
-  app.add_option("--spp-max", o.spp_max,
-                 "when above --spp: the paths per pixel are chosen within [--spp, this] from the "
-                 "photos' noise; -1 = up to the paths --analysis-megapixels of photos take at "
-                 "--spp, spread over the pixels analysed; 0 = fixed at --spp")
-      ->capture_default_str();
-  app.add_option("--render-noise-share", o.render_noise_share,
-                 "the renders' variance the chosen paths allow, as a share of the photos' noise")
-      ->capture_default_str();
-  app.add_option("--analysis-megapixels", o.analysis_megapixels,
-                 "larger photos are analysed as the means of pixel blocks that bring them within "
-                 "this size (0 = full size)")
-      ->capture_default_str();
-  app.add_option("--pixel-stride", o.pixel_stride, "residual samples: every Nth pixel")
-      ->capture_default_str();
-  app.add_option("--max-steps", o.max_steps, "effects modelled at most")->capture_default_str();
-  app.add_option("--holdout-fraction", o.holdout_fraction, "share of pixel blocks held out")
-      ->capture_default_str();
-  app.add_option("--holdout-block-px", o.holdout_block_px, "held-out block size, pixels")
-      ->capture_default_str();
-  app.add_option("--min-gain", o.min_gain, "held-out residual² reduction a step must reach")
-      ->capture_default_str();
-  app.add_option("--min-z", o.min_z, "standard errors the held-out gain must reach")
-      ->capture_default_str();
-  app.add_option("--light-samples", o.light_samples, "light samples per extended light")
-      ->capture_default_str();
-  app.add_option("--solve-stride", o.solve.pixel_stride, "igi-solve --pixel-stride")
-      ->capture_default_str();
-  app.add_option("--memory-budget", o.solve.memory_budget,
-                 "memory budget, GiB (0 = the machine's memory less a margin): the photos and "
-                 "re-renders at the analysis size are planned first, its solves get the rest")
-      ->capture_default_str();
-  app.add_option("--max-observations", o.solve.max_observations,
-                 "igi-solve --max-observations for its solves (0 = as the memory budget allows)")
-      ->capture_default_str();
-  app.add_option("--solve-iterations", o.solve.max_iterations, "igi-solve --max-iterations")
-      ->capture_default_str();
-  app.add_option("--refine-iterations", o.solve.refine_iterations, "igi-solve --refine-iterations")
-      ->capture_default_str();
-  app.add_option("--seed", o.seed, "random seed")->capture_default_str();
+  igi::diagnose::AddDiagnoseFlags(app, &flags);
   return igi::RunMain(app, common, argc, argv, [&]() {
-    o.num_threads = common.threads;
-    o.show_progress = !common.quiet;
-    o.Validate();
+    const igi::diagnose::DiagnoseOptions o =
+        igi::diagnose::FinishDiagnoseFlags(flags, common.threads, !common.quiet);
     igi::RejectOutputInSceneFolder(out_dir, scene_path);
     const igi::recon::Scene scene = igi::recon::LoadScene(scene_path);
     if (scene.photos.empty()) {

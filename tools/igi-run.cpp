@@ -7,8 +7,7 @@
 #include <cstdio>
 
 #include "tools/common/cli.h"
-#include "tools/pipeline/demo.h"
-#include "tools/pipeline/pipeline.h"
+#include "tools/pipeline/run_flags.h"
 
 namespace {
 
@@ -54,90 +53,19 @@ int main(int argc, char** argv) {
   app.footer(kLayout);
   igi::CommonFlags flags;
   igi::AddCommonFlags(app, &flags, /*computes=*/true);
-  igi::pipeline::RunOptions o;
-  igi::pipeline::DemoOptions demo;
-  // --demo's choice flags as typed; SetChoices parses them into `demo` and validates it.
-  igi::pipeline::DemoChoiceFlags demo_choices;
-  bool run_demo = false;
-  std::string photos, scene, out, bin, camera, colour, lights;
+  std::string photos, out;
   app.add_option("photos", photos, "PHOTOS_DIR (layout below)");
-  app.add_option("--scene", scene, "scene.json: geometry, materials, lights, lightings");
   app.add_option("--out", out, "Output folder (stages resume from it)")->required();
-  app.add_flag("--demo", run_demo, "Generate a synthetic capture (igi-synth) and run the chain");
-  app.add_flag("--hdr-photos", o.hdr_photos,
-               "Photos are radiance maps and the scene has cameras and photos: solve directly");
-  app.add_flag("--skip-diagnose", o.skip_diagnose, "Skip the diagnosis stage");
-  app.add_option("--solve-arg", o.solve_args, "Argument passed to igi-solve (repeatable)")
-      ->allow_extra_args(false);
-  app.add_option("--register-arg", o.register_args, "Argument passed to igi-register (repeatable)")
-      ->allow_extra_args(false);
-  app.add_option("--diagnose-spp", o.diagnose_spp, "igi-diagnose --spp (0 = its default)");
-  app.add_option("--radiance-scale", o.radiance_scale,
-                 "Absolute calibration: the HDR maps are this many times the radiance in the "
-                 "scene's units (1 = absolute already)")
-      ->capture_default_str();
-  app.add_option("--diagnose-arg", o.diagnose_args, "Argument passed to igi-diagnose (repeatable)")
-      ->allow_extra_args(false);
-  app.add_option("--report-spp", o.report_spp, "Samples per pixel of the report's renders")
-      ->capture_default_str();
-  app.add_option("--report-photos", o.report_photos, "Photos re-rendered in the report")
-      ->capture_default_str();
-  app.add_option("--report-lightings", o.report_lightings, "Lightings of the relit renders")
-      ->capture_default_str();
-  app.add_option("--report-megapixels", o.report_megapixels,
-                 "The report's renders and photo figures at most this many megapixels (block "
-                 "means of the photos; 0 = their size)")
-      ->capture_default_str();
-  app.add_option("--camera", camera,
-                 "camera.json (intrinsics, vignetting) instead of PHOTOS_DIR/camera.json");
-  app.add_option("--lights", lights,
-                 "lights.json (igi-calib lights) instead of PHOTOS_DIR/lights.json");
-  app.add_option("--colour", colour,
-                 "colour.json (igi-calib colour) instead of PHOTOS_DIR/colour.json");
-  app.add_option("--bin-dir", bin, "Folder of the igi executables (default: igi-run's)");
-  app.add_option("--demo-cameras", demo.cameras, "--demo: cameras")->capture_default_str();
-  app.add_option("--demo-ceiling-cameras", demo.ceiling_cameras,
-                 "--demo: cameras looking up at the ceiling, besides --demo-cameras (posed from "
-                 "surveyed targets)")
-      ->capture_default_str();
-  app.add_option("--demo-marker-noise", demo.marker_noise_px,
-                 "--demo: standard deviation (px) of the noise on the control points' pixels")
-      ->capture_default_str();
-  app.add_option("--demo-width", demo.width, "--demo: photo width")->capture_default_str();
-  app.add_option("--demo-height", demo.height, "--demo: photo height")->capture_default_str();
-  app.add_option("--demo-spp", demo.spp, "--demo: render samples per pixel")->capture_default_str();
-  app.add_option("--demo-calibration", demo_choices.calibration,
-                 "--demo: the HDR maps' absolute scale: measured (given, as a lab calibration), "
-                 "reference (solved from the matte box, its reflectance given) or none")
-      ->capture_default_str();
+  igi::pipeline::RunFlags f;
+  igi::pipeline::AddRunFlags(app, &f);
   return igi::RunMain(app, flags, argc, argv, [&]() -> int {
-    o.photos_dir = photos;
-    o.camera = camera;
-    o.colour = colour;
-    o.lights = lights;
-    o.scene = scene;
-    o.out = out;
-    o.bin_dir = bin;
-    o.num_threads = flags.threads;
-    igi::pipeline::RunSummary summary;
-    if (run_demo) {
-      demo.out = out;
-      demo.bin_dir = bin;
-      demo.skip_diagnose = o.skip_diagnose;
-      demo.num_threads = flags.threads;
-      if (!o.solve_args.empty()) demo.solve_args = o.solve_args;
-      if (!o.diagnose_args.empty()) demo.diagnose_args = o.diagnose_args;
-      demo.SetChoices(demo_choices);
-      const igi::pipeline::DemoSummary d = igi::pipeline::RunDemo(demo);
-      summary = d.run;
-      PrintSummary(summary);
+    const igi::pipeline::RunResult r = igi::pipeline::RunFromFlags(f, photos, out, flags.threads);
+    PrintSummary(r.run);
+    if (r.demo) {
       std::printf("recovered parameters beside the truth (%s/demo_summary.json):\n", out.c_str());
-      for (const std::string& line : d.table) std::printf("  %s\n", line.c_str());
-    } else {
-      summary = igi::pipeline::RunPipeline(o);
-      PrintSummary(summary);
+      for (const std::string& line : r.table) std::printf("  %s\n", line.c_str());
     }
-    if (summary.partial) throw igi::PartialError(summary.partial_lines);
+    if (r.run.partial) throw igi::PartialError(r.run.partial_lines);
     return 0;
   });
 }

@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "tools/common/parallel.h"
 
 namespace igi {
 namespace {
@@ -68,6 +72,58 @@ TEST(ProgressTest, DrawsWhenEnabledAndAfterTheDelay) {
     progress.Add(4);
   });
   EXPECT_EQ(quick, "");
+}
+
+// The observer sees every Progress, drawn or not, and the final count once it finishes.
+TEST(Progress, ObserverSeesUndrawnWorkAndItsEnd) {
+  std::vector<std::pair<int64_t, int64_t>> seen;
+  std::string label;
+  SetProgressObserver([&](const std::string& l, int64_t done, int64_t total) {
+    label = l;
+    seen.emplace_back(done, total);
+  });
+  {
+    Progress progress("observed", 5, 2.0, /*enabled=*/false);
+    for (int i = 0; i < 5; ++i) progress.Add();
+  }
+  SetProgressObserver(nullptr);
+  {
+    Progress progress("unobserved", 5, 2.0, false);
+    progress.Add(5);
+  }
+  EXPECT_EQ(label, "observed");
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back(), std::make_pair(int64_t{5}, int64_t{5}));
+}
+
+// A requested cancellation stops parallel work at its next unit with Cancelled, in the caller's
+// thread, and work after ClearCancel runs to the end.
+TEST(Progress, CancellationStopsParallelWorkWithCancelled) {
+  std::atomic<int64_t> ran{0};
+  const auto work = [&] {
+    Progress progress("cancellable", 1000, 2.0, false);
+    ParallelFor(0, 1000, [&](int64_t i) {
+      if (i == 10) RequestCancel();
+      ++ran;
+      progress.Add();
+    });
+  };
+  try {
+    work();
+    FAIL() << "no Cancelled thrown";
+  } catch (const Cancelled& e) {
+    EXPECT_EQ(std::string(e.what()), "cancellable: cancelled");
+    EXPECT_EQ(e.code(), ExitCode::kFailed);
+  }
+  EXPECT_LT(ran.load(), 1000);
+  ClearCancel();
+  ran = 0;
+  Progress progress("after", 1000, 2.0, false);
+  EXPECT_NO_THROW(ParallelFor(0, 1000, [&](int64_t) {
+    ++ran;
+    progress.Add();
+  }));
+  EXPECT_EQ(ran.load(), 1000);
 }
 
 }  // namespace

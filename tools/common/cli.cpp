@@ -1,5 +1,6 @@
 #include "tools/common/cli.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -50,6 +51,24 @@ int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: internal: %s\n", program.c_str(), e.what());
     return static_cast<int>(ExitCode::kFailed);
+  }
+}
+
+void ParseArguments(CLI::App& app, const std::string& program, std::vector<std::string> args) {
+  ProblemList problems;
+  for (const std::string& arg : args) {
+    const std::string name = arg.substr(0, arg.find('='));
+    if (name.rfind("--", 0) != 0 || app.get_option_no_throw(name) == nullptr) {
+      problems.Add("", name, arg.substr(std::min(arg.size(), name.size() + 1)),
+                   "not an option of " + program);
+    }
+  }
+  problems.ThrowIfAny();
+  std::reverse(args.begin(), args.end());  // CLI11 takes a vector's arguments from its back
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    throw InputError(program + ": " + e.what());
   }
 }
 

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace igi {
 
@@ -26,6 +27,12 @@ void AddCommonFlags(CLI::App& app, CommonFlags* flags, bool computes = true);
 // --help and --version exit 0.
 int RunMain(CLI::App& app, const CommonFlags& flags, int argc, char** argv,
             const std::function<int()>& body);
+
+// Parses `args` ("--name=value" or "--name", in order) with `app`, as a command line without the
+// program name: the flags of an executable given from elsewhere (the Python package's keyword
+// arguments). Throws InputError naming `program` and the argument: an unknown option, a value
+// the option refuses, a missing required one.
+void ParseArguments(CLI::App& app, const std::string& program, std::vector<std::string> args);
 
 // Throws InputError ("--out: DIR: must differ from the scene's folder") when `out_dir` is the
 // folder of `scene_path`: a tool never writes into its input scene's folder.

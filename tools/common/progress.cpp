@@ -4,8 +4,32 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 
 namespace igi {
+namespace {
+
+std::mutex g_observer_mutex;
+std::shared_ptr<const ProgressObserver> g_observer;
+std::atomic<bool> g_observed{false};
+std::atomic<bool> g_cancel{false};
+
+std::shared_ptr<const ProgressObserver> CurrentObserver() {
+  std::lock_guard<std::mutex> lock(g_observer_mutex);
+  return g_observer;
+}
+
+}  // namespace
+
+void SetProgressObserver(ProgressObserver observer) {
+  std::lock_guard<std::mutex> lock(g_observer_mutex);
+  g_observer = observer ? std::make_shared<const ProgressObserver>(std::move(observer)) : nullptr;
+  g_observed.store(g_observer != nullptr);
+}
+
+void RequestCancel() { g_cancel.store(true); }
+void ClearCancel() { g_cancel.store(false); }
+bool CancelRequested() { return g_cancel.load(std::memory_order_relaxed); }
 
 bool ProgressAllowed() {
   if (std::getenv("CI") != nullptr || std::getenv("IGI_NO_PROGRESS") != nullptr) return false;
@@ -20,16 +44,24 @@ Progress::Progress(std::string label, int64_t total, double delay_s, bool enable
       delay_s_(delay_s),
       enabled_(enabled),
       start_(std::chrono::steady_clock::now()),
-      last_draw_(start_) {}
+      last_draw_(start_),
+      last_notify_(start_) {}
 
 Progress::~Progress() { Finish(); }
 
 void Progress::Add(int64_t n) {
   done_.fetch_add(n);
-  if (!enabled_) return;
+  if (CancelRequested()) throw Cancelled(label_);
+  const bool observed = g_observed.load(std::memory_order_relaxed);
+  if (!enabled_ && !observed) return;
   const auto now = std::chrono::steady_clock::now();
   std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
   if (!lock.owns_lock() || finished_) return;
+  if (observed && std::chrono::duration<double>(now - last_notify_).count() >= 0.1) {
+    last_notify_ = now;
+    Notify();
+  }
+  if (!enabled_) return;
   const double since_start = std::chrono::duration<double>(now - start_).count();
   const double since_draw = std::chrono::duration<double>(now - last_draw_).count();
   if (since_start < delay_s_ || (shown_ && since_draw < 0.1)) return;
@@ -38,11 +70,18 @@ void Progress::Add(int64_t n) {
 }
 
 void Progress::Finish() {
-  if (!enabled_) return;
+  if (!enabled_ && !g_observed.load()) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (finished_) return;
   finished_ = true;
+  Notify();
   if (shown_) Draw(true);
+}
+
+void Progress::Notify() {
+  if (const std::shared_ptr<const ProgressObserver> observer = CurrentObserver()) {
+    (*observer)(label_, done_.load(), total_);
+  }
 }
 
 void Progress::Draw(bool final_draw) {
