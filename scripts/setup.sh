@@ -11,7 +11,8 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libceres-dev libembree-dev libraw-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev
   colmap libgtest-dev libgmock-dev
-  python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-opencv  # import igi
+  python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-opencv
+  python3-matplotlib  # import igi, and the plots of docs/python.md
   chromium  # igi-run report test (headless)
 )
 
