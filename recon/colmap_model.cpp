@@ -659,6 +659,123 @@ std::string Points3DText(const ColmapModel& model) {
   return out;
 }
 
+// Appends `value`'s bytes in little-endian order (COLMAP's WriteBinaryLittleEndian).
+template <typename T>
+void PutLittleEndian(std::string& out, T value) {
+  std::array<char, sizeof(T)> buffer;
+  std::memcpy(buffer.data(), &value, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(buffer.begin(), buffer.end());
+  out.append(buffer.data(), sizeof(T));
+}
+
+// cameras.bin: uint64 count; per camera uint32 id, int32 model id, uint64 width, uint64 height,
+// double params[].
+std::string CamerasBinary(const ColmapModel& model) {
+  std::string out;
+  out.reserve(8 + model.cameras.size() * (24 + 12 * 8));
+  PutLittleEndian<uint64_t>(out, model.cameras.size());
+  for (const auto& [id, camera] : model.cameras) {
+    PutLittleEndian<uint32_t>(out, id);
+    PutLittleEndian<int32_t>(out, ColmapModelIdFromName(camera.model).value());
+    PutLittleEndian<uint64_t>(out, static_cast<uint64_t>(camera.width));
+    PutLittleEndian<uint64_t>(out, static_cast<uint64_t>(camera.height));
+    for (double p : camera.params) PutLittleEndian<double>(out, p);
+  }
+  return out;
+}
+
+// images.bin: uint64 count; per image uint32 id, double qvec[4] (w, x, y, z), double tvec[3],
+// uint32 camera id, the name and a NUL, uint64 number of 2D points, then per 2D point double x,
+// double y and uint64 3D point id (2^64 - 1 for none, COLMAP's kInvalidPoint3DId).
+std::string ImagesBinary(const ColmapModel& model) {
+  size_t bytes = 8;
+  for (const auto& [id, image] : model.images) {
+    bytes += 4 + 7 * 8 + 4 + image.name.size() + 1 + 8 + image.points2d.size() * 24;
+  }
+  std::string out;
+  out.reserve(bytes);
+  PutLittleEndian<uint64_t>(out, model.images.size());
+  for (const auto& [id, image] : model.images) {
+    PutLittleEndian<uint32_t>(out, id);
+    const Eigen::Vector4d q = QuaternionToWrite(image.qvec);
+    for (int k = 0; k < 4; ++k) PutLittleEndian<double>(out, q[k]);
+    for (int k = 0; k < 3; ++k) PutLittleEndian<double>(out, image.tvec[k]);
+    PutLittleEndian<uint32_t>(out, image.camera_id);
+    out.append(image.name.c_str(), image.name.size() + 1);
+    PutLittleEndian<uint64_t>(out, image.points2d.size());
+    for (const ColmapPoint2D& point : image.points2d) {
+      PutLittleEndian<double>(out, point.xy.x());
+      PutLittleEndian<double>(out, point.xy.y());
+      PutLittleEndian<uint64_t>(out, point.point3d_id < 0
+                                         ? kInvalidPoint3DIdBinary
+                                         : static_cast<uint64_t>(point.point3d_id));
+    }
+  }
+  return out;
+}
+
+// points3D.bin: uint64 count; per point uint64 id, double xyz[3], uint8 rgb[3], double error,
+// uint64 track length, then per element uint32 image id and uint32 2D point index.
+std::string Points3DBinary(const ColmapModel& model) {
+  size_t bytes = 8;
+  for (const auto& [id, point] : model.points3d)
+    bytes += 8 + 24 + 3 + 8 + 8 + point.track.size() * 8;
+  std::string out;
+  out.reserve(bytes);
+  PutLittleEndian<uint64_t>(out, model.points3d.size());
+  for (const auto& [id, point] : model.points3d) {
+    PutLittleEndian<uint64_t>(out, id);
+    for (int k = 0; k < 3; ++k) PutLittleEndian<double>(out, point.xyz[k]);
+    for (uint8_t c : point.rgb) PutLittleEndian<uint8_t>(out, c);
+    PutLittleEndian<double>(out, point.error);
+    PutLittleEndian<uint64_t>(out, point.track.size());
+    for (const ColmapTrackElement& element : point.track) {
+      PutLittleEndian<uint32_t>(out, element.image_id);
+      PutLittleEndian<uint32_t>(out, element.point2d_idx);
+    }
+  }
+  return out;
+}
+
+// The PLY that COLMAP's Reconstruction::ExportPLY writes: binary little-endian, one vertex per 3D
+// point with float x, y, z and uchar red, green, blue (no normals), here in point id order.
+std::string PointsPly(const ColmapModel& model) {
+  std::string out = fmt::format(
+      "ply\n"
+      "format binary_little_endian 1.0\n"
+      "element vertex {}\n"
+      "property float x\n"
+      "property float y\n"
+      "property float z\n"
+      "property uchar red\n"
+      "property uchar green\n"
+      "property uchar blue\n"
+      "end_header\n",
+      model.points3d.size());
+  out.reserve(out.size() + model.points3d.size() * 15);
+  for (const auto& [id, point] : model.points3d) {
+    for (int k = 0; k < 3; ++k) PutLittleEndian<float>(out, static_cast<float>(point.xyz[k]));
+    for (uint8_t c : point.rgb) PutLittleEndian<uint8_t>(out, c);
+  }
+  return out;
+}
+
+// Every coordinate of every 3D point must be finite and within float's range (the PLY stores
+// float); problems name `path` and the point.
+void CheckPointsForPly(const ColmapModel& model, const fs::path& path) {
+  ProblemList problems;
+  for (const auto& [id, point] : model.points3d) {
+    if (Full(problems)) break;
+    if (!point.xyz.allFinite() ||
+        point.xyz.cwiseAbs().maxCoeff() > std::numeric_limits<float>::max()) {
+      problems.Add(path.string(), fmt::format("POINT3D_ID {}", id),
+                   fmt::format("{} {} {}", point.xyz[0], point.xyz[1], point.xyz[2]),
+                   "X, Y and Z must be finite and within float range (the PLY stores float)");
+    }
+  }
+  problems.ThrowIfAny();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -757,6 +874,21 @@ void WriteColmapModelText(const ColmapModel& model, const fs::path& dir) {
   WriteFileAtomic(dir / "cameras.txt", cameras);
   WriteFileAtomic(dir / "images.txt", images);
   WriteFileAtomic(dir / "points3D.txt", points3d);
+}
+
+void WriteColmapModelBinary(const ColmapModel& model, const fs::path& dir) {
+  ValidateModel(model, dir, ".bin", nullptr);
+  const std::string cameras = CamerasBinary(model);
+  const std::string images = ImagesBinary(model);
+  const std::string points3d = Points3DBinary(model);
+  WriteFileAtomic(dir / "cameras.bin", cameras);
+  WriteFileAtomic(dir / "images.bin", images);
+  WriteFileAtomic(dir / "points3D.bin", points3d);
+}
+
+void WriteColmapPointsPly(const ColmapModel& model, const fs::path& path) {
+  CheckPointsForPly(model, path);
+  WriteFileAtomic(path, PointsPly(model));
 }
 
 }  // namespace igi::recon

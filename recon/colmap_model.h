@@ -1,5 +1,6 @@
 #pragma once
-// COLMAP sparse models (cameras, images, points3D) as COLMAP 3.8 writes them, in TXT or BIN.
+// COLMAP sparse models (cameras, images, points3D) as COLMAP 3.8 writes them, in TXT or BIN;
+// the 3D points as COLMAP's PLY export.
 //
 // Frames and conventions are COLMAP's: an image's pose is `cam_from_world`
 // (x_cam = R(qvec) * x_world + tvec), qvec = (w, x, y, z); camera x right, y down, z forward;
@@ -112,6 +113,21 @@ ColmapModel ReadColmapModelBinary(const std::filesystem::path& dir);
 // model is validated first (ValidateColmapModel; nothing is written if it fails); each file is
 // written atomically. Unit quaternions are written as they are, others normalised.
 void WriteColmapModelText(const ColmapModel& model, const std::filesystem::path& dir);
+
+// Writes cameras.bin, images.bin and points3D.bin into `dir` (created if needed) in COLMAP 3.8's
+// binary layout (little-endian; the layout ReadColmapModelBinary reads), so that reading gives
+// back the same model bit for bit. A 2D point without a 3D point (point3d_id -1) is stored as
+// 2^64 - 1, as COLMAP stores kInvalidPoint3DId. Records are in id order. Validated first
+// (ValidateColmapModel with ".bin"; nothing is written if it fails); each file is written
+// atomically. Unit quaternions are written as they are, others normalised.
+void WriteColmapModelBinary(const ColmapModel& model, const std::filesystem::path& dir);
+
+// Writes the 3D points to `path` as COLMAP's `model_converter --output_type PLY` does: binary
+// little-endian PLY, one vertex per point with float x, y, z (world frame, rounded from double)
+// and uchar red, green, blue; no normals, no faces. Points are in id order (COLMAP's order is its
+// hash map's). Throws InputError, writing nothing, when a coordinate is not finite or beyond
+// float's range; the file is written atomically.
+void WriteColmapPointsPly(const ColmapModel& model, const std::filesystem::path& path);
 
 // Checks a model against the rules above (known models, param counts, sizes, unit quaternions,
 // non-empty unique names, every reference resolved). Problems name `dir`/cameras`extension` etc.

@@ -25,7 +25,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _igi
+from . import _igi, colmap
 from ._igi import Camera, Error, InputError
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "InputError",
     "Renderer",
     "Scene",
+    "colmap",
     "read_image",
     "set_log_level",
     "write_image",

@@ -17,6 +17,7 @@ void AddLogging(py::module_& m);
 void AddImages(py::module_& m);
 void AddScenes(py::module_& m);
 void AddRendering(py::module_& m);
+void AddColmap(py::module_& m);
 
 // An image's pixels as a float32 (H, W, C) array that owns them (moved, not copied), row 0 at the
 // top, and its metadata as a dict.

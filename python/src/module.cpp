@@ -36,4 +36,5 @@ PYBIND11_MODULE(_igi, m) {
   igi::python::AddImages(m);
   igi::python::AddScenes(m);
   igi::python::AddRendering(m);
+  igi::python::AddColmap(m);
 }

@@ -1,6 +1,7 @@
-// Tests of the COLMAP model readers and writer: round trips, a cross-check against COLMAP 3.8
-// itself (its model_converter reads igi's TXT and writes BIN and TXT that igi reads back; a real
-// reconstruction of the Sceaux castle photos), and a corpus of broken model folders.
+// Tests of the COLMAP model readers and writers: round trips, a cross-check against COLMAP 3.8
+// itself (its model_converter reads igi's TXT and BIN and writes BIN, TXT and PLY that igi reads
+// back or compares; a real reconstruction of the Sceaux castle photos), a corpus of broken model
+// folders, and the BIN and PLY writers.
 //
 // Every comparison of numbers here is exact: TXT carries 17 significant digits, which is enough
 // for any double to survive printing and parsing bit for bit, and BIN carries the bits.
@@ -10,12 +11,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <random>
 #include <sstream>
+#include <stdexcept>
+#include <tuple>
 
 #include "tools/common/atomic_file.h"
 #include "tools/common/error.h"
@@ -70,12 +75,14 @@ void RunColmap(const std::string& arguments, const fs::path& log) {
   ASSERT_EQ(status, 0) << command << "\n" << ReadFileToString(log);
 }
 
-// COLMAP's model_converter: `in` (TXT or BIN) to `out` in `type` (BIN or TXT).
+// COLMAP's model_converter: `in` (TXT or BIN) to `out` in `type` (BIN or TXT: a folder; PLY: a
+// file, its log beside it).
 void ConvertWithColmap(const fs::path& in, const fs::path& out, const std::string& type) {
-  fs::create_directories(out);
+  const bool folder = type != "PLY";
+  if (folder) fs::create_directories(out);
   RunColmap("model_converter --input_path " + in.string() + " --output_path " + out.string() +
                 " --output_type " + type,
-            out / "colmap.log");
+            folder ? out / "colmap.log" : fs::path(out.string() + ".log"));
 }
 
 // The first difference between two models, with full precision, or "" if they are equal.
@@ -455,6 +462,13 @@ TEST(ColmapModelCrossCheck, RealReconstructionOfSceauxCastle) {
     // Single camera: identical; points: same set (order may differ), so compare sizes.
     EXPECT_EQ(fs::file_size(bin / file), fs::file_size(tmp.path() / "back" / file)) << file;
   }
+  // igi's BIN writer on COLMAP's real model: the same model back, and files of COLMAP's sizes
+  // (records in id order rather than COLMAP's hash order, so the bytes themselves may differ).
+  WriteColmapModelBinary(model, tmp.path() / "igi_bin");
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelBinary(tmp.path() / "igi_bin")), "");
+  for (const char* file : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    EXPECT_EQ(fs::file_size(bin / file), fs::file_size(tmp.path() / "igi_bin" / file)) << file;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -742,6 +756,190 @@ TEST(ColmapModelBroken, ListsEveryProblemAndNamesMissingFiles) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.problems().size(), 3u) << e.what();
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The BIN and PLY writers
+
+// The three files of a model folder, by name.
+std::map<std::string, std::string> ReadFolder(const fs::path& dir, const char* extension) {
+  std::map<std::string, std::string> files;
+  for (const char* stem : {"cameras", "images", "points3D"}) {
+    const std::string name = std::string(stem) + extension;
+    files[name] = ReadFileToString(dir / name);
+  }
+  return files;
+}
+
+// A binary PLY point cloud as COLMAP writes it: its header text and its (x, y, z, r, g, b)
+// records.
+struct PlyPoints {
+  std::string header;
+  std::vector<std::tuple<float, float, float, uint8_t, uint8_t, uint8_t>> records;
+};
+
+PlyPoints ReadPlyPoints(const fs::path& path) {
+  const std::string bytes = ReadFileToString(path);
+  const std::string end = "end_header\n";
+  const size_t at = bytes.find(end);
+  if (at == std::string::npos) throw std::runtime_error(path.string() + ": no end_header");
+  PlyPoints ply;
+  ply.header = bytes.substr(0, at + end.size());
+  const size_t kRecordBytes = 3 * sizeof(float) + 3;
+  for (size_t pos = ply.header.size(); pos + kRecordBytes <= bytes.size(); pos += kRecordBytes) {
+    float xyz[3];
+    std::memcpy(xyz, bytes.data() + pos, sizeof(xyz));  // little-endian host assumed
+    const auto* rgb = reinterpret_cast<const uint8_t*>(bytes.data() + pos + sizeof(xyz));
+    ply.records.emplace_back(xyz[0], xyz[1], xyz[2], rgb[0], rgb[1], rgb[2]);
+  }
+  if ((bytes.size() - ply.header.size()) % kRecordBytes != 0) {
+    throw std::runtime_error(path.string() + ": a partial record at the end");
+  }
+  return ply;
+}
+
+// The synthetic model with every coordinate scaled into float's range, for the PLY.
+ColmapModel MakeSyntheticModelForPly(uint64_t seed) {
+  ColmapModel model = MakeSyntheticModel(seed);
+  for (auto& [id, point] : model.points3d) {
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(point.xyz[k]) > 1e30) point.xyz[k] = std::copysign(1e30, point.xyz[k]);
+    }
+  }
+  return model;
+}
+
+TEST(ColmapModelBinary, WriteReadIsBitExactAndRewriteIsIdentical) {
+  // Every camera model, sparse and extreme ids, names with folders and non-ASCII letters, an
+  // image without 2D points, 2D points with and without 3D points, tracks of 0 to 4 elements.
+  TempDir tmp;
+  const ColmapModel model = MakeSyntheticModel(5);
+  WriteColmapModelBinary(model, tmp.path() / "a");
+  const ColmapModel read = ReadColmapModelBinary(tmp.path() / "a");
+  EXPECT_EQ(FirstDifference(model, read), "");
+  EXPECT_TRUE(read == model);
+  EXPECT_TRUE(ReadColmapModel(tmp.path() / "a") == model);  // detects BIN
+  // == cannot tell -0.0 from 0.0; the rewrite's bytes can.
+  WriteColmapModelBinary(read, tmp.path() / "b");
+  EXPECT_EQ(ReadFolder(tmp.path() / "a", ".bin"), ReadFolder(tmp.path() / "b", ".bin"));
+}
+
+TEST(ColmapModelBinary, WritesColmapsByteLayout) {
+  // The good folder of the broken-folder corpus, whose bytes are laid out by hand from COLMAP's
+  // format (a -1 point id stored as 2^64 - 1 among them).
+  TempDir tmp;
+  WriteFolder(tmp.path() / "txt", kGoodText);
+  WriteColmapModelBinary(ReadColmapModelText(tmp.path() / "txt"), tmp.path() / "bin");
+  EXPECT_EQ(ReadFolder(tmp.path() / "bin", ".bin"), GoodBinary());
+}
+
+TEST(ColmapModelBinary, TextToBinaryToTextIsIdentical) {
+  TempDir tmp;
+  WriteColmapModelText(MakeSyntheticModel(6), tmp.path() / "txt");
+  WriteColmapModelBinary(ReadColmapModelText(tmp.path() / "txt"), tmp.path() / "bin");
+  WriteColmapModelText(ReadColmapModelBinary(tmp.path() / "bin"), tmp.path() / "txt2");
+  EXPECT_EQ(ReadFolder(tmp.path() / "txt", ".txt"), ReadFolder(tmp.path() / "txt2", ".txt"));
+}
+
+TEST(ColmapModelBinary, WriterValidatesFirstAndWritesNothingOnError) {
+  TempDir tmp;
+  ColmapModel model = MakeSyntheticModel(7);
+  model.points3d.begin()->second.track.push_back({4000000000u, 100000});
+  try {
+    WriteColmapModelBinary(model, tmp.path() / "out");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("points3D.bin: POINT3D_ID"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("track references a missing 2D point"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+}
+
+TEST(ColmapModelPly, HeaderAndValuesReadBack) {
+  TempDir tmp;
+  const ColmapModel model = MakeSyntheticModelForPly(8);
+  WriteColmapPointsPly(model, tmp.path() / "points.ply");
+  const PlyPoints ply = ReadPlyPoints(tmp.path() / "points.ply");
+  EXPECT_EQ(ply.header,
+            "ply\nformat binary_little_endian 1.0\nelement vertex 40\nproperty float x\n"
+            "property float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+            "property uchar blue\nend_header\n");
+  ASSERT_EQ(ply.records.size(), model.points3d.size());
+  size_t i = 0;
+  for (const auto& [id, point] : model.points3d) {  // id order; values exact after float rounding
+    const auto& [x, y, z, r, g, b] = ply.records[i++];
+    EXPECT_EQ(x, static_cast<float>(point.xyz[0])) << id;
+    EXPECT_EQ(y, static_cast<float>(point.xyz[1])) << id;
+    EXPECT_EQ(z, static_cast<float>(point.xyz[2])) << id;
+    EXPECT_EQ((std::array<uint8_t, 3>{r, g, b}), point.rgb) << id;
+  }
+}
+
+TEST(ColmapModelPly, RejectsCoordinatesBeyondFloatAndWritesNothing) {
+  TempDir tmp;
+  ColmapModel model = MakeSyntheticModelForPly(9);
+  model.points3d.at(114).xyz.y() = 1e300;
+  try {
+    WriteColmapPointsPly(model, tmp.path() / "points.ply");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("points.ply: POINT3D_ID 114:"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("within float range"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(tmp.path() / "points.ply"));
+}
+
+TEST(ColmapModelCrossCheck, ColmapReadsIgiBinary) {
+  // COLMAP's model_converter reads igi's BIN and writes TXT and BIN that igi reads back as the
+  // same model: the independent check that igi's layout is COLMAP's.
+  TempDir tmp;
+  const ColmapModel model = MakeSyntheticModel(10);
+  WriteColmapModelBinary(model, tmp.path() / "igi_bin");
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi_bin", tmp.path() / "txt", "TXT"));
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi_bin", tmp.path() / "bin", "BIN"));
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelText(tmp.path() / "txt")), "");
+  EXPECT_EQ(FirstDifference(model, ReadColmapModelBinary(tmp.path() / "bin")), "");
+  // COLMAP's counts and means of igi's BIN are those igi writes.
+  WriteColmapModelText(model, tmp.path() / "igi_txt");
+  for (auto [file, n] : {std::pair("cameras.txt", 3), {"images.txt", 4}, {"points3D.txt", 3}}) {
+    EXPECT_EQ(HeadLines(tmp.path() / "igi_txt" / file, n), HeadLines(tmp.path() / "txt" / file, n));
+  }
+}
+
+TEST(ColmapModelCrossCheck, SingleRecordBinaryAndPlyAreByteIdenticalToColmaps) {
+  // With one record per file COLMAP's order cannot differ: its BIN and PLY from igi's BIN must be
+  // igi's bytes. Several cameras of a larger model are compared as PLY record sets below.
+  TempDir tmp;
+  std::mt19937_64 rng(11);
+  ColmapModel model;
+  model.cameras[3] = {3, "FULL_OPENCV", 4000, 3000, {}};
+  for (int p = 0; p < 12; ++p) model.cameras[3].params.push_back(AwkwardDouble(rng));
+  model.images[5] = {
+      5, RandomUnitQuaternion(rng), {AwkwardDouble(rng), 1e-300, -0.0},
+      3, "dir/photo_01.jpg",        {{{1.5, 2.25}, -1}, {{1e-3, 4000.123456789}, 9}}};
+  model.points3d[9] = {9, {-1.25, 0.1, 3e7}, {1, 2, 250}, 0.7, {{5, 1}}};
+  WriteColmapModelBinary(model, tmp.path() / "igi");
+  WriteColmapPointsPly(model, tmp.path() / "igi.ply");
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi", tmp.path() / "colmap", "BIN"));
+  ASSERT_NO_FATAL_FAILURE(ConvertWithColmap(tmp.path() / "igi", tmp.path() / "colmap.ply", "PLY"));
+  EXPECT_EQ(ReadFolder(tmp.path() / "igi", ".bin"), ReadFolder(tmp.path() / "colmap", ".bin"));
+  EXPECT_EQ(ReadFileToString(tmp.path() / "igi.ply"), ReadFileToString(tmp.path() / "colmap.ply"));
+
+  // Many points: the same header and the same set of records.
+  const ColmapModel many = MakeSyntheticModelForPly(12);
+  WriteColmapModelBinary(many, tmp.path() / "many");
+  WriteColmapPointsPly(many, tmp.path() / "many_igi.ply");
+  ASSERT_NO_FATAL_FAILURE(
+      ConvertWithColmap(tmp.path() / "many", tmp.path() / "many_colmap.ply", "PLY"));
+  PlyPoints igi = ReadPlyPoints(tmp.path() / "many_igi.ply");
+  PlyPoints colmap = ReadPlyPoints(tmp.path() / "many_colmap.ply");
+  EXPECT_EQ(igi.header, colmap.header);
+  std::sort(igi.records.begin(), igi.records.end());
+  std::sort(colmap.records.begin(), colmap.records.end());
+  EXPECT_EQ(igi.records, colmap.records);
 }
 
 }  // namespace
