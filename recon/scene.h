@@ -148,6 +148,14 @@ Json RelativeScenePaths(Json doc, const std::filesystem::path& base);
 // any.
 Json CameraJson(const Camera& camera);
 
+// One material entry (a value of scene.json's "materials") read by LoadScene's rules as the
+// material of region `name`: relative paths (rho_d_map) are taken from `dir`, and problems name
+// `file` and the entry's own keys ("rho_s", not "materials.NAME.rho_s"). Throws InputError
+// listing every problem.
+Material ReadMaterialEntry(const Json& entry, const std::string& name,
+                           const std::filesystem::path& dir, const std::string& file,
+                           const SceneLoadOptions& options = {});
+
 // Loads and validates `path`. Throws InputError listing every problem ("FILE: KEY: VALUE: RULE").
 Scene LoadScene(const std::filesystem::path& path, const SceneLoadOptions& options = {});
 // Loads and validates a document held in memory as if it were read from the file `path`: `path`'s

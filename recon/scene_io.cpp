@@ -198,6 +198,15 @@ void BindRegions(const SceneLoader& ld, const JsonCursor& root,
 
 }  // namespace
 
+Material ReadMaterialEntry(const Json& entry, const std::string& name, const fs::path& dir,
+                           const std::string& file, const SceneLoadOptions& options) {
+  ProblemList problems;
+  const SceneLoader ld{options, dir, file, &problems};
+  Material m = ReadMaterial(ld, JsonCursor(&entry, file, "", &problems), name);
+  problems.ThrowIfAny();
+  return m;
+}
+
 Scene LoadScene(const fs::path& path, const SceneLoadOptions& options) {
   return LoadSceneFromDocument(ReadJsonFile(path), path, options);
 }

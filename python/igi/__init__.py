@@ -27,6 +27,7 @@ import numpy as np
 
 from . import _igi, colmap
 from ._igi import Camera, Error, InputError
+from . import brdf, lights, mitsuba
 
 __all__ = [
     "Camera",
@@ -39,6 +40,9 @@ __all__ = [
     "read_image",
     "set_log_level",
     "write_image",
+    "brdf",
+    "lights",
+    "mitsuba",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]

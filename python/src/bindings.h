@@ -17,6 +17,9 @@ void AddLogging(py::module_& m);
 void AddImages(py::module_& m);
 void AddScenes(py::module_& m);
 void AddRendering(py::module_& m);
+void AddBrdfs(py::module_& m);
+void AddLights(py::module_& m);
+void AddExports(py::module_& m);
 void AddColmap(py::module_& m);
 
 // An image's pixels as a float32 (H, W, C) array that owns them (moved, not copied), row 0 at the

@@ -36,5 +36,8 @@ PYBIND11_MODULE(_igi, m) {
   igi::python::AddImages(m);
   igi::python::AddScenes(m);
   igi::python::AddRendering(m);
+  igi::python::AddBrdfs(m);
+  igi::python::AddLights(m);
+  igi::python::AddExports(m);
   igi::python::AddColmap(m);
 }

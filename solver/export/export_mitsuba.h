@@ -23,15 +23,38 @@
 // Sensors: perspective with fov_axis x, fov = 2 atan(W / 2fx) degrees, principal_point_offset
 //   from cx, cy, an hdrfilm of the camera's size and a box filter; fx ≠ fy and OPENCV
 //   distortion are dropped (reported). Integrator: path, max_depth −1.
+// Ids: the camera, region or light name made safe (SafeName), "_2", "_3", ... appended where two
+// objects would share one; a region's BSDF is "bsdf.<region id>".
+//
+// MitsubaSceneDict gives the scene of one lighting as a mitsuba.load_dict dictionary. Both
+// outputs are rendered from one description of the scene's Mitsuba objects, so every object,
+// property name and value of scene_<L>.xml is in the dict:
+//   {"type": "scene", "integrator": {...}, <id>: {"type": <plugin>, <property>: <value>, ...}}
+// with floats, integers, booleans and strings as JSON values; rgb as {"type": "rgb", "value":
+// [r, g, b]}; points and vectors as [x, y, z]; to_world as {"type": "transform", "matrix":
+// 4x4 rows} (Mitsuba's look_at of the XML's lookat, row-major; mitsuba.ScalarTransform4f of it);
+// a nested object under its name (textures) or its tag ("bsdf", "emitter", "sampler", "film",
+// "rfilter"); the XML's <ref id="X"/> as "bsdf": {"type": "ref", "id": "X"}; filenames absolute.
 
 #include <filesystem>
 
 #include "recon/scene.h"
 #include "solver/export/export.h"
+#include "tools/common/json.h"
 
 namespace igi::exporter {
 
 void WriteMitsubaExport(const recon::Scene& scene, const ExportOptions& options,
                         const std::filesystem::path& dir, ExportReport* report);
+
+// The Mitsuba 3 scene of lighting `lighting` (an index into scene.lightings) as a load_dict
+// dictionary (above). The meshes and textures it names are written into `dir` (created when
+// absent; files of the same names there are replaced, each written to a temporary name and
+// renamed) as the XML export writes them: meshes/<region>.obj, meshes/light.<name>.obj for the
+// lighting's area lights, textures/<region>.exr. Validates `options` and requires complete
+// materials (CheckExportableScene) first; InputError for a lighting out of range or a `dir`
+// that is a file. Approximations and files go to `report`.
+Json MitsubaSceneDict(const recon::Scene& scene, int lighting, const ExportOptions& options,
+                      const std::filesystem::path& dir, ExportReport* report);
 
 }  // namespace igi::exporter

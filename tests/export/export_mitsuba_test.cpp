@@ -1,5 +1,6 @@
 // Mitsuba 3 export: well-formed XML (checked by a small tag-balance reader), the counts of
-// shapes, BSDFs, emitters and sensors, the meshes beside it and the fitted roughplastic.
+// shapes, BSDFs, emitters and sensors, the meshes beside it and the fitted roughplastic; the
+// load_dict dictionary built from the same description, and unique ids.
 #include "solver/export/export_mitsuba.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include "tests/temp_dir.h"
 #include "tools/common/atomic_file.h"
 #include "tools/common/image.h"
+#include "tools/common/json.h"
 
 namespace igi::exporter {
 namespace {
@@ -122,6 +124,84 @@ TEST(ExportMitsuba, GgxKeepsItsDistribution) {
   EXPECT_EQ(ReadXml(xml).types["bsdf:roughplastic"], 3);  // gold, old_ward, brushed
   const std::regex beckmann(R"re(<!-- gold \(ward_gmd\) -->\s*<bsdf[^\n]*value="beckmann")re");
   EXPECT_TRUE(std::regex_search(xml, beckmann));
+}
+
+// The load_dict dictionary of a lighting holds every top-level object of the XML of that lighting
+// under its id, with the XML's plugin type, and the values of the one description both come from.
+TEST(ExportMitsuba, SceneDictHasTheXmlObjects) {
+  recon::Scene scene = test::SyntheticScene();
+  const auto tmp = test::UniqueTempDir("igi_export_mi_dict");
+  ExportScene(scene, tmp / "xml", {.format = ExportFormat::kMitsuba});
+  ExportReport report;
+  const Json d =
+      MitsubaSceneDict(scene, 0, {.format = ExportFormat::kMitsuba}, tmp / "dict", &report);
+  EXPECT_EQ(d["type"], "scene");
+  EXPECT_EQ(d["integrator"]["type"], "path");
+  const std::string xml = ReadFileToString(tmp / "xml" / "scene_all.xml");
+  const std::regex top(R"re(\n  <(\w+) type="([^"]+)" id="([^"]+)")re");
+  int objects = 0;
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), top); it != std::sregex_iterator();
+       ++it, ++objects) {
+    const std::string id = (*it)[3];
+    ASSERT_TRUE(d.contains(id)) << id;
+    EXPECT_EQ(d[id]["type"], (*it)[2].str()) << id;
+  }
+  EXPECT_EQ(objects, 1 + 2 * 5 + 5);  // the sensor, a BSDF and a shape per region, the lights
+  EXPECT_EQ(d.size(), size_t(objects) + 2);  // and "type", "integrator"
+  // A shape refers to its BSDF; the emitter region carries its area emitter.
+  EXPECT_EQ(d["glow"]["bsdf"], Json({{"type", "ref"}, {"id", "bsdf.glow"}}));
+  EXPECT_EQ(d["glow"]["emitter"]["radiance"]["value"], Json::array({5.0, 5.0, 5.0}));
+  EXPECT_EQ(d["bsdf.matte"]["bsdf"]["reflectance"]["value"], Json::array({0.5, 0.4, 0.3}));
+  EXPECT_EQ(d["bulb"]["position"], Json::array({0.5, 0.5, 3.0}));
+  EXPECT_EQ(d["cam"]["film"]["width"], 200);
+  EXPECT_EQ(d["cam"]["sampler"]["sample_count"], 256);
+  // The camera's to_world is Mitsuba's look_at: its third column the viewing direction (the
+  // camera's z in the world), its fourth the centre, its first the image's left (−x).
+  const Json& m = d["cam"]["to_world"]["matrix"];
+  EXPECT_EQ(d["cam"]["to_world"]["type"], "transform");
+  const Eigen::Matrix3d world_from_cam =
+      scene.cameras[0].cam_from_world.rotation.toRotationMatrix().transpose();
+  const Eigen::Vector3d center = scene.cameras[0].CenterInWorld();
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_NEAR(m[r][0].get<double>(), -world_from_cam(r, 0), 1e-12);
+    EXPECT_NEAR(m[r][1].get<double>(), -world_from_cam(r, 1), 1e-12);
+    EXPECT_NEAR(m[r][2].get<double>(), world_from_cam(r, 2), 1e-12);
+    EXPECT_NEAR(m[r][3].get<double>(), center(r), 1e-12);
+  }
+  // Filenames are absolute and written: the regions' meshes, the area light's, no XML.
+  for (const std::string id : {"matte", "glow", "panel"}) {
+    const std::filesystem::path file = d[id]["filename"].get<std::string>();
+    EXPECT_TRUE(file.is_absolute()) << file;
+    EXPECT_TRUE(std::filesystem::exists(file)) << file;
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "dict" / "scene_all.xml"));
+  EXPECT_FALSE(report.approximations.empty());
+  // Another call into the same folder replaces the files.
+  EXPECT_NO_THROW(
+      MitsubaSceneDict(scene, 0, {.format = ExportFormat::kMitsuba}, tmp / "dict", &report));
+  EXPECT_THROW(
+      MitsubaSceneDict(scene, 1, {.format = ExportFormat::kMitsuba}, tmp / "dict", &report),
+      InputError);
+}
+
+// Names that would give two objects one id get "_2", "_3", ... in both outputs.
+TEST(ExportMitsuba, IdsAreUnique) {
+  recon::Scene scene = test::SyntheticScene();
+  scene.cameras[0].name = "matte";
+  scene.lights[0].name = "matte";
+  const auto tmp = test::UniqueTempDir("igi_export_mi_ids");
+  ExportScene(scene, tmp / "xml", {.format = ExportFormat::kMitsuba});
+  const std::string xml = ReadFileToString(tmp / "xml" / "scene_all.xml");
+  EXPECT_NE(xml.find("<sensor type=\"perspective\" id=\"matte\">"), std::string::npos);
+  EXPECT_NE(xml.find("<shape type=\"obj\" id=\"matte_2\">"), std::string::npos);
+  EXPECT_NE(xml.find("<ref id=\"bsdf.matte_2\"/>"), std::string::npos);
+  EXPECT_NE(xml.find("<emitter type=\"point\" id=\"matte_3\">"), std::string::npos);
+  ExportReport report;
+  const Json d =
+      MitsubaSceneDict(scene, 0, {.format = ExportFormat::kMitsuba}, tmp / "dict", &report);
+  EXPECT_EQ(d["matte"]["type"], "perspective");
+  EXPECT_EQ(d["matte_2"]["type"], "obj");
+  EXPECT_EQ(d["matte_3"]["type"], "point");
 }
 
 }  // namespace
