@@ -43,6 +43,8 @@ __all__ = [
     "brdf",
     "lights",
     "mitsuba",
+    "calib",
+    "hdr",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -208,3 +210,6 @@ class Renderer:
         image.metadata["render_seconds"] = info["seconds"]
         image.metadata["rays"] = info["rays"]
         return image
+
+
+from . import calib, hdr  # noqa: E402  (hdr uses Image from here)

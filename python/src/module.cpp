@@ -40,4 +40,5 @@ PYBIND11_MODULE(_igi, m) {
   igi::python::AddLights(m);
   igi::python::AddExports(m);
   igi::python::AddColmap(m);
+  igi::python::AddCalibration(m);
 }
