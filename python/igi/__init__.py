@@ -21,13 +21,14 @@ from __future__ import annotations
 import json
 import logging
 import os
+import tempfile
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _igi, colmap
+from . import _igi, brdf, colmap, lights, mitsuba
 from ._igi import Camera, Error, InputError
-from . import brdf, lights, mitsuba
+from ._jobs import ProgressCallback, Summary, bin_dir, flag_arguments, options_help, run_long
 
 __all__ = [
     "Camera",
@@ -36,15 +37,21 @@ __all__ = [
     "InputError",
     "Renderer",
     "Scene",
-    "colmap",
-    "read_image",
-    "set_log_level",
-    "write_image",
+    "Summary",
     "brdf",
+    "calib",
+    "colmap",
+    "diagnose",
+    "export",
+    "hdr",
     "lights",
     "mitsuba",
-    "calib",
-    "hdr",
+    "read_image",
+    "run",
+    "set_log_level",
+    "solve",
+    "synth",
+    "write_image",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -193,11 +200,15 @@ class Renderer:
         self._native = _igi._Renderer(scene._native, lighting)
 
     def render(self, camera: str, spp: int = 64, seed: int = 0, width: int = 0, height: int = 0,
-               max_bounces: int = 64, threads: int = 0) -> Image:
+               max_bounces: int = 64, threads: int = 0,
+               progress: Optional[ProgressCallback] = None) -> Image:
         """Renders camera ``camera`` (a name of ``scene.cameras``): ``spp`` paths per pixel,
         ``width``/``height`` 0 for the camera's size (another size keeps the field of view).
-        The Image's metadata holds the scene, camera, lighting, spp, seed and timing."""
-        array, info = self._native.render(camera, spp, seed, width, height, max_bounces, threads)
+        The Image's metadata holds the scene, camera, lighting, spp, seed and timing.
+        ``progress(label, done, total)`` is called as rows finish; Ctrl-C stops the render."""
+        array, info = run_long(
+            lambda: self._native.render(camera, spp, seed, width, height, max_bounces, threads),
+            progress)
         metadata = {
             "igi:scene": self.scene.file,
             "igi:camera": camera,
@@ -212,4 +223,94 @@ class Renderer:
         return image
 
 
-from . import calib, hdr  # noqa: E402  (hdr uses Image from here)
+def _output_dir(out: Optional[PathLike], prefix: str) -> Tuple[str, Any]:
+    """The job's output folder, or a temporary one that lives as long as the returned holder."""
+    if out is not None:
+        return os.fspath(out), None
+    holder = tempfile.TemporaryDirectory(prefix=prefix)
+    return holder.name, holder
+
+
+def _load_result(out: str, holder: Any) -> Scene:
+    scene = Scene.load(os.path.join(out, "scene.json"))
+    scene._output_holder = holder  # a temporary output folder lives as long as the scene
+    return scene
+
+
+def solve(scene: Scene, out: Optional[PathLike] = None, threads: int = 0,
+          progress: Optional[ProgressCallback] = None, **options: Any) -> Tuple[Scene, Summary]:
+    """Solves the scene's unknown material values (igi-solve): returns the solved scene and the
+    summary, whose :meth:`Summary.to_dict` equals ``OUT/report.json``.
+
+    ``out``: the output folder (scene.json, albedo/, report.json, report.html); None writes to a
+    temporary folder kept as long as the returned scene. ``threads``: workers (0 = all cores).
+    ``progress(label, done, total)``: called as the stages advance; Ctrl-C stops the solve and
+    nothing is written. A region no photo sees is reported in the summary (``regions``, status
+    ``unobserved``), where igi-solve exits 3.
+
+    Options (igi-solve's flags, ``-`` written ``_``):
+"""
+    folder, holder = _output_dir(out, "igi-solve-")
+    args = flag_arguments(options)
+    report = run_long(lambda: _igi._solve(scene._native, folder, args, threads), progress)
+    return _load_result(folder, holder), Summary("SolveSummary", json.loads(report))
+
+
+def diagnose(scene: Scene, out: Optional[PathLike] = None, threads: int = 0,
+             progress: Optional[ProgressCallback] = None,
+             **options: Any) -> Tuple[Scene, Summary]:
+    """Finds where the simulation and the photos differ, names the physics left out, models it
+    and keeps it where held-out pixels improve (igi-diagnose): returns the improved scene and the
+    summary, whose :meth:`Summary.to_dict` equals ``OUT/diagnosis.json`` (``steps``: each effect
+    tried, kept or not, with its verdict).
+
+    ``out``, ``threads`` and ``progress`` as for :func:`solve`.
+
+    Options (igi-diagnose's flags, ``-`` written ``_``):
+"""
+    folder, holder = _output_dir(out, "igi-diagnose-")
+    args = flag_arguments(options)
+    report = run_long(lambda: _igi._diagnose(scene._native, folder, args, threads), progress)
+    return _load_result(folder, holder), Summary("DiagnosisSummary", json.loads(report))
+
+
+def export(scene: Scene, out: PathLike, format: str, **options: Any) -> Summary:
+    """Writes a solved scene (every material value known) for another renderer (igi-export):
+    ``format`` radiance, mitsuba or gltf, into ``out`` (absent or empty). Returns the summary,
+    whose :meth:`Summary.to_dict` equals ``OUT/export_report.json`` (every approximation made,
+    with its fitted error).
+
+    Options (igi-export's flags, ``-`` written ``_``):
+"""
+    args = flag_arguments(dict(options, format=format))
+    report = run_long(lambda: _igi._export(scene._native, os.fspath(out), args))
+    return Summary("ExportSummary", json.loads(report))
+
+
+def run(out: PathLike, photos: Optional[PathLike] = None, threads: int = 0,
+        progress: Optional[ProgressCallback] = None, **options: Any) -> Summary:
+    """The whole chain (igi-run): response, HDR merge, registration, solve, diagnosis and report
+    from a folder of photos (``photos``, the layout of ``igi-run --help``), or ``demo=True`` for a
+    synthetic capture. Each stage resumes from ``out``. Returns the summary: ``stages`` (stage,
+    status, seconds, cpu_seconds), ``report``, ``solved_scene`` and, for a demo, ``demo_summary``
+    (``OUT/demo_summary.json``). ``scene`` may be a path or a :class:`Scene`.
+
+    Options (igi-run's flags, ``-`` written ``_``; ``bin_dir`` defaults to the executables beside
+    this package):
+"""
+    if isinstance(options.get("scene"), Scene):
+        options["scene"] = options["scene"].file
+    options.setdefault("bin_dir", bin_dir())
+    args = flag_arguments(options)
+    report = run_long(
+        lambda: _igi._run(os.fspath(photos) if photos is not None else "", os.fspath(out), args,
+                          threads), progress)
+    return Summary("RunSummary", json.loads(report))
+
+
+for _job, _program in ((solve, "igi-solve"), (diagnose, "igi-diagnose"), (export, "igi-export"),
+                       (run, "igi-run")):
+    _job.__doc__ = (_job.__doc__ or "") + options_help(_program) + "\n"
+
+# Submodules that use Scene, Image and Summary from here.
+from . import calib, hdr, synth  # noqa: E402

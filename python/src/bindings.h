@@ -21,6 +21,7 @@ void AddBrdfs(py::module_& m);
 void AddLights(py::module_& m);
 void AddExports(py::module_& m);
 void AddColmap(py::module_& m);
+void AddJobs(py::module_& m);
 void AddCalibration(py::module_& m);
 
 // An image's pixels as a float32 (H, W, C) array that owns them (moved, not copied), row 0 at the

@@ -40,5 +40,6 @@ PYBIND11_MODULE(_igi, m) {
   igi::python::AddLights(m);
   igi::python::AddExports(m);
   igi::python::AddColmap(m);
+  igi::python::AddJobs(m);
   igi::python::AddCalibration(m);
 }
