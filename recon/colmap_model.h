@@ -27,6 +27,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -43,6 +44,8 @@ inline constexpr double kQuaternionKeepTolerance = 1e-12;
 inline constexpr double kQuaternionNormalizeTolerance = 1e-3;
 // At most this many problems are listed in one InputError.
 inline constexpr size_t kMaxReportedProblems = 20;
+// A 2D point without a 3D point in images.bin: COLMAP stores point3D_id -1 as this uint64.
+inline constexpr uint64_t kColmapNoPoint3DIdBinary = std::numeric_limits<uint64_t>::max();
 
 struct ColmapCamera {
   uint32_t camera_id = 0;
