@@ -209,4 +209,14 @@ Image ShiftImage(const Image& image, const PixelShift& shift) {
   return out;
 }
 
+int MedianExposureFrame(const std::vector<double>& exposures_s) {
+  int reference = 0;
+  for (size_t j = 0; j < exposures_s.size(); ++j) {
+    int below = 0;
+    for (double t : exposures_s) below += t < exposures_s[j] ? 1 : 0;
+    if (below == int(exposures_s.size()) / 2) reference = int(j);
+  }
+  return reference;
+}
+
 }  // namespace igi::hdr

@@ -43,6 +43,9 @@ struct GreyImage {
 void ToGreyLevels(const float* pixels, size_t pixel_count, int channels, uint8_t* out);
 GreyImage ToGrey(const Image& image);
 
+// The frame of median exposure time (the best-exposed one): the reference to align a bracket to.
+int MedianExposureFrame(const std::vector<double>& exposures_s);
+
 // Shifts that align each image to images[reference] (whose shift is 0). Images are normalised
 // levels in [0, 1] (any response).
 std::vector<PixelShift> ComputeMtbShifts(const std::vector<Image>& images, int reference,

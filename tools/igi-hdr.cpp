@@ -129,17 +129,6 @@ std::vector<Job> LoadJobs(const Flags& flags) {
   return jobs;
 }
 
-// The median exposure: the best-exposed reference for alignment.
-int ReferenceFrame(const std::vector<double>& exposures_s) {
-  int reference = 0;
-  for (size_t j = 0; j < exposures_s.size(); ++j) {
-    int below = 0;
-    for (double t : exposures_s) below += t < exposures_s[j] ? 1 : 0;
-    if (below == int(exposures_s.size()) / 2) reference = int(j);
-  }
-  return reference;
-}
-
 void PrintShifts(const igi::hdr::HdrInput& input, const std::vector<igi::hdr::PixelShift>& shifts) {
   for (size_t j = 0; j < shifts.size(); ++j) {
     if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
@@ -148,7 +137,8 @@ void PrintShifts(const igi::hdr::HdrInput& input, const std::vector<igi::hdr::Pi
 }
 
 void AlignJob(igi::hdr::HdrInput* input) {
-  const auto shifts = igi::hdr::ComputeMtbShifts(input->images, ReferenceFrame(input->exposures_s));
+  const auto shifts =
+      igi::hdr::ComputeMtbShifts(input->images, igi::hdr::MedianExposureFrame(input->exposures_s));
   PrintShifts(*input, shifts);
   for (size_t j = 0; j < shifts.size(); ++j) {
     if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
@@ -186,7 +176,7 @@ MergeCounts MergeStreamed(const Job& job, const igi::hdr::MergeOptions& merge, c
   if (flags.align) {
     // Shifts from the frames' 8-bit grey levels (1 byte a pixel), applied while streaming.
     shifts = igi::hdr::ComputeMtbShifts(igi::hdr::ReadGreyFrames(job.input.paths, flags.stream),
-                                        ReferenceFrame(job.input.exposures_s));
+                                        igi::hdr::MedianExposureFrame(job.input.exposures_s));
     PrintShifts(job.input, shifts);
   }
   igi::hdr::StreamOutputs outputs;

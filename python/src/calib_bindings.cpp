@@ -377,17 +377,6 @@ hdr::HdrInput InputFromBracket(calib::Bracket bracket, const HdrArgs& a) {
   return input;
 }
 
-// The median exposure: the best-exposed reference for alignment (as igi-hdr).
-int ReferenceFrame(const std::vector<double>& exposures_s) {
-  int reference = 0;
-  for (size_t j = 0; j < exposures_s.size(); ++j) {
-    int below = 0;
-    for (double t : exposures_s) below += t < exposures_s[j] ? 1 : 0;
-    if (below == int(exposures_s.size()) / 2) reference = int(j);
-  }
-  return reference;
-}
-
 void LogShifts(const hdr::HdrInput& input, const std::vector<hdr::PixelShift>& shifts) {
   for (size_t j = 0; j < shifts.size(); ++j) {
     if (shifts[j].dx == 0 && shifts[j].dy == 0) continue;
@@ -414,7 +403,8 @@ ImageMetadata RadianceMetadata(const hdr::HdrInput& input, const hdr::MergeOptio
 Merged MergeWhole(hdr::HdrInput& input, const hdr::MergeOptions& merge, const HdrArgs& a,
                   const hdr::RadianceCorrection& correction, const fs::path& mask) {
   if (a.align) {
-    const auto shifts = hdr::ComputeMtbShifts(input.images, ReferenceFrame(input.exposures_s));
+    const auto shifts =
+        hdr::ComputeMtbShifts(input.images, hdr::MedianExposureFrame(input.exposures_s));
     LogShifts(input, shifts);
     for (size_t j = 0; j < shifts.size(); ++j) {
       if (shifts[j].dx != 0 || shifts[j].dy != 0) {
@@ -444,7 +434,7 @@ Merged MergeStreamed(const hdr::HdrInput& input, const hdr::MergeOptions& merge,
   std::vector<hdr::PixelShift> shifts;
   if (a.align) {
     shifts = hdr::ComputeMtbShifts(hdr::ReadGreyFrames(input.paths, a.stream),
-                                   ReferenceFrame(input.exposures_s));
+                                   hdr::MedianExposureFrame(input.exposures_s));
     LogShifts(input, shifts);
   }
   hdr::StreamOutputs outputs;

@@ -9,6 +9,7 @@
 #include "solver/export/export_common.h"
 #include "tools/common/error.h"
 #include "tools/common/geometry.h"
+#include "tools/common/html_report.h"
 #include "tools/common/image.h"
 
 namespace igi::exporter {
@@ -121,29 +122,6 @@ struct MiScene {
 
 // --- XML -------------------------------------------------------------------------------------
 
-std::string Attr(std::string_view value) {
-  std::string out;
-  for (char c : value) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string Csv(const Eigen::Vector3d& v) {
   return Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z());
 }
@@ -152,7 +130,7 @@ std::string XmlElement(const MiObject& object);
 
 std::string XmlProperty(const MiProperty& p) {
   using Kind = MiProperty::Kind;
-  const std::string name = Attr(p.name);
+  const std::string name = HtmlEscape(p.name);
   switch (p.kind) {
     case Kind::kFloat:
       return fmt::format("<float name=\"{}\" value=\"{}\"/>", name, Num(p.number));
@@ -163,7 +141,7 @@ std::string XmlProperty(const MiProperty& p) {
                          p.number != 0 ? "true" : "false");
     case Kind::kString:
     case Kind::kFilename:
-      return fmt::format("<string name=\"{}\" value=\"{}\"/>", name, Attr(p.text));
+      return fmt::format("<string name=\"{}\" value=\"{}\"/>", name, HtmlEscape(p.text));
     case Kind::kRgb:
       return fmt::format("<rgb name=\"{}\" value=\"{}\"/>", name, Csv(p.v));
     case Kind::kPoint:
@@ -178,16 +156,16 @@ std::string XmlProperty(const MiProperty& p) {
     case Kind::kObject:
       return XmlElement(*p.object);
     case Kind::kRef:
-      return "<ref id=\"" + Attr(p.text) + "\"/>";
+      return "<ref id=\"" + HtmlEscape(p.text) + "\"/>";
   }
   return {};
 }
 
 // One object as one element on one line: <tag type="..." id="..." name="...">...</tag>.
 std::string XmlElement(const MiObject& object) {
-  std::string out = "<" + object.tag + " type=\"" + Attr(object.type) + "\"";
-  if (!object.id.empty()) out += " id=\"" + Attr(object.id) + "\"";
-  if (!object.name.empty()) out += " name=\"" + Attr(object.name) + "\"";
+  std::string out = "<" + object.tag + " type=\"" + HtmlEscape(object.type) + "\"";
+  if (!object.id.empty()) out += " id=\"" + HtmlEscape(object.id) + "\"";
+  if (!object.name.empty()) out += " name=\"" + HtmlEscape(object.name) + "\"";
   if (object.properties.empty()) return out + "/>";
   out += ">";
   for (const MiProperty& p : object.properties) out += XmlProperty(p);
