@@ -51,7 +51,39 @@ HdrInput LoadRaw(const std::vector<std::filesystem::path>& paths, const HdrInput
   return input;
 }
 
+// The response of a non-raw bracket with `channels` channels: response.json, the curve given,
+// linear, or recovered from the bracket's pixels (which must then be loaded).
+void ChooseResponse(const calib::Bracket& bracket, int channels, const HdrInputOptions& options,
+                    HdrInput* input) {
+  if (!options.response.empty() || options.curve) {
+    input->response = options.curve ? *options.curve : calib::ReadResponseJson(options.response);
+    input->response_source = options.curve ? options.curve_source : options.response.string();
+    if (input->response.num_channels() != 1 && input->response.num_channels() != channels) {
+      throw InputError(DescribeProblem(
+          input->response_source, "channels", fmt::format("{}", input->response.num_channels()),
+          fmt::format("must be 1 or the images' channel count ({})", channels)));
+    }
+  } else if (options.linear) {
+    input->response = calib::LinearResponse(bracket.levels(), channels);
+    input->response_source = "linear";
+  } else {
+    spdlog::info("no --response: recovering a Debevec response from the bracket itself");
+    input->response = calib::RecoverResponse(bracket, {}).curve;
+    input->response_source = "recovered (debevec)";
+  }
+}
+
 }  // namespace
+
+HdrInput HdrInputFromBracket(calib::Bracket bracket, const HdrInputOptions& options) {
+  HdrInput input;
+  input.names = bracket.names;
+  input.exposures_s = bracket.exposures_s;
+  input.bits = bracket.bits_per_sample;
+  ChooseResponse(bracket, bracket.channels(), options, &input);
+  input.images = std::move(bracket.images);
+  return input;
+}
 
 HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
                       const HdrInputOptions& options, const std::vector<double>& exposures_s) {
@@ -72,7 +104,8 @@ HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
     for (double t : exposures_s) source.list += fmt::format("{:.17g},", t);
   }
   // Recovering a response samples the whole images: only a known response leaves them unread.
-  const bool headers_only = options.headers_only && (!options.response.empty() || options.linear);
+  const bool headers_only =
+      options.headers_only && (!options.response.empty() || options.curve || options.linear);
   int channels = 0;
   calib::Bracket bracket = headers_only ? calib::LoadBracketHeaders(paths, source, &channels)
                                         : calib::LoadBracket(paths, source);
@@ -83,22 +116,7 @@ HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
   input.bits = bracket.bits_per_sample;
   input.names = bracket.names;
   input.exposures_s = bracket.exposures_s;
-  if (!options.response.empty()) {
-    input.response = calib::ReadResponseJson(options.response);
-    input.response_source = options.response.string();
-    if (input.response.num_channels() != 1 && input.response.num_channels() != channels) {
-      throw InputError(DescribeProblem(
-          options.response.string(), "channels", fmt::format("{}", input.response.num_channels()),
-          fmt::format("must be 1 or the images' channel count ({})", channels)));
-    }
-  } else if (options.linear) {
-    input.response = calib::LinearResponse(bracket.levels(), channels);
-    input.response_source = "linear";
-  } else {
-    spdlog::info("no --response: recovering a Debevec response from the bracket itself");
-    input.response = calib::RecoverResponse(bracket, {}).curve;
-    input.response_source = "recovered (debevec)";
-  }
+  ChooseResponse(bracket, channels, options, &input);
   input.images = std::move(bracket.images);
   return input;
 }

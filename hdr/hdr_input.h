@@ -24,7 +24,11 @@ namespace igi::hdr {
 
 struct HdrInputOptions {
   calib::ExposureSource exposures;  // both empty = EXIF / raw metadata
-  std::filesystem::path response;   // response.json; empty = see `linear`
+  std::filesystem::path response;   // response.json; empty = see `curve`, then `linear`
+  // A response already in memory, used in place of a response.json (igi.calib.ResponseCurve in
+  // Python), its origin in `curve_source` (HdrInput::response_source).
+  std::optional<calib::ResponseCurve> curve;
+  std::string curve_source;
   bool linear = false;              // non-raw input is linear (no response.json needed)
   // How raw input is decoded (white balance, colour, binning).
   RawDecodeOptions raw;
@@ -46,5 +50,9 @@ struct HdrInput {
 // `exposures_s` (non-empty, e.g. from a manifest) overrides options.exposures and metadata.
 HdrInput LoadHdrInput(const std::vector<std::filesystem::path>& paths,
                       const HdrInputOptions& options, const std::vector<double>& exposures_s = {});
+
+// A bracket of 8/16-bit levels already in memory (arrays from Python) with its response chosen as
+// LoadHdrInput chooses it: response.json, `curve`, `linear`, or recovered from the bracket.
+HdrInput HdrInputFromBracket(calib::Bracket bracket, const HdrInputOptions& options);
 
 }  // namespace igi::hdr

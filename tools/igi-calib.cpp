@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "calib/bracket.h"
+#include "calib/calib_flags.h"
 #include "calib/colour_chart.h"
 #include "calib/intrinsics.h"
 #include "calib/light_calibration.h"
@@ -57,73 +58,30 @@ namespace {
 
 struct ResponseCommand {
   std::vector<std::string> images;
-  igi::calib::ExposureSource exposures;
   std::string out;
   std::string plot;  // empty = OUT with the extension .svg
   bool no_plot = false;
-  std::string lambda = "auto";
-  std::string black = "auto";
-  std::string method = "debevec";  // checked against debevec|robertson when parsed
-  igi::calib::ResponseOptions options;
+  igi::calib::ResponseFlags flags;
 };
 
 CLI::App* AddResponseCommand(CLI::App& app, ResponseCommand* cmd) {
   CLI::App* sub =
       app.add_subcommand("response", "Recover the camera response curve from an exposure bracket");
   sub->add_option("images", cmd->images, "8- or 16-bit images of one bracket")->required();
-  auto* list = sub->add_option("--exposures", cmd->exposures.list,
-                               "Exposure times in seconds, comma-separated (0.004 or 1/250)");
-  sub->add_option("--exposure-file", cmd->exposures.file,
-                  "File with one exposure time per line ('#' comments)")
-      ->excludes(list);
   sub->add_option("--out", cmd->out, "Output response.json")->required();
   sub->add_option("--plot", cmd->plot, "Plot of the curves (SVG); default OUT with .svg");
   sub->add_flag("--no-plot", cmd->no_plot, "Do not write the plot");
-  sub->add_option("--method", cmd->method, "debevec or robertson")
-      ->check(CLI::IsMember({"debevec", "robertson"}));
-  sub->add_option("--lambda", cmd->lambda,
-                  "Debevec smoothness weight, or auto (default): the smallest whose curve is "
-                  "reproducible to 0.2 % (split-half test)");
-  sub->add_option("--samples", cmd->options.samples, "Debevec sample pixels (0 = auto)");
-  sub->add_option("--levels", cmd->options.levels,
-                  "Levels of the curve (0 = 256 for 8-bit, 1024 for 16-bit)");
-  sub->add_option("--black", cmd->black,
-                  "Normalised level at or below which a value is unusable, or auto (default): "
-                  "each channel's black floor, at least 0.02");
-  sub->add_option("--saturated", cmd->options.saturated,
-                  "Normalised level at or above which a value is unusable (default 0.98)");
-  sub->add_option("--max-iterations", cmd->options.max_iterations, "Robertson iterations");
-  sub->add_option("--robertson-smoothing", cmd->options.robertson_smoothing,
-                  "Robertson: second-difference penalty on ln I (0 = none)");
+  igi::calib::AddResponseFlags(*sub, &cmd->flags);
   return sub;
 }
 
-int RunResponse(ResponseCommand cmd) {
-  cmd.options.method = igi::calib::ResponseRecoveryMethodFromName(cmd.method).value();
-  cmd.options.lambda = igi::calib::ParseLambda(cmd.lambda);
-  cmd.options.black = igi::calib::ParseBlack(cmd.black);
-  cmd.options.Validate();
+int RunResponse(const ResponseCommand& cmd) {
+  const igi::calib::ResponseOptions options = igi::calib::FinishResponseFlags(cmd.flags);
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
-  const igi::calib::Bracket bracket = igi::calib::LoadBracket(paths, cmd.exposures);
-  const igi::calib::ResponseSummary summary = igi::calib::RecoverResponse(bracket, cmd.options);
-  igi::Json info;
-  info["images"] = cmd.images;
-  info["exposures_s"] = bracket.exposures_s;
-  info["bits_per_sample"] = bracket.bits_per_sample;
-  info["samples"] = summary.samples;
-  info["equations"] = summary.equations;
-  if (cmd.options.method == igi::calib::ResponseRecoveryMethod::kDebevec) {
-    info["lambda"] = summary.lambda;  // per channel
-    info["lambda_mode"] = cmd.options.lambda == igi::calib::kLambdaAuto ? "auto" : "given";
-  }
-  if (cmd.options.method == igi::calib::ResponseRecoveryMethod::kRobertson) {
-    info["iterations"] = summary.iterations;
-    info["converged"] = summary.converged;
-  }
-  info["rms_residual_ln"] = summary.rms_residual;
-  info["black"] = summary.black;  // per channel
-  info["black_mode"] = cmd.options.black == igi::calib::kBlackAuto ? "auto" : "given";
-  igi::calib::WriteResponseJson(cmd.out, summary.curve, info);
+  const igi::calib::Bracket bracket = igi::calib::LoadBracket(paths, cmd.flags.exposures);
+  const igi::calib::ResponseSummary summary = igi::calib::RecoverResponse(bracket, options);
+  igi::calib::WriteResponseJson(cmd.out, summary.curve,
+                                igi::calib::ResponseInfo(cmd.images, bracket, summary, options));
   std::string plot;
   if (!cmd.no_plot) {
     plot = cmd.plot.empty() ? std::filesystem::path(cmd.out).replace_extension(".svg").string()
@@ -138,65 +96,23 @@ int RunResponse(ResponseCommand cmd) {
 
 struct IntrinsicsCommand {
   std::vector<std::string> images;
-  std::string board;  // COLSxROWS
   std::string out;
-  // Checked against their choices when parsed.
-  std::string board_type = "chessboard";
-  std::string model = "OPENCV";
-  igi::calib::IntrinsicsOptions options;
+  igi::calib::IntrinsicsFlags flags;
 };
 
 CLI::App* AddIntrinsicsCommand(CLI::App& app, IntrinsicsCommand* cmd) {
   CLI::App* sub = app.add_subcommand(
       "intrinsics", "Calibrate focal length, principal point and distortion from chessboard views");
   sub->add_option("images", cmd->images, "Views of a planar chessboard")->required();
-  sub->add_option("--board", cmd->board,
-                  "chessboard: inner corners COLSxROWS, e.g. 9x6; charuco: squares X x Y, e.g. 5x7")
-      ->required();
-  sub->add_option("--board-type", cmd->board_type, "chessboard (default) or charuco")
-      ->check(CLI::IsMember({"chessboard", "charuco"}));
-  sub->add_option("--dictionary", cmd->options.dictionary,
-                  "charuco: OpenCV ArUco dictionary (default DICT_4X4_50)");
-  sub->add_option("--marker", cmd->options.marker_m, "charuco: side of a marker in metres");
-  sub->add_option("--square", cmd->options.square_m, "Side of one square in metres")->required();
   sub->add_option("--out", cmd->out, "Output camera.json")->required();
-  sub->add_option("--model", cmd->model, "PINHOLE, OPENCV (default) or FULL_OPENCV")
-      ->check(CLI::IsMember({"PINHOLE", "OPENCV", "FULL_OPENCV"}));
-  sub->add_flag("--fix-aspect-ratio", cmd->options.fix_aspect_ratio, "Constrain fx = fy");
-  sub->add_flag("--zero-tangent-dist", cmd->options.zero_tangent_dist, "Constrain p1 = p2 = 0");
-  sub->add_flag("--fix-principal-point", cmd->options.fix_principal_point,
-                "Keep the principal point at the image centre");
-  sub->add_option("--subpix-window", cmd->options.subpix_window,
-                  "Half window of the sub-pixel corner refinement (pixels)");
+  igi::calib::AddIntrinsicsFlags(*sub, &cmd->flags);
   return sub;
 }
 
-// "9x6" -> (9, 6); InputError otherwise.
-void ParseBoard(const std::string& text, igi::calib::IntrinsicsOptions* options) {
-  const size_t x = text.find_first_of("xX");
-  int cols = 0;
-  int rows = 0;
-  try {
-    size_t used_cols = 0;
-    size_t used_rows = 0;
-    if (x == std::string::npos) throw std::invalid_argument(text);
-    cols = std::stoi(text.substr(0, x), &used_cols);
-    rows = std::stoi(text.substr(x + 1), &used_rows);
-    if (used_cols != x || used_rows != text.size() - x - 1) throw std::invalid_argument(text);
-  } catch (const std::exception&) {
-    throw igi::InputError(igi::DescribeProblem("", "--board", text, "must be COLSxROWS, e.g. 9x6"));
-  }
-  options->board_cols = cols;
-  options->board_rows = rows;
-}
-
-int RunIntrinsics(IntrinsicsCommand& cmd) {
-  ParseBoard(cmd.board, &cmd.options);
-  cmd.options.board_type = igi::calib::BoardTypeFromName(cmd.board_type).value();
-  cmd.options.model = igi::calib::ColmapCameraModelFromName(cmd.model).value();
-  cmd.options.Validate();
+int RunIntrinsics(const IntrinsicsCommand& cmd) {
+  const igi::calib::IntrinsicsOptions options = igi::calib::FinishIntrinsicsFlags(cmd.flags);
   std::vector<std::filesystem::path> paths(cmd.images.begin(), cmd.images.end());
-  const igi::calib::IntrinsicsSummary summary = igi::calib::CalibrateIntrinsics(paths, cmd.options);
+  const igi::calib::IntrinsicsSummary summary = igi::calib::CalibrateIntrinsics(paths, options);
   const igi::calib::CameraFile& camera = summary.camera;
   igi::calib::WriteCameraFile(cmd.out, camera);
   std::printf("%s: %s %dx%d, fx %.3f fy %.3f cx %.3f cy %.3f, RMS %.4f px over %zu views\n",

@@ -140,19 +140,11 @@ class _CameraFile:
     def document(self) -> str: ...
     def save(self, path: _Path) -> None: ...
 
-def _response(images: List[Any], metadata: List[Dict[str, Any]], bits: int, exposures: str,
-              exposure_file: str, method: str, lambda_: str, black: str, samples: int,
-              levels: int, saturated: float, max_iterations: int,
-              robertson_smoothing: float) -> _ResponseCurve: ...
-def _intrinsics(images: List[str], board: str, board_type: str, dictionary: str, marker: float,
-                square: float, model: str, fix_aspect_ratio: bool, zero_tangent_dist: bool,
-                fix_principal_point: bool, subpix_window: int) -> _CameraFile: ...
-def _merge(images: List[Any], metadata: List[Dict[str, Any]], bits: int, response: str,
-           curve: Optional[_ResponseCurve], exposures: str, exposure_file: str, linear: bool,
-           weighting: str, shot_noise: float, read_noise: float, black: Optional[float],
-           saturated: float, align: bool, camera: str, colour: str, raw_white_balance: str,
-           raw_color: str, half_size: bool, band_rows: int, whole_images: bool, out: str,
-           mask_out: str, threads: int
+def _response(images: List[Any], metadata: List[Dict[str, Any]], bits: int,
+              args: List[str]) -> _ResponseCurve: ...
+def _intrinsics(images: List[str], args: List[str]) -> _CameraFile: ...
+def _merge(images: List[Any], metadata: List[Dict[str, Any]], bits: int,
+           curve: Optional[_ResponseCurve], args: List[str], threads: int
            ) -> Tuple[npt.NDArray[np.float32], Dict[str, Any], npt.NDArray[np.float32],
                       Dict[str, Any]]: ...
 def _decode_raw(path: _Path, raw_white_balance: str, raw_color: str, half_size: bool

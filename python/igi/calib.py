@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _igi
-from ._jobs import ProgressCallback, run_long
+from ._jobs import ProgressCallback, flag_arguments, run_long
 
 __all__ = ["CameraIntrinsics", "ResponseCurve", "intrinsics", "response"]
 
@@ -190,11 +190,13 @@ def response(images: Sequence[Any], exposures: Exposures = None,
     call does and raises KeyboardInterrupt. Bad input raises :class:`igi.InputError`.
     """
     paths_or_arrays, metadata, bits_ = _bracket(images, bits)
-    args = (paths_or_arrays, metadata, bits_, _exposure_list(exposures),
-            os.fspath(exposure_file) if exposure_file is not None else "", method,
-            _text(lambda_), _text(black), samples, levels, saturated, max_iterations,
-            robertson_smoothing)
-    return ResponseCurve(run_long(lambda: _igi._response(*args), progress))
+    args = flag_arguments({
+        "exposures": _exposure_list(exposures) or None, "exposure_file": exposure_file,
+        "method": method, "lambda": _text(lambda_), "samples": samples, "levels": levels,
+        "black": _text(black), "saturated": saturated, "max_iterations": max_iterations,
+        "robertson_smoothing": robertson_smoothing})
+    return ResponseCurve(
+        run_long(lambda: _igi._response(paths_or_arrays, metadata, bits_, args), progress))
 
 
 class CameraIntrinsics:
@@ -319,10 +321,12 @@ def intrinsics(images: Sequence[PathLike], board: str, square: float,
         subpix_window: half window of the sub-pixel corner refinement, pixels.
     """
     paths = [os.fspath(image) for image in images]
-    args = (paths, board, board_type, dictionary, float(marker), float(square), model,
-            bool(fix_aspect_ratio), bool(zero_tangent_dist), bool(fix_principal_point),
-            int(subpix_window))
-    camera = CameraIntrinsics(run_long(lambda: _igi._intrinsics(*args), progress))
+    args = flag_arguments({
+        "board": board, "square": square, "board_type": board_type, "dictionary": dictionary,
+        "marker": marker, "model": model, "fix_aspect_ratio": fix_aspect_ratio,
+        "zero_tangent_dist": zero_tangent_dist, "fix_principal_point": fix_principal_point,
+        "subpix_window": subpix_window})
+    camera = CameraIntrinsics(run_long(lambda: _igi._intrinsics(paths, args), progress))
     for view in camera.rejected_views:
         logging.getLogger("igi").warning("%s: %s; view rejected", view["file"], view["reason"])
     return camera

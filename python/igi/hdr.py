@@ -21,7 +21,7 @@ import os
 from typing import Any, NamedTuple, Optional, Sequence, Union
 
 from . import Image, _igi
-from ._jobs import ProgressCallback, run_long
+from ._jobs import ProgressCallback, flag_arguments, run_long
 from .calib import Exposures, ResponseCurve, _bracket, _exposure_list
 
 __all__ = ["MergeResult", "decode_raw", "merge"]
@@ -94,17 +94,17 @@ def merge(images: Sequence[Any], exposures: Exposures = None,
     """
     paths_or_arrays, metadata, bits_ = _bracket(images, bits)
     curve = response._native if isinstance(response, ResponseCurve) else None
-    response_path = "" if response is None or curve is not None else os.fspath(response)
-
-    def text(path: Optional[PathLike]) -> str:
-        return os.fspath(path) if path is not None else ""
-
-    args = (paths_or_arrays, metadata, bits_, response_path, curve, _exposure_list(exposures),
-            text(exposure_file), bool(linear), weighting, float(shot_noise), float(read_noise),
-            None if black is None else float(black), float(saturated), bool(align), text(camera),
-            text(colour), raw_white_balance, raw_color, bool(half_size), int(band_rows),
-            bool(whole_images), text(out), text(mask_out), int(threads))
-    radiance, radiance_metadata, mask, counts = run_long(lambda: _igi._merge(*args), progress)
+    args = flag_arguments({
+        "exposures": _exposure_list(exposures) or None, "exposure_file": exposure_file,
+        "response": None if curve is not None else response, "linear": linear,
+        "weighting": weighting, "shot_noise": shot_noise, "read_noise": read_noise,
+        "black": black, "saturated": saturated, "align": align, "camera": camera,
+        "colour": colour, "raw_white_balance": raw_white_balance, "raw_color": raw_color,
+        "half_size": half_size, "band_rows": band_rows, "whole_images": whole_images,
+        "out": out, "mask_out": mask_out})
+    radiance, radiance_metadata, mask, counts = run_long(
+        lambda: _igi._merge(paths_or_arrays, metadata, bits_, curve, args, int(threads)),
+        progress)
     return MergeResult(Image(radiance, radiance_metadata), Image(mask),
                        int(counts["saturated_pixels"]), int(counts["black_pixels"]))
 

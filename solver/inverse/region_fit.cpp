@@ -12,6 +12,7 @@
 #include "solver/inverse/numeric.h"
 #include "solver/render/brdf.h"
 #include "tools/common/enum_names.h"
+#include "tools/common/progress.h"
 
 namespace igi::solver {
 
@@ -23,6 +24,15 @@ render::LobeWeights LobeWeight(recon::BrdfModel model, double alpha_x, double al
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// Ends a Ceres solve at its next iteration once cancellation is requested (Ctrl-C in the Python
+// package), so that a long fit does not run to the end before the job stops.
+class CancelCallback : public ceres::IterationCallback {
+ public:
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return CancelRequested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+};
 
 struct Prepared {
   std::vector<Eigen::Vector3d> w;  // residual weights per sample and channel
@@ -704,8 +714,11 @@ Polish PolishConstant(const RegionFitInput& in, const Prepared& pr, const AlphaS
   so.linear_solver_type = ceres::DENSE_QR;
   so.num_threads = std::max(1, options.num_threads);
   so.logging_type = ceres::SILENT;
+  CancelCallback cancel;
+  so.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  if (CancelRequested()) throw Cancelled("region fit");
   out.ok = summary.IsSolutionUsable();
   out.message = summary.message;
   if (!out.ok) return out;

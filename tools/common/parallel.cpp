@@ -7,6 +7,8 @@
 #include <atomic>
 #include <thread>
 
+#include "tools/common/progress.h"
+
 namespace igi {
 namespace {
 std::atomic<int> g_default_threads{0};
@@ -24,6 +26,7 @@ void ParallelForRange(int64_t begin, int64_t end,
                       const std::function<void(int64_t, int64_t)>& fn, int num_threads,
                       int64_t grain) {
   if (end <= begin) return;
+  if (CancelRequested()) throw Cancelled("parallel work");
   const int threads = ResolveThreads(num_threads);
   if (threads == 1 || end - begin <= grain) {
     fn(begin, end);
@@ -32,7 +35,10 @@ void ParallelForRange(int64_t begin, int64_t end,
   tbb::task_arena arena(threads);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int64_t>(begin, end, grain < 1 ? 1 : grain),
-                      [&](const tbb::blocked_range<int64_t>& r) { fn(r.begin(), r.end()); });
+                      [&](const tbb::blocked_range<int64_t>& r) {
+                        if (CancelRequested()) throw Cancelled("parallel work");
+                        fn(r.begin(), r.end());
+                      });
   });
 }
 
@@ -41,7 +47,10 @@ void ParallelFor(int64_t begin, int64_t end, const std::function<void(int64_t)>&
   ParallelForRange(
       begin, end,
       [&fn](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) fn(i);
+        for (int64_t i = b; i < e; ++i) {
+          if (CancelRequested()) throw Cancelled("parallel work");
+          fn(i);
+        }
       },
       num_threads, grain);
 }

@@ -1,7 +1,9 @@
 #pragma once
 // The one parallel primitive of igi (STYLE.md §8): ParallelFor over TBB, in an arena limited to
 // `num_threads` (0 = the process default, set by --threads; that default 0 = all cores).
-// An exception thrown by `fn` stops the loop and is rethrown in the caller.
+// An exception thrown by `fn` stops the loop and is rethrown in the caller. Once cancellation is
+// requested (tools/common/progress.h RequestCancel) no further item starts: the loop throws
+// Cancelled, so every parallel stage stops within one item, reporting progress or not.
 
 #include <cstdint>
 #include <functional>
