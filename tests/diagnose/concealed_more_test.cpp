@@ -83,12 +83,12 @@ INSTANTIATE_TEST_SUITE_P(Effects, ConcealedMoreTest, testing::Values("ambient_li
 INSTANTIATE_TEST_SUITE_P(SlowEffects, ConcealedMoreTest,
                          testing::Values("light_intensity", "specular_reflection"));
 
-INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest,
-                         testing::Values("light_emission_profile+camera_response"));
-// Labelled slow: CI names each of the two in another renderer's photos
-// (concealed_outside_test.cpp), and two effects at once in the pair above.
+INSTANTIATE_TEST_SUITE_P(Pairs, ConcealedMoreTest, testing::Values("vignetting+exposure_scale"));
+// Labelled slow: CI names each of the two in another renderer's photos (the profile in
+// concealed_cycles_test.cpp, the response in concealed_outside_test.cpp), and two effects at once
+// in the pair above.
 INSTANTIATE_TEST_SUITE_P(SlowPairs, ConcealedMoreTest,
-                         testing::Values("vignetting+exposure_scale"));
+                         testing::Values("light_emission_profile+camera_response"));
 
 }  // namespace
 }  // namespace igi::diagnose
