@@ -99,7 +99,6 @@ MergedBracket MergeHdrInput(HdrInput& input, const HdrFlags& flags,
   merge.bits = input.bits;
   if (input.raw && !flags.black) merge.black = 0.0;
   MergedBracket merged;
-  merged.weighting = merge.weighting;
   merged.radiance_metadata["igi:response"] = input.response_source;
   merged.radiance_metadata["igi:weighting"] = std::string(MergeWeightingName(merge.weighting));
   const int reference = MedianExposureFrame(input.exposures_s);

@@ -64,7 +64,6 @@ struct MergedBracket {
   int64_t black_pixels = 0;      // pixels black in every exposure (in some channel)
   std::vector<PixelShift> shifts;  // per frame when aligned, else empty
   ImageMetadata radiance_metadata;  // igi:response and igi:weighting, as written
-  MergeWeighting weighting = MergeWeighting::kNoise;
   // Held when the frames were merged whole; a merge band by band leaves them in the files.
   std::optional<Image> radiance;
   std::optional<Image> mask;

@@ -94,7 +94,7 @@ int Run(const std::vector<std::string>& images, const std::string& manifest,
         "%s: %d images, response %s, %s weights; saturated in every exposure: %lld px "
         "(%.3f %%), black in every exposure: %lld px (%.3f %%), masked in %s\n",
         job.out.string().c_str(), int(job.input.names.size()), job.input.response_source.c_str(),
-        std::string(igi::hdr::MergeWeightingName(merged.weighting)).c_str(),
+        std::string(igi::hdr::MergeWeightingName(flags.merge.weighting)).c_str(),
         (long long)merged.saturated_pixels, 100.0 * merged.saturated_pixels / total,
         (long long)merged.black_pixels, 100.0 * merged.black_pixels / total,
         mask.string().c_str());
