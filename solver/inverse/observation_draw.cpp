@@ -131,16 +131,20 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
   d.expected = d.available;
   if (d.available <= d.budget) return d;
   auto share = [](double keep, double n) { return n > 0 ? std::min(1.0, keep / n) : 1.0; };
-  if (needed >= d.budget) {
-    // The fits' needs alone exceed the budget: each scaled down by the same factor.
-    const double s = d.budget / needed;
+  // The needs within their share of the budget, so that the even draw below still covers every
+  // surface: each region's fit samples first (a region seen by few pixels has only those), up
+  // to the share less what the highlight candidates keep at least (half of it), the highlight
+  // candidates in what is left; each class scaled down alike where it exceeds its part.
+  const double limit = kNeedsShare * d.budget;
+  if (needed > limit) {
+    double near_sum = 0, rest_sum = 0;
+    for (size_t r = 0; r < regions; ++r) near_sum += need_near[r], rest_sum += need_rest[r];
+    const double rest_part = std::min(rest_sum, limit - std::min(near_sum, 0.5 * limit));
+    const double near_part = std::min(near_sum, limit - rest_part);
     for (size_t r = 0; r < regions; ++r) {
-      d.p_near[r] = share(s * need_near[r], n_near[r]);
-      d.p_rest[r] = share(s * need_rest[r], n_rest[r]);
+      if (rest_sum > 0) need_rest[r] *= rest_part / rest_sum;
+      if (near_sum > 0) need_near[r] *= near_part / near_sum;
     }
-    d.expected = d.budget;
-    blocks();
-    return d;
   }
   // One probability q for every pixel beyond the needs: the total kept is increasing in q.
   auto kept = [&](double q) {

@@ -9,9 +9,14 @@
 //    estimates, per region, how many pixels at the stride see it near a possible highlight
 //    (tanθh < 0.6 toward a light of the photo's lighting; those carry a lobe's ρs and α) and how
 //    many elsewhere;
-//  - every region's highlight candidates are kept up to SolveOptions::max_highlight_samples and
-//    its other pixels up to max_fit_samples (what its fit needs), and the rest of the budget is
-//    shared evenly: one probability for every other pixel, found by bisection.
+//  - every region's other pixels are kept up to max_fit_samples and its highlight candidates up
+//    to SolveOptions::max_highlight_samples (what its fit needs), together within kNeedsShare of
+//    the budget (the highlight candidates give way first), and the rest of the budget is shared
+//    evenly: one probability for every other pixel, found by bisection. The even share is what
+//    covers every surface with observations, whose patches send the gathered light; where the
+//    needs took the whole budget (4 glossy regions' highlight candidates in photos of 24 MP),
+//    many of a textured floor's patches had no observation and were modelled at the floor's mean
+//    albedo, and the light they sent a red wall beside them was 15 % too high.
 // The hash is a property of each pixel alone, so the draw is reproducible and a change to one
 // photo (its mask, its pose) does not redraw another's pixels; the fit's own subset
 // (SolverState::SelectFitSamples) is drawn with the same hash, nested inside this draw.
@@ -85,6 +90,10 @@ struct ObservationDraw {
              int* size) const;
 };
 
+// The largest share of the budget the regions' needs (highlight candidates and fit samples) take;
+// the rest is drawn evenly.
+inline constexpr double kNeedsShare = 0.5;
+
 struct ObservationDrawOptions {
   // Every pixel_stride-th pixel in x and y is a candidate (SolveOptions::pixel_stride).
   int pixel_stride = 2;
@@ -111,9 +120,9 @@ std::vector<RegionPixelCensus> CensusPixels(
     const std::vector<char>& lobe_class, const ObservationDrawOptions& options);
 
 // The probabilities (above) for `census`: each region's needs first (its highlight candidates up
-// to max_highlight_samples, its other pixels up to max_fit_samples; scaled down together when
-// they alone exceed the budget), then one probability for every other pixel; each class's block
-// side from its probability.
+// to max_highlight_samples, its other pixels up to max_fit_samples; within kNeedsShare of the
+// budget, above), then one probability for every other pixel; each class's block side from its
+// probability.
 ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census,
                                     const std::vector<char>& lobe_class,
                                     const ObservationDrawOptions& options);

@@ -211,13 +211,19 @@ void SolverState::PlanObservations() {
   draw = PlanObservationDraw(census, lobe_class, d);
   draw.census = draw.expected < draw.available;
   summary.observations_thinned = draw.census;
+  for (size_t r = 0; r < n && draw.census; ++r) {
+    spdlog::debug(
+        "draw: {}: {:.0f} highlight candidates (p {:.4g}), {:.0f} other pixels (p {:.4g})",
+        scene.materials[r].name, lobe_class[r] ? census[r].near : 0.0, draw.p_near[r],
+        census[r].rest + (lobe_class[r] ? 0.0 : census[r].near), draw.p_rest[r]);
+  }
   summary.memory_estimate_bytes =
       memory.BytesFor(draw.expected, share * draw.expected, std::min(lobe_fit, draw.expected));
   if (draw.census) {
     spdlog::warn(
         "the photos offer about {:.0f} observations at pixel stride {}; drawing about {:.0f} to "
         "fit {} of memory ({} budget{}): every region keeps its highlight candidates and fit "
-        "samples, the rest is drawn evenly",
+        "samples within half of them, the rest is drawn evenly",
         draw.available, options.pixel_stride, draw.expected, GiB(summary.memory_estimate_bytes),
         GiB(memory.budget_bytes),
         options.max_observations > 0 ? fmt::format(", at most {}", options.max_observations)

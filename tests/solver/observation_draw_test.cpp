@@ -66,18 +66,43 @@ TEST(PlanObservationDraw, KeepsEachRegionsNeedsAndSharesTheRest) {
   EXPECT_EQ(d.Probability(1, true), d.p_rest[1]);  // no lobe class: near counts as rest
 }
 
-TEST(PlanObservationDraw, NeedsBeyondTheBudgetAreScaledTogether) {
+// The needs take at most half of the budget (kNeedsShare), and the other half is still drawn
+// evenly over every pixel: the even draw is what covers every surface with observations. Within
+// that half the fit samples come first and the highlight candidates give way.
+TEST(PlanObservationDraw, HighlightCandidatesGiveWayBeyondHalfTheBudget) {
+  // Region 0: a fitted lobe; region 1: a large wall; region 2: seen by few pixels.
+  const std::vector<RegionPixelCensus> census = {{50000, 200000}, {0, 500000}, {0, 8000}};
+  ObservationDrawOptions o;
+  o.budget = 80000;  // the needs: 30 000 + 3 × 6000 = 48 000, over the half of 40 000
+  o.max_highlight_samples = 30000;
+  o.max_fit_samples = 6000;
+  const ObservationDraw d = PlanObservationDraw(census, {1, 0, 0}, o);
+  EXPECT_LE(d.expected, 80000);
+  EXPECT_GT(d.expected, 80000 - 1);
+  EXPECT_NEAR(d.p_rest[2] * 8000, 6000, 1e-3);                    // its fit samples, whole
+  EXPECT_NEAR(d.p_near[0] * 50000, kNeedsShare * 80000 - 18000, 1e-3);  // what is left of half
+  // Every other pixel at one probability q: the kept classes and q·(200 000 + 500 000) fill it.
+  EXPECT_NEAR(d.p_rest[0], d.p_rest[1], 1e-9);
+  EXPECT_NEAR(22000 + 6000 + d.p_rest[0] * 700000, 80000, 1);
+}
+
+// Where the fit samples alone would leave the highlight candidates under half of the needs'
+// share, both classes are scaled down to a half each.
+TEST(PlanObservationDraw, NeedsBeyondHalfTheBudgetAreScaledTogether) {
   const std::vector<RegionPixelCensus> census = {{50000, 200000}, {0, 500000}};
   ObservationDrawOptions o;
   o.budget = 18000;  // the needs: 30 000 + 6000 + 6000 = 42 000
   o.max_highlight_samples = 30000;
   o.max_fit_samples = 6000;
   const ObservationDraw d = PlanObservationDraw(census, {1, 0}, o);
-  EXPECT_NEAR(d.expected, 18000, 1e-6);
-  const double s = 18000.0 / 42000;
-  EXPECT_NEAR(d.p_near[0] * 50000, s * 30000, 1e-6);
-  EXPECT_NEAR(d.p_rest[0] * 200000, s * 6000, 1e-6);
-  EXPECT_NEAR(d.p_rest[1] * 500000, s * 6000, 1e-6);
+  EXPECT_LE(d.expected, 18000);
+  EXPECT_GT(d.expected, 18000 - 1);
+  const double half = 0.5 * kNeedsShare * 18000;  // 4500 for each class
+  EXPECT_NEAR(d.p_near[0] * 50000, half, 1e-3);
+  // Every other pixel at one probability q, above the scaled fit samples (2250 a region).
+  EXPECT_NEAR(d.p_rest[0], d.p_rest[1], 1e-9);
+  EXPECT_GT(d.p_rest[0] * 200000, half / 2);
+  EXPECT_NEAR(half + d.p_rest[0] * 700000, 18000, 1);
 }
 
 TEST(PlanObservationDraw, BlockSidesFollowTheProbabilities) {
