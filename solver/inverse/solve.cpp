@@ -222,8 +222,8 @@ void SolverState::PlanObservations() {
   if (draw.census) {
     spdlog::warn(
         "the photos offer about {:.0f} observations at pixel stride {}; drawing about {:.0f} to "
-        "fit {} of memory ({} budget{}): every region keeps its highlight candidates and fit "
-        "samples within half of them, the rest is drawn evenly",
+        "fit {} of memory ({} budget{}): every region keeps its fit samples and highlight "
+        "candidates within half of the budget, the rest is drawn evenly",
         draw.available, options.pixel_stride, draw.expected, GiB(summary.memory_estimate_bytes),
         GiB(memory.budget_bytes),
         options.max_observations > 0 ? fmt::format(", at most {}", options.max_observations)

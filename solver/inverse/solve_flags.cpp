@@ -14,7 +14,7 @@ void AddSolveFlags(CLI::App& app, SolveFlags* flags) {
   app.add_option(
          "--max-observations", o.max_observations,
          "at most this many observations (0 = as many as the memory budget allows); each region "
-         "keeps its highlight candidates and fit samples within half of them, the rest is drawn "
+         "keeps its fit samples and highlight candidates within half of them, the rest is drawn "
          "evenly")
       ->capture_default_str();
   app.add_option("--max-observation-block", o.max_observation_block,

@@ -79,7 +79,7 @@ TEST(PlanObservationDraw, HighlightCandidatesGiveWayBeyondHalfTheBudget) {
   const ObservationDraw d = PlanObservationDraw(census, {1, 0, 0}, o);
   EXPECT_LE(d.expected, 80000);
   EXPECT_GT(d.expected, 80000 - 1);
-  EXPECT_NEAR(d.p_rest[2] * 8000, 6000, 1e-3);                    // its fit samples, whole
+  EXPECT_NEAR(d.p_rest[2] * 8000, 6000, 1e-3);                          // its fit samples, whole
   EXPECT_NEAR(d.p_near[0] * 50000, kNeedsShare * 80000 - 18000, 1e-3);  // what is left of half
   // Every other pixel at one probability q: the kept classes and q·(200 000 + 500 000) fill it.
   EXPECT_NEAR(d.p_rest[0], d.p_rest[1], 1e-9);
