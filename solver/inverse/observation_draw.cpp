@@ -119,14 +119,15 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
   d.budget = options.budget > 0 ? options.budget : std::numeric_limits<double>::infinity();
   // Per region and class: the pixels, and how many the region's fit needs.
   std::vector<double> n_near(regions), n_rest(regions), need_near(regions), need_rest(regions);
-  double needed = 0;
+  double near_sum = 0, rest_sum = 0;  // the needs of each class
   for (size_t r = 0; r < regions; ++r) {
     n_near[r] = d.lobe_class[r] ? census[r].near : 0.0;
     n_rest[r] = census[r].rest + (d.lobe_class[r] ? 0.0 : census[r].near);
     need_near[r] = std::min(n_near[r], double(options.max_highlight_samples));
     need_rest[r] = std::min(n_rest[r], double(options.max_fit_samples));
     d.available += n_near[r] + n_rest[r];
-    needed += need_near[r] + need_rest[r];
+    near_sum += need_near[r];
+    rest_sum += need_rest[r];
   }
   d.expected = d.available;
   if (d.available <= d.budget) return d;
@@ -136,9 +137,7 @@ ObservationDraw PlanObservationDraw(const std::vector<RegionPixelCensus>& census
   // to the share less what the highlight candidates keep at least (half of it), the highlight
   // candidates in what is left; each class scaled down alike where it exceeds its part.
   const double limit = kNeedsShare * d.budget;
-  if (needed > limit) {
-    double near_sum = 0, rest_sum = 0;
-    for (size_t r = 0; r < regions; ++r) near_sum += need_near[r], rest_sum += need_rest[r];
+  if (near_sum + rest_sum > limit) {
     const double rest_part = std::min(rest_sum, limit - std::min(near_sum, 0.5 * limit));
     const double near_part = std::min(near_sum, limit - rest_part);
     for (size_t r = 0; r < regions; ++r) {
