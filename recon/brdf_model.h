@@ -111,8 +111,39 @@ enum class DiffuseShape {
   kOrenNayar,  // Oren–Nayar's rough diffuse surface of slope deviation σ (solver/render/brdf.h)
   kCoated,     // a Lambertian base under a smooth clear coat (solver/render/brdf.h)
 };
+
+struct DiffuseShapeInfo {
+  DiffuseShape shape;
+  std::string_view name;
+  // Whether the term has a roughness, the material's "sigma" (Oren–Nayar's slope deviation in
+  // radians), read from scene.json and fitted with ρd when unknown.
+  bool has_sigma;
+};
+
+// The diffuse terms' registry: one line per term. Its evaluation lives in solver/render/brdf.h,
+// its fit's choice of start in solver/inverse/region_fit.cpp, its exports' conversion in
+// solver/export/export_common.cpp.
+inline constexpr DiffuseShapeInfo kDiffuseShapes[] = {
+    {DiffuseShape::kLambert, "lambert", false},
+    {DiffuseShape::kOrenNayar, "oren_nayar", true},
+    {DiffuseShape::kCoated, "coated", false},
+};
+
+constexpr const DiffuseShapeInfo& Info(DiffuseShape shape) {
+  for (const DiffuseShapeInfo& d : kDiffuseShapes) {
+    if (d.shape == shape) return d;
+  }
+  return kDiffuseShapes[0];
+}
+constexpr bool HasSigma(DiffuseShape shape) { return Info(shape).has_sigma; }
+
+// "lambert", "oren_nayar", … as in kDiffuseShapes.
 std::string_view DiffuseShapeName(DiffuseShape shape);
 std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name);
+// Every diffuse term's name, comma-separated; those with a "sigma", joined by " or " (error
+// messages).
+std::string_view DiffuseShapeNames();
+std::string_view DiffuseShapesWithSigma();
 
 // "lambert", "ward", … as in kBrdfModels.
 std::string_view BrdfModelName(BrdfModel model);

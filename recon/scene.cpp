@@ -4,11 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "tools/common/enum_names.h"
-
 namespace igi::recon {
 namespace {
-
 
 template <typename T>
 int FindByName(const std::vector<T>& items, std::string_view name) {
@@ -29,16 +26,34 @@ std::optional<BrdfModel> BrdfModelFromName(std::string_view name) {
   return std::nullopt;
 }
 
-namespace {
-constexpr EnumNames<DiffuseShape, 3> kDiffuseShapeNames{{{DiffuseShape::kLambert, "lambert"},
-                                                         {DiffuseShape::kOrenNayar, "oren_nayar"},
-                                                         {DiffuseShape::kCoated, "coated"}}};
-}  // namespace
-
-std::string_view DiffuseShapeName(DiffuseShape shape) { return kDiffuseShapeNames.Name(shape); }
+std::string_view DiffuseShapeName(DiffuseShape shape) { return Info(shape).name; }
 
 std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name) {
-  return kDiffuseShapeNames.FromName(name);
+  for (const DiffuseShapeInfo& d : kDiffuseShapes) {
+    if (d.name == name) return d.shape;
+  }
+  return std::nullopt;
+}
+
+std::string_view DiffuseShapeNames() {
+  static const std::string names = [] {
+    std::string s;
+    for (const DiffuseShapeInfo& d : kDiffuseShapes)
+      s += (s.empty() ? "" : ", ") + std::string(d.name);
+    return s;
+  }();
+  return names;
+}
+
+std::string_view DiffuseShapesWithSigma() {
+  static const std::string names = [] {
+    std::string s;
+    for (const DiffuseShapeInfo& d : kDiffuseShapes) {
+      if (d.has_sigma) s += (s.empty() ? "" : " or ") + std::string(d.name);
+    }
+    return s;
+  }();
+  return names;
 }
 
 std::string_view BrdfModelNames() {
@@ -58,7 +73,7 @@ std::vector<std::string> Material::MissingForRendering() const {
     return missing;
   }
   if (!rho_d && !rho_d_map) missing.push_back("rho_d");
-  if (diffuse == DiffuseShape::kOrenNayar && !sigma) missing.push_back("sigma");
+  if (HasSigma(diffuse) && !sigma) missing.push_back("sigma");
   if (!HasSpecularLobe(brdf)) return missing;
   if (!rho_s) missing.push_back("rho_s");
   if (IsAnisotropic(brdf)) {
@@ -91,8 +106,8 @@ std::string_view LightTypeName(LightType type) {
 
 double Photo::LinearFromRecorded(double v) const {
   if (!HasResponse()) return v;
-  const double mag = response_reference * std::pow(std::abs(v) / response_reference,
-                                                   1.0 / response_exponent);
+  const double mag =
+      response_reference * std::pow(std::abs(v) / response_reference, 1.0 / response_exponent);
   return v < 0 ? -mag : mag;
 }
 

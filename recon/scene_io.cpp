@@ -121,7 +121,7 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
     if (auto shape = DiffuseShapeFromName(*diffuse)) {
       m.diffuse = *shape;
     } else {
-      c["diffuse"].Problem("unknown diffuse (known: lambert, oren_nayar, coated)");
+      c["diffuse"].Problem("unknown diffuse (known: " + std::string(DiffuseShapeNames()) + ")");
       diffuse_known = false;
     }
   }
@@ -130,8 +130,9 @@ Material ReadMaterial(const SceneLoader& ld, const JsonCursor& c, const std::str
     // Lambert's surface; past ~0.8 rad the model's facets are steeper than its V-groove geometry
     // assumes.
     m.sigma = c["sigma"].Number(NumberRule::Between(0, 1));
-    if (diffuse_known && m.diffuse != DiffuseShape::kOrenNayar) {
-      c["sigma"].Problem("is read only with \"diffuse\": \"oren_nayar\"");
+    if (diffuse_known && !HasSigma(m.diffuse)) {
+      c["sigma"].Problem("is read only with \"diffuse\": \"" +
+                         std::string(DiffuseShapesWithSigma()) + "\"");
     }
   }
   if (c["radiance"].present() || m.brdf == BrdfModel::kEmitter) {

@@ -16,7 +16,7 @@ namespace {
 Json ParamsJson(const MaterialState& m) {
   Json j;
   j["rho_d"] = {m.params.rho_d[0], m.params.rho_d[1], m.params.rho_d[2]};
-  if (m.params.diffuse == recon::DiffuseShape::kOrenNayar) j["sigma"] = m.params.sigma;
+  if (recon::HasSigma(m.params.diffuse)) j["sigma"] = m.params.sigma;
   if (recon::HasSpecularLobe(m.params.model)) {
     j["rho_s"] = {m.params.rho_s[0], m.params.rho_s[1], m.params.rho_s[2]};
     if (recon::IsAnisotropic(m.params.model)) {

@@ -19,7 +19,7 @@ MaterialEstimate MaterialEstimate::FromScene(const recon::Scene& scene, const Pa
     s.unknown_rho_d = !m.rho_d && !m.rho_d_map;
     s.unknown_rho_s = spec && !m.rho_s;
     s.unknown_alpha = spec && (aniso ? !(m.alpha_x && m.alpha_y) : !m.alpha);
-    s.unknown_sigma = m.diffuse == recon::DiffuseShape::kOrenNayar && !m.sigma;
+    s.unknown_sigma = recon::HasSigma(m.diffuse) && !m.sigma;
     s.params.rho_d = m.rho_d.value_or(Eigen::Vector3d::Constant(0.5));
     s.params.rho_s = m.rho_s.value_or(Eigen::Vector3d::Zero());
     s.params.alpha = m.alpha.value_or(0.1);

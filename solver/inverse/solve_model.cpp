@@ -66,7 +66,7 @@ recon::Scene SolverState::CompleteScene(std::vector<RegionAtlas>* atlases, std::
     if (!m.reflective) continue;
     recon::Material& out = model.materials[r];
     if (!out.rho_d_map) out.rho_d = m.params.rho_d;
-    if (m.params.diffuse == recon::DiffuseShape::kOrenNayar) out.sigma = m.params.sigma;
+    if (recon::HasSigma(m.params.diffuse)) out.sigma = m.params.sigma;
     if (recon::HasSpecularLobe(m.params.model)) {
       out.rho_s = m.params.rho_s;
       out.alpha = m.params.alpha;

@@ -34,7 +34,7 @@ Json FitJson(const RegionFitResult& f, const render::BrdfParams& params) {
   }
   j["rho_d"] = Vec(f.rho_d);
   j["sigma_rho_d"] = Vec(f.sigma_rho_d);
-  if (params.diffuse == recon::DiffuseShape::kOrenNayar) j["sigma"] = Num(f.sigma);
+  if (recon::HasSigma(params.diffuse)) j["sigma"] = Num(f.sigma);
   if (recon::HasSpecularLobe(model)) {
     j["rho_s"] = Vec(f.rho_s);
     j["sigma_rho_s"] = Num(f.sigma_rho_s);
@@ -74,7 +74,7 @@ Json SolvedSceneDocument(const recon::Scene& scene, const SolveSummary& summary,
     const render::BrdfParams& p = rs.final_params;
     if (!recon::IsReflective(scene.materials[r].brdf)) continue;
     doc.SetMaterialValue(name, "rho_d", Vec(p.rho_d));
-    if (p.diffuse == recon::DiffuseShape::kOrenNayar) doc.SetMaterialValue(name, "sigma", p.sigma);
+    if (recon::HasSigma(p.diffuse)) doc.SetMaterialValue(name, "sigma", p.sigma);
     if (!rs.albedo_map_file.empty()) doc.SetMaterialValue(name, "rho_d_map", rs.albedo_map_file);
     if (recon::HasSpecularLobe(p.model)) {
       const bool grey = p.rho_s[0] == p.rho_s[1] && p.rho_s[1] == p.rho_s[2];

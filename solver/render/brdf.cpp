@@ -31,8 +31,7 @@ double Mean(const Eigen::Vector3d& v) { return (v[0] + v[1] + v[2]) / 3.0; }
 std::vector<BrdfParamProblem> CheckBrdfParams(const BrdfParams& params) {
   std::vector<BrdfParamProblem> problems;
   CheckRgb(params.rho_d, "rho_d", &problems);
-  if (params.diffuse == recon::DiffuseShape::kOrenNayar &&
-      !(std::isfinite(params.sigma) && params.sigma >= 0.0)) {
+  if (recon::HasSigma(params.diffuse) && !(std::isfinite(params.sigma) && params.sigma >= 0.0)) {
     problems.push_back({"sigma", params.sigma, "must be finite and >= 0"});
   }
   if (recon::HasSpecularLobe(params.model)) {

@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "chi_square.h"
+#include "recon/scene.h"
 #include "solver/render/sampling.h"
 
 namespace igi::render {
@@ -134,6 +136,35 @@ TEST(BrdfModelTest, NamesRoundTrip) {
     EXPECT_TRUE(recon::IsMicrofacet(m) && recon::HasSpecularLobe(m) && !recon::HasFresnel(m));
     EXPECT_FALSE(recon::IsWardLobe(m) || recon::IsGmd(m));
   }
+}
+
+// The diffuse terms' registry: each line one term with one name, and a term with a roughness is
+// the one whose σ the scene needs and the parameter check reads.
+TEST(BrdfModelTest, DiffuseShapesRoundTripAndTheirSigmaIsRead) {
+  for (const recon::DiffuseShapeInfo& a : recon::kDiffuseShapes) {
+    EXPECT_EQ(&recon::Info(a.shape), &a);
+    EXPECT_EQ(recon::DiffuseShapeFromName(a.name), a.shape);
+    EXPECT_EQ(recon::DiffuseShapeName(a.shape), a.name);
+    for (const recon::DiffuseShapeInfo& b : recon::kDiffuseShapes) {
+      if (&a != &b) {
+        EXPECT_NE(a.name, b.name);
+      }
+    }
+    recon::Material m;
+    m.brdf = recon::BrdfModel::kLambert;
+    m.rho_d = Eigen::Vector3d::Constant(0.5);
+    m.diffuse = a.shape;
+    const std::vector<std::string> missing = m.MissingForRendering();
+    EXPECT_EQ(std::find(missing.begin(), missing.end(), "sigma") != missing.end(), a.has_sigma)
+        << a.name;
+    BrdfParams p = Grey(recon::BrdfModel::kLambert, 0.5, 0, 0, 0);
+    p.diffuse = a.shape;
+    p.sigma = -1;
+    EXPECT_EQ(CheckBrdfParams(p).size(), a.has_sigma ? 1u : 0u) << a.name;
+  }
+  EXPECT_EQ(recon::DiffuseShapeNames(), "lambert, oren_nayar, coated");
+  EXPECT_EQ(recon::DiffuseShapesWithSigma(), "oren_nayar");
+  EXPECT_FALSE(recon::DiffuseShapeFromName("rough"));
 }
 
 TEST(BrdfParamsTest, CheckNamesEachBadValueTheModelReads) {
