@@ -42,14 +42,24 @@ SynthOptions Small(const fs::path& out, int cameras = 4) {
   return o;
 }
 
-// One synthesis per configuration, shared by the tests (rendering is the slow part).
+// One synthesis per configuration, shared by the tests (rendering is the slow part) and removed
+// when the process exits.
 const fs::path& Synth(const std::string& name, SynthOptions o) {
-  static std::map<std::string, fs::path> done;
-  auto it = done.find(name);
-  if (it != done.end()) return it->second;
+  struct Cache {
+    std::map<std::string, fs::path> done;
+    ~Cache() {
+      for (const auto& [n, dir] : done) {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+      }
+    }
+  };
+  static Cache cache;
+  auto it = cache.done.find(name);
+  if (it != cache.done.end()) return it->second;
   o.out = TempDir(name);
   Synthesize(o);
-  return done[name] = o.out;
+  return cache.done[name] = o.out;
 }
 
 const fs::path& Plain() { return Synth("plain", Small("")); }
