@@ -3,9 +3,22 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
+
+#include "tools/common/strings.h"
 
 namespace igi::recon {
 namespace {
+
+// The names of a registry's lines that `keep` accepts, joined by `separator`.
+template <typename Line, size_t N, typename Keep>
+std::string JoinNames(const Line (&lines)[N], std::string_view separator, Keep keep) {
+  std::vector<std::string> names;
+  for (const Line& line : lines) {
+    if (keep(line)) names.emplace_back(line.name);
+  }
+  return Join(names, separator);
+}
 
 template <typename T>
 int FindByName(const std::vector<T>& items, std::string_view name) {
@@ -36,32 +49,20 @@ std::optional<DiffuseShape> DiffuseShapeFromName(std::string_view name) {
 }
 
 std::string_view DiffuseShapeNames() {
-  static const std::string names = [] {
-    std::string s;
-    for (const DiffuseShapeInfo& d : kDiffuseShapes)
-      s += (s.empty() ? "" : ", ") + std::string(d.name);
-    return s;
-  }();
+  static const std::string names =
+      JoinNames(kDiffuseShapes, ", ", [](const DiffuseShapeInfo&) { return true; });
   return names;
 }
 
 std::string_view DiffuseShapesWithSigma() {
-  static const std::string names = [] {
-    std::string s;
-    for (const DiffuseShapeInfo& d : kDiffuseShapes) {
-      if (d.has_sigma) s += (s.empty() ? "" : " or ") + std::string(d.name);
-    }
-    return s;
-  }();
+  static const std::string names =
+      JoinNames(kDiffuseShapes, " or ", [](const DiffuseShapeInfo& d) { return d.has_sigma; });
   return names;
 }
 
 std::string_view BrdfModelNames() {
-  static const std::string names = [] {
-    std::string s;
-    for (const BrdfModelInfo& b : kBrdfModels) s += (s.empty() ? "" : ", ") + std::string(b.name);
-    return s;
-  }();
+  static const std::string names =
+      JoinNames(kBrdfModels, ", ", [](const BrdfModelInfo&) { return true; });
   return names;
 }
 
